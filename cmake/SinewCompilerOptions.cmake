@@ -1,0 +1,29 @@
+# Warnings and instruction-set flags shared by every Sinew target, carried by
+# an INTERFACE target so third-party code is not compiled with them.
+add_library(sinew_compile_options INTERFACE)
+add_library(sinew::compile_options ALIAS sinew_compile_options)
+
+target_compile_options(sinew_compile_options INTERFACE
+  -Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor -Wcast-align
+  -Woverloaded-virtual -Wnull-dereference -Wdouble-promotion -Wformat=2
+  $<$<BOOL:${SINEW_WERROR}>:-Werror>)
+# GCC 12 reports false -Wrestrict positives inside libstdc++'s
+# std::string operator+ at -O2/-O3 (GCC bug 105329), which -Werror would
+# turn into build failures on Debian 12's default compiler.
+if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU" AND CMAKE_CXX_COMPILER_VERSION VERSION_LESS 13)
+  target_compile_options(sinew_compile_options INTERFACE -Wno-restrict)
+endif()
+
+# The instruction-set baseline is a deliberate build-time choice. x86-64-v3
+# (AVX2, FMA, BMI2: every x86 CPU since Haswell / Zen 1) is what the SIMD
+# kernels are tuned for; x86-64-v2 (SSE4.2) is the portable fallback. Programs
+# check at start-up that the CPU supports the baseline they were built for
+# (runtime/cpu/cpu_features.h) and say so instead of dying on SIGILL.
+if(SINEW_ISA STREQUAL "native")
+  target_compile_options(sinew_compile_options INTERFACE -march=native)
+elseif(SINEW_ISA STREQUAL "x86-64-v3" OR SINEW_ISA STREQUAL "x86-64-v2")
+  target_compile_options(sinew_compile_options INTERFACE -march=${SINEW_ISA})
+else()
+  message(FATAL_ERROR "SINEW_ISA must be x86-64-v3, x86-64-v2 or native, not '${SINEW_ISA}'")
+endif()
+target_compile_definitions(sinew_compile_options INTERFACE SINEW_ISA_NAME="${SINEW_ISA}")

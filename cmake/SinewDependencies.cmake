@@ -1,0 +1,19 @@
+# Every dependency comes from a Debian 12 package (the ./sinew script installs
+# them): CMake config packages where Debian ships one, pkg-config otherwise.
+find_package(PkgConfig REQUIRED)
+find_package(Threads REQUIRED)
+find_package(glm CONFIG REQUIRED)
+find_package(TBB CONFIG REQUIRED)
+# OpenImageIO via pkg-config: Debian 12's CMake config drags in Imath's
+# Python targets whose library is not installed (a packaging bug).
+pkg_check_modules(OIIO REQUIRED IMPORTED_TARGET OpenImageIO)
+pkg_check_modules(XXHASH REQUIRED IMPORTED_TARGET libxxhash)
+
+if(SINEW_BUILD_DISPLAY)
+  find_package(glfw3 CONFIG REQUIRED)
+  find_package(OpenGL REQUIRED)
+endif()
+
+if(SINEW_BUILD_TESTS)
+  find_package(GTest CONFIG REQUIRED)
+endif()

@@ -1,0 +1,71 @@
+#include "game_demo/demo_options.h"
+
+#include <charconv>
+#include <limits>
+
+namespace sinew::demo {
+namespace {
+
+template <typename T>
+Expected<T> parse_number(const std::string& flag, const std::string& text, T lo, T hi) {
+  T value{};
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (ec != std::errc() || end != text.data() + text.size() || value < lo || value > hi) {
+    return invalid_argument(flag, text,
+                            "expected an integer from " + std::to_string(lo) + " to " +
+                                std::to_string(hi));
+  }
+  return value;
+}
+
+}  // namespace
+
+std::string demo_usage() {
+  return "usage: sinew-demo [--headless] [--frames N] [--out DIR] [--threads N]\n"
+         "                  [--size WxH] [--seed S]\n"
+         "  --headless   no window: render frames to DIR (default out/demo)\n"
+         "  --frames N   frames to run (headless default 120; windowed: until Esc)\n"
+         "  --threads N  worker threads (default: all cores)\n"
+         "  --size WxH   frame size (default 1024x1024)\n"
+         "  --seed S     seed of the scripted run\n";
+}
+
+Expected<DemoOptions> parse_demo_options(const std::vector<std::string>& args) {
+  DemoOptions o;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    auto next = [&]() -> Expected<std::string> {
+      if (i + 1 >= args.size()) return invalid_argument(a, "", "missing value");
+      return args[++i];
+    };
+    if (a == "--headless") {
+      o.headless = true;
+    } else if (a == "--help" || a == "-h") {
+      o.help = true;
+    } else if (a == "--frames") {
+      SINEW_ASSIGN_OR_RETURN(std::string v, next());
+      SINEW_ASSIGN_OR_RETURN(o.frames, parse_number<int>(a, v, 1, 1000000));
+    } else if (a == "--threads") {
+      SINEW_ASSIGN_OR_RETURN(std::string v, next());
+      SINEW_ASSIGN_OR_RETURN(o.threads, parse_number<int>(a, v, 1, 1024));
+    } else if (a == "--seed") {
+      SINEW_ASSIGN_OR_RETURN(std::string v, next());
+      SINEW_ASSIGN_OR_RETURN(o.seed, parse_number<std::uint32_t>(
+                                          a, v, 0, std::numeric_limits<std::uint32_t>::max()));
+    } else if (a == "--out") {
+      SINEW_ASSIGN_OR_RETURN(o.out_dir, next());
+    } else if (a == "--size") {
+      SINEW_ASSIGN_OR_RETURN(std::string v, next());
+      const auto x = v.find('x');
+      if (x == std::string::npos) return invalid_argument(a, v, "expected WxH, e.g. 1024x1024");
+      SINEW_ASSIGN_OR_RETURN(o.width, parse_number<int>(a, v.substr(0, x), 16, 8192));
+      SINEW_ASSIGN_OR_RETURN(o.height, parse_number<int>(a, v.substr(x + 1), 16, 8192));
+    } else {
+      return invalid_argument("argument", a, "unknown option (see --help)");
+    }
+  }
+  if (o.headless && o.frames == 0) o.frames = 120;
+  return o;
+}
+
+}  // namespace sinew::demo

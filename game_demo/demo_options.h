@@ -1,0 +1,28 @@
+// Command-line options of sinew-demo. Parsing never exits the process: it
+// returns the options or a Status naming the bad flag, and main decides
+// (exit code 2 for usage errors).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "runtime/core/expected.h"
+
+namespace sinew::demo {
+
+struct DemoOptions {
+  bool headless = false;
+  int frames = 0;  // 0: run until the window closes (windowed), 120 headless
+  std::string out_dir = "out/demo";
+  int threads = 0;  // 0: all cores
+  int width = 1024;
+  int height = 1024;
+  std::uint32_t seed = 1;
+  bool help = false;
+};
+
+Expected<DemoOptions> parse_demo_options(const std::vector<std::string>& args);
+std::string demo_usage();
+
+}  // namespace sinew::demo
