@@ -29,17 +29,18 @@
 namespace sinew {
 
 static_assert(std::endian::native == std::endian::little,
-              "content packs are little-endian and used in place; big-endian hosts are not supported");
+              "packs are little-endian and used in place: big-endian hosts are unsupported");
 
 // A section's type tag: four ASCII characters stored in file order, so the
 // bytes "SKEL" in a hex dump are the id make_section_id("SKEL").
 enum class SectionId : std::uint32_t {};
 
 constexpr SectionId make_section_id(const char (&fourcc)[5]) {
-  return static_cast<SectionId>(static_cast<std::uint32_t>(static_cast<unsigned char>(fourcc[0])) |
-                                static_cast<std::uint32_t>(static_cast<unsigned char>(fourcc[1])) << 8 |
-                                static_cast<std::uint32_t>(static_cast<unsigned char>(fourcc[2])) << 16 |
-                                static_cast<std::uint32_t>(static_cast<unsigned char>(fourcc[3])) << 24);
+  std::uint32_t value = 0;
+  for (int i = 3; i >= 0; --i) {
+    value = value << 8 | static_cast<unsigned char>(fourcc[i]);
+  }
+  return static_cast<SectionId>(value);
 }
 
 // "SKEL" when all four bytes are printable ASCII, "0x0000002a" otherwise, so
@@ -119,7 +120,8 @@ struct SectionEntry {
 static_assert(sizeof(PackHeader) == kHeaderSize);
 static_assert(sizeof(SectionEntry) == kSectionEntrySize);
 static_assert(std::is_trivially_copyable_v<PackHeader> && std::is_standard_layout_v<PackHeader>);
-static_assert(std::is_trivially_copyable_v<SectionEntry> && std::is_standard_layout_v<SectionEntry>);
+static_assert(std::is_trivially_copyable_v<SectionEntry> &&
+              std::is_standard_layout_v<SectionEntry>);
 // No hidden padding: every byte of the structs is a named field, so a memcpy
 // round trip is exact and checksums are well defined.
 static_assert(std::has_unique_object_representations_v<PackHeader>);

@@ -206,10 +206,10 @@ Expected<PackReader> PackReader::parse(std::span<const std::byte> bytes, std::st
     }
     if (entry.offset < table_end) {
       std::string where;
-      if (end > header.table_offset) {
-        where = "overlaps the section table " + range(header.table_offset, table_end);
-      } else if (entry.offset < kHeaderSize) {
+      if (entry.offset < kHeaderSize) {
         where = "overlaps the header " + range(0, kHeaderSize);
+      } else if (end > header.table_offset) {
+        where = "overlaps the section table " + range(header.table_offset, table_end);
       } else {
         where = "lies before the section table; sections must follow it";
       }

@@ -225,7 +225,7 @@ std::vector<Corruption> corruptions() {
        E::kOutOfBounds, "header.table_offset", "4096 entries"},
       {"SectionCountOneLessLeavesPayloadAsPadding",
        [](Bytes& b) { edit_header(b, [](PackHeader& h) { h.section_count = 4; }); },
-       E::kInvalidData, "padding at offset " + std::to_string(e[4].offset)},
+       E::kInvalidData, "padding at offset " + std::to_string(table_end - kSectionEntrySize)},
       {"TableOffsetZero", [](Bytes& b) { edit_header(b, [](PackHeader& h) {
          h.table_offset = 0; }); },
        E::kOverlap, "header.table_offset", "overlaps the header"},
@@ -246,8 +246,10 @@ std::vector<Corruption> corruptions() {
        E::kOutOfBounds, "header.table_offset"},
 
       // Table checksum.
-      {"TableChecksumFlipped", [](Bytes& b) { flip(b, 40, 0x04); }, E::kChecksumMismatch,
-       "header.table_checksum"},
+      {"TableChecksumFlipped", [](Bytes& b) { edit_header_raw(b, [](PackHeader& h) {
+         h.table_checksum ^= 0x04;
+         h.header_checksum = pack_header_checksum(h); }); },
+       E::kChecksumMismatch, "header.table_checksum"},
       {"TableEntryOffsetFlippedUnsealed",
        [](Bytes& b) { flip(b, kHeaderSize + 2 * kSectionEntrySize + 8, 0x40); },
        E::kChecksumMismatch, "header.table_checksum"},
@@ -279,14 +281,16 @@ std::vector<Corruption> corruptions() {
       {"OffsetHuge", [](Bytes& b) { edit_entry(b, 1, [](SectionEntry& s) {
          s.offset = kU64Max - 63; }); },
        E::kOutOfBounds, "section[1].offset", "past the end"},
-      {"OffsetPastEnd", [size](Bytes& b) { edit_entry(b, 1, [size](PackHeader::* = nullptr,
-                                                             SectionEntry* = nullptr) {}); (void)size;
-         edit_entry(b, 1, [size](SectionEntry& s) { s.offset = (size + 63) / 64 * 64 + 64; }); },
+      {"OffsetNearTopMisaligned", [](Bytes& b) { edit_entry(b, 1, [](SectionEntry& s) {
+         s.offset = kU64Max - 31; }); },
+       E::kMisaligned, "section[1].offset", "18446744073709551584"},
+      {"OffsetPastEnd", [size](Bytes& b) { edit_entry(b, 1, [size](SectionEntry& s) {
+         s.offset = (size + 63) / 64 * 64 + 64; }); },
        E::kOutOfBounds, "section[1].offset"},
       {"OffsetPlusSizeOverflows", [](Bytes& b) { edit_entry(b, 2, [](SectionEntry& s) {
          s.size = kU64Max - 31; }); },
        E::kOutOfBounds, "section[2].size"},
-      {"OffsetAtEndSizeOverflows", [](Bytes& b) { edit_entry(b, 2, [](SectionEntry& s) {
+      {"OffsetAndSizeBothHuge", [](Bytes& b) { edit_entry(b, 2, [](SectionEntry& s) {
          s.offset = 1ull << 63; s.size = 1ull << 63; }); },
        E::kOutOfBounds, "section[2].offset"},
       {"SizeOneBytePastEnd", [size](Bytes& b) { edit_entry(b, 4, [size](SectionEntry& s) {
@@ -322,7 +326,7 @@ std::vector<Corruption> corruptions() {
       {"DuplicateIdFirstAndLast", [e](Bytes& b) { edit_entry(b, 4, [e](SectionEntry& s) {
          s.id = e[0].id; }); },
        E::kDuplicate, "section[4].id", "'SKEL'"},
-      {"ShrunkSectionLeavesPayloadAsPadding", [e](Bytes& b) { edit_entry(b, 3, [](SectionEntry& s) {
+      {"ShrunkSectionLeavesPayloadAsPadding", [](Bytes& b) { edit_entry(b, 3, [](SectionEntry& s) {
          s.size = 0; }); },
        E::kInvalidData, "padding at offset " + std::to_string(e[3].offset)},
       {"EntryChecksumFlipped", [](Bytes& b) { edit_entry(b, 1, [](SectionEntry& s) {
@@ -370,11 +374,13 @@ TEST_P(PackCorruptionTest, YieldsTheSpecificError) {
   EXPECT_THAT(status.message(), HasSubstr(c.field));
   EXPECT_THAT(status.message(), HasSubstr("corrupt.pack"));
   EXPECT_FALSE(status.value().empty()) << "errors name the bad value: " << status.message();
-  if (!c.detail.empty()) EXPECT_THAT(status.message(), HasSubstr(c.detail));
+  if (!c.detail.empty()) {
+    EXPECT_THAT(status.message(), HasSubstr(c.detail));
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Variants, PackCorruptionTest, ::testing::ValuesIn(corruptions()),
-                         [](const auto& info) { return info.param.name; });
+                         [](const auto& test) { return test.param.name; });
 
 TEST(PackCorruptionCountTest, AtLeastThirtyDistinctVariants) {
   EXPECT_GE(corruptions().size(), 30u);
