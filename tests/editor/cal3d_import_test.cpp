@@ -1,0 +1,508 @@
+// Cal3D importer: counts against content/README.md, an oracle against the
+// Cal3D library's own posing and skinning, and bad input.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cal3d/cal3d.h>
+#include <cal3d/coretrack.h>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+#include "animation/clip.h"
+#include "animation/pose.h"
+#include "animation/reference_skinning.h"
+#include "editor/import/cal3d_importer.h"
+
+namespace sinew::editor {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string model_cfg(const std::string& model) {
+  return std::string(SINEW_SHARED_DIR) + "/content/cal3d/" + model + "/" + model + ".cfg";
+}
+std::string model_file(const std::string& model, const std::string& file) {
+  return std::string(SINEW_SHARED_DIR) + "/content/cal3d/" + model + "/" + file;
+}
+
+// ---------------------------------------------------------------- counts
+
+TEST(Cal3dImport, CallyCountsMatchReadme) {
+  auto m = import_cal3d(model_cfg("cally"));
+  ASSERT_TRUE(m.ok()) << m.status().message();
+  EXPECT_EQ(m->mesh.triangle_count(), 3342u);
+  EXPECT_EQ(m->mesh.vertex_count(), 1844u);
+  EXPECT_EQ(m->skeleton.joint_count(), 37u);
+  ASSERT_EQ(m->clips.size(), 7u);
+  // The .cfg lists only walk: it comes first, the others follow by file name.
+  EXPECT_EQ(m->clips[0].name(), "walk");
+  for (const char* name : {"idle", "jog", "walk", "strut", "wave", "tornado_kick", "shoot_arrow"}) {
+    EXPECT_NE(m->find_clip(name), nullptr) << name;
+  }
+  // Durations are Cal3D's header durations (README), not the last key
+  // times (one frame earlier): see the importer's header.
+  EXPECT_NEAR(m->find_clip("wave")->duration(), 3.367f, 1e-3f);
+  EXPECT_NEAR(m->find_clip("walk")->duration(), 1.0333f, 1e-3f);
+  EXPECT_NEAR(m->find_clip("jog")->duration(), 0.8f, 1e-3f);
+  EXPECT_EQ(m->find_clip("wave")->tracks().size(), 14u);
+  EXPECT_EQ(m->mesh.normals.size(), m->mesh.vertex_count());
+  // Cally's meshes carry no texture coordinates (no maps in its .cmf files).
+  EXPECT_TRUE(m->mesh.uvs.empty());
+  EXPECT_EQ(m->mesh.triangle_material.size(), m->mesh.triangle_count());
+  EXPECT_EQ(m->mesh.material_colors.size(), m->material_names.size());
+  for (std::uint32_t mat : m->mesh.triangle_material) ASSERT_LT(mat, m->mesh.material_colors.size());
+  // Max 4 influences per vertex (README), rows sum to 1.
+  int max_infl = 0;
+  for (std::size_t v = 0; v < m->mesh.vertex_count(); ++v) {
+    float sum = 0.0f;
+    int n = 0;
+    for (float w : m->mesh.weights[v]) {
+      sum += w;
+      n += w > 0.0f ? 1 : 0;
+    }
+    max_infl = std::max(max_infl, n);
+    ASSERT_NEAR(sum, 1.0f, 1e-5f);
+  }
+  EXPECT_EQ(max_infl, 4);
+}
+
+TEST(Cal3dImport, PaladinCountsMatchReadme) {
+  auto m = import_cal3d(model_cfg("paladin"));
+  ASSERT_TRUE(m.ok()) << m.status().message();
+  EXPECT_EQ(m->mesh.triangle_count(), 3422u);
+  EXPECT_EQ(m->mesh.vertex_count(), 2235u);
+  EXPECT_EQ(m->skeleton.joint_count(), 58u);
+  EXPECT_EQ(m->clips.size(), 7u);
+  EXPECT_NE(m->find_clip("sneak"), nullptr);
+  EXPECT_EQ(m->mesh.uvs.size(), m->mesh.vertex_count());
+  EXPECT_EQ(m->material_names.size(), 19u);
+}
+
+TEST(Cal3dImport, SkeletonAndHeroLoad) {
+  auto s = import_cal3d(model_cfg("skeleton"));
+  ASSERT_TRUE(s.ok()) << s.status().message();
+  EXPECT_EQ(s->mesh.triangle_count(), 4604u);
+  EXPECT_EQ(s->mesh.vertex_count(), 2527u);
+  EXPECT_EQ(s->skeleton.joint_count(), 23u);
+  EXPECT_EQ(s->clips.size(), 7u);
+  auto h = import_cal3d(model_cfg("hero"));
+  ASSERT_TRUE(h.ok()) << h.status().message();
+  EXPECT_EQ(h->mesh.triangle_count(), 5188u);
+  EXPECT_EQ(h->mesh.vertex_count(), 3575u);
+  EXPECT_EQ(h->skeleton.joint_count(), 58u);
+  ASSERT_EQ(h->clips.size(), 1u);
+  EXPECT_EQ(h->clips[0].name(), "idle");
+}
+
+// ---------------------------------------------------------------- oracle
+
+// The Cal3D side, loaded independently of the importer: its own
+// CalCoreModel, the same files, the same scale.
+struct CalSide {
+  CalCoreModel core{"oracle"};
+  std::vector<int> mesh_ids;
+  float scale = 1.0f;
+
+  CalSide() = default;
+  CalSide(const CalSide&) = delete;
+  CalSide& operator=(const CalSide&) = delete;
+  // Cal3D 0.11's ~CalCoreAnimation leaks its tracks (as in the importer).
+  ~CalSide() {
+    for (int i = 0; i < core.getCoreAnimationCount(); ++i) {
+      if (CalCoreAnimation* anim = core.getCoreAnimation(i)) {
+        for (CalCoreTrack* track : anim->getListCoreTrack()) {
+          track->destroy();
+          delete track;
+        }
+        anim->getListCoreTrack().clear();
+      }
+    }
+  }
+};
+
+bool load_cal_side(const std::string& model, CalSide& side) {
+  std::ifstream in(model_cfg(model));
+  std::stringstream text;
+  text << in.rdbuf();
+  auto cfg = parse_cal3d_config(text.str(), model_cfg(model));
+  if (!cfg.ok()) return false;
+  side.scale = cfg->scale;
+  if (!side.core.loadCoreSkeleton(model_file(model, cfg->skeleton))) return false;
+  for (const std::string& mesh : cfg->meshes) {
+    const int id = side.core.loadCoreMesh(model_file(model, mesh));
+    if (id < 0) return false;
+    side.mesh_ids.push_back(id);
+  }
+  return true;
+}
+
+struct OracleErrors {
+  double joint_translation = 0.0;  // relative to the bounding-box diagonal
+  double joint_rotation = 0.0;     // max |R e_k - R_cal e_k|
+  double vertex = 0.0;             // relative to the bounding-box diagonal
+  int samples = 0;
+};
+
+double bbox_diagonal(const SkinnedMesh& mesh) {
+  Vec3 lo(1e30f), hi(-1e30f);
+  for (const Vec3& p : mesh.positions) {
+    lo = glm::min(lo, p);
+    hi = glm::max(hi, p);
+  }
+  return static_cast<double>(glm::length(hi - lo));
+}
+
+// Poses both sides with one clip as a weight-1 cycle (no fade: delay 0) at
+// 2 * sample_count times and compares every bone and every skinned vertex.
+void run_oracle(const std::string& model, const ImportedModel& ours, CalSide& side,
+                const std::string& clip_name, int sample_count, OracleErrors& err) {
+  const anim::Clip* clip = ours.find_clip(clip_name);
+  ASSERT_NE(clip, nullptr) << clip_name;
+  const int anim_id = side.core.loadCoreAnimation(model_file(model, model + "_" + clip_name + ".caf"));
+  ASSERT_GE(anim_id, 0);
+  CalCoreAnimation* core_anim = side.core.getCoreAnimation(anim_id);
+  // CalCoreModel::scale scales what is loaded so far: scale this clip alone.
+  if (side.scale != 1.0f) core_anim->scale(side.scale);
+  const float duration = core_anim->getDuration();
+  // The importer extends each track to Cal3D's header duration, so both
+  // sides loop at the same time.
+  EXPECT_NEAR(clip->duration(), duration, 1e-5f) << model << " " << clip_name;
+
+  CalModel cal(&side.core);
+  for (int id : side.mesh_ids) ASSERT_TRUE(cal.attachMesh(id));
+  // Without internal data the physique skins every vertex (spring vertices
+  // included) instead of leaving spring vertices to the spring system,
+  // whose state would depend on history (content/README.md).
+  cal.disableInternalData();
+  CalMixer* mixer = cal.getMixer();
+  ASSERT_TRUE(mixer->blendCycle(anim_id, 1.0f, 0.0f));
+  // A zero step applies the cycle's weight (delay 0) and sets the mixer's
+  // duration, with no fading; the spring system is never updated.
+  mixer->updateAnimation(0.0f);
+
+  const anim::Skeleton& skel = ours.skeleton;
+  std::vector<anim::JointTransform> local(skel.joint_count());
+  std::vector<Affine3> model_m(skel.joint_count()), skin(skel.joint_count());
+  std::vector<Vec3> positions(ours.mesh.vertex_count());
+  std::vector<float> cal_vertices;
+  anim::SamplingCache cache;
+  const double diag = bbox_diagonal(ours.mesh);
+  std::vector<CalBone*>& bones = cal.getSkeleton()->getVectorBone();
+  ASSERT_EQ(bones.size(), skel.joint_count());
+
+  // First `sample_count` times set directly, spread over [0, duration)
+  // including 0, off the key times; then as many played by stepping the
+  // mixer past the end several times, against Sinew's looping clip time.
+  double playback = 0.0;
+  const float step = duration * 0.29f;
+  for (int i = 0; i < 2 * sample_count; ++i) {
+    float t = 0.0f;
+    if (i < sample_count) {
+      t = duration * (static_cast<float>(i) + (i == 0 ? 0.0f : 0.37f)) / static_cast<float>(sample_count);
+      mixer->setAnimationTime(t);
+    } else {
+      if (i == sample_count) mixer->setAnimationTime(0.0f);
+      mixer->updateAnimation(step);  // never CalModel::update: no springs
+      playback += static_cast<double>(step);
+      t = anim::clip_time(*clip, playback, /*loop=*/true);
+    }
+    mixer->updateSkeleton();
+
+    ASSERT_TRUE(anim::rest_pose(skel, local).ok());
+    anim::sample_clip(*clip, t, cache, local);
+    ASSERT_TRUE(anim::local_to_model(skel, local, model_m).ok());
+    ASSERT_TRUE(anim::skinning_matrices(skel, model_m, Affine3::identity(), skin).ok());
+    ASSERT_TRUE(anim::skin_reference(ours.mesh, skin, positions, {}).ok());
+
+    for (CalBone* bone : bones) {
+      const auto j = skel.find(bone->getCoreBone()->getName());
+      ASSERT_TRUE(j.has_value());
+      const Affine3& m = model_m[static_cast<std::size_t>(*j)];
+      const CalVector& ct = bone->getTranslationAbsolute();
+      const Vec3 d = m.translation_part() - Vec3(ct.x, ct.y, ct.z);
+      err.joint_translation = std::max(err.joint_translation, static_cast<double>(glm::length(d)) / diag);
+      // Rotation compared by what it does to vectors, with Cal3D's own
+      // vector-by-quaternion product: this is what pins the conjugate mapping.
+      for (int k = 0; k < 3; ++k) {
+        CalVector e(k == 0 ? 1.0f : 0.0f, k == 1 ? 1.0f : 0.0f, k == 2 ? 1.0f : 0.0f);
+        e *= bone->getRotationAbsolute();
+        Vec3 ours_e = m.transform_vector(Vec3(k == 0 ? 1.0f : 0.0f, k == 1 ? 1.0f : 0.0f,
+                                              k == 2 ? 1.0f : 0.0f));
+        err.joint_rotation = std::max(
+            err.joint_rotation, static_cast<double>(glm::length(ours_e - Vec3(e.x, e.y, e.z))));
+      }
+    }
+
+    std::size_t base = 0;
+    for (int id : side.mesh_ids) {
+      for (CalSubmesh* sub : cal.getMesh(id)->getVectorSubmesh()) {
+        const int n = sub->getVertexCount();
+        cal_vertices.assign(static_cast<std::size_t>(n) * 3, 0.0f);
+        ASSERT_EQ(cal.getPhysique()->calculateVertices(sub, cal_vertices.data()), n);
+        for (int v = 0; v < n; ++v) {
+          const std::size_t vi = static_cast<std::size_t>(v);
+          ASSERT_LT(base + vi, positions.size());
+          const Vec3 c(cal_vertices[vi * 3], cal_vertices[vi * 3 + 1], cal_vertices[vi * 3 + 2]);
+          err.vertex = std::max(err.vertex,
+                                static_cast<double>(glm::length(positions[base + vi] - c)) / diag);
+        }
+        base += static_cast<std::size_t>(n);
+      }
+    }
+    ASSERT_EQ(base, positions.size());
+    ++err.samples;
+  }
+}
+
+void oracle_model(const std::string& model, const std::vector<std::string>& clips) {
+  auto ours = import_cal3d(model_cfg(model));
+  ASSERT_TRUE(ours.ok()) << ours.status().message();
+  CalSide side;
+  ASSERT_TRUE(load_cal_side(model, side)) << CalError::getLastErrorText();
+  if (side.scale != 1.0f) side.core.scale(side.scale);  // skeleton + meshes
+  constexpr double kTolerance = 1e-4;
+  for (const std::string& clip : clips) {
+    OracleErrors err;
+    run_oracle(model, *ours, side, clip, 24, err);
+    std::printf("[oracle] %s %-6s samples %d: joint translation %.3g, joint rotation %.3g, vertex %.3g"
+                " (relative to bbox diagonal)\n",
+                model.c_str(), clip.c_str(), err.samples, err.joint_translation, err.joint_rotation,
+                err.vertex);
+    EXPECT_EQ(err.samples, 48);
+    EXPECT_LT(err.joint_translation, kTolerance) << model << " " << clip;
+    EXPECT_LT(err.joint_rotation, kTolerance) << model << " " << clip;
+    EXPECT_LT(err.vertex, kTolerance) << model << " " << clip;
+  }
+}
+
+TEST(Cal3dOracle, CallyMatchesCal3dLibrary) { oracle_model("cally", {"walk", "jog", "strut", "wave"}); }
+
+TEST(Cal3dOracle, PaladinMatchesCal3dLibraryAtHalfScale) {
+  oracle_model("paladin", {"walk", "jog", "strut", "wave"});
+}
+
+// The rest pose (no clip) must reproduce the bind mesh on both sides.
+TEST(Cal3dOracle, RestPoseSkinsToBindMesh) {
+  auto ours = import_cal3d(model_cfg("cally"));
+  ASSERT_TRUE(ours.ok()) << ours.status().message();
+  const anim::Skeleton& skel = ours->skeleton;
+  std::vector<anim::JointTransform> local(skel.joint_count());
+  std::vector<Affine3> model_m(skel.joint_count()), skin(skel.joint_count());
+  std::vector<Vec3> positions(ours->mesh.vertex_count());
+  ASSERT_TRUE(anim::rest_pose(skel, local).ok());
+  ASSERT_TRUE(anim::local_to_model(skel, local, model_m).ok());
+  ASSERT_TRUE(anim::skinning_matrices(skel, model_m, Affine3::identity(), skin).ok());
+  ASSERT_TRUE(anim::skin_reference(ours->mesh, skin, positions, {}).ok());
+  const double diag = bbox_diagonal(ours->mesh);
+  double max_err = 0.0;
+  for (std::size_t v = 0; v < positions.size(); ++v) {
+    max_err = std::max(max_err, static_cast<double>(glm::length(positions[v] - ours->mesh.positions[v])) / diag);
+  }
+  EXPECT_LT(max_err, 1e-5);
+}
+
+// ---------------------------------------------------------------- bad input
+
+class Cal3dBadInput : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("sinew_cal3d_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override {
+    std::error_code ec;
+    fs::remove_all(dir_, ec);
+  }
+  std::string write(const std::string& name, const std::string& text) {
+    const std::string path = (dir_ / name).string();
+    std::ofstream(path, std::ios::binary) << text;
+    return path;
+  }
+  static std::string read(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::stringstream text;
+    text << in.rdbuf();
+    return text.str();
+  }
+  fs::path dir_;
+};
+
+TEST_F(Cal3dBadInput, MissingCfg) {
+  const std::string path = (dir_ / "nope.cfg").string();
+  auto m = import_cal3d(path);
+  ASSERT_FALSE(m.ok());
+  EXPECT_EQ(m.status().code(), ErrorCode::kNotFound);
+  EXPECT_EQ(m.status().file(), path);
+}
+
+TEST_F(Cal3dBadInput, CfgNamingMissingFiles) {
+  const std::string csf = model_file("cally", "cally.csf");
+  const std::string cmf = model_file("cally", "cally_chest.cmf");
+  struct Case {
+    std::string cfg;
+    std::string missing;
+  };
+  const std::vector<Case> cases = {
+      {"skeleton=missing.csf\nmesh=" + cmf + "\n", "missing.csf"},
+      {"skeleton=" + csf + "\nmesh=missing.cmf\n", "missing.cmf"},
+      {"skeleton=" + csf + "\nmesh=" + cmf + "\nanimation=missing.caf\n", "missing.caf"},
+      {"skeleton=" + csf + "\nmaterial=missing.xrf\n", "missing.xrf"},
+  };
+  for (const Case& c : cases) {
+    auto m = import_cal3d(write("m.cfg", c.cfg));
+    ASSERT_FALSE(m.ok()) << c.missing;
+    EXPECT_EQ(m.status().code(), ErrorCode::kNotFound) << m.status().message();
+    EXPECT_EQ(m.status().file(), (dir_ / c.missing).string()) << m.status().message();
+  }
+}
+
+TEST_F(Cal3dBadInput, GarbageCfgLines) {
+  const std::string csf = model_file("cally", "cally.csf");
+  const std::vector<std::string> bad = {
+      "skeleton=" + csf + "\nthis line is garbage\n",
+      "skeleton=" + csf + "\nscale=abc\n",
+      "skeleton=" + csf + "\nscale=-1\n",
+      "skeleton=" + csf + "\nscale=nan\n",
+      "skeleton=" + csf + "\nmesh=\n",
+      "skeleton=" + csf + "\nskeleton=" + csf + "\n",
+      "mesh=foo.cmf\n",
+      std::string("skeleton=") + csf + "\n\x01\x02\xff\xfe\n",
+  };
+  for (const std::string& text : bad) {
+    const std::string path = write("g.cfg", text);
+    auto m = import_cal3d(path);
+    ASSERT_FALSE(m.ok()) << text;
+    EXPECT_EQ(m.status().file(), path) << m.status().message();
+    EXPECT_FALSE(m.status().detail().empty());
+  }
+  // Unknown keys, comments, blanks and CRLF are fine.
+  auto ok = import_cal3d(write(
+      "u.cfg", "# comment\r\n\r\n  path = whatever \r\nfoo=bar\r\nskeleton = " + csf + "\r\n"));
+  ASSERT_TRUE(ok.ok()) << ok.status().message();
+  EXPECT_EQ(ok->skeleton.joint_count(), 37u);
+  EXPECT_EQ(ok->mesh.triangle_count(), 0u);
+}
+
+// Truncated copies of each binary file type at several lengths: an error
+// naming the truncated file, never a crash (run under ASan too).
+TEST_F(Cal3dBadInput, TruncatedFiles) {
+  const std::string csf = model_file("cally", "cally.csf");
+  const std::string cmf = model_file("cally", "cally_chest.cmf");
+  const std::string caf = model_file("cally", "cally_wave.caf");
+  struct Kind {
+    std::string source;
+    std::string name;
+  };
+  for (const Kind& kind : {Kind{csf, "t.csf"}, Kind{cmf, "t.cmf"}, Kind{caf, "t.caf"}}) {
+    const std::string bytes = read(kind.source);
+    ASSERT_GT(bytes.size(), 100u);
+    const std::vector<std::size_t> lengths = {0,  1,  3,  4,  7,  8,  12, 16, 20, 33, 64,
+                                              bytes.size() / 3, bytes.size() / 2, bytes.size() - 4,
+                                              bytes.size() - 1};
+    for (std::size_t len : lengths) {
+      const std::string file = write(kind.name, bytes.substr(0, len));
+      const std::string skel = kind.name == "t.csf" ? file : csf;
+      std::string cfg = "skeleton=" + skel + "\n";
+      if (kind.name == "t.cmf") cfg += "mesh=" + file + "\n";
+      if (kind.name == "t.caf") cfg += "animation=" + file + "\n";
+      auto m = import_cal3d(write("t.cfg", cfg));
+      ASSERT_FALSE(m.ok()) << kind.name << " truncated to " << len;
+      EXPECT_EQ(m.status().file(), file) << m.status().message();
+    }
+  }
+}
+
+// Bytes patched inside otherwise valid files: what Cal3D itself does not
+// check (counts against the file size, face ids, track bone ids, NaNs).
+TEST_F(Cal3dBadInput, CorruptFields) {
+  const std::string csf = model_file("cally", "cally.csf");
+  auto patch_i32 = [](std::string bytes, std::size_t at, std::uint32_t v) {
+    for (int i = 0; i < 4; ++i) bytes[at + static_cast<std::size_t>(i)] = static_cast<char>((v >> (8 * i)) & 0xff);
+    return bytes;
+  };
+  struct Case {
+    std::string name;
+    std::string bytes;
+    ErrorCode code;
+  };
+  const std::string cmf = read(model_file("cally", "cally_chest.cmf"));
+  const std::string caf = read(model_file("cally", "cally_wave.caf"));
+  const std::vector<Case> cases = {
+      // .cmf: magic, version, submeshCount, then material, vertexCount (16), ...
+      {"c.cmf", patch_i32(cmf, 16, 0x7fffffffu), ErrorCode::kTruncated},
+      {"c.cmf", patch_i32(cmf, 16, 0x80000000u), ErrorCode::kInvalidData},
+      // The last face's last vertex id.
+      {"c.cmf", patch_i32(cmf, cmf.size() - 4, 99999u), ErrorCode::kOutOfBounds},
+      // .caf: magic, version, duration, trackCount (12), track[0].bone (16),
+      // keyframeCount (20), key[0].time (24).
+      {"c.caf", patch_i32(caf, 12, 0x10000000u), ErrorCode::kTruncated},
+      {"c.caf", patch_i32(caf, 16, 999u), ErrorCode::kOutOfBounds},
+      {"c.caf", patch_i32(caf, 24, 0x7fc00000u), ErrorCode::kInvalidData},
+  };
+  for (const Case& c : cases) {
+    const std::string file = write(c.name, c.bytes);
+    std::string cfg = "skeleton=" + csf + "\n";
+    cfg += (c.name == "c.cmf" ? "mesh=" : "animation=") + file + "\n";
+    auto m = import_cal3d(write("c.cfg", cfg));
+    ASSERT_FALSE(m.ok()) << c.name;
+    EXPECT_EQ(m.status().code(), c.code) << m.status().message();
+    EXPECT_EQ(m.status().file(), file) << m.status().message();
+  }
+}
+
+TEST_F(Cal3dBadInput, TwoListedAnimationsWithOneClipName) {
+  const std::string csf = model_file("cally", "cally.csf");
+  const std::string walk = model_file("cally", "cally_walk.caf");
+  const std::string copy = write("cally_walk.caf", read(walk));
+  const std::string cfg = write("d.cfg", "skeleton=" + csf + "\nanimation=" + walk +
+                                             "\nanimation=" + walk + "\nanimation=" + copy + "\n");
+  auto m = import_cal3d(cfg);
+  ASSERT_FALSE(m.ok());
+  EXPECT_EQ(m.status().code(), ErrorCode::kDuplicate) << m.status().message();
+  EXPECT_EQ(m.status().file(), cfg);
+  // Listed twice is one clip.
+  auto once = import_cal3d(write("e.cfg", "skeleton=" + csf + "\nanimation=" + walk +
+                                              "\nanimation=" + walk + "\n"));
+  ASSERT_TRUE(once.ok()) << once.status().message();
+  EXPECT_EQ(once->clips.size(), 1u);
+  EXPECT_EQ(once->clips[0].name(), "cally_walk");  // no "e_" prefix to strip
+}
+
+// Not bad input, but needs the fixture's folder: paladin.cfg's scale=0.5
+// halves positions, bone and keyframe translations relative to scale=1.
+TEST_F(Cal3dBadInput, PaladinCfgScaleIsApplied) {
+  auto half = import_cal3d(model_cfg("paladin"));
+  ASSERT_TRUE(half.ok()) << half.status().message();
+  const std::string cfg = "scale=1.0\nskeleton=" + model_file("paladin", "paladin.csf") +
+                          "\nmesh=" + model_file("paladin", "paladin_body.cmf") +
+                          "\nanimation=" + model_file("paladin", "paladin_walk.caf") + "\n";
+  auto full = import_cal3d(write("p.cfg", cfg));
+  ASSERT_TRUE(full.ok()) << full.status().message();
+  ASSERT_LE(full->mesh.vertex_count(), half->mesh.vertex_count());
+  for (std::size_t v = 0; v < full->mesh.vertex_count(); ++v) {
+    ASSERT_NEAR(glm::length(full->mesh.positions[v] * 0.5f - half->mesh.positions[v]), 0.0f, 1e-4f);
+  }
+  for (std::size_t j = 0; j < full->skeleton.joint_count(); ++j) {
+    ASSERT_NEAR(glm::length(full->skeleton.rest_pose()[j].translation * 0.5f -
+                            half->skeleton.rest_pose()[j].translation),
+                0.0f, 1e-4f);
+  }
+  // Clip name "paladin_walk" here: the .cfg is p.cfg, no "p_" prefix.
+  const anim::JointTracks& a = full->clips.at(0).tracks()[0];
+  const anim::JointTracks& b = half->find_clip("walk")->tracks()[0];
+  ASSERT_EQ(a.translation.values.size(), b.translation.values.size());
+  EXPECT_NEAR(glm::length(a.translation.values[3] * 0.5f - b.translation.values[3]), 0.0f, 1e-4f);
+}
+
+}  // namespace
+}  // namespace sinew::editor
