@@ -1,0 +1,55 @@
+// glTF 2.0 importer (.gltf with external or embedded buffers, and .glb),
+// built on tinygltf for parsing; everything past the JSON (accessor decoding,
+// bounds, skins, node folding) is checked here so bad files give a Status.
+//
+// What becomes of a glTF file:
+//
+// * Skeleton. The joints are the union of the `joints` of every skin that a
+//   mesh node uses, in skin order then joint order. A joint's parent is its
+//   nearest ancestor node that is also a joint. Non-joint nodes between two
+//   joints, and above a root joint (e.g. an "Armature" or Z-up node), are
+//   folded into the child joint's rest transform and into its animation
+//   tracks, so model-space joint transforms equal the glTF global transforms.
+//   Folding an animated joint needs the folded transform to be a similarity
+//   (translation, rotation, uniform scale); otherwise the import fails.
+//   A node listed by two skins must have the same inverseBindMatrix in both
+//   (otherwise the import fails). An absent inverseBindMatrices accessor
+//   means identity. The skin's `skeleton` property is validated but not
+//   needed: global transforms always come from the full node hierarchy.
+// * Mesh. Every node with a mesh instantiates it; triangles come in mesh
+//   array order, then per mesh its instancing nodes in node order, then
+//   primitives in order, then triangles in index order (non-indexed
+//   primitives use 0,1,2,...). Meshes no node uses are skipped. Skinned mesh
+//   nodes follow the spec: their own transform is ignored, vertices are bind
+//   positions. Meshes on nodes without a skin are rigid: they are bound with
+//   weight 1 to their nearest joint ancestor (or self), or, if none, to a
+//   synthetic root joint "<static>" with identity transforms (added only
+//   when needed, so a model without skins imports as one root joint).
+//   JOINTS_0/WEIGHTS_0 and JOINTS_1/WEIGHTS_1 give up to 8 influences;
+//   weights are renormalised to sum 1. A joint index past the skin's joint
+//   list is an error when its weight is non-zero and is cleared to joint 0
+//   when its weight is zero (some exporters pad unused slots that way).
+//   Missing normals are computed (area-weighted); TEXCOORD_0 is optional.
+// * Materials. Every glTF material in array order, its colour the
+//   baseColorFactor rgb (white by default); primitives without a material
+//   use an extra "<default>" white material appended at the end.
+// * Clips. One per animation, named by `name` or "animation_<index>".
+//   Translation, rotation and scale channels on joints become tracks with
+//   STEP / LINEAR / CUBICSPLINE interpolation; `weights` channels (morph
+//   targets) and channels on non-joint nodes are ignored.
+#pragma once
+
+#include <string>
+
+#include "editor/import/imported_model.h"
+#include "runtime/core/expected.h"
+
+namespace sinew::editor {
+
+// Loads `path` (.gltf or .glb, decided by the file's magic, not its name).
+// Every failure is a Status naming the file and the offending field, e.g.
+// "m.gltf: meshes[0].primitives[1].attributes.WEIGHTS_0[17] = 0: the
+// vertex's weights are all zero".
+Expected<ImportedModel> import_gltf(const std::string& path);
+
+}  // namespace sinew::editor
