@@ -56,11 +56,51 @@ struct JointLimit {
 using JointLimits = std::vector<JointLimit>;
 
 // The allowed rotation closest to `delta` (for Euler limits: per-axis clamp
-// of the decomposed angles, which is what a user editing angles expects;
-// for swing-twist: twist clamped to its range and swing projected onto the
-// ellipse). Allowed rotations are returned unchanged.
+// of the decomposed angles, which is what a user editing angles expects, on
+// whichever of the two decompositions needs less clamping; at gimbal lock
+// the outer angles are split to fit their ranges when possible. For
+// swing-twist: the allowed rotation nearest in rotation angle: the twist is
+// solved exactly for each candidate swing, and the swing found by a search
+// over the ellipse seeded with the plain projection of the swing onto it,
+// because projecting swing and twist separately can land far from the
+// nearest rotation when both are out of range or the swing nears 180
+// degrees). Allowed rotations (within 1e-5 rad) are returned unchanged, bit
+// for bit. Non-finite input is treated as the identity.
+// is_within's tolerance is per Euler angle, or on the twist angle and the
+// swing vector's distance from the ellipse.
 Quat clamp_rotation(const JointLimit& limit, const Quat& delta);
 bool is_within(const JointLimit& limit, const Quat& delta, float tolerance_radians = 1e-4f);
+
+// Decomposition helpers, exposed for the editor, the pose-space sampler and
+// tests.
+
+// The two axes perpendicular to a twist axis that swing_max_1 and
+// swing_max_2 refer to: for the twist axis's dominant component i (x = 0),
+// axis_1 is the next coordinate axis (i + 1) mod 3 made perpendicular to the
+// twist axis, and axis_2 = cross(twist_axis, axis_1). So twist about x
+// swings about y then z; about y: z then x; about z: x then y.
+void swing_twist_basis(const Vec3& twist_axis, Vec3& axis_1, Vec3& axis_2);
+
+struct EulerAngles {
+  Vec3 angles{0.0f};           // by axis (x, y, z), radians, each in [-pi, pi]
+  bool gimbal_locked = false;  // middle angle at +-90 degrees: the outer
+                               // angles share one degree of freedom; the
+                               // first is then reported as 0
+};
+// delta = compose_euler(order, decompose_euler(order, delta).angles), with
+// the middle angle in [-pi/2, pi/2].
+EulerAngles decompose_euler(RotationOrder order, const Quat& delta);
+Quat compose_euler(RotationOrder order, const Vec3& angles);
+
+struct SwingTwistAngles {
+  Vec2 swing{0.0f};  // swing vector (axis * angle) in the swing_twist_basis, |swing| <= pi
+  float twist = 0.0f;  // radians, (-pi, pi]
+};
+SwingTwistAngles decompose_swing_twist(const Vec3& twist_axis, const Quat& delta);
+Quat compose_swing_twist(const Vec3& twist_axis, const Vec2& swing, float twist);
+
+// The angle of the rotation taking a to b, in [0, pi] (sign-insensitive).
+float rotation_distance(const Quat& a, const Quat& b);
 
 // Clamps every joint of a local pose in place. Errors: kInvalidArgument on a
 // size mismatch.
