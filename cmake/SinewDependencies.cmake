@@ -8,6 +8,11 @@ find_package(TBB CONFIG REQUIRED)
 # Python targets whose library is not installed (a packaging bug).
 pkg_check_modules(OIIO REQUIRED IMPORTED_TARGET OpenImageIO)
 pkg_check_modules(XXHASH REQUIRED IMPORTED_TARGET libxxhash)
+find_package(nlohmann_json CONFIG REQUIRED)
+# Debian's libtinygltf-dev ships a compiled library, so no
+# TINYGLTF_IMPLEMENTATION unit is needed; its headers sit in /usr/include,
+# a system directory, so their warnings stay out of -Werror.
+find_package(TinyGLTF CONFIG REQUIRED)
 
 if(SINEW_BUILD_DISPLAY)
   find_package(glfw3 CONFIG REQUIRED)

@@ -314,7 +314,6 @@ TEST(Mannequin, JointLimitsCoverTheSkeleton) {
   }
 }
 
-#if defined(SINEW_HAVE_JOINT_LIMITS)
 TEST(Mannequin, ClipPosesStayWithinJointLimits) {
   const auto& sk = model().skeleton;
   const anim::JointLimits limits = mannequin_joint_limits(sk);
@@ -351,7 +350,6 @@ TEST(Mannequin, JointLimitsRejectImplausibleRotations) {
   // The neck does not turn all the way round.
   EXPECT_FALSE(anim::is_within(limit("neck"), glm::angleAxis(2.0f, Vec3(0, 1, 0))));
 }
-#endif
 
 }  // namespace
 }  // namespace sinew::content
