@@ -1,8 +1,8 @@
 // The mixer against the Cal3D library: two blended cycles with fades plus an
 // action with fade-in and fade-out, driven by the same update steps on both
 // sides, compared bone by bone and vertex by vertex on Cally (issue 3's
-// oracle for blending). Complements the single-clip oracle in
-// cal3d_import_test.cpp.
+// oracle for blending), and the same on Paladin at its .cfg scale of 0.5.
+// Complements the single-clip oracle in cal3d_import_test.cpp.
 #include <gtest/gtest.h>
 
 #include <cal3d/cal3d.h>
@@ -10,6 +10,8 @@
 
 #include <cmath>
 #include <cstdio>
+#include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -22,15 +24,15 @@
 namespace sinew::editor {
 namespace {
 
-std::string cally_file(const std::string& file) {
-  return std::string(SINEW_SHARED_DIR) + "/content/cal3d/cally/" + file;
+std::string model_file(const std::string& model, const std::string& file) {
+  return std::string(SINEW_SHARED_DIR) + "/content/cal3d/" + model + "/" + file;
 }
 
 // Cal3D's side: its own core model from the same files.
-struct CalCally {
+struct CalSide {
   CalCoreModel core{"oracle"};
   std::vector<int> mesh_ids;
-  ~CalCally() {
+  ~CalSide() {
     // Cal3D 0.11's ~CalCoreAnimation leaks its tracks.
     for (int i = 0; i < core.getCoreAnimationCount(); ++i) {
       if (CalCoreAnimation* anim = core.getCoreAnimation(i)) {
@@ -66,23 +68,33 @@ int clip_index(const ImportedModel& model, const std::string& name) {
   return -1;
 }
 
-TEST(Cal3dMixerOracle, TwoCyclesAndAnActionMatchCal3d) {
-  auto ours = import_cal3d(cally_file("cally.cfg"));
+void run_mixer_oracle(const std::string& name) {
+  auto ours = import_cal3d(model_file(name, name + ".cfg"));
   ASSERT_TRUE(ours.ok()) << ours.status().message();
 
-  CalCally cal3d;
-  ASSERT_TRUE(cal3d.core.loadCoreSkeleton(cally_file("cally.csf")));
-  for (const char* mesh : {"calf_left", "calf_right", "chest", "foot_left", "foot_right",
-                           "hand_left", "hand_right", "head", "lowerarm_left", "lowerarm_right",
-                           "neck", "pelvis", "ponytail", "thigh_left", "thigh_right",
-                           "upperarm_left", "upperarm_right"}) {
-    const int id = cal3d.core.loadCoreMesh(cally_file(std::string("cally_") + mesh + ".cmf"));
+  // Cal3D's own model from the file names the .cfg lists, at the .cfg scale.
+  std::ifstream in(model_file(name, name + ".cfg"));
+  std::stringstream text;
+  text << in.rdbuf();
+  auto cfg = parse_cal3d_config(text.str(), name + ".cfg");
+  ASSERT_TRUE(cfg.ok()) << cfg.status().message();
+  CalSide cal3d;
+  ASSERT_TRUE(cal3d.core.loadCoreSkeleton(model_file(name, cfg->skeleton)));
+  for (const std::string& mesh : cfg->meshes) {
+    const int id = cal3d.core.loadCoreMesh(model_file(name, mesh));
     ASSERT_GE(id, 0) << mesh;
     cal3d.mesh_ids.push_back(id);
   }
-  const int cal_walk = cal3d.core.loadCoreAnimation(cally_file("cally_walk.caf"));
-  const int cal_jog = cal3d.core.loadCoreAnimation(cally_file("cally_jog.caf"));
-  const int cal_wave = cal3d.core.loadCoreAnimation(cally_file("cally_wave.caf"));
+  if (cfg->scale != 1.0f) cal3d.core.scale(cfg->scale);  // skeleton and meshes
+  auto load_clip = [&](const char* clip) {
+    const int id = cal3d.core.loadCoreAnimation(model_file(name, name + "_" + clip + ".caf"));
+    // CalCoreModel::scale scaled what was loaded before: scale the clip too.
+    if (id >= 0 && cfg->scale != 1.0f) cal3d.core.getCoreAnimation(id)->scale(cfg->scale);
+    return id;
+  };
+  const int cal_walk = load_clip("walk");
+  const int cal_jog = load_clip("jog");
+  const int cal_wave = load_clip("wave");
   ASSERT_GE(cal_walk, 0);
   ASSERT_GE(cal_jog, 0);
   ASSERT_GE(cal_wave, 0);
@@ -182,11 +194,15 @@ TEST(Cal3dMixerOracle, TwoCyclesAndAnActionMatchCal3d) {
     ASSERT_EQ(base, positions.size());
     ++err.samples;
   }
-  std::printf("[mixer oracle] cally walk+jog+wave, %d frames: joint %.3g, vertex %.3g (of bbox diagonal)\n",
-              err.samples, err.joint, err.vertex);
+  std::printf("[mixer oracle] %s walk+jog+wave, %d frames: joint %.3g, vertex %.3g (of bbox diagonal)\n",
+              name.c_str(), err.samples, err.joint, err.vertex);
   EXPECT_LT(err.joint, 1e-4);
   EXPECT_LT(err.vertex, 1e-4);
 }
+
+TEST(Cal3dMixerOracle, CallyTwoCyclesAndAnActionMatchCal3d) { run_mixer_oracle("cally"); }
+
+TEST(Cal3dMixerOracle, PaladinTwoCyclesAndAnActionMatchCal3d) { run_mixer_oracle("paladin"); }
 
 }  // namespace
 }  // namespace sinew::editor
