@@ -10,7 +10,7 @@
 //   chest > clavicle_{l,r} > upperarm_{l,r} > lowerarm_{l,r} > hand_{l,r}
 //   pelvis > thigh_{l,r} > calf_{l,r} > foot_{l,r} > toe_{l,r}
 //
-// Mesh: six closed tubes (torso+neck+head, two arms, two legs, two feet),
+// Mesh: seven closed tubes (torso+neck+head, two arms, two legs, two feet),
 // each a stack of elliptical rings capped by flattened hemispheres and a
 // pole vertex, so every edge is shared by exactly two triangles. Rings near
 // a joint blend the two adjacent bones with a smoothstep, so elbows and knees
