@@ -1,7 +1,6 @@
 #include "tests/bench/animation_bench.h"
 
 #include <cal3d/cal3d.h>
-#include <cal3d/coretrack.h>
 
 #include <chrono>
 #include <cstdio>
@@ -15,6 +14,7 @@
 #include "content/mannequin/mannequin.h"
 #include "editor/import/cal3d_importer.h"
 #include "runtime/timing/phase_timers.h"
+#include "tests/support/cal3d_support.h"
 
 namespace sinew::bench {
 namespace {
@@ -137,16 +137,7 @@ void bench_cal3d(const std::string& dir, int instances, int frames, Row& row) {
     row.cal_anim_us = s[0].median_ms * 1000.0 / instances;
     row.cal_skin_mvps = double(vertex_count) * instances / (s[1].median_ms * 1e-3) / 1e6;
   }
-  // Cal3D 0.11's ~CalCoreAnimation leaks its tracks.
-  for (int i = 0; i < core.getCoreAnimationCount(); ++i) {
-    if (CalCoreAnimation* anim = core.getCoreAnimation(i)) {
-      for (CalCoreTrack* track : anim->getListCoreTrack()) {
-        track->destroy();
-        delete track;
-      }
-      anim->getListCoreTrack().clear();
-    }
-  }
+  testing_support::free_cal3d_animation_tracks(core);
 }
 
 int walk_index(const editor::ImportedModel& m) {

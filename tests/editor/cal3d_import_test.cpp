@@ -19,6 +19,7 @@
 #include "animation/pose.h"
 #include "animation/reference_skinning.h"
 #include "editor/import/cal3d_importer.h"
+#include "tests/support/cal3d_support.h"
 
 namespace sinew::editor {
 namespace {
@@ -113,18 +114,7 @@ struct CalSide {
   CalSide() = default;
   CalSide(const CalSide&) = delete;
   CalSide& operator=(const CalSide&) = delete;
-  // Cal3D 0.11's ~CalCoreAnimation leaks its tracks (as in the importer).
-  ~CalSide() {
-    for (int i = 0; i < core.getCoreAnimationCount(); ++i) {
-      if (CalCoreAnimation* anim = core.getCoreAnimation(i)) {
-        for (CalCoreTrack* track : anim->getListCoreTrack()) {
-          track->destroy();
-          delete track;
-        }
-        anim->getListCoreTrack().clear();
-      }
-    }
-  }
+  ~CalSide() { testing_support::free_cal3d_animation_tracks(core); }
 };
 
 bool load_cal_side(const std::string& model, CalSide& side) {
@@ -149,15 +139,6 @@ struct OracleErrors {
   double vertex = 0.0;             // relative to the bounding-box diagonal
   int samples = 0;
 };
-
-double bbox_diagonal(const SkinnedMesh& mesh) {
-  Vec3 lo(1e30f), hi(-1e30f);
-  for (const Vec3& p : mesh.positions) {
-    lo = glm::min(lo, p);
-    hi = glm::max(hi, p);
-  }
-  return static_cast<double>(glm::length(hi - lo));
-}
 
 // Poses both sides with one clip as a weight-1 cycle (no fade: delay 0) at
 // 2 * sample_count times and compares every bone and every skinned vertex.
@@ -193,7 +174,7 @@ void run_oracle(const std::string& model, const ImportedModel& ours, CalSide& si
   std::vector<Vec3> positions(ours.mesh.vertex_count());
   std::vector<float> cal_vertices;
   anim::SamplingCache cache;
-  const double diag = bbox_diagonal(ours.mesh);
+  const double diag = testing_support::bbox_diagonal(ours.mesh);
   std::vector<CalBone*>& bones = cal.getSkeleton()->getVectorBone();
   ASSERT_EQ(bones.size(), skel.joint_count());
 
@@ -300,7 +281,7 @@ TEST(Cal3dOracle, RestPoseSkinsToBindMesh) {
   ASSERT_TRUE(anim::local_to_model(skel, local, model_m).ok());
   ASSERT_TRUE(anim::skinning_matrices(skel, model_m, Affine3::identity(), skin).ok());
   ASSERT_TRUE(anim::skin_reference(ours->mesh, skin, positions, {}).ok());
-  const double diag = bbox_diagonal(ours->mesh);
+  const double diag = testing_support::bbox_diagonal(ours->mesh);
   double max_err = 0.0;
   for (std::size_t v = 0; v < positions.size(); ++v) {
     max_err = std::max(max_err, static_cast<double>(glm::length(positions[v] - ours->mesh.positions[v])) / diag);

@@ -6,7 +6,6 @@
 #include <gtest/gtest.h>
 
 #include <cal3d/cal3d.h>
-#include <cal3d/coretrack.h>
 
 #include <cmath>
 #include <cstdio>
@@ -20,6 +19,7 @@
 #include "animation/pose.h"
 #include "animation/reference_skinning.h"
 #include "editor/import/cal3d_importer.h"
+#include "tests/support/cal3d_support.h"
 
 namespace sinew::editor {
 namespace {
@@ -32,18 +32,7 @@ std::string model_file(const std::string& model, const std::string& file) {
 struct CalSide {
   CalCoreModel core{"oracle"};
   std::vector<int> mesh_ids;
-  ~CalSide() {
-    // Cal3D 0.11's ~CalCoreAnimation leaks its tracks.
-    for (int i = 0; i < core.getCoreAnimationCount(); ++i) {
-      if (CalCoreAnimation* anim = core.getCoreAnimation(i)) {
-        for (CalCoreTrack* track : anim->getListCoreTrack()) {
-          track->destroy();
-          delete track;
-        }
-        anim->getListCoreTrack().clear();
-      }
-    }
-  }
+  ~CalSide() { testing_support::free_cal3d_animation_tracks(core); }
 };
 
 struct Errors {
@@ -51,15 +40,6 @@ struct Errors {
   double vertex = 0.0;
   int samples = 0;
 };
-
-double diagonal(const SkinnedMesh& mesh) {
-  Vec3 lo(1e30f), hi(-1e30f);
-  for (const Vec3& p : mesh.positions) {
-    lo = glm::min(lo, p);
-    hi = glm::max(hi, p);
-  }
-  return static_cast<double>(glm::length(hi - lo));
-}
 
 int clip_index(const ImportedModel& model, const std::string& name) {
   for (std::size_t i = 0; i < model.clips.size(); ++i) {
@@ -152,7 +132,7 @@ void run_mixer_oracle(const std::string& name) {
   std::vector<anim::SamplingCache> caches(ours->clips.size());
   anim::BlendScratch scratch;
   std::vector<float> cal_vertices;
-  const double diag = diagonal(ours->mesh);
+  const double diag = testing_support::bbox_diagonal(ours->mesh);
   std::vector<CalBone*>& bones = cal.getSkeleton()->getVectorBone();
   ASSERT_EQ(bones.size(), skel.joint_count());
 
