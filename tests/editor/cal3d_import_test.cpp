@@ -172,7 +172,6 @@ void run_oracle(const std::string& model, const ImportedModel& ours, CalSide& si
   std::vector<anim::JointTransform> local(skel.joint_count());
   std::vector<Affine3> model_m(skel.joint_count()), skin(skel.joint_count());
   std::vector<Vec3> positions(ours.mesh.vertex_count());
-  std::vector<float> cal_vertices;
   anim::SamplingCache cache;
   const double diag = testing_support::bbox_diagonal(ours.mesh);
   std::vector<CalBone*>& bones = cal.getSkeleton()->getVectorBone();
@@ -221,23 +220,10 @@ void run_oracle(const std::string& model, const ImportedModel& ours, CalSide& si
       }
     }
 
-    std::size_t base = 0;
-    for (int id : side.mesh_ids) {
-      for (CalSubmesh* sub : cal.getMesh(id)->getVectorSubmesh()) {
-        const int n = sub->getVertexCount();
-        cal_vertices.assign(static_cast<std::size_t>(n) * 3, 0.0f);
-        ASSERT_EQ(cal.getPhysique()->calculateVertices(sub, cal_vertices.data()), n);
-        for (int v = 0; v < n; ++v) {
-          const std::size_t vi = static_cast<std::size_t>(v);
-          ASSERT_LT(base + vi, positions.size());
-          const Vec3 c(cal_vertices[vi * 3], cal_vertices[vi * 3 + 1], cal_vertices[vi * 3 + 2]);
-          err.vertex = std::max(err.vertex,
-                                static_cast<double>(glm::length(positions[base + vi] - c)) / diag);
-        }
-        base += static_cast<std::size_t>(n);
-      }
-    }
-    ASSERT_EQ(base, positions.size());
+    const auto vertex_error =
+        testing_support::max_vertex_error_vs_cal3d(cal, side.mesh_ids, positions, diag);
+    ASSERT_TRUE(vertex_error.has_value()) << "vertex counts differ from Cal3D's";
+    err.vertex = std::max(err.vertex, *vertex_error);
     ++err.samples;
   }
 }

@@ -131,7 +131,6 @@ void run_mixer_oracle(const std::string& name) {
   std::vector<Vec3> positions(ours->mesh.vertex_count());
   std::vector<anim::SamplingCache> caches(ours->clips.size());
   anim::BlendScratch scratch;
-  std::vector<float> cal_vertices;
   const double diag = testing_support::bbox_diagonal(ours->mesh);
   std::vector<CalBone*>& bones = cal.getSkeleton()->getVectorBone();
   ASSERT_EQ(bones.size(), skel.joint_count());
@@ -157,21 +156,10 @@ void run_mixer_oracle(const std::string& name) {
       const Vec3 d = model_m[static_cast<std::size_t>(*j)].translation_part() - Vec3(t.x, t.y, t.z);
       err.joint = std::max(err.joint, static_cast<double>(glm::length(d)) / diag);
     }
-    std::size_t base = 0;
-    for (int id : cal3d.mesh_ids) {
-      for (CalSubmesh* sub : cal.getMesh(id)->getVectorSubmesh()) {
-        const int n = sub->getVertexCount();
-        cal_vertices.assign(static_cast<std::size_t>(n) * 3, 0.0f);
-        ASSERT_EQ(cal.getPhysique()->calculateVertices(sub, cal_vertices.data()), n);
-        for (int v = 0; v < n; ++v) {
-          const std::size_t vi = static_cast<std::size_t>(v);
-          const Vec3 c(cal_vertices[vi * 3], cal_vertices[vi * 3 + 1], cal_vertices[vi * 3 + 2]);
-          err.vertex = std::max(err.vertex, static_cast<double>(glm::length(positions[base + vi] - c)) / diag);
-        }
-        base += static_cast<std::size_t>(n);
-      }
-    }
-    ASSERT_EQ(base, positions.size());
+    const auto vertex_error =
+        testing_support::max_vertex_error_vs_cal3d(cal, cal3d.mesh_ids, positions, diag);
+    ASSERT_TRUE(vertex_error.has_value()) << "vertex counts differ from Cal3D's";
+    err.vertex = std::max(err.vertex, *vertex_error);
     ++err.samples;
   }
   std::printf("[mixer oracle] %s walk+jog+wave, %d frames: joint %.3g, vertex %.3g (of bbox diagonal)\n",
