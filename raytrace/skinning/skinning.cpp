@@ -1,0 +1,185 @@
+// Scalar skinning, path dispatch, chunking and the fused escape check.
+//
+// Decisions the header leaves open:
+// - Both paths blend the matrix first (sum_k w_k B_k) and transform once,
+//   which equals sum_k w_k (B_k p) up to rounding and lets the normal reuse
+//   the blended 3x3 part.
+// - Normals are written only when targets.normals is non-empty AND the mesh
+//   has normals; a mesh without normals leaves targets.normals untouched
+//   (skipped, not zeroed): there is nothing meaningful to write.
+// - The function has no error channel, so mismatched sizes are clamped rather
+//   than read or written out of bounds: only the vertices that fit every
+//   per-vertex array are skinned, normals only when both normal arrays cover
+//   them, and an escape flag is written only where targets.escaped has room
+//   (the check is still counted). A check whose bone has no bone_from_world
+//   or tolerance entry counts as escaped, the safe answer for the renderer.
+// - The escape check runs in scalar code on the chunk's fresh positions,
+//   right after they were written, while they are still in cache.
+#include "raytrace/skinning/skinning.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <vector>
+
+#include "raytrace/skinning/skinning_kernels.h"
+#include "runtime/jobs/job_system.h"
+
+namespace sinew::rt {
+
+namespace {
+
+static_assert(sizeof(Vec3) == 3 * sizeof(float), "kernels read Vec3 arrays as packed floats");
+static_assert(sizeof(Affine3) == detail::kFloatsPerBone * sizeof(float), "kernels read bones as 12 floats");
+static_assert(sizeof(std::array<std::uint16_t, kMaxInfluences>) == kMaxInfluences * sizeof(std::uint16_t));
+static_assert(sizeof(std::array<float, kMaxInfluences>) == kMaxInfluences * sizeof(float));
+
+// Vertices per job chunk: a multiple of the AVX2 width so only the last
+// chunk has a scalar tail; large enough to amortise the task overhead.
+constexpr std::size_t kChunkVertices = 1024;
+static_assert(kChunkVertices % detail::kAvx2Lanes == 0);
+
+void skin_vertex_scalar(const detail::SkinningArrays& a, std::size_t v) {
+  float m[detail::kFloatsPerBone] = {};
+  const float* weights = a.weights + v * kMaxInfluences;
+  const std::uint16_t* joints = a.joints + v * kMaxInfluences;
+  for (int k = 0; k < kMaxInfluences; ++k) {
+    const float w = weights[k];
+    if (w == 0.0f) continue;
+    const float* bone = a.bones + detail::kFloatsPerBone * joints[k];
+    for (std::size_t e = 0; e < detail::kFloatsPerBone; ++e) m[e] += w * bone[e];
+  }
+  const float* p = a.rest_positions + 3 * v;
+  float* out = a.positions + 3 * v;
+  for (int r = 0; r < 3; ++r) {
+    const float* row = m + 4 * r;
+    out[r] = row[0] * p[0] + row[1] * p[1] + row[2] * p[2] + row[3];
+  }
+  if (a.rest_normals == nullptr || a.normals == nullptr) return;
+  const float* n = a.rest_normals + 3 * v;
+  float* out_n = a.normals + 3 * v;
+  for (int r = 0; r < 3; ++r) {
+    const float* row = m + 4 * r;
+    out_n[r] = row[0] * n[0] + row[1] * n[1] + row[2] * n[2];
+  }
+}
+
+void skin_range(const detail::SkinningArrays& a, Range r, bool use_avx2) {
+  std::size_t v = r.begin;
+  if (use_avx2) {
+    const std::size_t simd_end = r.begin + (r.size() / detail::kAvx2Lanes) * detail::kAvx2Lanes;
+    detail::skin_range_avx2(a, r.begin, simd_end);
+    v = simd_end;
+  }
+  for (; v < r.end; ++v) skin_vertex_scalar(a, v);
+}
+
+// Ordered comparisons are false for NaN, so a non-finite q (a zero-scale
+// bone's inverse) is never "inside"; the explicit finiteness test also
+// rejects an infinite q against an unbounded box. Bitwise & instead of &&:
+// no short-circuit branches to mispredict when outcomes vary.
+bool inside_grown_box(const Vec3& q, const Aabb& box, float tolerance) {
+  const bool x = (q.x >= box.lower.x - tolerance) & (q.x <= box.upper.x + tolerance);
+  const bool y = (q.y >= box.lower.y - tolerance) & (q.y <= box.upper.y + tolerance);
+  const bool z = (q.z >= box.lower.z - tolerance) & (q.z <= box.upper.z + tolerance);
+  const bool finite = std::isfinite(q.x) & std::isfinite(q.y) & std::isfinite(q.z);
+  return x & y & z & finite;
+}
+
+std::size_t count_escapes(const EscapeCheckInput& e, std::span<const Vec3> positions,
+                          std::span<std::uint8_t> escaped, Range r) {
+  // Local copies of the spans: the byte stores into `escaped` may alias
+  // anything, and locals spare the reloads of pointers and sizes after each.
+  const std::span<const std::uint32_t> check_begin = e.vertex_check_begin;
+  const std::span<const VertexCheck> checks = e.vertex_checks;
+  const std::span<const Affine3> bone_from_world = e.bone_from_world;
+  const std::span<const float> tolerance = e.tolerance;
+  const std::size_t bone_limit = std::min(bone_from_world.size(), tolerance.size());
+  const std::size_t end = std::min(r.end, check_begin.empty() ? 0 : check_begin.size() - 1);
+
+  std::size_t count = 0;
+  for (std::size_t v = r.begin; v < end; ++v) {
+    const std::size_t first = std::min<std::size_t>(check_begin[v], checks.size());
+    const std::size_t last = std::min<std::size_t>(check_begin[v + 1], checks.size());
+    const Vec3 world = positions[v];
+    for (std::size_t c = first; c < last; ++c) {
+      const VertexCheck& check = checks[c];
+      // A check naming a bone without a transform or tolerance escapes.
+      const bool out = check.bone >= bone_limit ||
+                       !inside_grown_box(bone_from_world[check.bone].transform_point(world), check.box,
+                                         tolerance[check.bone]);
+      count += static_cast<std::size_t>(out);
+      if (c < escaped.size()) escaped[c] = static_cast<std::uint8_t>(out);
+    }
+  }
+  return count;
+}
+
+std::size_t skinnable_vertex_count(const SkinnedMesh& mesh, const SkinningTargets& targets) {
+  return std::min({mesh.positions.size(), mesh.joints.size(), mesh.weights.size(), targets.positions.size()});
+}
+
+detail::SkinningArrays flat_arrays(const SkinnedMesh& mesh, std::span<const Affine3> bones,
+                                   const SkinningTargets& targets, std::size_t vertex_count) {
+  detail::SkinningArrays a;
+  a.rest_positions = reinterpret_cast<const float*>(mesh.positions.data());
+  a.joints = mesh.joints.empty() ? nullptr : mesh.joints.front().data();
+  a.weights = mesh.weights.empty() ? nullptr : mesh.weights.front().data();
+  a.bones = reinterpret_cast<const float*>(bones.data());
+  a.positions = reinterpret_cast<float*>(targets.positions.data());
+  const bool normals = mesh.normals.size() >= vertex_count && targets.normals.size() >= vertex_count &&
+                       !mesh.normals.empty() && !targets.normals.empty();
+  if (normals) {
+    a.rest_normals = reinterpret_cast<const float*>(mesh.normals.data());
+    a.normals = reinterpret_cast<float*>(targets.normals.data());
+  }
+  return a;
+}
+
+}  // namespace
+
+bool avx2_skinning_available() {
+#if defined(__x86_64__) || defined(__i386__)
+  static const bool available = detail::avx2_kernel_compiled() && __builtin_cpu_supports("avx2") &&
+                                __builtin_cpu_supports("fma");
+  return available;
+#else
+  return false;
+#endif
+}
+
+SkinningResult skin_vertices(const SkinnedMesh& mesh, std::span<const Affine3> bones,
+                             const SkinningTargets& targets, const EscapeCheckInput* escape,
+                             JobSystem* jobs, SkinningPath path) {
+  SkinningResult result;
+  const bool use_avx2 = path != SkinningPath::kScalar && avx2_skinning_available();
+  result.path_used = use_avx2 ? SkinningPath::kAvx2 : SkinningPath::kScalar;
+
+  const std::size_t vertex_count = skinnable_vertex_count(mesh, targets);
+  if (vertex_count == 0) return result;
+  const detail::SkinningArrays arrays = flat_arrays(mesh, bones, targets, vertex_count);
+  const std::span<const Vec3> positions = targets.positions;
+
+  // One escape count per chunk, summed in chunk order afterwards: no atomics
+  // in the loop and the same total whatever the thread count.
+  const std::size_t chunk_count = (vertex_count + kChunkVertices - 1) / kChunkVertices;
+  std::vector<std::size_t> chunk_escapes(escape != nullptr ? chunk_count : 0, 0);
+
+  const auto run_chunk = [&](Range r) {
+    skin_range(arrays, r, use_avx2);
+    if (escape != nullptr) {
+      chunk_escapes[r.begin / kChunkVertices] = count_escapes(*escape, positions, targets.escaped, r);
+    }
+  };
+  if (jobs != nullptr) {
+    jobs->parallel_for(0, vertex_count, kChunkVertices, run_chunk);
+  } else {
+    for (std::size_t begin = 0; begin < vertex_count; begin += kChunkVertices) {
+      run_chunk(Range{begin, std::min(vertex_count, begin + kChunkVertices)});
+    }
+  }
+  result.escaped_checks = std::accumulate(chunk_escapes.begin(), chunk_escapes.end(), std::size_t{0});
+  return result;
+}
+
+}  // namespace sinew::rt

@@ -1,0 +1,79 @@
+// Per-frame linear blend skinning into world space, with the escape check
+// fused in (paper section 3; DESIGN.md section 4, "outside the pose space").
+//
+// The kernel reads the rest mesh once and writes world positions (and,
+// when asked, normals: blended with the same matrices and not renormalised,
+// the shader normalises). When an escape check is given, each vertex is also
+// transformed into the frame of every bone it has a check for and compared
+// with its fuzzy box grown by that bone's tolerance; failures are flagged per
+// check and counted. Work is split over vertices in fixed chunks, so results
+// do not depend on the thread count. An AVX2+FMA path (8 vertices at a time)
+// and a scalar path give the same results to within float rounding; kAuto
+// picks AVX2 when the build and the CPU have it.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+
+#include "raytrace/fuzzy/fuzzy_character.h"
+#include "runtime/math/affine.h"
+#include "runtime/mesh/skinned_mesh.h"
+
+namespace sinew {
+class JobSystem;
+}
+
+namespace sinew::rt {
+
+// Skins one rest position with `bones` (scalar reference for tests and the bake).
+inline Vec3 skin_point(const SkinnedMesh& mesh, std::size_t v, std::span<const Affine3> bones) {
+  const auto& joints = mesh.joints[v];
+  const auto& weights = mesh.weights[v];
+  const Vec3& p = mesh.positions[v];
+  Vec3 out(0.0f);
+  for (int k = 0; k < kMaxInfluences; ++k) {
+    const float w = weights[static_cast<std::size_t>(k)];
+    if (w == 0.0f) continue;
+    out += w * bones[joints[static_cast<std::size_t>(k)]].transform_point(p);
+  }
+  return out;
+}
+
+struct EscapeCheckInput {
+  std::span<const std::uint32_t> vertex_check_begin;  // from FuzzyCharacterView
+  std::span<const VertexCheck> vertex_checks;
+  // Per bone: world -> bone frame (the inverse skinning matrix). A bone whose
+  // inverse is not finite (zero scale) fails every check against it.
+  std::span<const Affine3> bone_from_world;
+  // Per bone: how far (bone-frame units) a vertex may lie outside its box
+  // before it counts as escaped; covers the float rounding of skinning and of
+  // the inverse transform far from the origin.
+  std::span<const float> tolerance;
+};
+
+enum class SkinningPath : std::uint8_t { kAuto, kScalar, kAvx2 };
+
+struct SkinningTargets {
+  std::span<Vec3> positions;  // vertex_count, required
+  std::span<Vec3> normals;    // vertex_count, or empty to skip normals
+  std::span<std::uint8_t> escaped;  // vertex_checks.size() when an escape check is given: 1 = escaped
+};
+
+struct SkinningResult {
+  std::size_t escaped_checks = 0;
+  SkinningPath path_used = SkinningPath::kScalar;
+};
+
+// `bones` are the skinning matrices (bind pose -> world) indexed by the mesh's
+// joint indices; the caller guarantees every joint index is < bones.size()
+// (the bake and the loaders validate it). `jobs` may be null (single thread).
+SkinningResult skin_vertices(const SkinnedMesh& mesh, std::span<const Affine3> bones,
+                             const SkinningTargets& targets, const EscapeCheckInput* escape,
+                             JobSystem* jobs, SkinningPath path = SkinningPath::kAuto);
+
+// Whether this build and CPU can run SkinningPath::kAvx2.
+bool avx2_skinning_available();
+
+}  // namespace sinew::rt

@@ -1,0 +1,39 @@
+// Private to raytrace/skinning: the per-range kernels behind skin_vertices().
+//
+// The AVX2 kernel lives in a translation unit compiled with -mavx2 -mfma even
+// in the portable build. Any inline function it instantiates from a shared
+// header (std::span, glm, Affine3) could be emitted there with AVX2
+// instructions and then picked by the linker for callers on a CPU without
+// AVX2 (an ODR trap). So the kernels exchange raw float pointers only and use
+// nothing but intrinsics inside.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+namespace sinew::rt::detail {
+
+// One frame's skinning inputs and outputs as flat arrays. Vertices are
+// 3 floats (x, y, z), influences kMaxInfluences per vertex, bones 12 floats
+// (three rows [r0 r1 r2 t]).
+struct SkinningArrays {
+  const float* rest_positions = nullptr;
+  const float* rest_normals = nullptr;  // null: no normals are written
+  const std::uint16_t* joints = nullptr;
+  const float* weights = nullptr;
+  const float* bones = nullptr;
+  float* positions = nullptr;
+  float* normals = nullptr;             // null: no normals are written
+};
+
+inline constexpr std::size_t kFloatsPerBone = 12;
+inline constexpr std::size_t kAvx2Lanes = 8;
+
+// Skins vertices [begin, end); end - begin must be a multiple of kAvx2Lanes.
+// Call only when avx2_kernel_compiled() and the CPU has AVX2 and FMA.
+void skin_range_avx2(const SkinningArrays& arrays, std::size_t begin, std::size_t end);
+
+// Whether skinning_avx2.cpp was compiled with AVX2 and FMA enabled.
+bool avx2_kernel_compiled();
+
+}  // namespace sinew::rt::detail
