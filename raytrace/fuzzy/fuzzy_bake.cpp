@@ -1,0 +1,701 @@
+// The fuzzy bake (paper sections 3.2-3.4); the contract is in fuzzy_bake.h.
+//
+// Pipeline:
+//   validate -> invert every sample matrix once
+//   -> candidate bones per triangle, and the (vertex, bone) pairs they need
+//   -> per chunk of bones: sweep the samples growing the chunk's vertex boxes,
+//      then update each triangle's best (smallest-area) bone
+//   -> one more sweep for the vertex boxes of the chosen bones (the escape
+//      checks), whose unions are the triangles' fuzzy boxes
+//   -> per bone an SAH kd-tree over its triangles' fuzzy boxes.
+//
+// Every box is a min/max over samples, which is independent of the order the
+// samples and vertices are visited in, so the result depends neither on the
+// thread count nor on the chunking.
+#include "raytrace/fuzzy/fuzzy_bake.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <optional>
+#include <string>
+#include <utility>
+
+#include "raytrace/skinning/skinning.h"
+#include "runtime/jobs/job_system.h"
+
+namespace sinew::rt {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+constexpr std::size_t kMaxBones = 65535;     // triangle_bone is uint16
+constexpr std::size_t kSamplesPerBatch = 8;  // samples swept per pass over the vertices
+constexpr std::size_t kVertexGrain = 512;
+constexpr std::size_t kTriangleGrain = 2048;
+// Share of the progress fraction spent before the kd-tree builds start.
+constexpr double kSweepShare = 0.9;
+
+double ms_since(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+std::string indexed(std::string_view name, std::size_t i) {
+  return std::string(name) + "[" + std::to_string(i) + "]";
+}
+
+std::string indexed(std::string_view name, std::size_t i, std::size_t j) {
+  return indexed(name, i) + "[" + std::to_string(j) + "]";
+}
+
+std::string format_float(float x) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%g", static_cast<double>(x));
+  return text;
+}
+
+std::string format_matrix(const Affine3& m) {
+  std::string out = "[";
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 4; ++c) {
+      out += format_float(m(r, c));
+      out += c < 3 ? " " : (r < 2 ? "; " : "]");
+    }
+  }
+  return out;
+}
+
+// Surface area in double: assignment compares areas of boxes that may differ
+// only slightly, and the stats sum many of them.
+double surface_area_d(const Aabb& box) {
+  if (box.is_empty()) return 0.0;
+  const double dx = static_cast<double>(box.upper.x) - static_cast<double>(box.lower.x);
+  const double dy = static_cast<double>(box.upper.y) - static_cast<double>(box.lower.y);
+  const double dz = static_cast<double>(box.upper.z) - static_cast<double>(box.lower.z);
+  return 2.0 * (dx * dy + dy * dz + dz * dx);
+}
+
+void pad_box(Aabb& box, float pad) {
+  if (box.is_empty()) return;
+  box.lower -= Vec3(pad);
+  box.upper += Vec3(pad);
+}
+
+template <typename T>
+std::size_t bytes_of(const std::vector<T>& v) {
+  return v.capacity() * sizeof(T);
+}
+
+// The working set of the bake, as the sum of its large live buffers.
+class MemoryLedger {
+ public:
+  void hold(std::size_t bytes) {
+    current_ += bytes;
+    peak_ = std::max(peak_, current_);
+  }
+  void release(std::size_t bytes) { current_ -= std::min(bytes, current_); }
+  std::size_t peak() const { return peak_; }
+
+ private:
+  std::size_t current_ = 0;
+  std::size_t peak_ = 0;
+};
+
+// ---------------------------------------------------------------------------
+// Validation
+
+Status validate_mesh(const SkinnedMesh& mesh, std::uint32_t bone_count) {
+  const std::size_t n = mesh.vertex_count();
+  const std::string expected_rows = "expected one row per position (" + std::to_string(n) + ")";
+  if (mesh.joints.size() != n) {
+    return make_error(ErrorCode::kInvalidData, "", "joints", std::to_string(mesh.joints.size()),
+                      expected_rows);
+  }
+  if (mesh.weights.size() != n) {
+    return make_error(ErrorCode::kInvalidData, "", "weights", std::to_string(mesh.weights.size()),
+                      expected_rows);
+  }
+  for (std::size_t v = 0; v < n; ++v) {
+    const Vec3& p = mesh.positions[v];
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+      return make_error(ErrorCode::kInvalidData, "", indexed("positions", v),
+                        format_float(p.x) + " " + format_float(p.y) + " " + format_float(p.z),
+                        "not finite");
+    }
+    for (std::size_t k = 0; k < static_cast<std::size_t>(kMaxInfluences); ++k) {
+      // Every slot is checked, weighted or not: SIMD skinning reads them all.
+      if (mesh.joints[v][k] >= bone_count) {
+        return make_error(ErrorCode::kInvalidData, "", indexed("joints", v, k),
+                          std::to_string(mesh.joints[v][k]),
+                          "not below bone_count (" + std::to_string(bone_count) + ")");
+      }
+      if (!std::isfinite(mesh.weights[v][k])) {
+        return make_error(ErrorCode::kInvalidData, "", indexed("weights", v, k),
+                          format_float(mesh.weights[v][k]), "not finite");
+      }
+    }
+  }
+  for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
+    for (std::size_t i = 0; i < 3; ++i) {
+      if (mesh.triangles[t][i] >= n) {
+        return make_error(ErrorCode::kInvalidData, "", indexed("triangles", t, i),
+                          std::to_string(mesh.triangles[t][i]),
+                          "not below the vertex count (" + std::to_string(n) + ")");
+      }
+    }
+  }
+  return {};
+}
+
+Status validate_input(const FuzzyBakeInput& input, const FuzzyBakeOptions& options) {
+  if (input.mesh == nullptr) return invalid_argument("mesh", "null", "there is no mesh to bake");
+  const std::uint32_t bones = input.bone_count;
+  if (bones == 0) return invalid_argument("bone_count", "0", "a character needs at least one bone");
+  if (bones > kMaxBones) {
+    return make_error(ErrorCode::kLimitExceeded, "", "bone_count", std::to_string(bones),
+                      "more bones than triangle_bone (uint16) can name (65535)");
+  }
+  if (input.bone_parents.size() != bones) {
+    return invalid_argument("bone_parents", std::to_string(input.bone_parents.size()) + " entries",
+                            "expected one parent per bone (" + std::to_string(bones) + ")");
+  }
+  for (std::size_t b = 0; b < bones; ++b) {
+    const int parent = input.bone_parents[b];
+    if (parent < -1 || parent >= static_cast<int>(bones)) {
+      return invalid_argument(indexed("bone_parents", b), std::to_string(parent),
+                              "not -1 (a root) or a bone index below " + std::to_string(bones));
+    }
+  }
+  if (input.samples.empty()) {
+    return invalid_argument("samples", "0 matrices", "at least one pose sample is needed");
+  }
+  if (input.samples.size() % bones != 0) {
+    return invalid_argument("samples", std::to_string(input.samples.size()) + " matrices",
+                            "not a multiple of bone_count (" + std::to_string(bones) + ")");
+  }
+  if (!std::isfinite(options.padding) || options.padding < 0.0f) {
+    return invalid_argument("padding", format_float(options.padding),
+                            "must be finite and not negative");
+  }
+  return validate_mesh(*input.mesh, bones);
+}
+
+// Inverts every sample matrix once (sample-major, like the input), rejecting
+// the first that is not finite or has no finite inverse.
+Expected<std::vector<Affine3>> invert_samples(std::span<const Affine3> samples,
+                                              std::uint32_t bone_count) {
+  std::vector<Affine3> inverses(samples.size());
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    const std::string field = indexed("samples", i / bone_count) + ".bone" + "[" +
+                              std::to_string(i % bone_count) + "]";
+    if (!is_finite(samples[i])) {
+      return make_error(ErrorCode::kInvalidData, "", field, format_matrix(samples[i]),
+                        "not finite");
+    }
+    inverses[i] = inverse(samples[i]);
+    if (!is_finite(inverses[i])) {
+      return make_error(ErrorCode::kInvalidData, "", field, format_matrix(samples[i]),
+                        "singular (a zero-scale bone has no frame to bound vertices in)");
+    }
+  }
+  return inverses;
+}
+
+// ---------------------------------------------------------------------------
+// Candidate bones
+
+// Per item (triangle or vertex) a sorted list of bones as CSR, or, when
+// `begin` is empty, every bone for every item (CandidateBones::kAll).
+struct BoneLists {
+  std::vector<std::uint32_t> begin;
+  std::vector<std::uint16_t> bones;
+  std::vector<std::uint16_t> every_bone;
+
+  std::span<const std::uint16_t> of(std::size_t i) const {
+    if (begin.empty()) return every_bone;
+    return std::span<const std::uint16_t>(bones).subspan(begin[i], begin[i + 1] - begin[i]);
+  }
+  std::size_t bytes() const { return bytes_of(begin) + bytes_of(bones) + bytes_of(every_bone); }
+
+  void append(std::vector<std::uint16_t>& list) {
+    std::sort(list.begin(), list.end());
+    list.erase(std::unique(list.begin(), list.end()), list.end());
+    bones.insert(bones.end(), list.begin(), list.end());
+    begin.push_back(static_cast<std::uint32_t>(bones.size()));
+  }
+};
+
+std::vector<std::uint16_t> all_bones(std::uint32_t bone_count) {
+  std::vector<std::uint16_t> bones(bone_count);
+  for (std::uint32_t b = 0; b < bone_count; ++b) bones[b] = static_cast<std::uint16_t>(b);
+  return bones;
+}
+
+// The part of a sorted bone list inside [first, last).
+std::span<const std::uint16_t> within(std::span<const std::uint16_t> list, std::uint32_t first,
+                                      std::uint32_t last) {
+  const auto lo = std::lower_bound(list.begin(), list.end(), first);
+  const auto hi = std::lower_bound(lo, list.end(), last);
+  return list.subspan(static_cast<std::size_t>(lo - list.begin()),
+                      static_cast<std::size_t>(hi - lo));
+}
+
+// Which triangles use each vertex (CSR).
+struct VertexTriangles {
+  std::vector<std::uint32_t> begin;
+  std::vector<std::uint32_t> triangles;
+
+  std::span<const std::uint32_t> of(std::size_t v) const {
+    return std::span<const std::uint32_t>(triangles).subspan(begin[v], begin[v + 1] - begin[v]);
+  }
+  std::size_t bytes() const { return bytes_of(begin) + bytes_of(triangles); }
+};
+
+VertexTriangles vertex_triangles(const SkinnedMesh& mesh) {
+  VertexTriangles adj;
+  adj.begin.assign(mesh.vertex_count() + 1, 0);
+  for (const auto& tri : mesh.triangles) {
+    for (std::uint32_t v : tri) ++adj.begin[v + 1];
+  }
+  for (std::size_t v = 0; v < mesh.vertex_count(); ++v) adj.begin[v + 1] += adj.begin[v];
+  adj.triangles.resize(adj.begin.back());
+  std::vector<std::uint32_t> cursor(adj.begin.begin(), adj.begin.end() - 1);
+  for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
+    for (std::uint32_t v : mesh.triangles[t]) adj.triangles[cursor[v]++] = static_cast<std::uint32_t>(t);
+  }
+  return adj;
+}
+
+// CandidateBones::kInfluencing: the bones weighting any corner, with their
+// parents and children.
+BoneLists influencing_candidates(const SkinnedMesh& mesh, std::span<const int> parents,
+                                 std::uint32_t bone_count) {
+  BoneLists children;  // per bone its children
+  {
+    std::vector<std::vector<std::uint16_t>> lists(bone_count);
+    for (std::uint32_t b = 0; b < bone_count; ++b) {
+      if (parents[b] >= 0) lists[static_cast<std::size_t>(parents[b])].push_back(static_cast<std::uint16_t>(b));
+    }
+    children.begin.push_back(0);
+    for (auto& list : lists) children.append(list);
+  }
+  BoneLists candidates;
+  candidates.begin.reserve(mesh.triangle_count() + 1);
+  candidates.begin.push_back(0);
+  std::vector<std::uint16_t> scratch;
+  for (const auto& tri : mesh.triangles) {
+    scratch.clear();
+    for (std::uint32_t v : tri) {
+      for (std::size_t k = 0; k < static_cast<std::size_t>(kMaxInfluences); ++k) {
+        if (mesh.weights[v][k] == 0.0f) continue;
+        const std::uint16_t bone = mesh.joints[v][k];
+        scratch.push_back(bone);
+        if (parents[bone] >= 0) scratch.push_back(static_cast<std::uint16_t>(parents[bone]));
+        for (std::uint16_t child : children.of(bone)) scratch.push_back(child);
+      }
+    }
+    // Corners without any weight skin to the origin in every pose: no bone
+    // is related to them, so let every bone compete.
+    if (scratch.empty()) scratch = all_bones(bone_count);
+    candidates.append(scratch);
+  }
+  return candidates;
+}
+
+// The bones each vertex needs a box in: the union of its triangles' candidates.
+BoneLists vertex_needs(const VertexTriangles& adj, const BoneLists& triangle_candidates,
+                       std::size_t vertex_count) {
+  BoneLists needs;
+  needs.begin.reserve(vertex_count + 1);
+  needs.begin.push_back(0);
+  std::vector<std::uint16_t> scratch;
+  for (std::size_t v = 0; v < vertex_count; ++v) {
+    scratch.clear();
+    for (std::uint32_t t : adj.of(v)) {
+      const auto list = triangle_candidates.of(t);
+      scratch.insert(scratch.end(), list.begin(), list.end());
+    }
+    needs.append(scratch);
+  }
+  return needs;
+}
+
+// ---------------------------------------------------------------------------
+// Progress
+
+class Progress {
+ public:
+  Progress(const FuzzyBakeOptions& options, double sweep_units)
+      : callback_(options.progress), sweep_units_(std::max(sweep_units, 1.0)) {}
+
+  // Reports `units` more sample sweeps done.
+  Status advance(std::string_view phase, double units) {
+    done_units_ += units;
+    return report(phase, kSweepShare * std::min(done_units_ / sweep_units_, 1.0));
+  }
+
+  Status report(std::string_view phase, double fraction) {
+    fraction_ = std::max(fraction_, std::clamp(fraction, 0.0, 1.0));
+    if (callback_ && !callback_(phase, fraction_)) {
+      return make_error(ErrorCode::kCancelled, "", "progress", std::string(phase),
+                        "the progress callback cancelled the bake");
+    }
+    return {};
+  }
+
+ private:
+  const std::function<bool(std::string_view, double)>& callback_;
+  double sweep_units_;
+  double done_units_ = 0.0;
+  double fraction_ = 0.0;
+};
+
+// ---------------------------------------------------------------------------
+// Sampling
+
+struct Samples {
+  const SkinnedMesh& mesh;
+  std::span<const Affine3> matrices;  // sample-major, bind pose -> pose
+  std::span<const Affine3> inverses;  // pose -> bone frame
+  std::uint32_t bone_count;
+
+  std::size_t count() const { return matrices.size() / bone_count; }
+  std::span<const Affine3> pose(std::size_t s) const {
+    return matrices.subspan(s * bone_count, bone_count);
+  }
+  const Affine3* bone_from_pose(std::size_t s) const { return inverses.data() + s * bone_count; }
+};
+
+// Calls grow(vertices, first_sample, last_sample) over all vertices for
+// batches of samples, reporting progress between batches.
+Status sweep_samples(const Samples& samples, JobSystem& jobs, Progress& progress,
+                     const std::function<void(Range, std::size_t, std::size_t)>& grow) {
+  const std::size_t count = samples.count();
+  const std::size_t vertex_count = samples.mesh.vertex_count();
+  for (std::size_t s0 = 0; s0 < count; s0 += kSamplesPerBatch) {
+    const std::size_t s1 = std::min(count, s0 + kSamplesPerBatch);
+    jobs.parallel_for(0, vertex_count, kVertexGrain, [&](Range r) { grow(r, s0, s1); });
+    SINEW_RETURN_IF_ERROR(progress.advance("sampling", static_cast<double>(s1 - s0)));
+  }
+  return {};
+}
+
+// A chunk of candidate bones [first, last) with a dense vertex x bone box array.
+struct BoxChunk {
+  std::uint32_t first = 0;
+  std::uint32_t last = 0;
+  std::vector<Aabb> boxes;  // boxes[v * width() + (b - first)]
+
+  std::size_t width() const { return last - first; }
+  Aabb& at(std::size_t v, std::uint32_t bone) { return boxes[v * width() + (bone - first)]; }
+  const Aabb& at(std::size_t v, std::uint32_t bone) const {
+    return boxes[v * width() + (bone - first)];
+  }
+};
+
+Status grow_chunk_boxes(const Samples& samples, const BoneLists& needs, BoxChunk& chunk, float pad,
+                        JobSystem& jobs, Progress& progress) {
+  std::fill(chunk.boxes.begin(), chunk.boxes.end(), Aabb::empty());
+  SINEW_RETURN_IF_ERROR(sweep_samples(samples, jobs, progress, [&](Range r, std::size_t s0, std::size_t s1) {
+    for (std::size_t v = r.begin; v < r.end; ++v) {
+      const auto bones = within(needs.of(v), chunk.first, chunk.last);
+      if (bones.empty()) continue;
+      Aabb* boxes = &chunk.at(v, chunk.first);
+      for (std::size_t s = s0; s < s1; ++s) {
+        const Vec3 p = skin_point(samples.mesh, v, samples.pose(s));
+        const Affine3* bone_from_pose = samples.bone_from_pose(s);
+        for (std::uint16_t b : bones) boxes[b - chunk.first].extend(bone_from_pose[b].transform_point(p));
+      }
+    }
+  }));
+  jobs.parallel_for(0, chunk.boxes.size(), kVertexGrain * 4, [&](Range r) {
+    for (std::size_t i = r.begin; i < r.end; ++i) pad_box(chunk.boxes[i], pad);
+  });
+  return {};
+}
+
+struct Assignment {
+  std::vector<double> area;          // the best candidate's fuzzy box area so far
+  std::vector<std::uint16_t> bone;   // the best candidate so far
+  std::size_t bytes() const { return bytes_of(area) + bytes_of(bone); }
+};
+
+// Candidates are visited in increasing bone order (chunks in order, sorted
+// lists within), so the strict comparison leaves ties with the lowest bone.
+void assign_chunk(const SkinnedMesh& mesh, const BoneLists& candidates, const BoxChunk& chunk,
+                  Assignment& best, JobSystem& jobs) {
+  jobs.parallel_for(0, mesh.triangle_count(), kTriangleGrain, [&](Range r) {
+    for (std::size_t t = r.begin; t < r.end; ++t) {
+      const auto& tri = mesh.triangles[t];
+      for (std::uint16_t b : within(candidates.of(t), chunk.first, chunk.last)) {
+        Aabb box = chunk.at(tri[0], b);
+        box.extend(chunk.at(tri[1], b));
+        box.extend(chunk.at(tri[2], b));
+        const double area = surface_area_d(box);
+        if (area < best.area[t]) {
+          best.area[t] = area;
+          best.bone[t] = b;
+        }
+      }
+    }
+  });
+}
+
+// ---------------------------------------------------------------------------
+// Escape checks
+
+// One check per distinct bone among each vertex's triangles, sorted by bone.
+void make_vertex_checks(const VertexTriangles& adj, std::span<const std::uint16_t> triangle_bone,
+                        std::size_t vertex_count, FuzzyCharacterData& out) {
+  out.vertex_check_begin.assign(1, 0);
+  out.vertex_check_begin.reserve(vertex_count + 1);
+  std::vector<std::uint16_t> scratch;
+  for (std::size_t v = 0; v < vertex_count; ++v) {
+    scratch.clear();
+    for (std::uint32_t t : adj.of(v)) scratch.push_back(triangle_bone[t]);
+    std::sort(scratch.begin(), scratch.end());
+    scratch.erase(std::unique(scratch.begin(), scratch.end()), scratch.end());
+    for (std::uint16_t b : scratch) out.vertex_checks.push_back({b, Aabb::empty()});
+    out.vertex_check_begin.push_back(static_cast<std::uint32_t>(out.vertex_checks.size()));
+  }
+}
+
+Status grow_check_boxes(const Samples& samples, float pad, JobSystem& jobs, Progress& progress,
+                        FuzzyCharacterData& out) {
+  SINEW_RETURN_IF_ERROR(sweep_samples(samples, jobs, progress, [&](Range r, std::size_t s0, std::size_t s1) {
+    for (std::size_t v = r.begin; v < r.end; ++v) {
+      VertexCheck* first = out.vertex_checks.data() + out.vertex_check_begin[v];
+      VertexCheck* last = out.vertex_checks.data() + out.vertex_check_begin[v + 1];
+      if (first == last) continue;
+      for (std::size_t s = s0; s < s1; ++s) {
+        const Vec3 p = skin_point(samples.mesh, v, samples.pose(s));
+        const Affine3* bone_from_pose = samples.bone_from_pose(s);
+        for (VertexCheck* c = first; c != last; ++c) c->box.extend(bone_from_pose[c->bone].transform_point(p));
+      }
+    }
+  }));
+  for (VertexCheck& c : out.vertex_checks) pad_box(c.box, pad);
+  return {};
+}
+
+void link_triangle_checks(const SkinnedMesh& mesh, FuzzyCharacterData& out) {
+  out.triangle_checks.resize(mesh.triangle_count());
+  for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
+    const std::uint16_t bone = out.triangle_bone[t];
+    for (std::size_t i = 0; i < 3; ++i) {
+      const std::uint32_t v = mesh.triangles[t][i];
+      const auto first = out.vertex_checks.begin() + out.vertex_check_begin[v];
+      const auto last = out.vertex_checks.begin() + out.vertex_check_begin[v + 1];
+      const auto it = std::lower_bound(first, last, bone,
+                                       [](const VertexCheck& c, std::uint16_t b) { return c.bone < b; });
+      out.triangle_checks[t][i] = static_cast<std::uint32_t>(it - out.vertex_checks.begin());
+    }
+  }
+}
+
+std::vector<Aabb> triangle_fuzzy_boxes(const FuzzyCharacterData& out) {
+  std::vector<Aabb> boxes(out.triangle_checks.size());
+  for (std::size_t t = 0; t < boxes.size(); ++t) {
+    for (std::uint32_t c : out.triangle_checks[t]) boxes[t].extend(out.vertex_checks[c].box);
+  }
+  return boxes;
+}
+
+// ---------------------------------------------------------------------------
+// Bone trees
+
+Status build_bone_trees(std::span<const Aabb> triangle_boxes, const FuzzyBakeOptions& options,
+                        JobSystem& jobs, FuzzyCharacterData& out) {
+  const std::uint32_t bone_count = out.bone_count;
+  // Triangles per bone (CSR, ascending triangle ids).
+  std::vector<std::uint32_t> begin(bone_count + 1, 0);
+  for (std::uint16_t b : out.triangle_bone) ++begin[b + 1u];
+  for (std::uint32_t b = 0; b < bone_count; ++b) begin[b + 1] += begin[b];
+  std::vector<std::uint32_t> triangles(out.triangle_bone.size());
+  {
+    std::vector<std::uint32_t> cursor(begin.begin(), begin.end() - 1);
+    for (std::size_t t = 0; t < out.triangle_bone.size(); ++t) {
+      triangles[cursor[out.triangle_bone[t]]++] = static_cast<std::uint32_t>(t);
+    }
+  }
+
+  std::vector<std::optional<KdTree>> trees(bone_count);
+  std::vector<Status> errors(bone_count);
+  jobs.parallel_for(0, bone_count, 1, [&](Range r) {
+    for (std::size_t b = r.begin; b < r.end; ++b) {
+      if (begin[b] == begin[b + 1]) continue;
+      std::vector<Aabb> boxes;
+      boxes.reserve(begin[b + 1] - begin[b]);
+      for (std::uint32_t i = begin[b]; i < begin[b + 1]; ++i) boxes.push_back(triangle_boxes[triangles[i]]);
+      Expected<KdTree> tree = build_kd_tree(boxes, options.kd);
+      if (tree.ok()) {
+        trees[b] = std::move(tree).value();
+      } else {
+        errors[b] = std::move(tree).status();
+      }
+    }
+  });
+  for (const Status& error : errors) SINEW_RETURN_IF_ERROR(error);
+
+  // Concatenate in bone order: node indices are tree-relative, item indices
+  // become triangle ids.
+  out.bone_trees.assign(bone_count, BoneTree{});
+  std::uint64_t full_leaves = 0;
+  std::uint64_t item_refs = 0;
+  for (std::uint32_t b = 0; b < bone_count; ++b) {
+    BoneTree& bt = out.bone_trees[b];
+    bt.triangle_count = begin[b + 1] - begin[b];
+    bt.node_begin = static_cast<std::uint32_t>(out.nodes.size());
+    bt.item_begin = static_cast<std::uint32_t>(out.items.size());
+    bt.bounds = Aabb::empty();
+    if (!trees[b]) continue;
+    const KdTree& tree = *trees[b];
+    bt.node_count = static_cast<std::uint32_t>(tree.nodes.size());
+    bt.item_count = static_cast<std::uint32_t>(tree.items.size());
+    bt.bounds = tree.bounds;
+    out.nodes.insert(out.nodes.end(), tree.nodes.begin(), tree.nodes.end());
+    for (std::uint32_t item : tree.items) out.items.push_back(triangles[begin[b] + item]);
+    full_leaves += tree.stats.leaf_count - tree.stats.empty_leaf_count;
+    item_refs += tree.stats.item_refs;
+    out.stats.max_depth = std::max(out.stats.max_depth, tree.stats.max_depth);
+  }
+  out.stats.node_count = static_cast<std::uint32_t>(out.nodes.size());
+  out.stats.mean_items_per_leaf =
+      full_leaves ? static_cast<double>(item_refs) / static_cast<double>(full_leaves) : 0.0;
+  return {};
+}
+
+double rest_area(const SkinnedMesh& mesh) {
+  double sum = 0.0;
+  for (const auto& tri : mesh.triangles) {
+    Aabb box;
+    for (std::uint32_t v : tri) box.extend(mesh.positions[v]);
+    sum += surface_area_d(box);
+  }
+  return sum;
+}
+
+float padding_distance(const SkinnedMesh& mesh, float padding) {
+  Aabb bind;
+  for (const Vec3& p : mesh.positions) bind.extend(p);
+  if (bind.is_empty()) return 0.0f;
+  const Vec3 e = bind.extent();
+  const double x = static_cast<double>(e.x);
+  const double y = static_cast<double>(e.y);
+  const double z = static_cast<double>(e.z);
+  const double diagonal = std::sqrt(x * x + y * y + z * z);
+  return static_cast<float>(static_cast<double>(padding) * diagonal);
+}
+
+}  // namespace
+
+Expected<FuzzyCharacterData> bake_fuzzy_character(const FuzzyBakeInput& input,
+                                                  const FuzzyBakeOptions& options, JobSystem& jobs) {
+  SINEW_RETURN_IF_ERROR(validate_input(input, options));
+  const SkinnedMesh& mesh = *input.mesh;
+  const std::uint32_t bone_count = input.bone_count;
+  const std::size_t vertex_count = mesh.vertex_count();
+  const std::size_t triangle_count = mesh.triangle_count();
+  MemoryLedger memory;
+
+  auto sampling_start = Clock::now();
+  SINEW_ASSIGN_OR_RETURN(std::vector<Affine3> inverses, invert_samples(input.samples, bone_count));
+  memory.hold(bytes_of(inverses));
+  const Samples samples{mesh, input.samples, inverses, bone_count};
+  const float pad = padding_distance(mesh, options.padding);
+
+  FuzzyCharacterData out;
+  out.bone_count = bone_count;
+  FuzzyBakeStats& stats = out.stats;
+  stats.sample_count = static_cast<std::uint32_t>(samples.count());
+  stats.vertex_count = static_cast<std::uint32_t>(vertex_count);
+  stats.triangle_count = static_cast<std::uint32_t>(triangle_count);
+  stats.bone_count = bone_count;
+  stats.candidates = options.candidates;
+  stats.sampling_ms = ms_since(sampling_start);
+
+  // Candidates per triangle and the (vertex, bone) pairs they need.
+  auto assignment_start = Clock::now();
+  VertexTriangles adj = vertex_triangles(mesh);
+  memory.hold(adj.bytes());
+  BoneLists candidates;
+  BoneLists needs;
+  if (options.candidates == CandidateBones::kInfluencing) {
+    candidates = influencing_candidates(mesh, input.bone_parents, bone_count);
+    needs = vertex_needs(adj, candidates, vertex_count);
+  } else {
+    candidates.every_bone = all_bones(bone_count);
+    needs.every_bone = candidates.every_bone;
+  }
+  memory.hold(candidates.bytes() + needs.bytes());
+  Assignment best;
+  best.area.assign(triangle_count, std::numeric_limits<double>::infinity());
+  best.bone.assign(triangle_count, 0);
+  memory.hold(best.bytes());
+  stats.assignment_ms = ms_since(assignment_start);
+
+  // As many bones per chunk as the budget allows, at least one.
+  const std::size_t bytes_per_bone = std::max<std::size_t>(vertex_count * sizeof(Aabb), 1);
+  const std::uint32_t chunk_bones = static_cast<std::uint32_t>(
+      std::clamp<std::size_t>(options.memory_budget_bytes / bytes_per_bone, 1, bone_count));
+  const std::uint32_t chunk_count = (bone_count + chunk_bones - 1) / chunk_bones;
+  Progress progress(options, static_cast<double>(samples.count()) * (chunk_count + 1));
+
+  {
+    BoxChunk chunk;
+    chunk.boxes.resize(vertex_count * chunk_bones);
+    memory.hold(bytes_of(chunk.boxes));
+    for (std::uint32_t first = 0; first < bone_count; first += chunk_bones) {
+      chunk.first = first;
+      chunk.last = std::min(bone_count, first + chunk_bones);
+      sampling_start = Clock::now();
+      SINEW_RETURN_IF_ERROR(grow_chunk_boxes(samples, needs, chunk, pad, jobs, progress));
+      stats.sampling_ms += ms_since(sampling_start);
+      assignment_start = Clock::now();
+      assign_chunk(mesh, candidates, chunk, best, jobs);
+      stats.assignment_ms += ms_since(assignment_start);
+      SINEW_RETURN_IF_ERROR(progress.advance("assignment", 0.0));
+    }
+    memory.release(bytes_of(chunk.boxes));
+  }
+  memory.release(candidates.bytes() + needs.bytes() + best.bytes());
+  candidates = BoneLists{};
+  needs = BoneLists{};
+  out.triangle_bone = std::move(best.bone);
+  best = Assignment{};
+  memory.hold(bytes_of(out.triangle_bone));
+
+  // The escape checks: the vertex boxes of the chosen bones.
+  assignment_start = Clock::now();
+  make_vertex_checks(adj, out.triangle_bone, vertex_count, out);
+  memory.hold(bytes_of(out.vertex_checks) + bytes_of(out.vertex_check_begin));
+  memory.release(adj.bytes());
+  adj = VertexTriangles{};
+  stats.assignment_ms += ms_since(assignment_start);
+  sampling_start = Clock::now();
+  SINEW_RETURN_IF_ERROR(grow_check_boxes(samples, pad, jobs, progress, out));
+  stats.sampling_ms += ms_since(sampling_start);
+  memory.release(bytes_of(inverses));
+  inverses = std::vector<Affine3>{};  // `samples` is not used past this point
+  assignment_start = Clock::now();
+  link_triangle_checks(mesh, out);
+  const std::vector<Aabb> triangle_boxes = triangle_fuzzy_boxes(out);
+  memory.hold(bytes_of(out.triangle_checks) + bytes_of(triangle_boxes));
+  for (const Aabb& box : triangle_boxes) stats.fuzzy_area += surface_area_d(box);
+  stats.rest_area = rest_area(mesh);
+  stats.assignment_ms += ms_since(assignment_start);
+
+  // The per-bone trees (their builders' own memory is not counted).
+  SINEW_RETURN_IF_ERROR(progress.report("build", kSweepShare));
+  const auto build_start = Clock::now();
+  SINEW_RETURN_IF_ERROR(build_bone_trees(triangle_boxes, options, jobs, out));
+  memory.hold(bytes_of(out.nodes) + bytes_of(out.items) + bytes_of(out.bone_trees));
+  stats.build_ms = ms_since(build_start);
+  stats.peak_bytes = memory.peak();
+  SINEW_RETURN_IF_ERROR(progress.report("build", 1.0));
+  return out;
+}
+
+}  // namespace sinew::rt

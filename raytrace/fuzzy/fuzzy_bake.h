@@ -1,0 +1,62 @@
+// The fuzzy bake (paper sections 3.2-3.4): from sampled poses to per-bone
+// fuzzy kd-trees.
+//
+// For each pose sample, every vertex is skinned and transformed into every
+// candidate bone's frame; a vertex's fuzzy box in bone b is the AABB of those
+// positions. A triangle's fuzzy box in b is the union of its vertices' boxes;
+// it is assigned to the candidate bone with the smallest box surface area
+// (ties: the lowest bone index). Each bone then gets an SAH kd-tree over its
+// triangles' boxes.
+//
+// Memory stays bounded for large meshes: boxes are grown for a chunk of
+// candidate bones at a time (as many as fit in `memory_budget_bytes`),
+// re-skinning the samples per chunk, so a 300k-triangle x 60-bone bake needs
+// neither V x B boxes nor samples x V positions at once.
+#pragma once
+
+#include <cstddef>
+#include <functional>
+#include <span>
+#include <string_view>
+
+#include "raytrace/fuzzy/fuzzy_character.h"
+#include "runtime/core/expected.h"
+#include "runtime/math/affine.h"
+#include "runtime/mesh/skinned_mesh.h"
+
+namespace sinew {
+class JobSystem;
+}
+
+namespace sinew::rt {
+
+struct FuzzyBakeInput {
+  const SkinnedMesh* mesh = nullptr;
+  std::uint32_t bone_count = 0;
+  // Per bone its parent (-1 for a root); used by CandidateBones::kInfluencing.
+  std::span<const int> bone_parents;
+  // sample_count x bone_count skinning matrices (bind pose -> pose), sample-major.
+  std::span<const Affine3> samples;
+};
+
+struct FuzzyBakeOptions {
+  CandidateBones candidates = CandidateBones::kAll;
+  // Every vertex box grows by this fraction of the bind-pose bounding box's
+  // diagonal on each side: slack for poses between the samples.
+  float padding = 0.0f;
+  KdBuildOptions kd;
+  std::size_t memory_budget_bytes = std::size_t{256} << 20;
+  // Called from the calling thread with a phase name ("sampling",
+  // "assignment", "build") and the fraction of the whole bake done, in [0, 1].
+  // Returning false cancels the bake (kCancelled).
+  std::function<bool(std::string_view phase, double fraction)> progress;
+};
+
+// Errors: kInvalidArgument (no mesh, no samples, samples not a multiple of
+// bone_count, bone_parents of the wrong size, bad padding); kInvalidData
+// naming the first non-finite sample matrix ("samples[s].bone[b]") or a vertex
+// whose joint index is out of range ("joints[v][k]"); kCancelled.
+Expected<FuzzyCharacterData> bake_fuzzy_character(const FuzzyBakeInput& input,
+                                                  const FuzzyBakeOptions& options, JobSystem& jobs);
+
+}  // namespace sinew::rt
