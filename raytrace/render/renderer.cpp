@@ -1,0 +1,263 @@
+#include "raytrace/render/renderer.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "runtime/jobs/job_system.h"
+#include "runtime/timing/phase_timers.h"
+
+namespace sinew::rt {
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+double elapsed_ms(std::chrono::steady_clock::time_point since) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - since).count();
+}
+
+Status check_buffer(std::size_t size, std::size_t expected, std::string_view name) {
+  if (size == 0 || size == expected) return {};
+  return invalid_argument(name, std::to_string(size), "expected " + std::to_string(expected) + " entries");
+}
+
+// pbrt's gamma(n): a bound on n successive float roundings.
+constexpr float gamma(int n) {
+  constexpr float u = std::numeric_limits<float>::epsilon() * 0.5f;
+  return (static_cast<float>(n) * u) / (1.0f - static_cast<float>(n) * u);
+}
+
+float encode_srgb(float linear) {
+  const float c = std::clamp(linear, 0.0f, 1.0f);
+  return c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
+}
+
+std::uint8_t to_byte(float unit) { return static_cast<std::uint8_t>(std::lround(unit * 255.0f)); }
+
+Vec3 light_vector(const Light& light, const Vec3& from) {
+  return light.kind == Light::Kind::kPoint ? light.position - from : light.direction;
+}
+
+// Sums per-tile counters in tile order so the totals are deterministic.
+void add(TraversalCounters& into, const TraversalCounters& from) {
+  into.rays += from.rays;
+  into.node_visits += from.node_visits;
+  into.object_visits += from.object_visits;
+  into.triangle_tests += from.triangle_tests;
+}
+
+}  // namespace
+
+SurfacePoint surface_at(const Scene& scene, const Hit& hit, const Vec3& default_albedo) {
+  SurfacePoint s;
+  const Scene::ObjectSlot slot = scene.object_slots()[hit.instance_id];
+  const float w = 1.0f - hit.u - hit.v;
+  Vec3 p[3];
+  Vec3 shading(0.0f);
+  bool have_normals = false;
+  if (slot.kind == Scene::ObjectKind::kCharacter) {
+    const InstanceFrame& frame = scene.instances()[slot.index];
+    const SkinnedMesh& mesh = *scene.characters()[frame.character].mesh;
+    const auto& v = mesh.triangles[hit.triangle_id];
+    for (int i = 0; i < 3; ++i) p[i] = frame.positions[v[static_cast<std::size_t>(i)]];
+    if (!frame.normals.empty()) {
+      shading = w * frame.normals[v[0]] + hit.u * frame.normals[v[1]] + hit.v * frame.normals[v[2]];
+      have_normals = true;
+    }
+    s.albedo = default_albedo;
+    if (hit.triangle_id < mesh.triangle_material.size()) {
+      const std::uint32_t m = mesh.triangle_material[hit.triangle_id];
+      if (m < mesh.material_colors.size()) s.albedo = mesh.material_colors[m];
+    }
+  } else {
+    const StaticMeshDesc& mesh = scene.static_meshes()[slot.index].desc;
+    const auto& v = mesh.triangles[hit.triangle_id];
+    for (int i = 0; i < 3; ++i) p[i] = mesh.positions[v[static_cast<std::size_t>(i)]];
+    s.albedo = default_albedo;
+    const std::uint32_t m = mesh.triangle_material.empty() ? 0 : mesh.triangle_material[hit.triangle_id];
+    if (m < mesh.material_colors.size()) s.albedo = mesh.material_colors[m];
+  }
+  s.position = w * p[0] + hit.u * p[1] + hit.v * p[2];
+  s.error = gamma(7) * (glm::abs(w * p[0]) + glm::abs(hit.u * p[1]) + glm::abs(hit.v * p[2]));
+  const Vec3 n = glm::cross(p[1] - p[0], p[2] - p[0]);
+  const float length = glm::length(n);
+  s.geometric_normal = length > 0.0f && std::isfinite(length) ? n / length : Vec3(0.0f, 0.0f, 1.0f);
+  const float shading_length = have_normals ? glm::length(shading) : 0.0f;
+  s.shading_normal = shading_length > 0.0f && std::isfinite(shading_length) ? shading / shading_length
+                                                                             : s.geometric_normal;
+  return s;
+}
+
+Vec3 offset_origin(const SurfacePoint& surface, const Vec3& toward) {
+  const Vec3& n = surface.geometric_normal;
+  const float distance = glm::dot(glm::abs(n), surface.error);
+  Vec3 offset = distance * n;
+  if (glm::dot(n, toward) < 0.0f) offset = -offset;
+  Vec3 origin = surface.position + offset;
+  // The addition itself rounds: step one more float away from the surface.
+  for (int a = 0; a < 3; ++a) {
+    if (offset[a] > 0.0f) origin[a] = std::nextafter(origin[a], kInf);
+    if (offset[a] < 0.0f) origin[a] = std::nextafter(origin[a], -kInf);
+  }
+  return origin;
+}
+
+Expected<RenderStats> Renderer::render(const Scene& scene, const PinholeCamera& camera,
+                                       const RenderSettings& settings, const FrameBuffers& buffers,
+                                       JobSystem& jobs, PhaseTimers* timers) {
+  if (buffers.width != camera.width() || buffers.height != camera.height()) {
+    return invalid_argument("buffers.width x height",
+                            std::to_string(buffers.width) + "x" + std::to_string(buffers.height),
+                            "differs from the camera's image size");
+  }
+  if (settings.tile_size < 1) {
+    return invalid_argument("settings.tile_size", std::to_string(settings.tile_size), "must be at least 1");
+  }
+  const std::size_t pixels = static_cast<std::size_t>(buffers.width) * static_cast<std::size_t>(buffers.height);
+  SINEW_RETURN_IF_ERROR(check_buffer(buffers.color_rgba8.size(), 4 * pixels, "buffers.color_rgba8"));
+  SINEW_RETURN_IF_ERROR(check_buffer(buffers.color_rgba32f.size(), 4 * pixels, "buffers.color_rgba32f"));
+  SINEW_RETURN_IF_ERROR(check_buffer(buffers.depth.size(), pixels, "buffers.depth"));
+  SINEW_RETURN_IF_ERROR(check_buffer(buffers.normal.size(), pixels, "buffers.normal"));
+  SINEW_RETURN_IF_ERROR(check_buffer(buffers.triangle_id.size(), pixels, "buffers.triangle_id"));
+  SINEW_RETURN_IF_ERROR(check_buffer(buffers.instance_id.size(), pixels, "buffers.instance_id"));
+
+  const bool want_color = !buffers.color_rgba8.empty() || !buffers.color_rgba32f.empty();
+  const bool want_shadows = want_color && settings.shadows;
+  const int width = buffers.width;
+  const int tile = settings.tile_size;
+  const int tiles_x = (buffers.width + tile - 1) / tile;
+  const int tiles_y = (buffers.height + tile - 1) / tile;
+  const std::size_t tile_count = static_cast<std::size_t>(tiles_x) * static_cast<std::size_t>(tiles_y);
+  std::vector<TraversalCounters> tile_counters(tile_count);
+  std::vector<std::uint64_t> tile_hits(tile_count, 0);
+  hits_.resize(pixels);
+  RenderStats stats;
+
+  // Pass 1: nearest hits.
+  auto start = std::chrono::steady_clock::now();
+  jobs.parallel_for_tiles(buffers.width, buffers.height, tile, [&](const Tile& t) {
+    TraversalCounters counters;
+    std::uint64_t hits = 0;
+    for (int y = t.y0; y < t.y1; ++y) {
+      for (int x = t.x0; x < t.x1; ++x) {
+        const Hit hit = intersect(scene, camera.ray(x, y), settings.triangle_test, &counters);
+        hits += hit.valid() ? 1 : 0;
+        hits_[static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x)] = hit;
+      }
+    }
+    tile_counters[static_cast<std::size_t>(t.index)] = counters;
+    tile_hits[static_cast<std::size_t>(t.index)] = hits;
+  });
+  stats.trace_primary_ms = elapsed_ms(start);
+  for (std::size_t i = 0; i < tile_count; ++i) {
+    add(stats.primary, tile_counters[i]);
+    stats.primary_hits += tile_hits[i];
+  }
+  stats.primary_rays = pixels;
+
+  // Pass 2: one shadow ray per hit that faces the light.
+  start = std::chrono::steady_clock::now();
+  lit_.assign(pixels, 1);
+  if (want_shadows) {
+    std::fill(tile_counters.begin(), tile_counters.end(), TraversalCounters{});
+    std::vector<std::uint64_t> tile_shadowed(tile_count, 0);
+    jobs.parallel_for_tiles(buffers.width, buffers.height, tile, [&](const Tile& t) {
+      TraversalCounters counters;
+      std::uint64_t shadowed = 0;
+      for (int y = t.y0; y < t.y1; ++y) {
+        for (int x = t.x0; x < t.x1; ++x) {
+          const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x);
+          const Hit& hit = hits_[i];
+          if (!hit.valid()) continue;
+          const SurfacePoint s = surface_at(scene, hit, settings.default_albedo);
+          const Ray primary = camera.ray(x, y);
+          Vec3 facing = s.geometric_normal;
+          if (glm::dot(facing, primary.direction) > 0.0f) facing = -facing;
+          const Vec3 to_light = light_vector(settings.light, s.position);
+          if (glm::dot(facing, to_light) <= 0.0f) {
+            lit_[i] = 0;  // the light is behind the surface: no ray needed
+            continue;
+          }
+          Ray shadow;
+          shadow.origin = offset_origin(s, facing);
+          shadow.direction = light_vector(settings.light, shadow.origin);
+          shadow.t_min = 0.0f;
+          shadow.t_max = settings.light.kind == Light::Kind::kPoint ? 1.0f : kInf;
+          if (occluded(scene, shadow, settings.triangle_test, &counters)) {
+            lit_[i] = 0;
+            ++shadowed;
+          }
+        }
+      }
+      tile_counters[static_cast<std::size_t>(t.index)] = counters;
+      tile_shadowed[static_cast<std::size_t>(t.index)] = shadowed;
+    });
+    for (std::size_t i = 0; i < tile_count; ++i) {
+      add(stats.shadow, tile_counters[i]);
+      stats.shadowed += tile_shadowed[i];
+    }
+    stats.shadow_rays = stats.shadow.rays;
+  }
+  stats.trace_shadow_ms = elapsed_ms(start);
+
+  // Pass 3: shading and the requested outputs.
+  start = std::chrono::steady_clock::now();
+  jobs.parallel_for_tiles(buffers.width, buffers.height, tile, [&](const Tile& t) {
+    for (int y = t.y0; y < t.y1; ++y) {
+      for (int x = t.x0; x < t.x1; ++x) {
+        const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x);
+        const Hit& hit = hits_[i];
+        if (!buffers.triangle_id.empty()) buffers.triangle_id[i] = hit.triangle_id;
+        if (!buffers.instance_id.empty()) buffers.instance_id[i] = hit.instance_id;
+        if (!hit.valid()) {
+          if (!buffers.depth.empty()) buffers.depth[i] = kInf;
+          if (!buffers.normal.empty()) buffers.normal[i] = Vec3(0.0f);
+          if (want_color) {
+            const Vec4 c(settings.background, 1.0f);
+            if (!buffers.color_rgba32f.empty()) {
+              for (int k = 0; k < 4; ++k) buffers.color_rgba32f[4 * i + static_cast<std::size_t>(k)] = c[k];
+            }
+            if (!buffers.color_rgba8.empty()) {
+              for (int k = 0; k < 3; ++k) buffers.color_rgba8[4 * i + static_cast<std::size_t>(k)] = to_byte(encode_srgb(c[k]));
+              buffers.color_rgba8[4 * i + 3] = 255;
+            }
+          }
+          continue;
+        }
+        const Ray primary = camera.ray(x, y);
+        if (!buffers.depth.empty()) buffers.depth[i] = hit.t * glm::length(primary.direction);
+        if (!want_color && buffers.normal.empty()) continue;
+        const SurfacePoint s = surface_at(scene, hit, settings.default_albedo);
+        Vec3 facing = s.geometric_normal;
+        if (glm::dot(facing, primary.direction) > 0.0f) facing = -facing;
+        Vec3 n = s.shading_normal;
+        if (glm::dot(n, facing) < 0.0f) n = -n;
+        if (!buffers.normal.empty()) buffers.normal[i] = n;
+        if (!want_color) continue;
+        const Vec3 l = glm::normalize(light_vector(settings.light, s.position));
+        const float lambert = lit_[i] ? std::max(0.0f, glm::dot(n, l)) : 0.0f;
+        const Vec3 linear = s.albedo * (settings.ambient + settings.light.color * lambert);
+        if (!buffers.color_rgba32f.empty()) {
+          for (int k = 0; k < 3; ++k) buffers.color_rgba32f[4 * i + static_cast<std::size_t>(k)] = linear[k];
+          buffers.color_rgba32f[4 * i + 3] = 1.0f;
+        }
+        if (!buffers.color_rgba8.empty()) {
+          for (int k = 0; k < 3; ++k) buffers.color_rgba8[4 * i + static_cast<std::size_t>(k)] = to_byte(encode_srgb(linear[k]));
+          buffers.color_rgba8[4 * i + 3] = 255;
+        }
+      }
+    }
+  });
+  stats.shade_ms = elapsed_ms(start);
+
+  if (timers) {
+    timers->record("trace primary", stats.trace_primary_ms);
+    timers->record("trace shadow", stats.trace_shadow_ms);
+    timers->record("shade", stats.shade_ms);
+  }
+  return stats;
+}
+
+}  // namespace sinew::rt

@@ -1,0 +1,104 @@
+// Renderer: primary rays, shadow rays and diffuse shading over image tiles
+// in parallel (paper section 4.1), writing only the outputs (AOVs) the
+// caller asks for.
+//
+// A frame runs as three passes, each a timed phase ("trace primary",
+// "trace shadow", "shade"): nearest hits for every pixel, then one shadow ray
+// per lit hit, then shading and writing the AOVs. Separating them keeps the
+// phase timings honest and lets each pass run a coherent kind of ray. Tiles
+// are fixed squares processed in any order; every pixel's result depends
+// only on the scene, so images are identical for any thread count.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "raytrace/camera/camera.h"
+#include "raytrace/geometry/triangle_intersect.h"
+#include "raytrace/render/traversal.h"
+#include "raytrace/scene/scene.h"
+#include "runtime/core/expected.h"
+
+namespace sinew {
+class JobSystem;
+class PhaseTimers;
+}  // namespace sinew
+
+namespace sinew::rt {
+
+struct Light {
+  enum class Kind : std::uint8_t { kPoint, kDirectional };
+  Kind kind = Kind::kPoint;
+  Vec3 position{4.0f, 8.0f, 6.0f};   // kPoint
+  Vec3 direction{0.4f, 1.0f, 0.6f};  // kDirectional: towards the light (any length)
+  Vec3 color{1.0f};                  // linear RGB radiance scale (no distance falloff)
+};
+
+struct RenderSettings {
+  TriangleTest triangle_test = TriangleTest::kFast;
+  bool shadows = true;
+  Light light;
+  Vec3 ambient{0.18f};
+  Vec3 background{0.32f, 0.36f, 0.42f};
+  Vec3 default_albedo{0.7f};  // meshes without material colors
+  int tile_size = 16;
+};
+
+// Host-owned outputs; an empty span means "not requested" and is neither
+// computed nor written. Each non-empty span holds width * height entries
+// (colour: 4 bytes per pixel, sRGB-encoded RGBA8), row-major, y = 0 on top.
+struct FrameBuffers {
+  int width = 0;
+  int height = 0;
+  std::span<std::uint8_t> color_rgba8;
+  std::span<float> color_rgba32f;  // linear RGBA
+  std::span<float> depth;          // distance along the unit primary ray; +inf on a miss
+  std::span<Vec3> normal;          // unit shading normal facing the camera; 0 on a miss
+  std::span<std::uint32_t> triangle_id;  // kInvalidId on a miss
+  std::span<std::uint32_t> instance_id;  // kInvalidId on a miss
+};
+
+struct RenderStats {
+  std::uint64_t primary_rays = 0;
+  std::uint64_t primary_hits = 0;
+  std::uint64_t shadow_rays = 0;
+  std::uint64_t shadowed = 0;
+  TraversalCounters primary;
+  TraversalCounters shadow;
+  double trace_primary_ms = 0.0;
+  double trace_shadow_ms = 0.0;
+  double shade_ms = 0.0;
+};
+
+class Renderer {
+ public:
+  // Errors: kInvalidArgument when a buffer's size does not match
+  // width x height, the camera's size differs from the buffers', or the tile
+  // size is below 1.
+  Expected<RenderStats> render(const Scene& scene, const PinholeCamera& camera,
+                               const RenderSettings& settings, const FrameBuffers& buffers,
+                               JobSystem& jobs, PhaseTimers* timers = nullptr);
+
+ private:
+  std::vector<Hit> hits_;            // per pixel, pass 1
+  std::vector<std::uint8_t> lit_;    // per pixel, pass 2: 1 = the light reaches the hit
+};
+
+// The shading inputs at a hit, in world space.
+struct SurfacePoint {
+  Vec3 position{0.0f};
+  Vec3 geometric_normal{0.0f};  // unit
+  Vec3 shading_normal{0.0f};    // unit; the geometric normal where no vertex normals exist
+  Vec3 albedo{0.0f};
+  Vec3 error{0.0f};  // a bound on the rounding error of `position`, per axis
+};
+SurfacePoint surface_at(const Scene& scene, const Hit& hit, const Vec3& default_albedo);
+
+// The shadow ray's origin: `p` pushed off the surface along the geometric
+// normal, to the side `toward` points to, by its rounding error bound
+// (pbrt-v4's OffsetRayOrigin idea), so neither acne far from the origin nor
+// a visible gap at tiny scales.
+Vec3 offset_origin(const SurfacePoint& surface, const Vec3& toward);
+
+}  // namespace sinew::rt

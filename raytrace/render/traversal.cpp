@@ -1,0 +1,340 @@
+#include "raytrace/render/traversal.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <span>
+
+namespace sinew::rt {
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+float max_abs(const Vec3& v) { return std::max({std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)}); }
+float max_abs(const Aabb& box) { return std::max(max_abs(box.lower), max_abs(box.upper)); }
+
+float linear_norm(const Affine3& m) {
+  float norm = 0.0f;
+  for (const Vec4& row : m.rows) {
+    norm = std::max(norm, std::fabs(row.x) + std::fabs(row.y) + std::fabs(row.z));
+  }
+  return norm;
+}
+
+bool finite(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+// Clips [t0, t1] to the ray's passage through `box` grown by `eps` on every
+// side. The growth absorbs the rounding of the slab arithmetic, which is
+// relative to the magnitudes folded into `eps` by the callers.
+bool clip_to_box(const Aabb& box, float eps, const Vec3& o, const Vec3& d, float& t0, float& t1) {
+  for (int a = 0; a < 3; ++a) {
+    const float lo = box.lower[a] - eps;
+    const float hi = box.upper[a] + eps;
+    if (d[a] == 0.0f) {
+      if (!(o[a] >= lo && o[a] <= hi)) return false;
+      continue;
+    }
+    const float inv = 1.0f / d[a];
+    float near = (lo - o[a]) * inv;
+    float far = (hi - o[a]) * inv;
+    if (near > far) std::swap(near, far);
+    t0 = std::max(t0, near);
+    t1 = std::min(t1, far);
+  }
+  return t0 <= t1;
+}
+
+// Per object, the triangles already tested: a triangle whose fuzzy box
+// straddles splits is listed in several leaves. Direct-mapped on the low bits
+// of the id, which neighbouring triangles in a leaf differ in.
+class Mailbox {
+ public:
+  void reset() { ids_.fill(kInvalidId); }
+  bool seen(std::uint32_t id) {
+    std::uint32_t& slot = ids_[id & (ids_.size() - 1)];
+    if (slot == id) return true;
+    slot = id;
+    return false;
+  }
+
+ private:
+  std::array<std::uint32_t, 16> ids_{};
+};
+
+struct StackEntry {
+  std::uint32_t node;
+  float t0;
+  float t1;
+};
+
+// Front-to-back traversal of one kd-tree over [t0, t1] with split planes
+// thickened by `eps`: a child is entered whenever the ray passes within eps
+// of its cell. Cells whose entry lies beyond `t_limit` (the best hit so far,
+// read on every pop) are pruned. `leaf` returns true to stop (any hit).
+template <class LeafFn>
+bool traverse_tree(const KdTreeView& tree, const Vec3& o, const Vec3& d, float eps, float t0, float t1,
+                   const float& t_limit, std::uint64_t& visits, LeafFn&& leaf) {
+  const Vec3 inv(1.0f / d.x, 1.0f / d.y, 1.0f / d.z);
+  std::array<StackEntry, kMaxTraversalDepth + 2> stack;
+  std::size_t top = 0;
+  std::uint32_t index = 0;
+  for (;;) {
+    ++visits;
+    const KdNode node = tree.nodes[index];
+    if (!node.is_leaf()) {
+      const int a = node.axis();
+      const float split = node.split();
+      const float oa = o[a];
+      const float da = d[a];
+      const float below_edge = split + eps;  // the below cell, thickened, reaches up to here
+      const float above_edge = split - eps;  // the above cell, thickened, starts here
+      float b0 = t0, b1 = t1, a0 = t0, a1 = t1;
+      bool below_first = true;
+      if (da > 0.0f) {
+        b1 = std::min(t1, (below_edge - oa) * inv[a]);
+        a0 = std::max(t0, (above_edge - oa) * inv[a]);
+      } else if (da < 0.0f) {
+        b0 = std::max(t0, (below_edge - oa) * inv[a]);
+        a1 = std::min(t1, (above_edge - oa) * inv[a]);
+        below_first = false;
+      } else {
+        if (!(oa <= below_edge)) b1 = -kInf;
+        if (!(oa >= above_edge)) a1 = -kInf;
+      }
+      const std::uint32_t below = index + 1;
+      const std::uint32_t above = node.above_child();
+      const StackEntry first = below_first ? StackEntry{below, b0, b1} : StackEntry{above, a0, a1};
+      const StackEntry second = below_first ? StackEntry{above, a0, a1} : StackEntry{below, b0, b1};
+      const bool first_ok = first.t0 <= first.t1;
+      const bool second_ok = second.t0 <= second.t1 && second.t0 <= t_limit;
+      if (first_ok) {
+        if (second_ok) stack[top++] = second;
+        index = first.node;
+        t0 = first.t0;
+        t1 = first.t1;
+        continue;
+      }
+      if (second_ok) {
+        index = second.node;
+        t0 = second.t0;
+        t1 = second.t1;
+        continue;
+      }
+    } else if (node.item_count() > 0) {
+      if (leaf(tree.items.subspan(node.first_item(), node.item_count()))) return true;
+    }
+    for (;;) {
+      if (top == 0) return false;
+      const StackEntry& entry = stack[--top];
+      if (entry.t0 <= t_limit) {
+        index = entry.node;
+        t0 = entry.t0;
+        t1 = std::min(entry.t1, t_limit);
+        break;
+      }
+    }
+  }
+}
+
+// One query: the world ray, its per-ray triangle-test data, and the best hit
+// (closest-hit) or the first hit (any-hit).
+template <TriangleTest kTest, bool kAnyHit>
+class Query {
+ public:
+  Query(const Scene& scene, const Ray& ray) : scene_(scene), ray_(ray), t_limit_(ray.t_max) {
+    if constexpr (kTest == TriangleTest::kWatertight) watertight_ = prepare_watertight(ray);
+  }
+
+  bool run() {
+    const KdTreeView top = scene_.top_level().view();
+    if (top.empty()) return false;
+    float t0 = ray_.t_min;
+    float t1 = ray_.t_max;
+    if (!clip_to_box(top.bounds, world_eps(top.bounds, 0.0f), ray_.origin, ray_.direction, t0, t1)) {
+      return false;
+    }
+    const float eps = world_eps(top.bounds, t1);
+    return traverse_tree(top, ray_.origin, ray_.direction, eps, t0, t1, t_limit_, counters_.node_visits,
+                         [this](std::span<const std::uint32_t> objects) {
+                           for (const std::uint32_t object : objects) {
+                             if (already_visited(object)) continue;
+                             if (visit(scene_.top_level().objects()[object])) return true;
+                           }
+                           return false;
+                         });
+  }
+
+  const Hit& hit() const { return best_; }
+  const TraversalCounters& counters() const { return counters_; }
+
+ private:
+  // The slack of a world-space computation: rounding relative to the ray's
+  // origin, its reach and the box's own coordinates.
+  float world_eps(const Aabb& box, float t_end) const {
+    const float reach = std::isfinite(t_end) ? t_end * max_abs(ray_.direction) : 0.0f;
+    return kFrameRelativeSlack * (max_abs(ray_.origin) + reach + max_abs(box));
+  }
+
+  // Objects overlap several top-level leaves; each is traversed once, over
+  // the whole ray, so later leaves skip it. Past the list's capacity an
+  // object may be traversed again, which costs time but not correctness.
+  bool already_visited(std::uint32_t object) {
+    for (std::size_t i = 0; i < visited_count_; ++i) {
+      if (visited_[i] == object) return true;
+    }
+    if (visited_count_ < visited_.size()) visited_[visited_count_++] = object;
+    return false;
+  }
+
+  bool visit(const TopLevelObject& object) {
+    float t0 = ray_.t_min;
+    float t1 = t_limit_;
+    if (!clip_to_box(object.box, world_eps(object.box, t1), ray_.origin, ray_.direction, t0, t1)) {
+      return false;
+    }
+    ++counters_.object_visits;
+    mailbox_.reset();
+    switch (object.kind) {
+      case TopLevelObject::Kind::kBone:
+        return visit_bone(scene_.instances()[object.index], object.bone, t0, t1);
+      case TopLevelObject::Kind::kStatic:
+        return visit_static(scene_.static_meshes()[object.index], t0, t1);
+      case TopLevelObject::Kind::kFallback:
+        return visit_fallback(scene_.instances()[object.index], t0, t1);
+    }
+    return false;
+  }
+
+  bool visit_bone(const InstanceFrame& frame, std::uint32_t bone, float t0, float t1) {
+    const Scene::Character& character = scene_.characters()[frame.character];
+    const KdTreeView tree = character.fuzzy.bone_tree(bone);
+    const Affine3& to_bone = frame.bone_from_world[bone];
+    const Vec3 o = to_bone.transform_point(ray_.origin);
+    const Vec3 d = to_bone.transform_vector(ray_.direction);
+    // Slack in the bone frame: the escape check's tolerance (a vertex may sit
+    // that far outside its box and still count as inside), twice, for the
+    // rounding of both frame changes, plus the rounding of carrying this ray
+    // over and of the traversal arithmetic.
+    const float carried = linear_norm(to_bone) * max_abs(ray_.origin) + max_abs(to_bone.translation_part());
+    const float eps = 2.0f * frame.tolerance[bone] +
+                      kFrameRelativeSlack * (carried + max_abs(o) + t1 * max_abs(d) + max_abs(tree.bounds));
+    if (!clip_to_box(tree.bounds, eps, o, d, t0, t1)) return false;
+    const SkinnedMesh& mesh = *character.mesh;
+    return traverse_tree(tree, o, d, eps, t0, t1, t_limit_, counters_.node_visits,
+                         [&](std::span<const std::uint32_t> triangles) {
+                           for (const std::uint32_t t : triangles) {
+                             if (mailbox_.seen(t)) continue;
+                             const auto& v = mesh.triangles[t];
+                             if (test(frame.positions[v[0]], frame.positions[v[1]], frame.positions[v[2]], t,
+                                      frame.instance_id)) {
+                               return true;
+                             }
+                           }
+                           return false;
+                         });
+  }
+
+  bool visit_static(const Scene::StaticMesh& mesh, float t0, float t1) {
+    const KdTreeView tree = mesh.tree.view();
+    const float eps = world_eps(tree.bounds, t1);
+    return traverse_tree(tree, ray_.origin, ray_.direction, eps, t0, t1, t_limit_, counters_.node_visits,
+                         [&](std::span<const std::uint32_t> triangles) {
+                           for (const std::uint32_t t : triangles) {
+                             if (mailbox_.seen(t)) continue;
+                             const auto& v = mesh.desc.triangles[t];
+                             if (test(mesh.desc.positions[v[0]], mesh.desc.positions[v[1]],
+                                      mesh.desc.positions[v[2]], t, mesh.instance_id)) {
+                               return true;
+                             }
+                           }
+                           return false;
+                         });
+  }
+
+  bool visit_fallback(const InstanceFrame& frame, float t0, float t1) {
+    const SkinnedMesh& mesh = *scene_.characters()[frame.character].mesh;
+    const KdTreeView tree = frame.fallback.view();
+    const float eps = world_eps(tree.bounds, t1);
+    return traverse_tree(tree, ray_.origin, ray_.direction, eps, t0, t1, t_limit_, counters_.node_visits,
+                         [&](std::span<const std::uint32_t> items) {
+                           for (const std::uint32_t item : items) {
+                             if (mailbox_.seen(item)) continue;
+                             const std::uint32_t t = frame.escaped_triangles[item];
+                             const auto& v = mesh.triangles[t];
+                             if (test(frame.positions[v[0]], frame.positions[v[1]], frame.positions[v[2]], t,
+                                      frame.instance_id)) {
+                               return true;
+                             }
+                           }
+                           return false;
+                         });
+  }
+
+  // Tests one world-space triangle; records a nearer hit. Returns true when
+  // the query is answered (any-hit found something).
+  bool test(const Vec3& p0, const Vec3& p1, const Vec3& p2, std::uint32_t triangle, std::uint32_t instance) {
+    ++counters_.triangle_tests;
+    TriangleHit h;
+    bool hit_found;
+    if constexpr (kTest == TriangleTest::kWatertight) {
+      hit_found = intersect_triangle_watertight(watertight_, ray_, t_limit_, p0, p1, p2, h);
+    } else {
+      hit_found = intersect_triangle_fast(ray_, t_limit_, p0, p1, p2, h);
+    }
+    if (!hit_found) return false;
+    best_ = Hit{h.t, h.u, h.v, triangle, instance};
+    if constexpr (kAnyHit) return true;
+    t_limit_ = h.t;
+    return false;
+  }
+
+  const Scene& scene_;
+  Ray ray_;
+  float t_limit_;
+  WatertightRay watertight_;
+  Hit best_;
+  Mailbox mailbox_;
+  std::array<std::uint32_t, 32> visited_{};
+  std::size_t visited_count_ = 0;
+  TraversalCounters counters_;
+};
+
+bool valid_ray(const Ray& ray) {
+  return finite(ray.origin) && finite(ray.direction) && ray.direction != Vec3(0.0f) &&
+         !std::isnan(ray.t_min) && !std::isnan(ray.t_max) && ray.t_min < ray.t_max;
+}
+
+void accumulate(TraversalCounters* into, const TraversalCounters& from) {
+  if (!into) return;
+  into->rays += 1;
+  into->node_visits += from.node_visits;
+  into->object_visits += from.object_visits;
+  into->triangle_tests += from.triangle_tests;
+}
+
+template <TriangleTest kTest, bool kAnyHit>
+Hit run_query(const Scene& scene, const Ray& ray, TraversalCounters* counters) {
+  Query<kTest, kAnyHit> query(scene, ray);
+  query.run();
+  accumulate(counters, query.counters());
+  return query.hit();
+}
+
+}  // namespace
+
+Hit intersect(const Scene& scene, const Ray& ray, TriangleTest test, TraversalCounters* counters) {
+  if (!valid_ray(ray)) return {};
+  return test == TriangleTest::kWatertight ? run_query<TriangleTest::kWatertight, false>(scene, ray, counters)
+                                           : run_query<TriangleTest::kFast, false>(scene, ray, counters);
+}
+
+bool occluded(const Scene& scene, const Ray& ray, TriangleTest test, TraversalCounters* counters) {
+  if (!valid_ray(ray)) return false;
+  const Hit hit = test == TriangleTest::kWatertight
+                      ? run_query<TriangleTest::kWatertight, true>(scene, ray, counters)
+                      : run_query<TriangleTest::kFast, true>(scene, ray, counters);
+  return hit.valid();
+}
+
+}  // namespace sinew::rt

@@ -1,0 +1,135 @@
+#include "raytrace/scene/frame_state.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "runtime/jobs/job_system.h"
+
+namespace sinew::rt {
+namespace {
+
+float max_abs(const Vec3& v) { return std::max({std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)}); }
+
+float max_abs(const Aabb& box) {
+  return box.is_empty() ? 0.0f : std::max(max_abs(box.lower), max_abs(box.upper));
+}
+
+// The infinity norm of the linear part (largest row sum of |m_ij|): how much
+// the transform can stretch a rounding error.
+float linear_norm(const Affine3& m) {
+  float norm = 0.0f;
+  for (const Vec4& row : m.rows) {
+    norm = std::max(norm, std::fabs(row.x) + std::fabs(row.y) + std::fabs(row.z));
+  }
+  return norm;
+}
+
+Aabb grown(const Aabb& box, float by) {
+  if (box.is_empty()) return box;
+  return {box.lower - Vec3(by), box.upper + Vec3(by)};
+}
+
+}  // namespace
+
+void update_bone_frames(InstanceFrame& frame, const FuzzyCharacterView& fuzzy) {
+  const std::size_t bones = frame.skinning.size();
+  frame.bone_from_world.resize(bones);
+  frame.bone_usable.resize(bones);
+  frame.tolerance.resize(bones);
+  frame.singular_bones = 0;
+  for (std::size_t b = 0; b < bones; ++b) {
+    const Affine3& to_world = frame.skinning[b];
+    const Affine3 from_world = inverse(to_world);
+    const bool usable = is_finite(from_world);
+    frame.bone_from_world[b] = from_world;
+    frame.bone_usable[b] = usable ? 1 : 0;
+    if (!usable) {
+      frame.tolerance[b] = 0.0f;
+      if (fuzzy.bone_trees[b].triangle_count > 0) ++frame.singular_bones;
+      continue;
+    }
+    // A skinned vertex near this bone has world coordinates up to `world`;
+    // skinning it and carrying it back into the bone frame each round
+    // relative to that magnitude (and to the inverse's translation, which
+    // cancels against it far from the origin), stretched by the inverse.
+    const Aabb& local = fuzzy.bone_trees[b].bounds;
+    const float world = max_abs(transform(to_world, local));
+    const float carried = linear_norm(from_world) * world + max_abs(from_world.translation_part());
+    frame.tolerance[b] = kFrameRelativeSlack * (carried + max_abs(local));
+  }
+}
+
+void skin_instance(InstanceFrame& frame, const SkinnedMesh& mesh, const FuzzyCharacterView& fuzzy,
+                   bool normals, SkinningPath path, JobSystem& jobs) {
+  frame.positions.resize(mesh.vertex_count());
+  frame.normals.resize(normals && !mesh.normals.empty() ? mesh.vertex_count() : 0);
+  frame.escaped.resize(fuzzy.vertex_checks.size());
+  const EscapeCheckInput escape{fuzzy.vertex_check_begin, fuzzy.vertex_checks, frame.bone_from_world,
+                                frame.tolerance};
+  const SkinningTargets targets{frame.positions, frame.normals, frame.escaped};
+  const SkinningResult result = skin_vertices(mesh, frame.skinning, targets, &escape, &jobs, path);
+  frame.escaped_checks = result.escaped_checks;
+}
+
+void compute_bone_boxes(InstanceFrame& frame, const FuzzyCharacterView& fuzzy, bool exact,
+                        JobSystem& jobs) {
+  const std::size_t bones = frame.skinning.size();
+  frame.bone_world_boxes.assign(bones, Aabb::empty());
+  if (!exact) {
+    for (std::size_t b = 0; b < bones; ++b) {
+      if (!frame.bone_usable[b]) continue;
+      const Aabb local = grown(fuzzy.bone_trees[b].bounds, frame.tolerance[b]);
+      frame.bone_world_boxes[b] = transform(frame.skinning[b], local);
+    }
+    return;
+  }
+  // The vertex checks list, per vertex, exactly the bones whose triangles use
+  // it: growing each check's bone box by its vertex gives every bone the
+  // bounds of its skinned triangles. Fixed chunks each fill their own row of
+  // boxes, merged in chunk order (deterministic for any thread count).
+  const std::size_t vertices = frame.positions.size();
+  constexpr std::size_t kGrain = 8192;
+  const std::size_t chunks = (vertices + kGrain - 1) / kGrain;
+  std::vector<Aabb> partial(chunks * bones, Aabb::empty());
+  jobs.parallel_for(0, vertices, kGrain, [&](Range range) {
+    Aabb* boxes = partial.data() + (range.begin / kGrain) * bones;
+    for (std::size_t v = range.begin; v < range.end; ++v) {
+      const Vec3& p = frame.positions[v];
+      for (std::uint32_t c = fuzzy.vertex_check_begin[v]; c < fuzzy.vertex_check_begin[v + 1]; ++c) {
+        boxes[fuzzy.vertex_checks[c].bone].extend(p);
+      }
+    }
+  });
+  for (std::size_t chunk = 0; chunk < chunks; ++chunk) {
+    for (std::size_t b = 0; b < bones; ++b) frame.bone_world_boxes[b].extend(partial[chunk * bones + b]);
+  }
+  for (std::size_t b = 0; b < bones; ++b) {
+    if (!frame.bone_usable[b]) frame.bone_world_boxes[b] = Aabb::empty();
+  }
+}
+
+Status build_fallback(InstanceFrame& frame, const SkinnedMesh& mesh, const FuzzyCharacterView& fuzzy,
+                      const KdBuildOptions& kd) {
+  frame.escaped_triangles.clear();
+  if (frame.escaped_checks == 0 && frame.singular_bones == 0) {
+    frame.fallback = KdTree{};
+    return {};
+  }
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+    const auto& corners = fuzzy.triangle_checks[t];
+    const bool escaped = !frame.bone_usable[fuzzy.triangle_bone[t]] || frame.escaped[corners[0]] ||
+                         frame.escaped[corners[1]] || frame.escaped[corners[2]];
+    if (escaped) frame.escaped_triangles.push_back(static_cast<std::uint32_t>(t));
+  }
+  std::vector<Aabb> boxes;
+  boxes.reserve(frame.escaped_triangles.size());
+  for (const std::uint32_t t : frame.escaped_triangles) {
+    Aabb box;
+    for (const std::uint32_t v : mesh.triangles[t]) box.extend(frame.positions[v]);
+    boxes.push_back(box);
+  }
+  SINEW_ASSIGN_OR_RETURN(frame.fallback, build_kd_tree(boxes, kd));
+  return {};
+}
+
+}  // namespace sinew::rt

@@ -1,0 +1,129 @@
+// Scene: what one frame traces: skinned character instances (sharing their
+// characters' baked fuzzy data) and static meshes (a ground, a level), with
+// a top-level kd-tree over them rebuilt every frame (paper section 4).
+//
+// Use: add characters and static meshes once, add instances, then every frame
+// set each instance's bone matrices and call prepare_frame(), which skins,
+// checks escapes, computes bone world boxes, builds the fallback for escaped
+// triangles and rebuilds the top level. After that the scene is read-only and
+// can be traced from many threads (render/traversal.h).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "raytrace/fuzzy/fuzzy_character.h"
+#include "raytrace/kdtree/kd_tree.h"
+#include "raytrace/scene/frame_state.h"
+#include "raytrace/scene/top_level.h"
+#include "raytrace/skinning/skinning.h"
+#include "runtime/core/expected.h"
+#include "runtime/math/affine.h"
+#include "runtime/mesh/skinned_mesh.h"
+
+namespace sinew {
+class JobSystem;
+class PhaseTimers;
+}  // namespace sinew
+
+namespace sinew::rt {
+
+// How a bone's world box is found each frame (issue 4, point 4).
+enum class BoneBoxMode : std::uint8_t {
+  kExact,  // the union of the bone's skinned triangles: tight, costs a pass over them
+  kCheap,  // the fuzzy root box carried by the bone matrix: free, looser
+};
+
+struct FrameOptions {
+  BoneBoxMode bone_boxes = BoneBoxMode::kExact;
+  // Route triangles that left their fuzzy boxes through a per-frame
+  // world-space kd-tree so the image stays exact (DESIGN.md section 4). Off:
+  // escapes are still counted, and may show as holes.
+  bool fallback = true;
+  bool normals = true;  // skin normals (shading needs them; depth-only passes do not)
+  SkinningPath skinning = SkinningPath::kAuto;
+  KdBuildOptions top_level_kd{.traversal_cost = 1.0f, .intersection_cost = 4.0f,
+                              .empty_bonus = 0.2f, .max_leaf_items = 1, .max_depth = 0};
+  KdBuildOptions fallback_kd{};
+};
+
+struct FrameStats {
+  std::size_t escaped_checks = 0;     // (vertex, bone) pairs outside their fuzzy boxes
+  std::size_t escaped_triangles = 0;  // triangles routed through the fallback
+  std::size_t singular_bones = 0;     // bones without a finite inverse (zero scale)
+  std::uint32_t top_level_objects = 0;
+  std::uint32_t top_level_nodes = 0;
+};
+
+// A static triangle mesh in world space (the arena's ground, obstacles).
+struct StaticMeshDesc {
+  std::vector<Vec3> positions;
+  std::vector<std::array<std::uint32_t, 3>> triangles;
+  std::vector<std::uint32_t> triangle_material;  // per triangle, or empty (material 0)
+  std::vector<Vec3> material_colors;             // linear RGB; empty = mid grey
+};
+
+class Scene {
+ public:
+  Scene();
+  ~Scene();
+  Scene(const Scene&) = delete;
+  Scene& operator=(const Scene&) = delete;
+  Scene(Scene&&) noexcept;
+  Scene& operator=(Scene&&) noexcept;
+
+  // Registers a character's core data; both must outlive the scene. Checks
+  // that the fuzzy data matches the mesh (counts, bone indices).
+  Expected<std::uint32_t> add_character(const SkinnedMesh& mesh, const FuzzyCharacterView& fuzzy);
+
+  // An instance of a character, at the bind pose until set_bones. Instance
+  // ids and static mesh ids share one numbering (Hit::instance_id).
+  Expected<std::uint32_t> add_instance(std::uint32_t character);
+
+  // Builds the static mesh's kd-tree once.
+  Expected<std::uint32_t> add_static_mesh(StaticMeshDesc mesh, const KdBuildOptions& kd = {});
+
+  // This frame's skinning matrices of an instance (bind pose -> world), one
+  // per bone of its character. Copied. Non-finite matrices are rejected.
+  Status set_bones(std::uint32_t instance, std::span<const Affine3> skinning);
+
+  // Skinning, escape check, bone boxes, fallback and top level. Phases are
+  // recorded into `timers` when given: "skinning", "boxes", "fallback",
+  // "top level".
+  Expected<FrameStats> prepare_frame(const FrameOptions& options, JobSystem& jobs,
+                                     PhaseTimers* timers = nullptr);
+
+  // Read access for traversal and shading (valid after prepare_frame).
+  struct Character {
+    const SkinnedMesh* mesh = nullptr;
+    FuzzyCharacterView fuzzy;
+  };
+  struct StaticMesh {
+    StaticMeshDesc desc;
+    KdTree tree;
+    std::uint32_t instance_id = 0;  // scene-wide id reported in hits
+  };
+  enum class ObjectKind : std::uint8_t { kCharacter, kStatic };
+  struct ObjectSlot {
+    ObjectKind kind = ObjectKind::kCharacter;
+    std::uint32_t index = 0;  // into instances() or static_meshes()
+  };
+
+  std::span<const Character> characters() const { return characters_; }
+  std::span<const InstanceFrame> instances() const { return instances_; }
+  std::span<const StaticMesh> static_meshes() const { return statics_; }
+  std::span<const ObjectSlot> object_slots() const { return slots_; }  // by instance id
+  const TopLevel& top_level() const { return top_level_; }
+  const Aabb& world_bounds() const { return top_level_.bounds(); }
+
+ private:
+  std::vector<Character> characters_;
+  std::vector<InstanceFrame> instances_;
+  std::vector<StaticMesh> statics_;
+  std::vector<ObjectSlot> slots_;
+  TopLevel top_level_;
+};
+
+}  // namespace sinew::rt
