@@ -1,0 +1,54 @@
+// The bridge from an imported model to the ray tracer: pose-space samples as
+// skinning matrices, a clip's pose at a time, and the in-memory bake
+// (DESIGN.md section 3, offline half, without the pack).
+//
+// raytrace/ never sees animation types: it gets spans of Affine3 skinning
+// matrices, produced here.
+#pragma once
+
+#include <span>
+#include <vector>
+
+#include "animation/joint_limits.h"
+#include "animation/pose_space.h"
+#include "editor/import/imported_model.h"
+#include "raytrace/fuzzy/fuzzy_bake.h"
+#include "runtime/core/expected.h"
+#include "runtime/math/affine.h"
+
+namespace sinew {
+class JobSystem;
+}
+
+namespace sinew::editor {
+
+// The pose space `render` bakes by default: every clip of the model, at
+// every key time and every 1/30 s.
+anim::PoseSpaceDesc default_pose_space();
+
+// Skinning matrices (bind pose -> model space) of every pose of the space,
+// sample-major (poses x joints). A clip space over a model without clips
+// gives the rest pose alone, so a static skinned model still bakes.
+Expected<std::vector<Affine3>> pose_space_skinning(const ImportedModel& model,
+                                                   const anim::PoseSpaceDesc& space,
+                                                   std::span<const anim::JointLimit> limits);
+
+// Skinning matrices of the model posed by one clip alone at weight 1 at
+// playback time `seconds` (looping), placed in the world by `instance`.
+Expected<std::vector<Affine3>> clip_skinning(const ImportedModel& model, const anim::Clip& clip,
+                                             double seconds, const Affine3& instance = Affine3::identity());
+
+struct BakeRequest {
+  anim::PoseSpaceDesc pose_space = default_pose_space();
+  std::vector<anim::JointLimit> limits;  // kLimits only
+  rt::FuzzyBakeOptions fuzzy;
+};
+
+struct InMemoryBake {
+  rt::FuzzyCharacterData fuzzy;
+  double pose_sampling_ms = 0.0;  // producing the samples' matrices (before the fuzzy bake)
+};
+
+Expected<InMemoryBake> bake_in_memory(const ImportedModel& model, const BakeRequest& request, JobSystem& jobs);
+
+}  // namespace sinew::editor

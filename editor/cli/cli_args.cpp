@@ -1,0 +1,175 @@
+#include "editor/cli/cli_args.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <limits>
+
+namespace sinew::editor::cli {
+namespace {
+
+const FlagSpec* find_spec(const std::vector<FlagSpec>& specs, std::string_view name) {
+  for (const FlagSpec& spec : specs) {
+    if (spec.name == name) return &spec;
+  }
+  return nullptr;
+}
+
+bool looks_like_flag(const std::string& arg) {
+  return (arg.size() > 2 && arg.compare(0, 2, "--") == 0) || arg == "-h";
+}
+
+std::vector<std::string> split_commas(const std::string& text) {
+  std::vector<std::string> parts;
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t comma = text.find(',', start);
+    parts.push_back(text.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return parts;
+}
+
+// std::from_chars of the whole string, or nothing.
+template <typename T>
+std::optional<T> whole_number(std::string_view text) {
+  T value{};
+  const char* last = text.data() + text.size();
+  const auto [end, ec] = std::from_chars(text.data(), last, value);
+  if (text.empty() || ec != std::errc() || end != last) return std::nullopt;
+  return value;
+}
+
+std::string format_number(double x) {
+  std::string s = std::to_string(x);
+  // Drop the trailing zeros std::to_string pads with ("180.000000" -> "180").
+  if (s.find('.') != std::string::npos) {
+    s.erase(s.find_last_not_of('0') + 1);
+    if (s.back() == '.') s.pop_back();
+  }
+  return s;
+}
+
+}  // namespace
+
+bool ParsedArgs::has(std::string_view name) const { return value(name).has_value(); }
+
+std::optional<std::string> ParsedArgs::value(std::string_view name) const {
+  for (const auto& [flag, text] : flags) {
+    if (flag == name) return text;
+  }
+  return std::nullopt;
+}
+
+Expected<ParsedArgs> parse_args(const std::vector<std::string>& args, const std::vector<FlagSpec>& specs) {
+  ParsedArgs parsed;
+  bool flags_ended = false;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& arg = args[i];
+    if (!flags_ended && arg == "--") {
+      flags_ended = true;
+      continue;
+    }
+    if (flags_ended || !looks_like_flag(arg)) {
+      parsed.positionals.push_back(arg);
+      continue;
+    }
+    const std::size_t equals = arg.find('=');
+    const std::string name = arg.substr(0, equals);
+    const FlagSpec* spec = find_spec(specs, name);
+    if (spec == nullptr) return invalid_argument("option", name, "unknown option (see --help)");
+    if (parsed.has(name)) return invalid_argument(name, arg, "given twice");
+    std::string text;
+    if (equals != std::string::npos) {
+      if (!spec->takes_value) return invalid_argument(name, arg, "takes no value");
+      text = arg.substr(equals + 1);
+    } else if (spec->takes_value) {
+      if (i + 1 >= args.size()) return invalid_argument(name, "", "missing value");
+      text = args[++i];
+    }
+    parsed.flags.emplace_back(name, std::move(text));
+  }
+  return parsed;
+}
+
+Expected<std::int64_t> parse_int(std::string_view flag, const std::string& text, std::int64_t lo,
+                                 std::int64_t hi) {
+  const auto value = whole_number<std::int64_t>(text);
+  if (!value || *value < lo || *value > hi) {
+    return invalid_argument(flag, text,
+                            "expected an integer from " + std::to_string(lo) + " to " + std::to_string(hi));
+  }
+  return *value;
+}
+
+Expected<std::uint64_t> parse_uint64(std::string_view flag, const std::string& text) {
+  const auto value = whole_number<std::uint64_t>(text);
+  if (!value) return invalid_argument(flag, text, "expected a non-negative 64-bit integer");
+  return *value;
+}
+
+Expected<double> parse_double(std::string_view flag, const std::string& text, double lo, double hi) {
+  const auto value = whole_number<double>(text);
+  if (!value || !std::isfinite(*value) || *value < lo || *value > hi) {
+    return invalid_argument(flag, text, "expected a number from " + format_number(lo) + " to " + format_number(hi));
+  }
+  return *value;
+}
+
+Expected<std::vector<float>> parse_floats(std::string_view flag, const std::string& text, std::size_t count) {
+  const std::vector<std::string> parts = split_commas(text);
+  const std::string expected = "expected " + std::to_string(count) + " comma-separated numbers";
+  if (parts.size() != count) {
+    return invalid_argument(flag, text, expected + ", got " + std::to_string(parts.size()));
+  }
+  std::vector<float> values;
+  for (const std::string& part : parts) {
+    const auto value = whole_number<float>(part);
+    if (!value || !std::isfinite(*value)) {
+      return invalid_argument(flag, text, expected + " ('" + part + "' is not a finite number)");
+    }
+    values.push_back(*value);
+  }
+  return values;
+}
+
+Expected<std::vector<std::string>> parse_list(std::string_view flag, const std::string& text) {
+  std::vector<std::string> parts = split_commas(text);
+  if (std::any_of(parts.begin(), parts.end(), [](const std::string& p) { return p.empty(); })) {
+    return invalid_argument(flag, text, "expected a comma-separated list of non-empty names");
+  }
+  return parts;
+}
+
+Expected<Size2> parse_size(std::string_view flag, const std::string& text, int max_side) {
+  const std::size_t x = text.find('x');
+  const auto fail = [&] {
+    return invalid_argument(flag, text,
+                            "expected WxH with W and H from 1 to " + std::to_string(max_side) + ", e.g. 512x512");
+  };
+  if (x == std::string::npos) return fail();
+  const auto w = whole_number<int>(std::string_view(text).substr(0, x));
+  const auto h = whole_number<int>(std::string_view(text).substr(x + 1));
+  if (!w || !h || *w < 1 || *h < 1 || *w > max_side || *h > max_side) return fail();
+  return Size2{*w, *h};
+}
+
+Expected<int> parse_choice(std::string_view flag, const std::string& text,
+                           std::initializer_list<std::string_view> choices) {
+  int index = 0;
+  std::string listed;
+  for (const std::string_view choice : choices) {
+    if (choice == text) return index;
+    listed += (index == 0 ? "" : "|") + std::string(choice);
+    ++index;
+  }
+  return invalid_argument(flag, text, "expected one of " + listed);
+}
+
+Expected<bool> parse_on_off(std::string_view flag, const std::string& text) {
+  SINEW_ASSIGN_OR_RETURN(const int index, parse_choice(flag, text, {"on", "off"}));
+  return index == 0;
+}
+
+}  // namespace sinew::editor::cli

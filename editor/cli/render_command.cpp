@@ -1,0 +1,592 @@
+#include "editor/cli/render_command.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <filesystem>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "animation/joint_limits.h"
+#include "animation/pose.h"
+#include "editor/bake/in_memory_bake.h"
+#include "editor/cli/cli_args.h"
+#include "editor/import/gltf_importer.h"
+#include "raytrace/render/renderer.h"
+#include "raytrace/skinning/skinning.h"
+#include "runtime/image/image_io.h"
+#include "runtime/io/atomic_file.h"
+#include "runtime/jobs/job_system.h"
+#if SINEW_HAVE_CAL3D
+#include "editor/import/cal3d_importer.h"
+#endif
+
+namespace sinew::editor {
+namespace {
+
+constexpr double kFramesPerSecond = 30.0;
+constexpr double kInstanceTimeStep = 0.37;    // seconds between instances' clip times
+constexpr float kInstanceSpacing = 1.2f;      // x the rest bounds' largest extent
+constexpr float kDefaultFovyDegrees = 40.0f;
+constexpr int kMaxImageSide = 16384;
+
+const std::vector<cli::FlagSpec>& render_flags() {
+  static const std::vector<cli::FlagSpec> flags = {
+      {"--help", false}, {"-h", false},          {"--clip"},      {"--time"},          {"--camera"},
+      {"--size"},        {"--out"},              {"--pose-space"}, {"--clips"},        {"--samples"},
+      {"--seed"},        {"--shadows"},          {"--light"},      {"--threads"},      {"--instances"},
+      {"--frames"},      {"--triangle-test"},    {"--bone-boxes"}, {"--fallback"},     {"--limits"},
+  };
+  return flags;
+}
+
+std::string usage_line() {
+  return "usage: sinew-editor render MODEL --out DIR [--clip NAME] [--time SECONDS] [options]"
+         " (sinew-editor render --help lists them)";
+}
+
+// --- option parsing -------------------------------------------------------
+
+Status parse_pose_space(const cli::ParsedArgs& args, RenderOptions& o) {
+  if (const auto text = args.value("--pose-space")) {
+    std::string mode_name = *text;
+    std::string clip_name;
+    if (const std::size_t colon = text->find(':'); colon != std::string::npos) {
+      mode_name = text->substr(0, colon);
+      clip_name = text->substr(colon + 1);
+    }
+    const auto mode = anim::parse_pose_space_mode(mode_name);
+    const bool clip_mode = mode.ok() && *mode == anim::PoseSpaceMode::kClip;
+    if (!mode.ok() || clip_mode == clip_name.empty()) {
+      return invalid_argument("--pose-space", *text, "expected arbitrary, limits, clips or clip:NAME");
+    }
+    if (*mode == anim::PoseSpaceMode::kArbitrary || *mode == anim::PoseSpaceMode::kLimits) {
+      o.pose_space = anim::PoseSpaceDesc{};  // random poses: 1000 samples, seed 1
+      o.pose_space.mode = *mode;
+    } else {
+      o.pose_space.mode = *mode;  // keeps default_pose_space()'s every key + 1/30 s
+      if (clip_mode) o.pose_space.clips = {clip_name};
+    }
+  }
+  const anim::PoseSpaceMode mode = o.pose_space.mode;
+  const bool random = mode == anim::PoseSpaceMode::kArbitrary || mode == anim::PoseSpaceMode::kLimits;
+  if (const auto text = args.value("--clips")) {
+    if (mode != anim::PoseSpaceMode::kClips) {
+      return invalid_argument("--clips", *text, "applies to --pose-space clips only");
+    }
+    SINEW_ASSIGN_OR_RETURN(o.pose_space.clips, cli::parse_list("--clips", *text));
+  }
+  if (const auto text = args.value("--samples")) {
+    SINEW_ASSIGN_OR_RETURN(const std::int64_t n,
+                           cli::parse_int("--samples", *text, random ? 1 : 0, anim::kMaxPoseSamples));
+    o.pose_space.samples = static_cast<int>(n);
+  }
+  if (const auto text = args.value("--seed")) {
+    SINEW_ASSIGN_OR_RETURN(o.pose_space.seed, cli::parse_uint64("--seed", *text));
+  }
+  if (const auto text = args.value("--limits")) {
+    if (mode != anim::PoseSpaceMode::kLimits) {
+      return invalid_argument("--limits", *text, "applies to --pose-space limits only");
+    }
+    o.limits_path = *text;
+  } else if (mode == anim::PoseSpaceMode::kLimits) {
+    return invalid_argument("--pose-space", "limits", "needs --limits FILE.json (the joint limits to sample within)");
+  }
+  return {};
+}
+
+Status parse_view(const cli::ParsedArgs& args, RenderOptions& o) {
+  if (const auto text = args.value("--camera")) {
+    SINEW_ASSIGN_OR_RETURN(const std::vector<float> v, cli::parse_floats("--camera", *text, 10));
+    rt::CameraDesc desc{{v[0], v[1], v[2]}, {v[3], v[4], v[5]}, {v[6], v[7], v[8]}, v[9]};
+    // The camera's own checks (eye == target, up along the view, fovy range)
+    // are usage errors too: report them against the flag.
+    const auto camera = rt::PinholeCamera::create(desc, 1, 1);
+    if (!camera.ok()) {
+      const Status& s = camera.status();
+      return invalid_argument("--camera", *text,
+                              std::string(s.field()) + " = " + std::string(s.value()) + ": " + std::string(s.detail()));
+    }
+    o.camera = desc;
+  }
+  if (const auto text = args.value("--light")) {
+    SINEW_ASSIGN_OR_RETURN(const std::vector<float> v, cli::parse_floats("--light", *text, 3));
+    o.light = Vec3(v[0], v[1], v[2]);
+  }
+  if (const auto text = args.value("--size")) {
+    SINEW_ASSIGN_OR_RETURN(const cli::Size2 size, cli::parse_size("--size", *text, kMaxImageSide));
+    o.width = size.width;
+    o.height = size.height;
+  }
+  return {};
+}
+
+Status parse_run(const cli::ParsedArgs& args, RenderOptions& o) {
+  if (const auto text = args.value("--clip")) {
+    if (text->empty()) return invalid_argument("--clip", "", "expected a clip name or #index");
+    o.clip = *text;
+  }
+  if (const auto text = args.value("--time")) {
+    SINEW_ASSIGN_OR_RETURN(o.time_seconds, cli::parse_double("--time", *text, 0.0, 1e6));
+  }
+  if (const auto text = args.value("--out")) o.out_dir = *text;
+  if (const auto text = args.value("--shadows")) {
+    SINEW_ASSIGN_OR_RETURN(o.shadows, cli::parse_on_off("--shadows", *text));
+  }
+  if (const auto text = args.value("--fallback")) {
+    SINEW_ASSIGN_OR_RETURN(o.fallback, cli::parse_on_off("--fallback", *text));
+  }
+  if (const auto text = args.value("--triangle-test")) {
+    SINEW_ASSIGN_OR_RETURN(const int i, cli::parse_choice("--triangle-test", *text, {"fast", "watertight"}));
+    o.triangle_test = i == 0 ? rt::TriangleTest::kFast : rt::TriangleTest::kWatertight;
+  }
+  if (const auto text = args.value("--bone-boxes")) {
+    SINEW_ASSIGN_OR_RETURN(const int i, cli::parse_choice("--bone-boxes", *text, {"exact", "cheap"}));
+    o.bone_boxes = i == 0 ? rt::BoneBoxMode::kExact : rt::BoneBoxMode::kCheap;
+  }
+  const auto int_flag = [&](const char* flag, std::int64_t lo, std::int64_t hi, int& target) -> Status {
+    if (const auto text = args.value(flag)) {
+      SINEW_ASSIGN_OR_RETURN(const std::int64_t n, cli::parse_int(flag, *text, lo, hi));
+      target = static_cast<int>(n);
+    }
+    return {};
+  };
+  SINEW_RETURN_IF_ERROR(int_flag("--threads", 0, 1024, o.threads));
+  SINEW_RETURN_IF_ERROR(int_flag("--instances", 1, 256, o.instances));
+  SINEW_RETURN_IF_ERROR(int_flag("--frames", 1, 100000, o.frames));
+  return {};
+}
+
+// --- model, pose and scene --------------------------------------------------
+
+std::string lower_extension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext;
+}
+
+Expected<ImportedModel> load_model(const std::string& path) {
+  const std::string ext = lower_extension(path);
+  if (ext == ".pack") {
+    return make_error(ErrorCode::kInvalidArgument, path, "", "", "packs are not supported yet (editor issue)");
+  }
+  const bool gltf = ext == ".gltf" || ext == ".glb";
+  if (!gltf && ext != ".cfg") {
+    return make_error(ErrorCode::kInvalidArgument, path, "extension", ext.empty() ? "(none)" : ext,
+                      "unsupported model format (expected .gltf, .glb or .cfg)");
+  }
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) {
+    return make_error(ErrorCode::kNotFound, path, "", "", "no such file");
+  }
+  if (gltf) return import_gltf(path);
+#if SINEW_HAVE_CAL3D
+  return import_cal3d(path);
+#else
+  return make_error(ErrorCode::kInvalidArgument, path, "", "", "this sinew-editor was built without Cal3D");
+#endif
+}
+
+Expected<std::vector<Affine3>> rest_skinning(const ImportedModel& model, const Affine3& placement) {
+  const std::size_t joints = model.skeleton.joint_count();
+  std::vector<anim::JointTransform> local(joints);
+  std::vector<Affine3> model_space(joints);
+  std::vector<Affine3> skin(joints);
+  SINEW_RETURN_IF_ERROR(anim::rest_pose(model.skeleton, local));
+  SINEW_RETURN_IF_ERROR(anim::local_to_model(model.skeleton, local, model_space));
+  SINEW_RETURN_IF_ERROR(anim::skinning_matrices(model.skeleton, model_space, placement, skin));
+  return skin;
+}
+
+// The instance's skinning matrices at playback time `seconds`: the clip
+// alone at weight 1 (looping), or the rest pose when there is no clip.
+Expected<std::vector<Affine3>> pose_instance(const ImportedModel& model, const anim::Clip* clip, double seconds,
+                                             const Affine3& placement) {
+  if (clip == nullptr) return rest_skinning(model, placement);
+  return clip_skinning(model, *clip, seconds, placement);
+}
+
+Expected<const anim::Clip*> resolve_clip(const ImportedModel& model, const RenderOptions& options) {
+  if (options.clip.empty()) return model.clips.empty() ? nullptr : &model.clips.front();
+  if (const anim::Clip* clip = model.find_clip(options.clip)) return clip;
+  std::string names;
+  for (const anim::Clip& c : model.clips) names += (names.empty() ? "" : ", ") + c.name();
+  return make_error(ErrorCode::kNotFound, options.model_path, "clip", "'" + options.clip + "'",
+                    "no such clip (clips: " + (names.empty() ? std::string("none") : names) + ")");
+}
+
+Aabb posed_bounds(const rt::Scene& scene) {
+  Aabb box;
+  for (const rt::InstanceFrame& frame : scene.instances()) {
+    for (const Vec3& p : frame.positions) box.extend(p);
+  }
+  return box;
+}
+
+Vec3 axis_vector(int axis, float sign = 1.0f) {
+  Vec3 v(0.0f);
+  v[axis] = sign;
+  return v;
+}
+
+Vec3 front_of(int up) { return up == 1 ? axis_vector(2) : axis_vector(1, -1.0f); }
+
+float bounding_radius(const Aabb& box) { return std::max(0.5f * glm::length(box.extent()), 1e-6f); }
+
+rt::CameraDesc frame_bounds(const Aabb& box, int up, int width, int height) {
+  const float radius = bounding_radius(box);
+  const float half_fovy = glm::radians(0.5f * kDefaultFovyDegrees);
+  const float aspect = static_cast<float>(width) / static_cast<float>(height);
+  const float half_fovx = std::atan(std::tan(half_fovy) * aspect);
+  const float distance = 1.15f * radius / std::sin(std::min(half_fovy, half_fovx));
+  const Vec3 view = glm::normalize(front_of(up) + 0.2f * axis_vector(up));
+  return {box.center() + distance * view, box.center(), axis_vector(up), kDefaultFovyDegrees};
+}
+
+Vec3 default_light(const Aabb& box, int up) {
+  const float radius = bounding_radius(box);
+  return box.center() + radius * (2.0f * front_of(up) + 3.0f * axis_vector(up) + axis_vector(0));
+}
+
+// --- stats ----------------------------------------------------------------
+
+struct FrameRecord {
+  double total_ms = 0.0;
+  rt::FrameStats frame;
+  rt::RenderStats render;
+};
+
+Expected<std::string> stats_document(const RenderOptions& options, const ImportedModel& model,
+                                     const InMemoryBake& bake, const RenderOutputs& outputs) {
+  const nlohmann::ordered_json phases = nlohmann::ordered_json::parse(outputs.timers.json(), nullptr, false);
+  if (phases.is_discarded()) {
+    return make_error(ErrorCode::kInternal, "stats.json", "phases", "", "PhaseTimers::json() is not valid JSON");
+  }
+  const rt::FuzzyBakeStats& b = bake.fuzzy.stats;
+  const RenderStatsSummary& s = outputs.stats;
+  nlohmann::ordered_json doc;
+  doc["model"] = options.model_path;
+  doc["clip"] = outputs.clip_name;
+  doc["time"] = options.time_seconds;
+  doc["triangles"] = model.mesh.triangle_count();
+  doc["bones"] = model.skeleton.joint_count();
+  doc["instances"] = options.instances;
+  doc["frames"] = options.frames;
+  doc["size"] = {options.width, options.height};
+  doc["samples"] = b.sample_count;
+  doc["pose_space"] = anim::pose_space_mode_name(options.pose_space.mode);
+  doc["bake"] = {{"sampling_ms", b.sampling_ms},
+                 {"assignment_ms", b.assignment_ms},
+                 {"build_ms", b.build_ms},
+                 {"fuzzy_area", b.fuzzy_area},
+                 {"rest_area", b.rest_area},
+                 {"mean_items_per_leaf", b.mean_items_per_leaf},
+                 {"max_depth", b.max_depth},
+                 {"node_count", b.node_count},
+                 {"pose_sampling_ms", bake.pose_sampling_ms}};
+  doc["phases"] = phases;
+  doc["frame_ms"] = {{"median_ms", s.median_frame_ms}};
+  doc["rays"] = {{"primary", s.primary_rays}, {"shadow", s.shadow_rays}};
+  doc["escapes"] = {{"escaped_checks", s.escaped_checks},
+                    {"escaped_triangles", s.escaped_triangles},
+                    {"total_escaped_checks", s.total_escaped_checks},
+                    {"total_escaped_triangles", s.total_escaped_triangles}};
+  doc["fps"] = s.fps;
+  return doc.dump(2) + "\n";
+}
+
+Status write_outputs(const std::string& dir, const RenderOutputs& o) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) return make_error(ErrorCode::kIoError, dir, "--out", dir, "cannot create the folder: " + ec.message());
+  const std::filesystem::path base(dir);
+  SINEW_RETURN_IF_ERROR(write_png((base / "color.png").string(), o.width, o.height, 4, o.color_rgba8));
+  SINEW_RETURN_IF_ERROR(write_exr((base / "depth.exr").string(), o.width, o.height, 1, std::span<const float>(o.depth)));
+  SINEW_RETURN_IF_ERROR(write_exr((base / "triangle_id.exr").string(), o.width, o.height, 1,
+                                  std::span<const std::uint32_t>(o.triangle_id)));
+  return write_file_atomic((base / "stats.json").string(), o.stats_json);
+}
+
+void report(const RenderOptions& options, const std::string& line) {
+  if (options.progress) options.progress(line);
+}
+
+}  // namespace
+
+// --- conventions ------------------------------------------------------------
+
+Aabb rest_bounds(const ImportedModel& model) {
+  Aabb box;
+  const auto skin = rest_skinning(model, Affine3::identity());
+  if (!skin.ok()) return box;
+  for (std::size_t v = 0; v < model.mesh.vertex_count(); ++v) box.extend(rt::skin_point(model.mesh, v, *skin));
+  return box;
+}
+
+int up_axis_of(const Aabb& rest) {
+  const Vec3 e = rest.extent();
+  return e.y >= e.z ? 1 : 2;
+}
+
+Affine3 instance_placement(const Aabb& rest, int index) {
+  const Vec3 e = rest.extent();
+  const float spacing = kInstanceSpacing * std::max({e.x, e.y, e.z});
+  return Affine3::translation(axis_vector(0, static_cast<float>(index) * spacing));
+}
+
+double instance_time_offset(int index) { return kInstanceTimeStep * index; }
+
+rt::StaticMeshDesc ground_plane_for(const Aabb& rest, int instances) {
+  const int up = up_axis_of(rest);
+  const Vec3 e = rest.extent();
+  const float largest = std::max({e.x, e.y, e.z, 1e-3f});
+  // Centred under the row of instances and reaching well past it, so the
+  // ground fills the background of the default camera.
+  const Vec3 row_end = instance_placement(rest, std::max(instances - 1, 0)).translation_part();
+  const Vec3 centre = rest.center() + 0.5f * row_end;
+  const float reach = 10.0f * largest + 0.5f * glm::length(row_end);
+  const int a = (up + 1) % 3;
+  const int b = (up + 2) % 3;
+  rt::StaticMeshDesc ground;
+  for (int corner = 0; corner < 4; ++corner) {
+    Vec3 p(0.0f);
+    p[up] = rest.lower[up];
+    p[a] = centre[a] + ((corner & 1) ? reach : -reach);
+    p[b] = centre[b] + ((corner & 2) ? reach : -reach);
+    ground.positions.push_back(p);
+  }
+  ground.triangles = {{0, 1, 3}, {0, 3, 2}};
+  ground.material_colors = {Vec3(0.5f)};
+  return ground;
+}
+
+rt::StaticMeshDesc ground_plane_for(const ImportedModel& model, int instances) {
+  return ground_plane_for(rest_bounds(model), instances);
+}
+
+// --- the command --------------------------------------------------------------
+
+std::string render_usage() {
+  return usage_line() +
+         "\n\n"
+         "Imports a glTF (.gltf/.glb) or Cal3D (.cfg) model, bakes it in memory, poses it with one\n"
+         "clip and ray traces it. Writes DIR/color.png, DIR/depth.exr, DIR/triangle_id.exr and\n"
+         "DIR/stats.json.\n\n"
+         "  --out DIR                 output folder (created if missing; required)\n"
+         "  --clip NAME|#I            the clip, by name or index (default: the first; rest pose without clips)\n"
+         "  --time SECONDS            playback time, looping (default 0)\n"
+         "  --camera ex,ey,ez,tx,ty,tz,ux,uy,uz,fovy_deg\n"
+         "                            eye, target, up, vertical field of view (default: frames the\n"
+         "                            posed model from the front, +Z for Y-up models, -Y for Z-up)\n"
+         "  --size WxH                image size (default 512x512)\n"
+         "  --pose-space MODE         arbitrary|limits|clips|clip:NAME (default: clips, every key\n"
+         "                            and every 1/30 s of every clip)\n"
+         "  --clips a,b,c             the clips of --pose-space clips (default: all)\n"
+         "  --samples N               pose samples (random modes: default 1000; clip modes: 0 = all)\n"
+         "  --seed S                  seed of the random pose spaces (default 1)\n"
+         "  --limits FILE.json        joint limits, required by --pose-space limits\n"
+         "  --shadows on|off          shadow rays (default on)\n"
+         "  --light x,y,z             point light position (default: above-front of the model)\n"
+         "  --threads N               worker threads (default 0: all cores)\n"
+         "  --instances N             copies side by side along +X, each 0.37 s later (default 1)\n"
+         "  --frames N                frames rendered at 30 fps from --time; the last is written (default 1)\n"
+         "  --triangle-test fast|watertight   ray-triangle test (default fast)\n"
+         "  --bone-boxes exact|cheap  per-frame bone boxes (default exact)\n"
+         "  --fallback on|off         exact rendering of triangles outside their fuzzy boxes (default on)\n"
+         "  --help                    this text\n"
+         "The model's up axis is the larger of its rest bounds' Y and Z extents; a ground quad lies\n"
+         "under the rest bounds on that axis.\n";
+}
+
+Expected<RenderOptions> parse_render_options(const std::vector<std::string>& args) {
+  SINEW_ASSIGN_OR_RETURN(const cli::ParsedArgs parsed, cli::parse_args(args, render_flags()));
+  RenderOptions o;
+  if (parsed.has("--help") || parsed.has("-h")) {
+    o.help = true;
+    return o;
+  }
+  if (parsed.positionals.empty()) return invalid_argument("MODEL", "", "missing: the model file to render");
+  if (parsed.positionals.size() > 1) {
+    return invalid_argument("argument", parsed.positionals[1], "unexpected extra argument (only one MODEL)");
+  }
+  o.model_path = parsed.positionals.front();
+  SINEW_RETURN_IF_ERROR(parse_run(parsed, o));
+  SINEW_RETURN_IF_ERROR(parse_view(parsed, o));
+  SINEW_RETURN_IF_ERROR(parse_pose_space(parsed, o));
+  if (o.out_dir.empty()) return invalid_argument("--out", "", "missing: the output folder is required");
+  return o;
+}
+
+Expected<RenderOutputs> render_model(const RenderOptions& options) {
+  if (options.width < 1 || options.height < 1 || options.instances < 1 || options.frames < 1) {
+    return invalid_argument("options", std::to_string(options.width) + "x" + std::to_string(options.height),
+                            "size, instances and frames must be at least 1");
+  }
+  report(options, "importing " + options.model_path);
+  SINEW_ASSIGN_OR_RETURN(const ImportedModel model, load_model(options.model_path));
+  if (model.mesh.triangle_count() == 0) {
+    return make_error(ErrorCode::kInvalidData, options.model_path, "triangles", "0", "the model has no triangles");
+  }
+  SINEW_ASSIGN_OR_RETURN(const anim::Clip* clip, resolve_clip(model, options));
+
+  BakeRequest request;
+  request.pose_space = options.pose_space;
+  if (!options.limits_path.empty()) {
+    SINEW_ASSIGN_OR_RETURN(request.limits, anim::load_joint_limits(options.limits_path, model.skeleton));
+  }
+  JobSystem jobs(options.threads);
+  report(options, "baking (" + std::string(anim::pose_space_mode_name(request.pose_space.mode)) + " pose space)");
+  SINEW_ASSIGN_OR_RETURN(const InMemoryBake bake, bake_in_memory(model, request, jobs));
+
+  RenderOutputs out;
+  out.width = options.width;
+  out.height = options.height;
+  out.clip_name = clip != nullptr ? clip->name() : "";
+  const Aabb rest = rest_bounds(model);
+  const int up = up_axis_of(rest);
+
+  // Scene: the instances first (ids 0..n-1), then the ground.
+  rt::Scene scene;
+  SINEW_ASSIGN_OR_RETURN(const std::uint32_t character, scene.add_character(model.mesh, bake.fuzzy.view()));
+  std::vector<std::uint32_t> instance_ids;
+  for (int i = 0; i < options.instances; ++i) {
+    SINEW_ASSIGN_OR_RETURN(const std::uint32_t id, scene.add_instance(character));
+    instance_ids.push_back(id);
+    out.instance_placements.push_back(instance_placement(rest, i));
+  }
+  out.ground = ground_plane_for(rest, options.instances);
+  SINEW_ASSIGN_OR_RETURN(out.ground_instance_id, scene.add_static_mesh(out.ground));
+
+  rt::FrameOptions frame_options;
+  frame_options.bone_boxes = options.bone_boxes;
+  frame_options.fallback = options.fallback;
+  rt::RenderSettings settings;
+  settings.triangle_test = options.triangle_test;
+  settings.shadows = options.shadows;
+
+  const std::size_t pixels = static_cast<std::size_t>(options.width) * static_cast<std::size_t>(options.height);
+  out.color_rgba8.assign(4 * pixels, 0);
+  out.depth.assign(pixels, 0.0f);
+  out.triangle_id.assign(pixels, 0);
+  out.instance_id.assign(pixels, 0);
+  rt::FrameBuffers buffers;
+  buffers.width = options.width;
+  buffers.height = options.height;
+  buffers.color_rgba8 = out.color_rgba8;
+  buffers.depth = out.depth;
+  buffers.triangle_id = out.triangle_id;
+  buffers.instance_id = out.instance_id;
+
+  report(options, "rendering " + std::to_string(options.frames) + " frame(s) at " + std::to_string(options.width) +
+                      "x" + std::to_string(options.height));
+  rt::Renderer renderer;
+  std::optional<rt::PinholeCamera> camera;
+  std::vector<double> frame_ms;
+  std::vector<std::vector<Affine3>> bones(instance_ids.size());
+  RenderStatsSummary& stats = out.stats;
+  for (int f = 0; f < options.frames; ++f) {
+    const double seconds = options.time_seconds + f / kFramesPerSecond;
+    PhaseTimers frame_timers;
+    {
+      ScopedPhase animation(frame_timers, "animation");
+      for (std::size_t i = 0; i < instance_ids.size(); ++i) {
+        const int index = static_cast<int>(i);
+        SINEW_ASSIGN_OR_RETURN(bones[i], pose_instance(model, clip, seconds + instance_time_offset(index),
+                                                       out.instance_placements[i]));
+        SINEW_RETURN_IF_ERROR(scene.set_bones(instance_ids[i], bones[i]));
+      }
+    }
+    SINEW_ASSIGN_OR_RETURN(const rt::FrameStats frame, scene.prepare_frame(frame_options, jobs, &frame_timers));
+    if (!camera) {
+      // Framed once, on the first frame's pose, so every frame shares one view.
+      const Aabb posed = posed_bounds(scene);
+      out.camera = options.camera ? *options.camera : frame_bounds(posed, up, options.width, options.height);
+      out.light.position = options.light ? *options.light : default_light(posed, up);
+      settings.light = out.light;
+      SINEW_ASSIGN_OR_RETURN(camera, rt::PinholeCamera::create(out.camera, options.width, options.height));
+    }
+    SINEW_ASSIGN_OR_RETURN(const rt::RenderStats rendered,
+                           renderer.render(scene, *camera, settings, buffers, jobs, &frame_timers));
+
+    double total = 0.0;
+    for (const PhaseSummary& phase : frame_timers.summarize()) {
+      const double ms = phase.mean_ms * static_cast<double>(phase.samples);
+      out.timers.record(phase.name, ms);
+      total += ms;
+    }
+    frame_ms.push_back(total);
+    stats.primary_rays = rendered.primary_rays;
+    stats.shadow_rays = rendered.shadow_rays;
+    stats.escaped_checks = frame.escaped_checks;
+    stats.escaped_triangles = frame.escaped_triangles;
+    stats.total_escaped_checks += frame.escaped_checks;
+    stats.total_escaped_triangles += frame.escaped_triangles;
+    out.last_frame_seconds = seconds;
+  }
+  stats.triangles = model.mesh.triangle_count();
+  stats.bones = model.skeleton.joint_count();
+  stats.pose_samples = bake.fuzzy.stats.sample_count;
+  stats.median_frame_ms = median_of(frame_ms);
+  stats.fps = stats.median_frame_ms > 0.0 ? 1000.0 / stats.median_frame_ms : 0.0;
+  SINEW_ASSIGN_OR_RETURN(out.stats_json, stats_document(options, model, bake, out));
+
+  if (!options.out_dir.empty()) {
+    report(options, "writing " + options.out_dir);
+    SINEW_RETURN_IF_ERROR(write_outputs(options.out_dir, out));
+  }
+  return out;
+}
+
+namespace {
+
+void print_summary(const RenderOptions& options, const RenderOutputs& o, std::ostream& out) {
+  const RenderStatsSummary& s = o.stats;
+  std::ostringstream text;
+  text.setf(std::ios::fixed);
+  text.precision(2);
+  text << options.model_path << ": " << s.triangles << " triangles, " << s.bones << " bones, " << options.instances
+       << (options.instances == 1 ? " instance" : " instances") << ", clip "
+       << (o.clip_name.empty() ? std::string("(rest pose)") : "'" + o.clip_name + "'") << ", " << s.pose_samples
+       << " pose samples\n";
+  text << o.width << "x" << o.height << ", " << options.frames << (options.frames == 1 ? " frame" : " frames")
+       << ": " << s.fps << " fps (median frame " << s.median_frame_ms << " ms)\n";
+  for (const PhaseSummary& phase : o.timers.summarize()) {
+    text << "  " << phase.name << std::string(phase.name.size() < 14 ? 14 - phase.name.size() : 1, ' ')
+         << phase.median_ms << " ms\n";
+  }
+  text << "escapes (last frame): " << s.escaped_checks << " checks, " << s.escaped_triangles
+       << " triangles; over all frames: " << s.total_escaped_checks << " checks, " << s.total_escaped_triangles
+       << " triangles\n";
+  text << "wrote " << options.out_dir << "/{color.png,depth.exr,triangle_id.exr,stats.json}\n";
+  out << text.str();
+}
+
+}  // namespace
+
+int run_render(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
+  auto options = parse_render_options(args);
+  if (!options.ok()) {
+    err << "sinew-editor render: " << options.status().message() << "\n" << usage_line() << "\n";
+    return 2;
+  }
+  if (options->help) {
+    out << render_usage();
+    return 0;
+  }
+  // Progress lines only for a person watching a terminal.
+  if (&out == &std::cout && ::isatty(STDOUT_FILENO) == 1) {
+    options->progress = [&out](std::string_view line) { out << line << "..." << std::endl; };
+  }
+  const auto outputs = render_model(*options);
+  if (!outputs.ok()) {
+    err << "sinew-editor: " << outputs.status().message() << "\n";
+    return 1;
+  }
+  print_summary(*options, *outputs, out);
+  return 0;
+}
+
+}  // namespace sinew::editor

@@ -1,0 +1,134 @@
+// `sinew-editor render`: import a model, bake it in memory, pose it with one
+// clip, ray trace it and write the image, its AOVs and timing stats.
+//
+//   sinew-editor render MODEL [--clip NAME] [--time SECONDS] [--camera ex,ey,ez,tx,ty,tz,ux,uy,uz,fovy_deg]
+//       [--size WxH] --out DIR [--pose-space arbitrary|limits|clips|clip:NAME] [--clips a,b,c]
+//       [--samples N] [--seed S] [--shadows on|off] [--light x,y,z] [--threads N] [--instances N]
+//       [--frames N] [--triangle-test fast|watertight] [--bone-boxes exact|cheap]
+//       [--fallback on|off] [--limits FILE.json]
+//
+// Writes DIR/color.png (RGBA8, sRGB), DIR/depth.exr (float32: distance along
+// the unit primary ray, +inf on a miss), DIR/triangle_id.exr (uint32,
+// 0xFFFFFFFF on a miss) and DIR/stats.json.
+//
+// Conventions of the defaults (the model's own axes; nothing is re-oriented):
+// * Rest bounds: the model skinned at its skeleton's rest pose.
+// * Up axis: whichever of Y and Z has the larger rest-bounds extent (glTF
+//   characters are Y-up, Cal3D ones usually Z-up). Front: +Z for Y-up
+//   models, -Y for Z-up models; right: +X in both (the image's right-hand
+//   side when the camera looks back along -front with that up).
+// * Instances: instance i is moved by i * 1.2 * (largest rest extent) along
+//   +X and plays the clip 0.37 s * i later than --time.
+// * Ground: a quad (2 triangles, a static mesh added after the instances)
+//   at the rest bounds' lowest up coordinate, reaching far beyond them.
+// * Camera (no --camera): looks at the centre of all instances' posed
+//   bounds at the first frame from the front, slightly above, far enough
+//   that the bounds' sphere fits the smaller of the two fields of view,
+//   fovy 40 degrees.
+// * Light (no --light): a point light above-front-right of those bounds.
+// * --clip: default the model's first clip; a model without clips is
+//   rendered at its rest pose.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <ostream>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "animation/pose_space.h"
+#include "editor/bake/in_memory_bake.h"
+#include "editor/import/imported_model.h"
+#include "raytrace/camera/camera.h"
+#include "raytrace/geometry/triangle_intersect.h"
+#include "raytrace/render/renderer.h"
+#include "raytrace/scene/scene.h"
+#include "runtime/core/expected.h"
+#include "runtime/math/aabb.h"
+#include "runtime/timing/phase_timers.h"
+
+namespace sinew::editor {
+
+struct RenderOptions {
+  std::string model_path;
+  std::string clip;  // name or "#index"; empty: the first clip (rest pose without clips)
+  double time_seconds = 0.0;
+  std::optional<rt::CameraDesc> camera;  // empty: framed automatically
+  int width = 512;
+  int height = 512;
+  std::string out_dir;  // empty: nothing is written (in-process use)
+  anim::PoseSpaceDesc pose_space = default_pose_space();
+  std::string limits_path;         // joint limits JSON, for pose space "limits"
+  bool shadows = true;
+  std::optional<Vec3> light;  // empty: placed automatically
+  int threads = 0;            // 0: all cores
+  int instances = 1;
+  int frames = 1;
+  rt::TriangleTest triangle_test = rt::TriangleTest::kFast;
+  rt::BoneBoxMode bone_boxes = rt::BoneBoxMode::kExact;
+  bool fallback = true;
+  // Called with one line per step (import, bake, frames, write); null: quiet.
+  std::function<void(std::string_view)> progress;
+  bool help = false;
+};
+
+// Parses the arguments after "render". Errors name the flag and the value;
+// they are usage errors (exit code 2).
+Expected<RenderOptions> parse_render_options(const std::vector<std::string>& args);
+std::string render_usage();
+
+struct RenderStatsSummary {
+  std::size_t triangles = 0;
+  std::size_t bones = 0;
+  std::uint32_t pose_samples = 0;
+  double fps = 0.0;
+  double median_frame_ms = 0.0;
+  std::uint64_t primary_rays = 0;  // last frame
+  std::uint64_t shadow_rays = 0;   // last frame
+  std::size_t escaped_checks = 0;  // last frame
+  std::size_t escaped_triangles = 0;
+  std::size_t total_escaped_checks = 0;  // over all frames
+  std::size_t total_escaped_triangles = 0;
+};
+
+// Everything the last frame produced, for tests and callers in-process.
+struct RenderOutputs {
+  int width = 0;
+  int height = 0;
+  std::vector<std::uint8_t> color_rgba8;
+  std::vector<float> depth;
+  std::vector<std::uint32_t> triangle_id;
+  std::vector<std::uint32_t> instance_id;
+  rt::CameraDesc camera;   // the camera used (given or framed)
+  rt::Light light;         // the light used
+  std::string clip_name;   // empty: rest pose
+  double last_frame_seconds = 0.0;  // playback time of instance 0 in the written frame
+  std::vector<Affine3> instance_placements;  // per instance: model -> world
+  rt::StaticMeshDesc ground;                 // world space
+  std::uint32_t ground_instance_id = 0;      // Hit::instance_id of the ground
+  PhaseTimers timers;                        // one sample per phase per frame
+  RenderStatsSummary stats;
+  std::string stats_json;  // what stats.json holds
+};
+
+// The axis conventions above, exposed for tests.
+Aabb rest_bounds(const ImportedModel& model);
+int up_axis_of(const Aabb& rest);
+// Instance i's placement and clip time offset.
+Affine3 instance_placement(const Aabb& rest, int index);
+double instance_time_offset(int index);
+// The ground quad under `rest` sized for `instances` instances.
+rt::StaticMeshDesc ground_plane_for(const Aabb& rest, int instances);
+rt::StaticMeshDesc ground_plane_for(const ImportedModel& model, int instances = 1);
+
+// Runs the whole command in-process. Errors (user errors, exit code 1) name
+// the file, the field and the value.
+Expected<RenderOutputs> render_model(const RenderOptions& options);
+
+// The subcommand: arguments after "render". Returns the exit code: 0
+// success, 1 user error, 2 usage error; one message on `err` on failure.
+int run_render(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
+
+}  // namespace sinew::editor

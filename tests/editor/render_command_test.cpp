@@ -1,0 +1,486 @@
+// sinew-editor render, in-process: the files it writes read back as
+// written; its depth and triangle-id AOVs agree with an independent brute
+// force (the model imported and posed again here, every triangle
+// intersected one by one); multi-frame stats and instances; and every kind
+// of bad input gives exit code 2 (usage) or 1 (user error) with one message
+// naming the flag or file and the value.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "editor/bake/in_memory_bake.h"
+#include "editor/cli/cli_args.h"
+#include "editor/cli/render_command.h"
+#include "editor/import/gltf_importer.h"
+#include "raytrace/camera/camera.h"
+#include "raytrace/geometry/triangle_intersect.h"
+#include "raytrace/skinning/skinning.h"
+#include "runtime/image/image_io.h"
+#include "runtime/io/atomic_file.h"
+#if SINEW_HAVE_CAL3D
+#include "editor/import/cal3d_importer.h"
+#endif
+
+namespace sinew::editor {
+namespace {
+
+const std::string kCesiumMan = std::string(SINEW_SHARED_DIR) + "/content/gltf/CesiumMan/CesiumMan.glb";
+const std::string kCally = std::string(SINEW_SHARED_DIR) + "/content/cal3d/cally/cally.cfg";
+
+std::string fresh_dir(const std::string& name) {
+  const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / ("sinew_render_command_" + name);
+  std::filesystem::remove_all(dir);
+  return dir.string();
+}
+
+// Small, quick renders: a handful of pose samples is enough for tests that
+// are not about the bake (the fallback keeps any pose exact).
+RenderOptions small_options(const std::string& model) {
+  RenderOptions o;
+  o.model_path = model;
+  o.width = 96;
+  o.height = 96;
+  o.pose_space.samples = 24;
+  o.threads = 2;
+  return o;
+}
+
+// --- files and stats -----------------------------------------------------------
+
+TEST(RenderCommand, WritesFilesThatReadBackAsRendered) {
+  RenderOptions o = small_options(kCesiumMan);
+  o.time_seconds = 0.3;
+  o.out_dir = fresh_dir("files");
+  const auto outputs = render_model(o);
+  ASSERT_TRUE(outputs.ok()) << outputs.status().message();
+  const std::size_t pixels = 96 * 96;
+
+  const auto color = read_image(o.out_dir + "/color.png");
+  ASSERT_TRUE(color.ok()) << color.status().message();
+  EXPECT_EQ(color->desc.width, 96);
+  EXPECT_EQ(color->desc.height, 96);
+  EXPECT_EQ(color->desc.channels, 4);
+  EXPECT_EQ(color->desc.type, PixelType::kU8);
+  const auto rgba = color->as<std::uint8_t>();
+  ASSERT_EQ(rgba.size(), 4 * pixels);
+  EXPECT_TRUE(std::equal(rgba.begin(), rgba.end(), outputs->color_rgba8.begin()));
+
+  const auto depth = read_image(o.out_dir + "/depth.exr");
+  ASSERT_TRUE(depth.ok()) << depth.status().message();
+  EXPECT_EQ(depth->desc.channels, 1);
+  EXPECT_EQ(depth->desc.type, PixelType::kF32);
+  const auto d = depth->as<float>();
+  ASSERT_EQ(d.size(), pixels);
+  std::size_t misses = 0;
+  for (std::size_t i = 0; i < pixels; ++i) {
+    ASSERT_TRUE(d[i] == outputs->depth[i]) << "pixel " << i;  // +inf compares equal too
+    if (std::isinf(d[i])) ++misses;
+  }
+
+  const auto ids = read_image(o.out_dir + "/triangle_id.exr");
+  ASSERT_TRUE(ids.ok()) << ids.status().message();
+  EXPECT_EQ(ids->desc.channels, 1);
+  EXPECT_EQ(ids->desc.type, PixelType::kU32);
+  const auto t = ids->as<std::uint32_t>();
+  ASSERT_EQ(t.size(), pixels);
+  EXPECT_TRUE(std::equal(t.begin(), t.end(), outputs->triangle_id.begin()));
+  // The default camera sees the model, the ground and some sky.
+  EXPECT_EQ(std::count(t.begin(), t.end(), kInvalidId), static_cast<std::ptrdiff_t>(misses));
+  EXPECT_GT(misses, 0u);
+  EXPECT_LT(misses, pixels);
+  EXPECT_GT(std::count(outputs->instance_id.begin(), outputs->instance_id.end(), 0u), 100);
+
+  const auto text = read_file_text(o.out_dir + "/stats.json");
+  ASSERT_TRUE(text.ok()) << text.status().message();
+  const nlohmann::json stats = nlohmann::json::parse(*text, nullptr, false);
+  ASSERT_FALSE(stats.is_discarded()) << *text;
+  EXPECT_EQ(*text, outputs->stats_json);
+  EXPECT_EQ(stats["model"], kCesiumMan);
+  EXPECT_EQ(stats["triangles"], 4672);  // CesiumMan's one primitive
+  EXPECT_EQ(stats["bones"], 19);
+  EXPECT_EQ(stats["instances"], 1);
+  EXPECT_EQ(stats["size"], nlohmann::json::array({96, 96}));
+  EXPECT_GT(stats["samples"].get<int>(), 1);
+  EXPECT_LE(stats["samples"].get<int>(), 24);
+  for (const char* key : {"sampling_ms", "assignment_ms", "build_ms", "fuzzy_area", "mean_items_per_leaf",
+                          "max_depth", "pose_sampling_ms"}) {
+    EXPECT_TRUE(stats["bake"].contains(key)) << key;
+  }
+  EXPECT_GT(stats["bake"]["fuzzy_area"].get<double>(), 0.0);
+  for (const char* phase : {"animation", "skinning", "boxes", "fallback", "top level", "trace primary",
+                            "trace shadow", "shade"}) {
+    ASSERT_TRUE(stats["phases"].contains(phase)) << phase;
+    EXPECT_EQ(stats["phases"][phase]["samples"], 1) << phase;
+    EXPECT_GE(stats["phases"][phase]["median_ms"].get<double>(), 0.0) << phase;
+    EXPECT_GE(stats["phases"][phase]["min_ms"].get<double>(), 0.0) << phase;
+  }
+  EXPECT_EQ(stats["rays"]["primary"], pixels);
+  // Shadows are on: at most one shadow ray per hit (hits facing away from
+  // the light need none).
+  EXPECT_LE(stats["rays"]["shadow"].get<std::size_t>(), pixels - misses);
+  EXPECT_GT(stats["rays"]["shadow"].get<std::size_t>(), (pixels - misses) / 2);
+  for (const char* key : {"escaped_checks", "escaped_triangles", "total_escaped_checks", "total_escaped_triangles"}) {
+    EXPECT_TRUE(stats["escapes"].contains(key)) << key;
+  }
+  EXPECT_GT(stats["fps"].get<double>(), 0.0);
+}
+
+// --- AOVs against brute force ------------------------------------------------
+
+struct SoupTriangle {
+  Vec3 p0, p1, p2;
+  bool ground = false;
+  std::uint32_t id = 0;  // triangle id within the model or the ground
+};
+
+struct RefHit {
+  float t = std::numeric_limits<float>::infinity();
+  const SoupTriangle* triangle = nullptr;
+};
+
+RefHit nearest(const std::vector<SoupTriangle>& soup, const Ray& ray) {
+  const rt::WatertightRay wr = rt::prepare_watertight(ray);
+  RefHit best;
+  for (const SoupTriangle& tri : soup) {
+    rt::TriangleHit h;
+    if (rt::intersect_triangle_watertight(wr, ray, best.t, tri.p0, tri.p1, tri.p2, h)) best = {h.t, &tri};
+  }
+  return best;
+}
+
+Expected<ImportedModel> import_any(const std::string& path) {
+#if SINEW_HAVE_CAL3D
+  if (path.ends_with(".cfg")) return import_cal3d(path);
+#endif
+  return import_gltf(path);
+}
+
+// The model posed again from scratch: clip_skinning at the same time, each
+// vertex skinned with the scalar reference, plus the ground quad.
+std::vector<SoupTriangle> posed_soup(const ImportedModel& model, const anim::Clip& clip, double seconds,
+                                     const rt::StaticMeshDesc& ground) {
+  const auto bones = clip_skinning(model, clip, seconds);
+  EXPECT_TRUE(bones.ok()) << bones.status().message();
+  if (!bones.ok()) return {};
+  std::vector<Vec3> world(model.mesh.vertex_count());
+  for (std::size_t v = 0; v < world.size(); ++v) world[v] = rt::skin_point(model.mesh, v, *bones);
+  std::vector<SoupTriangle> soup;
+  for (std::uint32_t t = 0; t < model.mesh.triangle_count(); ++t) {
+    const auto& tri = model.mesh.triangles[t];
+    soup.push_back({world[tri[0]], world[tri[1]], world[tri[2]], false, t});
+  }
+  for (std::uint32_t t = 0; t < ground.triangles.size(); ++t) {
+    const auto& tri = ground.triangles[t];
+    soup.push_back({ground.positions[tri[0]], ground.positions[tri[1]], ground.positions[tri[2]], true, t});
+  }
+  return soup;
+}
+
+bool near(float a, float b) { return std::fabs(a - b) <= 1e-5f * std::max(std::fabs(b), 1e-30f); }
+
+void expect_aovs_match_brute_force(const std::string& path, double seconds) {
+  RenderOptions o = small_options(path);
+  o.clip = "#0";
+  o.time_seconds = seconds;
+  o.triangle_test = rt::TriangleTest::kWatertight;
+  const auto outputs = render_model(o);
+  ASSERT_TRUE(outputs.ok()) << outputs.status().message();
+
+  const auto model = import_any(path);
+  ASSERT_TRUE(model.ok()) << model.status().message();
+  ASSERT_FALSE(model->clips.empty());
+  // The ground the command added, derived again from the model alone.
+  const rt::StaticMeshDesc ground = ground_plane_for(*model, 1);
+  ASSERT_EQ(ground.positions.size(), outputs->ground.positions.size());
+  for (std::size_t i = 0; i < ground.positions.size(); ++i) EXPECT_EQ(ground.positions[i], outputs->ground.positions[i]);
+  const std::vector<SoupTriangle> soup = posed_soup(*model, model->clips.front(), seconds, ground);
+  const auto camera = rt::PinholeCamera::create(outputs->camera, o.width, o.height);
+  ASSERT_TRUE(camera.ok()) << camera.status().message();
+
+  std::size_t checked = 0, model_hits = 0, ground_hits = 0, wrong = 0;
+  std::string first;
+  for (int y = 0; y < o.height; y += 2) {
+    for (int x = 0; x < o.width; x += 2) {
+      const Ray ray = camera->ray(x, y);
+      const RefHit ref = nearest(soup, ray);
+      const std::size_t i = static_cast<std::size_t>(y * o.width + x);
+      const float depth = outputs->depth[i];
+      const std::uint32_t tri = outputs->triangle_id[i];
+      const std::uint32_t inst = outputs->instance_id[i];
+      ++checked;
+      bool ok = true;
+      if (ref.triangle == nullptr) {
+        ok = std::isinf(depth) && depth > 0.0f && tri == kInvalidId && inst == kInvalidId;
+      } else {
+        ok = near(depth, ref.t);
+        const bool ours_ground = inst == outputs->ground_instance_id;
+        ok = ok && (inst == 0 || ours_ground);
+        if (ok && (ref.triangle->ground != ours_ground || ref.triangle->id != tri)) {
+          // Another triangle at the same t: a shared edge or vertex. It must
+          // really be hit there.
+          ok = false;
+          for (const SoupTriangle& s : soup) {
+            if (s.ground != ours_ground || s.id != tri) continue;
+            rt::TriangleHit h;
+            ok = rt::intersect_triangle_watertight(rt::prepare_watertight(ray), ray,
+                                                   std::numeric_limits<float>::infinity(), s.p0, s.p1, s.p2, h) &&
+                 near(h.t, ref.t);
+          }
+        }
+        (ref.triangle->ground ? ground_hits : model_hits) += 1;
+      }
+      if (!ok && wrong++ == 0) {
+        first = "pixel (" + std::to_string(x) + "," + std::to_string(y) + "): depth " + std::to_string(depth) +
+                " tri " + std::to_string(tri) + " inst " + std::to_string(inst) + "; reference t " +
+                std::to_string(ref.t) + " tri " + (ref.triangle ? std::to_string(ref.triangle->id) : "-") +
+                (ref.triangle && ref.triangle->ground ? " (ground)" : "");
+      }
+    }
+  }
+  EXPECT_EQ(wrong, 0u) << "of " << checked << "; first: " << first;
+  // Not vacuous: the default camera sees plenty of both.
+  EXPECT_GT(model_hits, checked / 20);
+  EXPECT_GT(ground_hits, checked / 20);
+}
+
+TEST(RenderCommand, AovsMatchBruteForceCesiumMan) { expect_aovs_match_brute_force(kCesiumMan, 0.7); }
+
+#if SINEW_HAVE_CAL3D
+TEST(RenderCommand, AovsMatchBruteForceCally) { expect_aovs_match_brute_force(kCally, 0.45); }
+#endif
+
+// --- frames and instances ------------------------------------------------------
+
+TEST(RenderCommand, FramesRecordOneSamplePerPhasePerFrame) {
+  RenderOptions o = small_options(kCesiumMan);
+  o.frames = 3;
+  o.time_seconds = 0.25;
+  const auto outputs = render_model(o);
+  ASSERT_TRUE(outputs.ok()) << outputs.status().message();
+  const auto phases = outputs->timers.summarize();
+  ASSERT_EQ(phases.size(), 8u);
+  for (const PhaseSummary& p : phases) EXPECT_EQ(p.samples, 3u) << p.name;
+  const nlohmann::json stats = nlohmann::json::parse(outputs->stats_json);
+  EXPECT_EQ(stats["frames"], 3);
+  EXPECT_EQ(stats["phases"]["trace primary"]["samples"], 3);
+  EXPECT_NEAR(outputs->last_frame_seconds, 0.25 + 2.0 / 30.0, 1e-12);
+  EXPECT_NEAR(stats["fps"].get<double>(), 1000.0 / outputs->stats.median_frame_ms, 1e-9);
+}
+
+TEST(RenderCommand, InstancesStandSideBySideWithDifferentPoses) {
+  RenderOptions o = small_options(kCesiumMan);
+  o.instances = 2;
+  o.width = 128;
+  const auto outputs = render_model(o);
+  ASSERT_TRUE(outputs.ok()) << outputs.status().message();
+  EXPECT_EQ(outputs->ground_instance_id, 2u);
+  const std::set<std::uint32_t> seen(outputs->instance_id.begin(), outputs->instance_id.end());
+  EXPECT_TRUE(seen.count(0) && seen.count(1) && seen.count(2)) << "instances 0, 1 and the ground all visible";
+  ASSERT_EQ(outputs->instance_placements.size(), 2u);
+  const Vec3 offset = outputs->instance_placements[1].translation_part();
+  EXPECT_GT(offset.x, 0.0f);
+  EXPECT_EQ(offset.y, 0.0f);
+  EXPECT_EQ(offset.z, 0.0f);
+
+  // The second instance plays 0.37 s later: posed differently from the first.
+  const auto model = import_gltf(kCesiumMan);
+  ASSERT_TRUE(model.ok());
+  const auto a = clip_skinning(*model, model->clips.front(), 0.0);
+  const auto b = clip_skinning(*model, model->clips.front(), instance_time_offset(1));
+  ASSERT_TRUE(a.ok() && b.ok());
+  EXPECT_EQ(instance_time_offset(1), 0.37);
+  bool differ = false;
+  for (std::size_t j = 0; j < a->size(); ++j) differ = differ || (*a)[j].rows != (*b)[j].rows;
+  EXPECT_TRUE(differ);
+}
+
+TEST(RenderCommand, UpAxisIsTheLargerOfYAndZ) {
+  EXPECT_EQ(up_axis_of(Aabb{Vec3(0.0f), Vec3(5.0f, 2.0f, 1.0f)}), 1);
+  EXPECT_EQ(up_axis_of(Aabb{Vec3(0.0f), Vec3(5.0f, 1.0f, 2.0f)}), 2);
+  const rt::StaticMeshDesc ground = ground_plane_for(Aabb{Vec3(-1.0f, -0.5f, 0.0f), Vec3(1.0f, 0.5f, 3.0f)}, 1);
+  ASSERT_EQ(ground.triangles.size(), 2u);
+  for (const Vec3& p : ground.positions) EXPECT_EQ(p.z, 0.0f);  // Z-up: under the box's lowest z
+}
+
+// --- errors --------------------------------------------------------------------
+
+struct RunResult {
+  int code = 0;
+  std::string out;
+  std::string err;
+};
+
+RunResult run(std::vector<std::string> args) {
+  std::ostringstream out, err;
+  RunResult r;
+  r.code = run_render(args, out, err);
+  r.out = out.str();
+  r.err = err.str();
+  return r;
+}
+
+TEST(RenderCommand, UsageErrorsNameTheFlagAndValue) {
+  const std::string dir = fresh_dir("usage");
+  struct Case {
+    std::vector<std::string> args;
+    std::string message;
+  };
+  const std::vector<Case> cases = {
+      {{kCesiumMan, "--out", dir, "--bogus", "1"}, "option = --bogus: unknown option"},
+      {{kCesiumMan, "--out", dir, "--size", "0x5"}, "--size = 0x5: expected WxH"},
+      {{kCesiumMan, "--out", dir, "--size", "64"}, "--size = 64: expected WxH"},
+      {{kCesiumMan, "--out", dir, "--camera", "0,1,4,0,1,0,0,1,0"}, "--camera = 0,1,4,0,1,0,0,1,0: expected 10"},
+      {{kCesiumMan, "--out", dir, "--camera", "0,1,4,0,1,0,0,1,0,180"}, "--camera = 0,1,4,0,1,0,0,1,0,180: "},
+      {{kCesiumMan, "--out", dir, "--shadows", "maybe"}, "--shadows = maybe: expected one of on|off"},
+      {{kCesiumMan, "--out", dir, "--frames", "0"}, "--frames = 0: expected an integer from 1"},
+      {{kCesiumMan, "--out", dir, "--threads", "two"}, "--threads = two: expected an integer"},
+      {{kCesiumMan, "--out", dir, "--time", "nan"}, "--time = nan: expected a number"},
+      {{kCesiumMan, "--out", dir, "--light", "1,2"}, "--light = 1,2: expected 3"},
+      {{kCesiumMan, "--out", dir, "--pose-space", "limits"}, "--pose-space = limits: needs --limits"},
+      {{kCesiumMan, "--out", dir, "--pose-space", "clip"}, "--pose-space = clip: expected"},
+      {{kCesiumMan, "--out", dir, "--pose-space", "arbitrary", "--clips", "a"}, "--clips = a: applies to"},
+      {{kCesiumMan, "--out", dir, "--clip"}, "--clip: missing value"},
+      {{kCesiumMan}, "--out: missing"},
+      {{"--out", dir}, "MODEL: missing"},
+      {{kCesiumMan, "extra", "--out", dir}, "argument = extra: unexpected"},
+  };
+  for (const Case& c : cases) {
+    const RunResult r = run(c.args);
+    EXPECT_EQ(r.code, 2) << c.message;
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << "expected '" << c.message << "' in: " << r.err;
+    EXPECT_NE(r.err.find("usage: sinew-editor render"), std::string::npos) << r.err;
+    EXPECT_TRUE(r.out.empty()) << r.out;
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir)) << "nothing runs on a usage error";
+}
+
+TEST(RenderCommand, UserErrorsAreOneClearLine) {
+  const std::string dir = fresh_dir("user");
+  const std::string missing = dir + "-nope/CesiumMan.glb";
+  struct Case {
+    std::vector<std::string> args;
+    std::string message;
+  };
+  const std::vector<Case> cases = {
+      {{missing, "--out", dir}, "sinew-editor: " + missing + ": no such file"},
+      {{kCesiumMan, "--out", dir, "--clip", "nope"},
+       "sinew-editor: " + kCesiumMan + ": clip = 'nope': no such clip (clips: animation_0)"},
+      {{kCesiumMan, "--out", dir, "--clip", "#1"}, "clip = '#1': no such clip"},
+      {{"model.pack", "--out", dir}, "sinew-editor: model.pack: packs are not supported yet (editor issue)"},
+      {{"model.obj", "--out", dir}, "model.obj: extension = .obj: unsupported model format"},
+      {{kCesiumMan, "--out", dir, "--pose-space", "limits", "--limits", dir + "-nope.json"}, dir + "-nope.json"},
+  };
+  for (const Case& c : cases) {
+    const RunResult r = run(c.args);
+    EXPECT_EQ(r.code, 1) << c.message;
+    EXPECT_EQ(r.err.rfind(c.message, 0) == 0 || r.err.find(c.message) != std::string::npos, true)
+        << "expected '" << c.message << "' in: " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir + "/color.png"));
+}
+
+TEST(RenderCommand, HelpPrintsUsageAndSucceeds) {
+  const RunResult r = run({"--help"});
+  EXPECT_EQ(r.code, 0);
+  EXPECT_EQ(r.out.rfind("usage: sinew-editor render MODEL", 0), 0u) << r.out;
+  EXPECT_NE(r.out.find("--triangle-test fast|watertight"), std::string::npos);
+  EXPECT_TRUE(r.err.empty());
+}
+
+TEST(RenderCommand, OptionsMapToTheirSettings) {
+  const auto o = parse_render_options({"m.glb", "--out=o", "--size", "64x32", "--pose-space", "clip:walk",
+                                       "--samples", "0", "--triangle-test", "watertight", "--bone-boxes", "cheap",
+                                       "--fallback", "off", "--shadows", "off", "--camera",
+                                       "1,2,3,0,0,0,0,0,1,30", "--light", "4,5,6", "--instances", "3",
+                                       "--time", "1.5"});
+  ASSERT_TRUE(o.ok()) << o.status().message();
+  EXPECT_EQ(o->model_path, "m.glb");
+  EXPECT_EQ(o->out_dir, "o");
+  EXPECT_EQ(o->width, 64);
+  EXPECT_EQ(o->height, 32);
+  EXPECT_EQ(o->pose_space.mode, anim::PoseSpaceMode::kClip);
+  EXPECT_EQ(o->pose_space.clips, std::vector<std::string>{"walk"});
+  EXPECT_EQ(o->triangle_test, rt::TriangleTest::kWatertight);
+  EXPECT_EQ(o->bone_boxes, rt::BoneBoxMode::kCheap);
+  EXPECT_FALSE(o->fallback);
+  EXPECT_FALSE(o->shadows);
+  ASSERT_TRUE(o->camera.has_value());
+  EXPECT_EQ(o->camera->eye, Vec3(1.0f, 2.0f, 3.0f));
+  EXPECT_EQ(o->camera->up, Vec3(0.0f, 0.0f, 1.0f));
+  EXPECT_EQ(o->camera->fovy_degrees, 30.0f);
+  EXPECT_EQ(o->light, Vec3(4.0f, 5.0f, 6.0f));
+  EXPECT_EQ(o->instances, 3);
+  EXPECT_EQ(o->time_seconds, 1.5);
+
+  const auto d = parse_render_options({"m.glb", "--out", "o"});
+  ASSERT_TRUE(d.ok());
+  EXPECT_EQ(d->width, 512);
+  EXPECT_EQ(d->height, 512);
+  EXPECT_TRUE(d->shadows);
+  EXPECT_TRUE(d->fallback);
+  EXPECT_EQ(d->frames, 1);
+  EXPECT_EQ(d->instances, 1);
+  EXPECT_EQ(d->threads, 0);
+  EXPECT_FALSE(d->camera.has_value());
+  EXPECT_EQ(d->pose_space.mode, default_pose_space().mode);
+  EXPECT_EQ(d->pose_space.every_frame_30hz, default_pose_space().every_frame_30hz);
+
+  const auto r = parse_render_options({"m.glb", "--out", "o", "--pose-space", "arbitrary", "--samples", "50",
+                                       "--seed", "18446744073709551615"});
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  EXPECT_EQ(r->pose_space.mode, anim::PoseSpaceMode::kArbitrary);
+  EXPECT_EQ(r->pose_space.samples, 50);
+  EXPECT_EQ(r->pose_space.seed, 18446744073709551615ull);
+}
+
+TEST(CliArgs, ParsesTypedValuesAndRejectsBadOnes) {
+  using namespace cli;
+  const auto f = parse_floats("--v", "1,-2.5,3e2", 3);
+  ASSERT_TRUE(f.ok());
+  EXPECT_EQ(*f, (std::vector<float>{1.0f, -2.5f, 300.0f}));
+  EXPECT_FALSE(parse_floats("--v", "1,,3", 3).ok());
+  EXPECT_FALSE(parse_floats("--v", "1,2,inf", 3).ok());
+  EXPECT_FALSE(parse_floats("--v", "1,2,3,", 3).ok());
+  const auto s = parse_size("--size", "640x480", 1000);
+  ASSERT_TRUE(s.ok());
+  EXPECT_EQ(s->width, 640);
+  EXPECT_EQ(s->height, 480);
+  for (const char* bad : {"0x5", "5x0", "x5", "5x", "1001x5", "-5x5", "5x5x5", "5 x5"}) {
+    const auto e = parse_size("--size", bad, 1000);
+    ASSERT_FALSE(e.ok()) << bad;
+    EXPECT_EQ(e.status().field(), "--size");
+    EXPECT_EQ(e.status().value(), bad);
+  }
+  EXPECT_EQ(*parse_int("--n", "-7", -10, 10), -7);
+  EXPECT_FALSE(parse_int("--n", "11", -10, 10).ok());
+  EXPECT_FALSE(parse_int("--n", "1.5", -10, 10).ok());
+  EXPECT_EQ(*parse_double("--t", "0.25", 0.0, 1.0), 0.25);
+  EXPECT_FALSE(parse_double("--t", "1.5", 0.0, 1.0).ok());
+  EXPECT_EQ(*parse_choice("--c", "b", {"a", "b"}), 1);
+  EXPECT_EQ(parse_choice("--c", "z", {"a", "b"}).status().message(), "--c = z: expected one of a|b");
+  EXPECT_EQ(*parse_list("--l", "a,b"), (std::vector<std::string>{"a", "b"}));
+  EXPECT_FALSE(parse_list("--l", "a,,b").ok());
+
+  const std::vector<FlagSpec> specs = {{"--x"}, {"--on", false}};
+  const auto p = parse_args({"pos", "--x=1", "--on", "--", "--not-a-flag"}, specs);
+  ASSERT_TRUE(p.ok()) << p.status().message();
+  EXPECT_EQ(p->value("--x"), "1");
+  EXPECT_TRUE(p->has("--on"));
+  EXPECT_EQ(p->positionals, (std::vector<std::string>{"pos", "--not-a-flag"}));
+  EXPECT_EQ(parse_args({"--x", "1", "--x", "2"}, specs).status().message(), "--x = --x: given twice");
+  EXPECT_EQ(parse_args({"--on=1"}, specs).status().message(), "--on = --on=1: takes no value");
+  EXPECT_EQ(parse_args({"--y"}, specs).status().message(), "option = --y: unknown option (see --help)");
+  EXPECT_EQ(parse_args({"--x"}, specs).status().message(), "--x: missing value");
+}
+
+}  // namespace
+}  // namespace sinew::editor

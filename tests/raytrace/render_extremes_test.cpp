@@ -1,0 +1,386 @@
+// Beyond the sampled pose space and at numerical extremes (DESIGN.md
+// sections 4 and 5): escapes are detected and the fallback keeps every ray
+// exact; scales 1e-3 and 1e4, a character 1e5 units from the origin,
+// axis-parallel rays, origins on split planes, zero-area triangles and
+// zero-scale bones all match brute force. Also the renderer: its AOVs are
+// the traversal's hits, and images are identical for 1 and 2 threads.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "animation/pose_space.h"
+#include "content/mannequin/mannequin.h"
+#include "editor/bake/in_memory_bake.h"
+#include "raytrace/camera/camera.h"
+#include "raytrace/render/renderer.h"
+#include "raytrace/render/traversal.h"
+#include "raytrace/scene/scene.h"
+#include "runtime/jobs/job_system.h"
+#include "tests/support/brute_force.h"
+
+namespace sinew {
+namespace {
+
+using rt::TriangleTest;
+using testing_support::SoupTriangle;
+
+constexpr TriangleTest kTests[] = {TriangleTest::kFast, TriangleTest::kWatertight};
+
+float unit(std::mt19937_64& g) { return anim::unit_float(g()); }
+
+// The mannequin baked over one clip's keys: small and quick, and posing it
+// with another clip leaves that pose space.
+struct Mannequin {
+  editor::ImportedModel model;
+  editor::InMemoryBake bake;
+};
+
+const Mannequin& idle_mannequin() {
+  static const Mannequin m = [] {
+    Mannequin out;
+    out.model = content::make_mannequin().value();
+    editor::BakeRequest request;
+    request.pose_space.mode = anim::PoseSpaceMode::kClip;
+    request.pose_space.clips = {"idle"};
+    request.pose_space.samples = 0;
+    request.pose_space.every_frame_30hz = false;
+    JobSystem jobs(2);
+    out.bake = editor::bake_in_memory(out.model, request, jobs).value();
+    return out;
+  }();
+  return m;
+}
+
+std::vector<Affine3> pose(const editor::ImportedModel& model, const std::string& clip, double t,
+                          const Affine3& instance = Affine3::identity()) {
+  return editor::clip_skinning(model, *model.find_clip(clip), t, instance).value();
+}
+
+struct Checked {
+  std::size_t rays = 0;
+  std::size_t wrong = 0;
+  std::string first;
+};
+
+void check_ray(const rt::Scene& scene, std::span<const SoupTriangle> soup, const Ray& ray, Checked& c) {
+  for (const TriangleTest test : kTests) {
+    const Hit ours = rt::intersect(scene, ray, test);
+    const Hit ref = testing_support::nearest(soup, ray, test);
+    ++c.rays;
+    const bool ok = testing_support::same_nearest(ours, ref, soup, ray, test) &&
+                    rt::occluded(scene, ray, test) == ref.valid();
+    if (!ok && c.wrong++ == 0) {
+      c.first = "ray (" + std::to_string(ray.origin.x) + "," + std::to_string(ray.origin.y) + "," +
+                std::to_string(ray.origin.z) + ") dir (" + std::to_string(ray.direction.x) + "," +
+                std::to_string(ray.direction.y) + "," + std::to_string(ray.direction.z) + "): ours t=" +
+                std::to_string(ours.t) + " tri " + std::to_string(ours.triangle_id) + ", ref t=" +
+                std::to_string(ref.t) + " tri " + std::to_string(ref.triangle_id);
+    }
+  }
+}
+
+// Rays at the character from all around plus rays from inside it, half of
+// them aimed at triangle points, some axis-parallel.
+Checked check_scene(const rt::Scene& scene, std::size_t count, std::uint64_t seed) {
+  const std::vector<SoupTriangle> soup = testing_support::world_triangles(scene);
+  Aabb box;
+  for (const Vec3& p : scene.instances()[0].positions) box.extend(p);
+  const Vec3 c = box.center();
+  const Vec3 e = box.extent();
+  std::mt19937_64 g(seed);
+  Checked checked;
+  for (std::size_t i = 0; i < count; ++i) {
+    Ray ray;
+    ray.origin = c + Vec3(unit(g) - 0.5f, unit(g) - 0.5f, unit(g) - 0.5f) * e * 1.6f;
+    if (i % 3 == 0) {
+      ray.direction = Vec3(0.0f);
+      ray.direction[static_cast<int>(i / 3 % 3)] = (i % 2) ? 1.0f : -1.0f;
+    } else {
+      const SoupTriangle& tri = soup[g() % soup.size()];
+      const float u = unit(g);
+      const float v = unit(g) * (1.0f - u);
+      ray.direction = (1.0f - u - v) * tri.p0 + u * tri.p1 + v * tri.p2 - ray.origin;
+      if (ray.direction == Vec3(0.0f)) ray.direction = Vec3(0.0f, 0.0f, 1.0f);
+    }
+    check_ray(scene, soup, ray, checked);
+  }
+  return checked;
+}
+
+rt::Scene scene_with(const Mannequin& m, std::span<const Affine3> bones, const rt::FrameOptions& options,
+                     rt::FrameStats* stats_out = nullptr) {
+  rt::Scene scene;
+  const std::uint32_t character = scene.add_character(m.model.mesh, m.bake.fuzzy.view()).value();
+  const std::uint32_t instance = scene.add_instance(character).value();
+  EXPECT_TRUE(scene.set_bones(instance, bones).ok());
+  JobSystem jobs(2);
+  auto stats = scene.prepare_frame(options, jobs);
+  EXPECT_TRUE(stats.ok()) << stats.status().message();
+  if (stats_out && stats.ok()) *stats_out = *stats;
+  return scene;
+}
+
+TEST(RenderEscapes, PosesOutsideThePoseSpaceAreCountedAndTheFallbackKeepsRaysExact) {
+  const Mannequin& m = idle_mannequin();
+  const std::vector<Affine3> kick = pose(m.model, "kick", 0.4);
+  rt::FrameStats stats;
+  const rt::Scene scene = scene_with(m, kick, rt::FrameOptions{}, &stats);
+  EXPECT_GT(stats.escaped_checks, 0u) << "a kick is not an idle pose: vertices must escape";
+  EXPECT_GT(stats.escaped_triangles, 0u);
+  const Checked checked = check_scene(scene, 4000, 7);
+  EXPECT_EQ(checked.wrong, 0u) << checked.rays << " rays; first: " << checked.first;
+  RecordProperty("escaped_triangles", static_cast<int>(stats.escaped_triangles));
+}
+
+TEST(RenderEscapes, WithoutTheFallbackEscapesAreStillCounted) {
+  const Mannequin& m = idle_mannequin();
+  rt::FrameOptions options;
+  options.fallback = false;
+  rt::FrameStats stats;
+  const rt::Scene scene = scene_with(m, pose(m.model, "kick", 0.4), options, &stats);
+  EXPECT_GT(stats.escaped_checks, 0u);
+  EXPECT_EQ(stats.escaped_triangles, 0u) << "no fallback: nothing is routed";
+  // Holes are allowed here; how many is a benchmark figure, not a test.
+  const Checked checked = check_scene(scene, 2000, 8);
+  RecordProperty("wrong_rays_without_fallback", static_cast<int>(checked.wrong));
+}
+
+TEST(RenderEscapes, ASampledPoseHasNoEscapes) {
+  const Mannequin& m = idle_mannequin();
+  rt::FrameStats stats;
+  const rt::Scene scene = scene_with(m, pose(m.model, "idle", 0.0), rt::FrameOptions{}, &stats);
+  EXPECT_EQ(stats.escaped_checks, 0u);
+  EXPECT_EQ(stats.escaped_triangles, 0u);
+}
+
+struct Placement {
+  const char* name;
+  float scale;
+  Vec3 offset;
+};
+
+class RenderExtremes : public ::testing::TestWithParam<Placement> {};
+
+TEST_P(RenderExtremes, ScaledAndDistantCharactersMatchBruteForce) {
+  const Placement p = GetParam();
+  const Mannequin& m = idle_mannequin();
+  const Affine3 instance = Affine3::from_trs(p.offset, Quat(1.0f, 0.0f, 0.0f, 0.0f), Vec3(p.scale));
+  for (const rt::BoneBoxMode boxes : {rt::BoneBoxMode::kExact, rt::BoneBoxMode::kCheap}) {
+    rt::FrameOptions options;
+    options.bone_boxes = boxes;
+    rt::FrameStats stats;
+    const rt::Scene scene = scene_with(m, pose(m.model, "idle", 1.3, instance), options, &stats);
+    // Far from the origin float spacing is ~1 cm, so the traversal's
+    // rounding slack covers most of a bone's tree: correct but slow, so
+    // fewer rays there.
+    const Checked checked = check_scene(scene, p.offset == Vec3(0.0f) ? 3000 : 500, 11);
+    EXPECT_EQ(checked.wrong, 0u) << p.name << (boxes == rt::BoneBoxMode::kExact ? " exact" : " cheap")
+                                 << " boxes: " << checked.rays << " rays; first: " << checked.first;
+    RecordProperty(std::string(p.name) + "_escaped_checks", static_cast<int>(stats.escaped_checks));
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Placements, RenderExtremes,
+                         ::testing::Values(Placement{"unit", 1.0f, Vec3(0.0f)},
+                                           Placement{"millimetre", 1e-3f, Vec3(0.0f)},
+                                           Placement{"huge", 1e4f, Vec3(0.0f)},
+                                           Placement{"far", 1.0f, Vec3(1e5f, -3e4f, 7e4f)}),
+                         [](const ::testing::TestParamInfo<Placement>& param) { return std::string(param.param.name); });
+
+TEST(RenderExtremes, ZeroScaleBonesGoThroughTheFallback) {
+  const Mannequin& m = idle_mannequin();
+  std::vector<Affine3> bones = pose(m.model, "idle", 0.5);
+  const auto lowerarm = m.model.skeleton.find("lowerarm_l");
+  ASSERT_TRUE(lowerarm.has_value());
+  // Collapse the forearm onto its joint: the skinning matrix loses all scale.
+  Affine3& b = bones[static_cast<std::size_t>(*lowerarm)];
+  const Vec3 keep = b.transform_point(m.model.mesh.positions[0]);
+  for (Vec4& row : b.rows) row = Vec4(0.0f, 0.0f, 0.0f, 0.0f);
+  b.rows[0].w = keep.x;
+  b.rows[1].w = keep.y;
+  b.rows[2].w = keep.z;
+  rt::FrameStats stats;
+  const rt::Scene scene = scene_with(m, bones, rt::FrameOptions{}, &stats);
+  EXPECT_EQ(stats.singular_bones, 1u);
+  EXPECT_GT(stats.escaped_triangles, 0u);
+  const Checked checked = check_scene(scene, 3000, 12);
+  EXPECT_EQ(checked.wrong, 0u) << checked.rays << " rays; first: " << checked.first;
+}
+
+TEST(RenderExtremes, ZeroAreaTrianglesNeverHitAndDoNotDisturbTheirNeighbours) {
+  Mannequin m;
+  m.model = content::make_mannequin().value();
+  // Collapse every 17th triangle to a segment (a repeated corner) and a
+  // few to a point.
+  for (std::size_t t = 0; t < m.model.mesh.triangles.size(); t += 17) {
+    auto& tri = m.model.mesh.triangles[t];
+    tri[2] = tri[1];
+    if (t % 5 == 0) tri[1] = tri[0];
+  }
+  editor::BakeRequest request;
+  request.pose_space.mode = anim::PoseSpaceMode::kClip;
+  request.pose_space.clips = {"walk"};
+  request.pose_space.samples = 0;
+  JobSystem jobs(2);
+  m.bake = editor::bake_in_memory(m.model, request, jobs).value();
+  const rt::Scene scene = scene_with(m, pose(m.model, "walk", 0.2), rt::FrameOptions{});
+  const Checked checked = check_scene(scene, 3000, 13);
+  EXPECT_EQ(checked.wrong, 0u) << checked.rays << " rays; first: " << checked.first;
+}
+
+TEST(RenderExtremes, OriginsOnSplitPlanes) {
+  const Mannequin& m = idle_mannequin();
+  rt::Scene scene;
+  const std::uint32_t character = scene.add_character(m.model.mesh, m.bake.fuzzy.view()).value();
+  const std::uint32_t instance = scene.add_instance(character).value();
+  // A ground grid whose kd-tree splits lie on exact floats.
+  rt::StaticMeshDesc ground;
+  for (int z = 0; z <= 8; ++z) {
+    for (int x = 0; x <= 8; ++x) ground.positions.push_back(Vec3(-2.0f + 0.5f * x, 0.0f, -2.0f + 0.5f * z));
+  }
+  for (std::uint32_t z = 0; z < 8; ++z) {
+    for (std::uint32_t x = 0; x < 8; ++x) {
+      const std::uint32_t i = z * 9 + x;
+      ground.triangles.push_back({i, i + 9, i + 1});
+      ground.triangles.push_back({i + 1, i + 9, i + 10});
+    }
+  }
+  ASSERT_TRUE(scene.add_static_mesh(ground).ok());
+  ASSERT_TRUE(scene.set_bones(instance, pose(m.model, "idle", 0.0)).ok());
+  JobSystem jobs(1);
+  ASSERT_TRUE(scene.prepare_frame(rt::FrameOptions{}, jobs).ok());
+  const std::vector<SoupTriangle> soup = testing_support::world_triangles(scene);
+
+  // Collect split planes of the static tree and of the bone trees (in world
+  // space for the bone at the rest pose, where bone frames are model space).
+  std::vector<std::pair<int, float>> planes;
+  for (const rt::KdNode& node : scene.static_meshes()[0].tree.nodes) {
+    if (!node.is_leaf()) planes.emplace_back(node.axis(), node.split());
+  }
+  const rt::FuzzyCharacterView fuzzy = m.bake.fuzzy.view();
+  for (const rt::KdNode& node : fuzzy.nodes) {
+    if (!node.is_leaf() && planes.size() < 400) planes.emplace_back(node.axis(), node.split());
+  }
+  ASSERT_GT(planes.size(), 10u);
+  std::mt19937_64 g(21);
+  Checked checked;
+  for (const auto& [axis, split] : planes) {
+    for (int k = 0; k < 4; ++k) {
+      Ray ray;
+      ray.origin = Vec3(unit(g) * 2.0f - 1.0f, unit(g) * 2.0f, unit(g) * 2.0f - 1.0f);
+      ray.origin[axis] = split;
+      // In the plane, across it, and along each axis.
+      Vec3 d(unit(g) - 0.5f, unit(g) - 0.5f, unit(g) - 0.5f);
+      if (k == 0) d[axis] = 0.0f;
+      if (k >= 2) {
+        d = Vec3(0.0f);
+        d[(axis + k - 1) % 3] = (k == 2) ? 1.0f : -1.0f;
+      }
+      if (d == Vec3(0.0f)) d = Vec3(0.0f, -1.0f, 0.0f);
+      ray.direction = d;
+      check_ray(scene, soup, ray, checked);
+    }
+  }
+  EXPECT_EQ(checked.wrong, 0u) << checked.rays << " rays; first: " << checked.first;
+}
+
+TEST(Renderer, AovsAreTheTraversalsHitsAndImagesDoNotDependOnThreads) {
+  const Mannequin& m = idle_mannequin();
+  rt::Scene scene;
+  const std::uint32_t character = scene.add_character(m.model.mesh, m.bake.fuzzy.view()).value();
+  for (int i = 0; i < 2; ++i) {
+    const std::uint32_t instance = scene.add_instance(character).value();
+    const Affine3 place = Affine3::translation(Vec3(0.9f * static_cast<float>(i) - 0.45f, 0.0f, 0.0f));
+    ASSERT_TRUE(scene.set_bones(instance, pose(m.model, "idle", 0.7 * i, place)).ok());
+  }
+  rt::StaticMeshDesc ground;
+  ground.positions = {{-5, 0, -5}, {5, 0, -5}, {-5, 0, 5}, {5, 0, 5}};
+  ground.triangles = {{0, 2, 1}, {1, 2, 3}};
+  ASSERT_TRUE(scene.add_static_mesh(ground).ok());
+  JobSystem one(1), two(2);
+  ASSERT_TRUE(scene.prepare_frame(rt::FrameOptions{}, two).ok());
+  const int w = 96, h = 80;
+  const auto camera = rt::PinholeCamera::create({Vec3(0.5f, 1.4f, 3.0f), Vec3(0.0f, 0.9f, 0.0f), Vec3(0, 1, 0), 45.0f}, w, h);
+  ASSERT_TRUE(camera.ok());
+  struct Images {
+    std::vector<std::uint8_t> color;
+    std::vector<float> depth;
+    std::vector<Vec3> normal;
+    std::vector<std::uint32_t> triangle, instance;
+  };
+  const auto render = [&](JobSystem& jobs, TriangleTest test) {
+    Images im;
+    const std::size_t n = static_cast<std::size_t>(w * h);
+    im.color.resize(4 * n);
+    im.depth.resize(n);
+    im.normal.resize(n);
+    im.triangle.resize(n);
+    im.instance.resize(n);
+    rt::FrameBuffers buffers{w, h, im.color, {}, im.depth, im.normal, im.triangle, im.instance};
+    rt::RenderSettings settings;
+    settings.triangle_test = test;
+    rt::Renderer renderer;
+    auto stats = renderer.render(scene, *camera, settings, buffers, jobs);
+    EXPECT_TRUE(stats.ok()) << stats.status().message();
+    if (stats.ok()) {
+      EXPECT_EQ(stats->primary_rays, n);
+      EXPECT_GT(stats->shadow_rays, 0u);
+      EXPECT_GT(stats->shadowed, 0u) << "the characters shadow the ground";
+    }
+    return im;
+  };
+  for (const TriangleTest test : kTests) {
+    const Images a = render(one, test);
+    const Images b = render(two, test);
+    EXPECT_EQ(a.color, b.color);
+    EXPECT_EQ(a.depth, b.depth);
+    EXPECT_EQ(a.triangle, b.triangle);
+    EXPECT_EQ(a.instance, b.instance);
+    std::size_t character_pixels = 0;
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) {
+        const std::size_t i = static_cast<std::size_t>(y * w + x);
+        const Ray ray = camera->ray(x, y);
+        const Hit hit = rt::intersect(scene, ray, test);
+        ASSERT_EQ(a.triangle[i], hit.triangle_id) << x << "," << y;
+        ASSERT_EQ(a.instance[i], hit.instance_id) << x << "," << y;
+        if (hit.valid()) {
+          EXPECT_EQ(a.depth[i], hit.t * glm::length(ray.direction));
+          EXPECT_NEAR(glm::length(a.normal[i]), 1.0f, 1e-4f);
+          // Shading normals lie on the camera's side of the surface.
+          Vec3 facing = rt::surface_at(scene, hit, Vec3(1.0f)).geometric_normal;
+          if (glm::dot(facing, ray.direction) > 0.0f) facing = -facing;
+          EXPECT_GE(glm::dot(a.normal[i], facing), 0.0f) << x << "," << y;
+          character_pixels += hit.instance_id < 2 ? 1 : 0;
+        } else {
+          EXPECT_TRUE(std::isinf(a.depth[i]));
+        }
+      }
+    }
+    EXPECT_GT(character_pixels, 500u);
+  }
+}
+
+TEST(Renderer, RejectsMismatchedBuffers) {
+  rt::Scene scene;
+  JobSystem jobs(1);
+  ASSERT_TRUE(scene.prepare_frame(rt::FrameOptions{}, jobs).ok());
+  const auto camera = rt::PinholeCamera::create({}, 8, 8);
+  ASSERT_TRUE(camera.ok());
+  std::vector<float> depth(10);
+  rt::FrameBuffers buffers;
+  buffers.width = 8;
+  buffers.height = 8;
+  buffers.depth = depth;
+  rt::Renderer renderer;
+  auto stats = renderer.render(scene, *camera, {}, buffers, jobs);
+  ASSERT_FALSE(stats.ok());
+  EXPECT_EQ(stats.status().field(), "buffers.depth");
+}
+
+}  // namespace
+}  // namespace sinew
