@@ -1,6 +1,7 @@
 #include "raytrace/render/renderer.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -34,7 +35,35 @@ float encode_srgb(float linear) {
   return c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
 }
 
-std::uint8_t to_byte(float unit) { return static_cast<std::uint8_t>(std::lround(unit * 255.0f)); }
+// Linear -> sRGB byte through a table: std::pow per channel per pixel cost
+// more than the shading itself. 16384 entries keep the darkest steps
+// (sRGB byte 1 is linear 3e-4) apart.
+class SrgbTable {
+ public:
+  SrgbTable() {
+    for (std::size_t i = 0; i < bytes_.size(); ++i) {
+      const float linear = (static_cast<float>(i) + 0.5f) / static_cast<float>(bytes_.size());
+      bytes_[i] = static_cast<std::uint8_t>(std::lround(encode_srgb(linear) * 255.0f));
+    }
+  }
+  std::uint8_t operator()(float linear) const {
+    const float scaled = std::clamp(linear, 0.0f, 1.0f) * static_cast<float>(bytes_.size() - 1);
+    return bytes_[static_cast<std::size_t>(scaled)];  // callers pass no NaN (to_byte)
+  }
+
+ private:
+  std::array<std::uint8_t, 16384> bytes_{};
+};
+
+const SrgbTable& srgb_table() {
+  static const SrgbTable table;
+  return table;
+}
+
+std::uint8_t to_byte(float linear) {
+  if (!(linear > 0.0f)) return 0;  // also NaN
+  return srgb_table()(linear);
+}
 
 Vec3 light_vector(const Light& light, const Vec3& from) {
   return light.kind == Light::Kind::kPoint ? light.position - from : light.direction;
@@ -220,7 +249,7 @@ Expected<RenderStats> Renderer::render(const Scene& scene, const PinholeCamera& 
               for (int k = 0; k < 4; ++k) buffers.color_rgba32f[4 * i + static_cast<std::size_t>(k)] = c[k];
             }
             if (!buffers.color_rgba8.empty()) {
-              for (int k = 0; k < 3; ++k) buffers.color_rgba8[4 * i + static_cast<std::size_t>(k)] = to_byte(encode_srgb(c[k]));
+              for (int k = 0; k < 3; ++k) buffers.color_rgba8[4 * i + static_cast<std::size_t>(k)] = to_byte(c[k]);
               buffers.color_rgba8[4 * i + 3] = 255;
             }
           }
@@ -244,7 +273,7 @@ Expected<RenderStats> Renderer::render(const Scene& scene, const PinholeCamera& 
           buffers.color_rgba32f[4 * i + 3] = 1.0f;
         }
         if (!buffers.color_rgba8.empty()) {
-          for (int k = 0; k < 3; ++k) buffers.color_rgba8[4 * i + static_cast<std::size_t>(k)] = to_byte(encode_srgb(linear[k]));
+          for (int k = 0; k < 3; ++k) buffers.color_rgba8[4 * i + static_cast<std::size_t>(k)] = to_byte(linear[k]);
           buffers.color_rgba8[4 * i + 3] = 255;
         }
       }

@@ -14,20 +14,13 @@ constexpr float kInf = std::numeric_limits<float>::infinity();
 float max_abs(const Vec3& v) { return std::max({std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)}); }
 float max_abs(const Aabb& box) { return std::max(max_abs(box.lower), max_abs(box.upper)); }
 
-float linear_norm(const Affine3& m) {
-  float norm = 0.0f;
-  for (const Vec4& row : m.rows) {
-    norm = std::max(norm, std::fabs(row.x) + std::fabs(row.y) + std::fabs(row.z));
-  }
-  return norm;
-}
-
 bool finite(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
 // Clips [t0, t1] to the ray's passage through `box` grown by `eps` on every
 // side. The growth absorbs the rounding of the slab arithmetic, which is
 // relative to the magnitudes folded into `eps` by the callers.
-bool clip_to_box(const Aabb& box, float eps, const Vec3& o, const Vec3& d, float& t0, float& t1) {
+bool clip_to_box(const Aabb& box, float eps, const Vec3& o, const Vec3& d, const Vec3& inv_d, float& t0,
+                 float& t1) {
   for (int a = 0; a < 3; ++a) {
     const float lo = box.lower[a] - eps;
     const float hi = box.upper[a] + eps;
@@ -35,9 +28,8 @@ bool clip_to_box(const Aabb& box, float eps, const Vec3& o, const Vec3& d, float
       if (!(o[a] >= lo && o[a] <= hi)) return false;
       continue;
     }
-    const float inv = 1.0f / d[a];
-    float near = (lo - o[a]) * inv;
-    float far = (hi - o[a]) * inv;
+    float near = (lo - o[a]) * inv_d[a];
+    float far = (hi - o[a]) * inv_d[a];
     if (near > far) std::swap(near, far);
     t0 = std::max(t0, near);
     t1 = std::min(t1, far);
@@ -73,9 +65,8 @@ struct StackEntry {
 // of its cell. Cells whose entry lies beyond `t_limit` (the best hit so far,
 // read on every pop) are pruned. `leaf` returns true to stop (any hit).
 template <class LeafFn>
-bool traverse_tree(const KdTreeView& tree, const Vec3& o, const Vec3& d, float eps, float t0, float t1,
-                   const float& t_limit, std::uint64_t& visits, LeafFn&& leaf) {
-  const Vec3 inv(1.0f / d.x, 1.0f / d.y, 1.0f / d.z);
+bool traverse_tree(const KdTreeView& tree, const Vec3& o, const Vec3& d, const Vec3& inv, float eps, float t0,
+                   float t1, const float& t_limit, std::uint64_t& visits, LeafFn&& leaf) {
   std::array<StackEntry, kMaxTraversalDepth + 2> stack;
   std::size_t top = 0;
   std::uint32_t index = 0;
@@ -142,7 +133,13 @@ bool traverse_tree(const KdTreeView& tree, const Vec3& o, const Vec3& d, float e
 template <TriangleTest kTest, bool kAnyHit>
 class Query {
  public:
-  Query(const Scene& scene, const Ray& ray) : scene_(scene), ray_(ray), t_limit_(ray.t_max) {
+  Query(const Scene& scene, const Ray& ray)
+      : scene_(scene),
+        ray_(ray),
+        inv_dir_(1.0f / ray.direction.x, 1.0f / ray.direction.y, 1.0f / ray.direction.z),
+        origin_magnitude_(max_abs(ray.origin)),
+        direction_magnitude_(max_abs(ray.direction)),
+        t_limit_(ray.t_max) {
     if constexpr (kTest == TriangleTest::kWatertight) watertight_ = prepare_watertight(ray);
   }
 
@@ -151,11 +148,11 @@ class Query {
     if (top.empty()) return false;
     float t0 = ray_.t_min;
     float t1 = ray_.t_max;
-    if (!clip_to_box(top.bounds, world_eps(top.bounds, 0.0f), ray_.origin, ray_.direction, t0, t1)) {
+    if (!clip_to_box(top.bounds, world_eps(top.bounds, 0.0f), ray_.origin, ray_.direction, inv_dir_, t0, t1)) {
       return false;
     }
     const float eps = world_eps(top.bounds, t1);
-    return traverse_tree(top, ray_.origin, ray_.direction, eps, t0, t1, t_limit_, counters_.node_visits,
+    return traverse_tree(top, ray_.origin, ray_.direction, inv_dir_, eps, t0, t1, t_limit_, counters_.node_visits,
                          [this](std::span<const std::uint32_t> objects) {
                            for (const std::uint32_t object : objects) {
                              if (already_visited(object)) continue;
@@ -172,8 +169,8 @@ class Query {
   // The slack of a world-space computation: rounding relative to the ray's
   // origin, its reach and the box's own coordinates.
   float world_eps(const Aabb& box, float t_end) const {
-    const float reach = std::isfinite(t_end) ? t_end * max_abs(ray_.direction) : 0.0f;
-    return kFrameRelativeSlack * (max_abs(ray_.origin) + reach + max_abs(box));
+    const float reach = std::isfinite(t_end) ? t_end * direction_magnitude_ : 0.0f;
+    return kFrameRelativeSlack * (origin_magnitude_ + reach + max_abs(box));
   }
 
   // Objects overlap several top-level leaves; each is traversed once, over
@@ -190,7 +187,7 @@ class Query {
   bool visit(const TopLevelObject& object) {
     float t0 = ray_.t_min;
     float t1 = t_limit_;
-    if (!clip_to_box(object.box, world_eps(object.box, t1), ray_.origin, ray_.direction, t0, t1)) {
+    if (!clip_to_box(object.box, world_eps(object.box, t1), ray_.origin, ray_.direction, inv_dir_, t0, t1)) {
       return false;
     }
     ++counters_.object_visits;
@@ -216,12 +213,14 @@ class Query {
     // that far outside its box and still count as inside), twice, for the
     // rounding of both frame changes, plus the rounding of carrying this ray
     // over and of the traversal arithmetic.
-    const float carried = linear_norm(to_bone) * max_abs(ray_.origin) + max_abs(to_bone.translation_part());
+    const InstanceFrame::BoneCarry& carry = frame.bone_carry[bone];
+    const float carried = carry.linear_norm * origin_magnitude_ + carry.translation_magnitude;
     const float eps = 2.0f * frame.tolerance[bone] +
-                      kFrameRelativeSlack * (carried + max_abs(o) + t1 * max_abs(d) + max_abs(tree.bounds));
-    if (!clip_to_box(tree.bounds, eps, o, d, t0, t1)) return false;
+                      kFrameRelativeSlack * (carried + max_abs(o) + t1 * max_abs(d) + carry.bounds_magnitude);
+    const Vec3 inv(1.0f / d.x, 1.0f / d.y, 1.0f / d.z);
+    if (!clip_to_box(tree.bounds, eps, o, d, inv, t0, t1)) return false;
     const SkinnedMesh& mesh = *character.mesh;
-    return traverse_tree(tree, o, d, eps, t0, t1, t_limit_, counters_.node_visits,
+    return traverse_tree(tree, o, d, inv, eps, t0, t1, t_limit_, counters_.node_visits,
                          [&](std::span<const std::uint32_t> triangles) {
                            for (const std::uint32_t t : triangles) {
                              if (mailbox_.seen(t)) continue;
@@ -238,7 +237,7 @@ class Query {
   bool visit_static(const Scene::StaticMesh& mesh, float t0, float t1) {
     const KdTreeView tree = mesh.tree.view();
     const float eps = world_eps(tree.bounds, t1);
-    return traverse_tree(tree, ray_.origin, ray_.direction, eps, t0, t1, t_limit_, counters_.node_visits,
+    return traverse_tree(tree, ray_.origin, ray_.direction, inv_dir_, eps, t0, t1, t_limit_, counters_.node_visits,
                          [&](std::span<const std::uint32_t> triangles) {
                            for (const std::uint32_t t : triangles) {
                              if (mailbox_.seen(t)) continue;
@@ -256,7 +255,7 @@ class Query {
     const SkinnedMesh& mesh = *scene_.characters()[frame.character].mesh;
     const KdTreeView tree = frame.fallback.view();
     const float eps = world_eps(tree.bounds, t1);
-    return traverse_tree(tree, ray_.origin, ray_.direction, eps, t0, t1, t_limit_, counters_.node_visits,
+    return traverse_tree(tree, ray_.origin, ray_.direction, inv_dir_, eps, t0, t1, t_limit_, counters_.node_visits,
                          [&](std::span<const std::uint32_t> items) {
                            for (const std::uint32_t item : items) {
                              if (mailbox_.seen(item)) continue;
@@ -291,11 +290,14 @@ class Query {
 
   const Scene& scene_;
   Ray ray_;
+  Vec3 inv_dir_;
+  float origin_magnitude_;
+  float direction_magnitude_;
   float t_limit_;
   WatertightRay watertight_;
   Hit best_;
   Mailbox mailbox_;
-  std::array<std::uint32_t, 32> visited_{};
+  std::array<std::uint32_t, 32> visited_;  // the first visited_count_ are set
   std::size_t visited_count_ = 0;
   TraversalCounters counters_;
 };

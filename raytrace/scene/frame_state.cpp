@@ -36,6 +36,7 @@ void update_bone_frames(InstanceFrame& frame, const FuzzyCharacterView& fuzzy) {
   frame.bone_from_world.resize(bones);
   frame.bone_usable.resize(bones);
   frame.tolerance.resize(bones);
+  frame.bone_carry.resize(bones);
   frame.singular_bones = 0;
   for (std::size_t b = 0; b < bones; ++b) {
     const Affine3& to_world = frame.skinning[b];
@@ -45,6 +46,7 @@ void update_bone_frames(InstanceFrame& frame, const FuzzyCharacterView& fuzzy) {
     frame.bone_usable[b] = usable ? 1 : 0;
     if (!usable) {
       frame.tolerance[b] = 0.0f;
+      frame.bone_carry[b] = {};
       if (fuzzy.bone_trees[b].triangle_count > 0) ++frame.singular_bones;
       continue;
     }
@@ -56,6 +58,7 @@ void update_bone_frames(InstanceFrame& frame, const FuzzyCharacterView& fuzzy) {
     const float world = max_abs(transform(to_world, local));
     const float carried = linear_norm(from_world) * world + max_abs(from_world.translation_part());
     frame.tolerance[b] = kFrameRelativeSlack * (carried + max_abs(local));
+    frame.bone_carry[b] = {linear_norm(from_world), max_abs(from_world.translation_part()), max_abs(local)};
   }
 }
 

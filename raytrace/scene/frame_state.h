@@ -27,6 +27,14 @@ struct InstanceFrame {
   std::vector<Affine3> bone_from_world;  // per bone: the inverse (the bone frame)
   std::vector<std::uint8_t> bone_usable; // per bone: inverse finite (not a zero-scale bone)
   std::vector<float> tolerance;          // per bone: escape slack in bone-frame units
+  // Per bone, the magnitudes that bound the rounding of carrying a ray into
+  // the bone frame (read by every ray that enters the bone).
+  struct BoneCarry {
+    float linear_norm = 0.0f;            // infinity norm of bone_from_world's 3x3 part
+    float translation_magnitude = 0.0f;  // max |translation| of bone_from_world
+    float bounds_magnitude = 0.0f;       // max |coordinate| of the fuzzy root box
+  };
+  std::vector<BoneCarry> bone_carry;
   std::vector<Aabb> bone_world_boxes;    // per bone (empty for bones without triangles)
 
   std::vector<Vec3> positions;  // skinned, world space

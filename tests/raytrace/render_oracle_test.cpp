@@ -10,6 +10,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <ostream>
 #include <random>
 #include <string>
 #include <vector>
@@ -62,6 +63,9 @@ struct Subject {
   std::string name;
   int up_axis = 1;  // the model's up axis, for the ground plane
 };
+
+// gtest prints parameters in test names and failures: show the model's name.
+void PrintTo(const Subject& subject, std::ostream* os) { *os << subject.name; }
 
 Expected<editor::ImportedModel> load(const Subject& subject) {
   const std::string shared = SINEW_SHARED_DIR;
