@@ -169,11 +169,33 @@ Expected<RenderStats> Renderer::render(const Scene& scene, const PinholeCamera& 
   jobs.parallel_for_tiles(buffers.width, buffers.height, tile, [&](const Tile& t) {
     TraversalCounters counters;
     std::uint64_t hits = 0;
-    for (int y = t.y0; y < t.y1; ++y) {
-      for (int x = t.x0; x < t.x1; ++x) {
-        const Hit hit = intersect(scene, camera.ray(x, y), settings.triangle_test, &counters);
-        hits += hit.valid() ? 1 : 0;
-        hits_[static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x)] = hit;
+    const auto store = [&](int x, int y, const Hit& hit) {
+      hits += hit.valid() ? 1 : 0;
+      hits_[static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x)] = hit;
+    };
+    if (settings.packets) {
+      // 4x2 pixel blocks; lanes outside the tile stay inactive.
+      for (int y = t.y0; y < t.y1; y += 2) {
+        for (int x = t.x0; x < t.x1; x += 4) {
+          RayPacket packet;
+          packet.active = 0;
+          for (int lane = 0; lane < kPacketSize; ++lane) {
+            const int px = x + lane % 4;
+            const int py = y + lane / 4;
+            if (px >= t.x1 || py >= t.y1) continue;
+            packet.set(lane, camera.ray(px, py));
+            packet.active = static_cast<std::uint8_t>(packet.active | (1u << lane));
+          }
+          Hit lane_hits[kPacketSize];
+          intersect_packet(scene, packet, settings.triangle_test, lane_hits, &counters);
+          for (int lane = 0; lane < kPacketSize; ++lane) {
+            if (packet.active & (1u << lane)) store(x + lane % 4, y + lane / 4, lane_hits[lane]);
+          }
+        }
+      }
+    } else {
+      for (int y = t.y0; y < t.y1; ++y) {
+        for (int x = t.x0; x < t.x1; ++x) store(x, y, intersect(scene, camera.ray(x, y), settings.triangle_test, &counters));
       }
     }
     tile_counters[static_cast<std::size_t>(t.index)] = counters;
@@ -195,6 +217,21 @@ Expected<RenderStats> Renderer::render(const Scene& scene, const PinholeCamera& 
     jobs.parallel_for_tiles(buffers.width, buffers.height, tile, [&](const Tile& t) {
       TraversalCounters counters;
       std::uint64_t shadowed = 0;
+      RayPacket pending;
+      std::size_t pending_pixel[kPacketSize];
+      int pending_count = 0;
+      const auto flush = [&] {
+        if (pending_count == 0) return;
+        pending.active = static_cast<std::uint8_t>((1u << pending_count) - 1u);
+        const std::uint8_t blocked = occluded_packet(scene, pending, settings.triangle_test, &counters);
+        for (int lane = 0; lane < pending_count; ++lane) {
+          if (blocked & (1u << lane)) {
+            lit_[pending_pixel[lane]] = 0;
+            ++shadowed;
+          }
+        }
+        pending_count = 0;
+      };
       for (int y = t.y0; y < t.y1; ++y) {
         for (int x = t.x0; x < t.x1; ++x) {
           const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x);
@@ -214,12 +251,20 @@ Expected<RenderStats> Renderer::render(const Scene& scene, const PinholeCamera& 
           shadow.direction = light_vector(settings.light, shadow.origin);
           shadow.t_min = 0.0f;
           shadow.t_max = settings.light.kind == Light::Kind::kPoint ? 1.0f : kInf;
-          if (occluded(scene, shadow, settings.triangle_test, &counters)) {
-            lit_[i] = 0;
-            ++shadowed;
+          if (!settings.packets) {
+            if (occluded(scene, shadow, settings.triangle_test, &counters)) {
+              lit_[i] = 0;
+              ++shadowed;
+            }
+            continue;
           }
+          // Hits of a tile in scan order fill packets of eight shadow rays.
+          pending.set(pending_count, shadow);
+          pending_pixel[pending_count++] = i;
+          if (pending_count == kPacketSize) flush();
         }
       }
+      flush();
       tile_counters[static_cast<std::size_t>(t.index)] = counters;
       tile_shadowed[static_cast<std::size_t>(t.index)] = shadowed;
     });

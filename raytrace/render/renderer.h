@@ -16,6 +16,7 @@
 
 #include "raytrace/camera/camera.h"
 #include "raytrace/geometry/triangle_intersect.h"
+#include "raytrace/render/packet_traversal.h"
 #include "raytrace/render/traversal.h"
 #include "raytrace/scene/scene.h"
 #include "runtime/core/expected.h"
@@ -43,6 +44,9 @@ struct RenderSettings {
   Vec3 background{0.32f, 0.36f, 0.42f};
   Vec3 default_albedo{0.7f};  // meshes without material colors
   int tile_size = 16;
+  // Trace primary rays as 4x2-pixel packets and shadow rays as packets of
+  // eight hits (render/packet_traversal.h). Same images either way.
+  bool packets = true;
 };
 
 // Host-owned outputs; an empty span means "not requested" and is neither

@@ -6,13 +6,29 @@
 
 #include "runtime/cpu/cpu_features.h"
 #include "tests/bench/animation_bench.h"
+#include "tests/bench/raytrace_bench.h"
 
 namespace {
 
 void usage() {
   std::printf(
       "usage: sinew-bench <benchmark> [options]\n"
-      "  animation [--frames N] [--shared DIR]   animation + skinning vs the Cal3D library\n");
+      "  animation [--frames N] [--shared DIR]   animation + skinning vs the Cal3D library\n"
+      "  raytrace [--size WxH] [--frames N] [--threads LIST] [--models LIST] [--instances LIST]\n"
+      "           [--shared DIR] [--triangle-test fast|watertight] [--bone-boxes exact|cheap]\n"
+      "           [--json FILE]   ray tracer frame phases, and fuzzy vs exact kd-tree trace time\n");
+}
+
+// The command as typed (arguments with spaces quoted), so a printed table
+// says how to reproduce it.
+std::string command_line(int argc, char** argv) {
+  std::string line;
+  for (int i = 0; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (!line.empty()) line += ' ';
+    line += arg.find_first_of(" \t") == std::string::npos ? arg : "'" + arg + "'";
+  }
+  return line;
 }
 
 }  // namespace
@@ -29,6 +45,7 @@ int main(int argc, char** argv) {
   const std::string what = argv[1];
   const std::vector<std::string> args(argv + 2, argv + argc);
   if (what == "animation") return sinew::bench::run_animation_bench(args);
+  if (what == "raytrace") return sinew::bench::run_raytrace_bench(args, command_line(argc, argv));
   if (what == "--help" || what == "-h" || what == "help") {
     usage();
     return 0;

@@ -312,7 +312,7 @@ TEST(Renderer, AovsAreTheTraversalsHitsAndImagesDoNotDependOnThreads) {
     std::vector<Vec3> normal;
     std::vector<std::uint32_t> triangle, instance;
   };
-  const auto render = [&](JobSystem& jobs, TriangleTest test) {
+  const auto render = [&](JobSystem& jobs, TriangleTest test, bool packets = true) {
     Images im;
     const std::size_t n = static_cast<std::size_t>(w * h);
     im.color.resize(4 * n);
@@ -323,6 +323,7 @@ TEST(Renderer, AovsAreTheTraversalsHitsAndImagesDoNotDependOnThreads) {
     rt::FrameBuffers buffers{w, h, im.color, {}, im.depth, im.normal, im.triangle, im.instance};
     rt::RenderSettings settings;
     settings.triangle_test = test;
+    settings.packets = packets;
     rt::Renderer renderer;
     auto stats = renderer.render(scene, *camera, settings, buffers, jobs);
     EXPECT_TRUE(stats.ok()) << stats.status().message();
@@ -340,6 +341,11 @@ TEST(Renderer, AovsAreTheTraversalsHitsAndImagesDoNotDependOnThreads) {
     EXPECT_EQ(a.depth, b.depth);
     EXPECT_EQ(a.triangle, b.triangle);
     EXPECT_EQ(a.instance, b.instance);
+    // Packets and single rays give the same image.
+    const Images c = render(two, test, /*packets=*/false);
+    EXPECT_EQ(a.color, c.color);
+    EXPECT_EQ(a.depth, c.depth);
+    EXPECT_EQ(a.triangle, c.triangle);
     std::size_t character_pixels = 0;
     for (int y = 0; y < h; ++y) {
       for (int x = 0; x < w; ++x) {

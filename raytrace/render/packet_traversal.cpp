@@ -1,0 +1,621 @@
+#include "raytrace/render/packet_traversal.h"
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cmath>
+#include <limits>
+#include <span>
+
+#if defined(__AVX2__) && defined(__FMA__)
+#include <immintrin.h>
+#define SINEW_PACKET_AVX2 1
+#else
+#define SINEW_PACKET_AVX2 0
+#endif
+
+namespace sinew::rt {
+
+Ray RayPacket::ray(int lane) const {
+  Ray r;
+  r.origin = Vec3(ox[lane], oy[lane], oz[lane]);
+  r.direction = Vec3(dx[lane], dy[lane], dz[lane]);
+  r.t_min = t_min[lane];
+  r.t_max = t_max[lane];
+  return r;
+}
+
+void RayPacket::set(int lane, const Ray& r) {
+  ox[lane] = r.origin.x;
+  oy[lane] = r.origin.y;
+  oz[lane] = r.origin.z;
+  dx[lane] = r.direction.x;
+  dy[lane] = r.direction.y;
+  dz[lane] = r.direction.z;
+  t_min[lane] = r.t_min;
+  t_max[lane] = r.t_max;
+}
+
+#if SINEW_PACKET_AVX2
+namespace {
+
+constexpr int kLanes = kPacketSize;
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+// The helpers below repeat the single-ray traversal's (render/traversal.cpp)
+// expression for expression: the packet must reach the very cells the single
+// ray reaches, so its slack and clipping must round the same way.
+float max_abs(const Vec3& v) { return std::max({std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)}); }
+float max_abs(const Aabb& box) { return std::max(max_abs(box.lower), max_abs(box.upper)); }
+
+bool finite(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+bool valid_ray(const Ray& ray) {
+  return finite(ray.origin) && finite(ray.direction) && ray.direction != Vec3(0.0f) &&
+         !std::isnan(ray.t_min) && !std::isnan(ray.t_max) && ray.t_min < ray.t_max;
+}
+
+bool clip_to_box(const Aabb& box, float eps, const Vec3& o, const Vec3& d, const Vec3& inv_d, float& t0,
+                 float& t1) {
+  for (int a = 0; a < 3; ++a) {
+    const float lo = box.lower[a] - eps;
+    const float hi = box.upper[a] + eps;
+    if (d[a] == 0.0f) {
+      if (!(o[a] >= lo && o[a] <= hi)) return false;
+      continue;
+    }
+    float near = (lo - o[a]) * inv_d[a];
+    float far = (hi - o[a]) * inv_d[a];
+    if (near > far) std::swap(near, far);
+    t0 = std::max(t0, near);
+    t1 = std::min(t1, far);
+  }
+  return t0 <= t1;
+}
+
+class Mailbox {
+ public:
+  void reset() { ids_.fill(kInvalidId); }
+  bool seen(std::uint32_t id) {
+    std::uint32_t& slot = ids_[id & (ids_.size() - 1)];
+    if (slot == id) return true;
+    slot = id;
+    return false;
+  }
+
+ private:
+  std::array<std::uint32_t, 16> ids_{};
+};
+
+template <class Fn>
+void for_each_lane(std::uint32_t mask, Fn&& fn) {
+  while (mask != 0) {
+    const int lane = __builtin_ctz(mask);
+    mask &= mask - 1;
+    fn(lane);
+  }
+}
+
+// The packet's rays in the frame of the tree being walked (world or a
+// bone's), with each lane's slack.
+struct alignas(32) FrameRays {
+  float o[3][kLanes];
+  float d[3][kLanes];
+  float inv[3][kLanes];
+  float eps[kLanes];
+
+  Vec3 origin(int lane) const { return {o[0][lane], o[1][lane], o[2][lane]}; }
+  Vec3 direction(int lane) const { return {d[0][lane], d[1][lane], d[2][lane]}; }
+  Vec3 inverse(int lane) const { return {inv[0][lane], inv[1][lane], inv[2][lane]}; }
+  void set(int lane, const Vec3& origin, const Vec3& direction) {
+    for (int a = 0; a < 3; ++a) {
+      o[a][lane] = origin[a];
+      d[a][lane] = direction[a];
+      inv[a][lane] = 1.0f / direction[a];
+    }
+  }
+};
+
+// Lanes whose interval [t0, t1] is still open, and those intervals.
+struct alignas(32) Intervals {
+  float t0[kLanes];
+  float t1[kLanes];
+};
+
+struct alignas(32) StackEntry {
+  Intervals span;
+  std::uint32_t node;
+  std::uint32_t mask;
+  // Lanes the single ray would have descended into this child directly
+  // (their near child was empty): it does not clip t1 to the best hit there,
+  // so neither does the packet when it gets to them.
+  std::uint32_t direct;
+};
+
+// One inner node for the packet: each lane's below and above intervals
+// (thick planes), which child is near, and which lanes reach each child.
+struct SplitStep {
+  Intervals near;
+  Intervals far;
+  std::uint32_t near_mask = 0;
+  std::uint32_t far_mask = 0;
+  bool below_first = true;
+  bool coherent = true;
+  std::uint32_t negative = 0;  // lanes whose direction is negative along the split axis
+};
+
+// Per lane exactly traverse_tree's arithmetic in traversal.cpp, eight lanes
+// at once. _mm256_min_ps(x, y) is x < y ? x : y, so
+// std::min(t1, x) == _mm256_min_ps(x, t1) and std::max(t0, x) ==
+// _mm256_max_ps(x, t0), NaN included.
+[[gnu::always_inline]] inline void split_step_avx2(const FrameRays& r, int a, float split, std::uint32_t mask, const Intervals& cur,
+                     const float* t_limit, SplitStep& s) {
+  const __m256 da = _mm256_load_ps(r.d[a]);
+  const __m256 zero = _mm256_setzero_ps();
+  const std::uint32_t negative =
+      static_cast<std::uint32_t>(_mm256_movemask_ps(_mm256_cmp_ps(da, zero, _CMP_LT_OQ))) & mask;
+  s.negative = negative;
+  if (negative != 0 && negative != mask) {
+    s.coherent = false;
+    return;
+  }
+  s.coherent = true;
+  s.below_first = negative == 0;
+  const __m256 t0 = _mm256_load_ps(cur.t0);
+  const __m256 t1 = _mm256_load_ps(cur.t1);
+  const __m256 oa = _mm256_load_ps(r.o[a]);
+  const __m256 inv = _mm256_load_ps(r.inv[a]);
+  const __m256 eps = _mm256_load_ps(r.eps);
+  const __m256 sp = _mm256_set1_ps(split);
+  const __m256 below_edge = _mm256_add_ps(sp, eps);
+  const __m256 above_edge = _mm256_sub_ps(sp, eps);
+  const __m256 t_below = _mm256_mul_ps(_mm256_sub_ps(below_edge, oa), inv);
+  const __m256 t_above = _mm256_mul_ps(_mm256_sub_ps(above_edge, oa), inv);
+  const __m256 minus_inf = _mm256_set1_ps(-kInf);
+  __m256 n0, n1, f0, f1;
+  if (s.below_first) {
+    // Positive lanes clip by the plane; zero (or NaN) lanes keep the whole
+    // interval for each side their origin lies within.
+    const __m256 pos = _mm256_cmp_ps(da, zero, _CMP_GT_OQ);
+    const __m256 b1_zero = _mm256_blendv_ps(minus_inf, t1, _mm256_cmp_ps(oa, below_edge, _CMP_LE_OQ));
+    const __m256 a1_zero = _mm256_blendv_ps(minus_inf, t1, _mm256_cmp_ps(oa, above_edge, _CMP_GE_OQ));
+    n0 = t0;
+    n1 = _mm256_blendv_ps(b1_zero, _mm256_min_ps(t_below, t1), pos);
+    f0 = _mm256_blendv_ps(t0, _mm256_max_ps(t_above, t0), pos);
+    f1 = _mm256_blendv_ps(a1_zero, t1, pos);
+  } else {
+    n0 = t0;
+    n1 = _mm256_min_ps(t_above, t1);
+    f0 = _mm256_max_ps(t_below, t0);
+    f1 = t1;
+  }
+  _mm256_store_ps(s.near.t0, n0);
+  _mm256_store_ps(s.near.t1, n1);
+  _mm256_store_ps(s.far.t0, f0);
+  _mm256_store_ps(s.far.t1, f1);
+  const __m256 limit = _mm256_loadu_ps(t_limit);
+  s.near_mask = static_cast<std::uint32_t>(_mm256_movemask_ps(_mm256_cmp_ps(n0, n1, _CMP_LE_OQ))) & mask;
+  s.far_mask = static_cast<std::uint32_t>(_mm256_movemask_ps(
+                   _mm256_and_ps(_mm256_cmp_ps(f0, f1, _CMP_LE_OQ), _mm256_cmp_ps(f0, limit, _CMP_LE_OQ)))) &
+               mask;
+}
+
+// Pop: lanes whose entry is not beyond their best hit, t1 clipped to it
+// (std::min(entry.t1, t_limit) == _mm256_min_ps(t_limit, entry.t1)).
+[[gnu::always_inline]] inline std::uint32_t pop_lanes(const StackEntry& e, const float* t_limit, std::uint32_t live, Intervals& cur) {
+  const __m256 limit = _mm256_loadu_ps(t_limit);
+  const __m256 t0 = _mm256_load_ps(e.span.t0);
+  const std::uint32_t mask =
+      static_cast<std::uint32_t>(_mm256_movemask_ps(_mm256_cmp_ps(t0, limit, _CMP_LE_OQ))) & e.mask & live;
+  if (mask == 0) return 0;
+  const __m256 t1 = _mm256_load_ps(e.span.t1);
+  const __m256i lane_bits = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+  const __m256 direct = _mm256_castsi256_ps(_mm256_cmpeq_epi32(
+      _mm256_and_si256(_mm256_set1_epi32(static_cast<int>(e.direct)), lane_bits), lane_bits));
+  _mm256_store_ps(cur.t0, t0);
+  _mm256_store_ps(cur.t1, _mm256_blendv_ps(_mm256_min_ps(limit, t1), t1, direct));
+  return mask;
+}
+// clip_to_box for the lanes in `mask`: each lane's [t0, t1] clipped to
+// `box` grown by that lane's eps[lane]; returns the lanes left with t0 <= t1.
+[[gnu::always_inline]] inline std::uint32_t clip_lanes(const Aabb& box, const float* eps_lanes, const FrameRays& r, std::uint32_t mask,
+                         Intervals& span) {
+  const __m256 eps = _mm256_loadu_ps(eps_lanes);
+  const __m256 zero = _mm256_setzero_ps();
+  __m256 t0 = _mm256_load_ps(span.t0);
+  __m256 t1 = _mm256_load_ps(span.t1);
+  __m256 outside = zero;
+  for (int a = 0; a < 3; ++a) {
+    const __m256 lo = _mm256_sub_ps(_mm256_set1_ps(box.lower[a]), eps);
+    const __m256 hi = _mm256_add_ps(_mm256_set1_ps(box.upper[a]), eps);
+    const __m256 o = _mm256_load_ps(r.o[a]);
+    const __m256 inv = _mm256_load_ps(r.inv[a]);
+    const __m256 parallel = _mm256_cmp_ps(_mm256_load_ps(r.d[a]), zero, _CMP_EQ_OQ);
+    const __m256 inside = _mm256_and_ps(_mm256_cmp_ps(o, lo, _CMP_GE_OQ), _mm256_cmp_ps(o, hi, _CMP_LE_OQ));
+    outside = _mm256_or_ps(outside, _mm256_andnot_ps(inside, parallel));
+    const __m256 near = _mm256_mul_ps(_mm256_sub_ps(lo, o), inv);
+    const __m256 far = _mm256_mul_ps(_mm256_sub_ps(hi, o), inv);
+    const __m256 swap = _mm256_cmp_ps(near, far, _CMP_GT_OQ);
+    const __m256 n = _mm256_blendv_ps(near, far, swap);
+    const __m256 f = _mm256_blendv_ps(far, near, swap);
+    t0 = _mm256_blendv_ps(_mm256_max_ps(n, t0), t0, parallel);
+    t1 = _mm256_blendv_ps(_mm256_min_ps(f, t1), t1, parallel);
+  }
+  _mm256_store_ps(span.t0, t0);
+  _mm256_store_ps(span.t1, t1);
+  const std::uint32_t open = static_cast<std::uint32_t>(_mm256_movemask_ps(_mm256_cmp_ps(t0, t1, _CMP_LE_OQ)));
+  return open & ~static_cast<std::uint32_t>(_mm256_movemask_ps(outside)) & mask;
+}
+// Front-to-back walk of one kd-tree for the lanes in `mask`, from node
+// `index` over their intervals `start`. Each lane visits exactly the nodes,
+// in exactly the order, the single-ray walk would: lanes only share the
+// node fetches. Where the lanes disagree on the near child, the subtree is
+// walked once per direction sign (each half agrees on this axis, so the
+// recursion is at most three deep). `leaf(items,
+// lanes)` returns true to stop (every lane answered).
+template <class LeafFn>
+bool traverse_packet(const KdTreeView& tree, const FrameRays& r, std::uint32_t index, std::uint32_t mask,
+                     const Intervals& start, const float* t_limit, const std::uint32_t& live,
+                     std::uint64_t& visits, LeafFn& leaf) {
+  std::array<StackEntry, kMaxTraversalDepth + 2> stack;
+  std::size_t top = 0;
+  Intervals cur = start;
+  SplitStep s;
+  for (;;) {
+    ++visits;
+    const KdNode node = tree.nodes[index];
+    if (!node.is_leaf()) {
+      split_step_avx2(r, node.axis(), node.split(), mask, cur, t_limit, s);
+      if (s.coherent) {
+        const std::uint32_t below = index + 1;
+        const std::uint32_t above = node.above_child();
+        const std::uint32_t near_node = s.below_first ? below : above;
+        const std::uint32_t far_node = s.below_first ? above : below;
+        if (s.near_mask != 0) {
+          if (s.far_mask != 0) {
+            StackEntry& e = stack[top++];
+            e.span = s.far;
+            e.node = far_node;
+            e.mask = s.far_mask;
+            e.direct = s.far_mask & ~s.near_mask;
+          }
+          index = near_node;
+          mask = s.near_mask;
+          cur = s.near;
+          continue;
+        }
+        if (s.far_mask != 0) {
+          index = far_node;
+          mask = s.far_mask;
+          cur = s.far;
+          continue;
+        }
+      } else {
+        // Two packets, one per sign, each walking the subtree in its own
+        // order; a lane finishes the subtree before it pops, as it would alone.
+        const std::uint32_t forward = mask & ~s.negative;
+        if (traverse_packet(tree, r, index, forward, cur, t_limit, live, visits, leaf)) return true;
+        const std::uint32_t backward = mask & s.negative & live;
+        if (backward != 0 && traverse_packet(tree, r, index, backward, cur, t_limit, live, visits, leaf)) {
+          return true;
+        }
+      }
+    } else if (node.item_count() > 0) {
+      if (leaf(tree.items.subspan(node.first_item(), node.item_count()), mask & live)) return true;
+    }
+    for (;;) {
+      if (top == 0) return false;
+      const StackEntry& e = stack[--top];
+      mask = pop_lanes(e, t_limit, live, cur);
+      if (mask != 0) {
+        index = e.node;
+        break;
+      }
+    }
+  }
+}
+
+// One packet query: per lane the world ray, its triangle-test data and its
+// best (closest-hit) or first (any-hit) hit; per lane the same state the
+// single-ray Query keeps.
+template <TriangleTest kTest, bool kAnyHit>
+class PacketQuery {
+ public:
+  PacketQuery(const Scene& scene, const RayPacket& packet) : scene_(scene) {
+    for (int lane = 0; lane < kLanes; ++lane) {
+      // Inactive lanes get a harmless ray so the eight-wide arithmetic stays finite.
+      const Ray ray = (packet.active >> lane & 1u) ? packet.ray(lane) : Ray{};
+      const bool valid = (packet.active >> lane & 1u) && valid_ray(ray);
+      rays_[lane] = valid ? ray : Ray{};
+      if (valid) live_ |= 1u << lane;
+      world_.set(lane, rays_[lane].origin, rays_[lane].direction);
+      world_.eps[lane] = 0.0f;
+      origin_magnitude_[lane] = max_abs(rays_[lane].origin);
+      direction_magnitude_[lane] = max_abs(rays_[lane].direction);
+      t_limit_[lane] = rays_[lane].t_max;
+      if constexpr (kTest == TriangleTest::kWatertight) watertight_[lane] = prepare_watertight(rays_[lane]);
+    }
+    valid_ = live_;
+  }
+
+  void run() {
+    const KdTreeView top = scene_.top_level().view();
+    if (top.empty() || live_ == 0) return;
+    Intervals span{};
+    std::uint32_t mask = 0;
+    for_each_lane(live_, [&](int lane) {
+      float t0 = rays_[lane].t_min;
+      float t1 = rays_[lane].t_max;
+      const Vec3 o = world_.origin(lane), d = world_.direction(lane), inv = world_.inverse(lane);
+      if (!clip_to_box(top.bounds, world_eps(lane, max_abs(top.bounds), 0.0f), o, d, inv, t0, t1)) return;
+      world_.eps[lane] = world_eps(lane, max_abs(top.bounds), t1);
+      span.t0[lane] = t0;
+      span.t1[lane] = t1;
+      mask |= 1u << lane;
+    });
+    if (mask == 0) return;
+    auto leaf = [this](std::span<const std::uint32_t> objects, std::uint32_t lanes) {
+      for (const std::uint32_t object : objects) {
+        const std::uint32_t entering = lanes_entering(object, lanes & live_);
+        if (entering != 0 && visit(scene_.top_level().objects()[object], entering)) return true;
+      }
+      return false;
+    };
+    traverse_packet(top, world_, 0, mask, span, t_limit_, live_, counters_.node_visits, leaf);
+  }
+
+  const Hit& hit(int lane) const { return best_[lane]; }
+  std::uint32_t valid_lanes() const { return valid_; }
+  const TraversalCounters& counters() const { return counters_; }
+
+ private:
+  // `box_magnitude`: max_abs(box), the same for every lane.
+  float world_eps(int lane, float box_magnitude, float t_end) const {
+    const float reach = std::isfinite(t_end) ? t_end * direction_magnitude_[lane] : 0.0f;
+    return kFrameRelativeSlack * (origin_magnitude_[lane] + reach + box_magnitude);
+  }
+
+  // Of `lanes`, those that have not entered `object` yet (marking them).
+  // Objects overlap several top-level leaves and each lane traverses an
+  // object once, over its whole ray. Past the list's capacity an object may
+  // be entered again: that costs time but changes no hit (a triangle must
+  // beat the best t strictly), as in the single-ray query.
+  std::uint32_t lanes_entering(std::uint32_t object, std::uint32_t lanes) {
+    for (std::size_t i = 0; i < visited_count_; ++i) {
+      if (visited_objects_[i] == object) {
+        const std::uint32_t entering = lanes & ~visited_lanes_[i];
+        visited_lanes_[i] |= lanes;
+        return entering;
+      }
+    }
+    if (visited_count_ < visited_objects_.size()) {
+      visited_objects_[visited_count_] = object;
+      visited_lanes_[visited_count_++] = lanes;
+    }
+    return lanes;
+  }
+
+  bool visit(const TopLevelObject& object, std::uint32_t lanes) {
+    Intervals span{};
+    alignas(32) float eps[kLanes] = {};
+    const float box_magnitude = max_abs(object.box);
+    for_each_lane(lanes, [&](int lane) {
+      span.t0[lane] = rays_[lane].t_min;
+      span.t1[lane] = t_limit_[lane];
+      eps[lane] = world_eps(lane, box_magnitude, t_limit_[lane]);
+    });
+    const std::uint32_t mask = clip_lanes(object.box, eps, world_, lanes, span);
+    if (mask == 0) return false;
+    for_each_lane(mask, [&](int lane) { mailbox_[lane].reset(); });
+    counters_.object_visits += static_cast<std::uint64_t>(std::popcount(mask));
+    switch (object.kind) {
+      case TopLevelObject::Kind::kBone:
+        return visit_bone(scene_.instances()[object.index], object.bone, mask, span);
+      case TopLevelObject::Kind::kStatic:
+        return visit_static(scene_.static_meshes()[object.index], mask, span);
+      case TopLevelObject::Kind::kFallback:
+        return visit_fallback(scene_.instances()[object.index], mask, span);
+    }
+    return false;
+  }
+
+  bool visit_bone(const InstanceFrame& frame, std::uint32_t bone, std::uint32_t lanes, Intervals& span) {
+    const Scene::Character& character = scene_.characters()[frame.character];
+    const KdTreeView tree = character.fuzzy.bone_tree(bone);
+    const Affine3& to_bone = frame.bone_from_world[bone];
+    const InstanceFrame::BoneCarry& carry = frame.bone_carry[bone];
+    FrameRays local;
+    for (int lane = 0; lane < kLanes; ++lane) {
+      Vec3 o(0.0f), d(1.0f);
+      local.eps[lane] = 0.0f;
+      if (lanes >> lane & 1u) {
+        o = to_bone.transform_point(rays_[lane].origin);
+        d = to_bone.transform_vector(rays_[lane].direction);
+        const float carried = carry.linear_norm * origin_magnitude_[lane] + carry.translation_magnitude;
+        const float t1 = span.t1[lane];
+        local.eps[lane] = 2.0f * frame.tolerance[bone] +
+                          kFrameRelativeSlack * (carried + max_abs(o) + t1 * max_abs(d) + carry.bounds_magnitude);
+      }
+      for (int a = 0; a < 3; ++a) {
+        local.o[a][lane] = o[a];
+        local.d[a][lane] = d[a];
+      }
+    }
+    // 1 / d, correctly rounded like the single ray's.
+    for (int a = 0; a < 3; ++a) {
+      _mm256_store_ps(local.inv[a], _mm256_div_ps(_mm256_set1_ps(1.0f), _mm256_load_ps(local.d[a])));
+    }
+    const std::uint32_t mask = clip_lanes(tree.bounds, local.eps, local, lanes, span);
+    if (mask == 0) return false;
+    const SkinnedMesh& mesh = *character.mesh;
+    auto leaf = [&](std::span<const std::uint32_t> triangles, std::uint32_t active) {
+      for (const std::uint32_t t : triangles) {
+        const auto& v = mesh.triangles[t];
+        if (test(active, frame.positions[v[0]], frame.positions[v[1]], frame.positions[v[2]], t,
+                 frame.instance_id, t)) {
+          return true;
+        }
+      }
+      return false;
+    };
+    return traverse_packet(tree, local, 0, mask, span, t_limit_, live_, counters_.node_visits, leaf);
+  }
+
+  bool visit_static(const Scene::StaticMesh& mesh, std::uint32_t lanes, const Intervals& span) {
+    const KdTreeView tree = mesh.tree.view();
+    auto leaf = [&](std::span<const std::uint32_t> triangles, std::uint32_t active) {
+      for (const std::uint32_t t : triangles) {
+        const auto& v = mesh.desc.triangles[t];
+        if (test(active, mesh.desc.positions[v[0]], mesh.desc.positions[v[1]], mesh.desc.positions[v[2]], t,
+                 mesh.instance_id, t)) {
+          return true;
+        }
+      }
+      return false;
+    };
+    return walk_world_tree(tree, lanes, span, leaf);
+  }
+
+  bool visit_fallback(const InstanceFrame& frame, std::uint32_t lanes, const Intervals& span) {
+    const SkinnedMesh& mesh = *scene_.characters()[frame.character].mesh;
+    const KdTreeView tree = frame.fallback.view();
+    auto leaf = [&](std::span<const std::uint32_t> items, std::uint32_t active) {
+      for (const std::uint32_t item : items) {
+        const std::uint32_t t = frame.escaped_triangles[item];
+        const auto& v = mesh.triangles[t];
+        if (test(active, frame.positions[v[0]], frame.positions[v[1]], frame.positions[v[2]], t,
+                 frame.instance_id, item)) {
+          return true;
+        }
+      }
+      return false;
+    };
+    return walk_world_tree(tree, lanes, span, leaf);
+  }
+
+  // A world-space tree below the top level: the world rays with this
+  // tree's slack (the top level's own stays in world_ for its walk).
+  template <class LeafFn>
+  bool walk_world_tree(const KdTreeView& tree, std::uint32_t lanes, const Intervals& span, LeafFn& leaf) {
+    FrameRays rays = world_;
+    const float box_magnitude = max_abs(tree.bounds);
+    for_each_lane(lanes, [&](int lane) { rays.eps[lane] = world_eps(lane, box_magnitude, span.t1[lane]); });
+    return traverse_packet(tree, rays, 0, lanes, span, t_limit_, live_, counters_.node_visits, leaf);
+  }
+
+  // Tests one world-space triangle for every lane in `lanes` that has not
+  // tested it in this object (`mail`: the id the single ray mailboxes).
+  // Returns true when every lane is answered (any-hit).
+  bool test(std::uint32_t lanes, const Vec3& p0, const Vec3& p1, const Vec3& p2, std::uint32_t triangle,
+            std::uint32_t instance, std::uint32_t mail) {
+    for_each_lane(lanes & live_, [&](int lane) {
+      if (mailbox_[lane].seen(mail)) return;
+      ++counters_.triangle_tests;
+      TriangleHit h;
+      bool hit_found;
+      if constexpr (kTest == TriangleTest::kWatertight) {
+        hit_found = intersect_triangle_watertight(watertight_[lane], rays_[lane], t_limit_[lane], p0, p1, p2, h);
+      } else {
+        hit_found = intersect_triangle_fast(rays_[lane], t_limit_[lane], p0, p1, p2, h);
+      }
+      if (!hit_found) return;
+      best_[lane] = Hit{h.t, h.u, h.v, triangle, instance};
+      if constexpr (kAnyHit) {
+        // Answered: retire the lane; -inf also prunes every cell left for it.
+        live_ &= ~(1u << lane);
+        t_limit_[lane] = -kInf;
+      } else {
+        t_limit_[lane] = h.t;
+      }
+    });
+    return kAnyHit && live_ == 0;
+  }
+
+  const Scene& scene_;
+  std::array<Ray, kLanes> rays_;
+  FrameRays world_;
+  alignas(32) float t_limit_[kLanes];
+  float origin_magnitude_[kLanes];
+  float direction_magnitude_[kLanes];
+  std::array<WatertightRay, kLanes> watertight_;
+  std::array<Hit, kLanes> best_;
+  std::array<Mailbox, kLanes> mailbox_;
+  // The first visited_count_ objects entered, and by which lanes.
+  std::array<std::uint32_t, 64> visited_objects_;
+  std::array<std::uint32_t, 64> visited_lanes_;
+  std::size_t visited_count_ = 0;
+  std::uint32_t live_ = 0;
+  std::uint32_t valid_ = 0;
+  TraversalCounters counters_;
+};
+
+void accumulate(TraversalCounters* into, const TraversalCounters& from, std::uint32_t rays) {
+  if (!into) return;
+  into->rays += static_cast<std::uint64_t>(std::popcount(rays));
+  into->node_visits += from.node_visits;
+  into->object_visits += from.object_visits;
+  into->triangle_tests += from.triangle_tests;
+}
+
+template <TriangleTest kTest>
+void closest_hits(const Scene& scene, const RayPacket& packet, Hit hits[kPacketSize], TraversalCounters* counters) {
+  PacketQuery<kTest, false> query(scene, packet);
+  query.run();
+  for (int lane = 0; lane < kLanes; ++lane) hits[lane] = query.hit(lane);
+  accumulate(counters, query.counters(), query.valid_lanes());
+}
+
+template <TriangleTest kTest>
+std::uint8_t any_hits(const Scene& scene, const RayPacket& packet, TraversalCounters* counters) {
+  PacketQuery<kTest, true> query(scene, packet);
+  query.run();
+  std::uint8_t bits = 0;
+  for (int lane = 0; lane < kLanes; ++lane) {
+    if (query.hit(lane).valid()) bits = static_cast<std::uint8_t>(bits | (1u << lane));
+  }
+  accumulate(counters, query.counters(), query.valid_lanes());
+  return bits;
+}
+
+}  // namespace
+
+void intersect_packet(const Scene& scene, const RayPacket& packet, TriangleTest test, Hit hits[kPacketSize],
+                      TraversalCounters* counters) {
+  if (test == TriangleTest::kWatertight) {
+    closest_hits<TriangleTest::kWatertight>(scene, packet, hits, counters);
+  } else {
+    closest_hits<TriangleTest::kFast>(scene, packet, hits, counters);
+  }
+}
+
+std::uint8_t occluded_packet(const Scene& scene, const RayPacket& packet, TriangleTest test,
+                             TraversalCounters* counters) {
+  return test == TriangleTest::kWatertight ? any_hits<TriangleTest::kWatertight>(scene, packet, counters)
+                                           : any_hits<TriangleTest::kFast>(scene, packet, counters);
+}
+
+#else
+
+// Without AVX2 the lanes gain nothing from walking together: each is the
+// single-ray query itself.
+void intersect_packet(const Scene& scene, const RayPacket& packet, TriangleTest test, Hit hits[kPacketSize],
+                      TraversalCounters* counters) {
+  for (int lane = 0; lane < kPacketSize; ++lane) {
+    hits[lane] = (packet.active >> lane & 1u) ? intersect(scene, packet.ray(lane), test, counters) : Hit{};
+  }
+}
+
+std::uint8_t occluded_packet(const Scene& scene, const RayPacket& packet, TriangleTest test,
+                             TraversalCounters* counters) {
+  std::uint8_t bits = 0;
+  for (int lane = 0; lane < kPacketSize; ++lane) {
+    if ((packet.active >> lane & 1u) && occluded(scene, packet.ray(lane), test, counters)) {
+      bits = static_cast<std::uint8_t>(bits | (1u << lane));
+    }
+  }
+  return bits;
+}
+
+#endif  // SINEW_PACKET_AVX2
+
+}  // namespace sinew::rt

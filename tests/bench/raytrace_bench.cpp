@@ -1,0 +1,605 @@
+#include "tests/bench/raytrace_bench.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include "content/mannequin/mannequin.h"
+#include "editor/bake/in_memory_bake.h"
+#include "editor/cli/cli_args.h"
+#include "editor/cli/render_command.h"
+#include "editor/import/cal3d_importer.h"
+#include "raytrace/camera/camera.h"
+#include "raytrace/render/renderer.h"
+#include "raytrace/scene/scene.h"
+#include "runtime/cpu/cpu_features.h"
+#include "runtime/jobs/job_system.h"
+#include "runtime/timing/phase_timers.h"
+
+namespace sinew::bench {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using Json = nlohmann::ordered_json;
+
+constexpr double kFramesPerSecond = 30.0;
+constexpr int kMaxImageSide = 16384;
+// The framing of `sinew-editor render`'s default camera (render_command.cpp
+// keeps its helpers private): fovy 40 degrees, the posed bounds' sphere
+// fitting the narrower field of view with 15% margin, seen from the front
+// and slightly above.
+constexpr float kFovyDegrees = 40.0f;
+constexpr float kFramingMargin = 1.15f;
+
+// The error of an Expected whose value the caller does not need.
+template <typename T>
+Status status_of(const Expected<T>& result) {
+  return result.ok() ? Status{} : result.status();
+}
+
+double ms_since(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+// --- options -----------------------------------------------------------------
+
+struct BenchOptions {
+  int width = 1024;
+  int height = 1024;
+  int frames = 30;
+  std::vector<int> threads{1, 2};
+  std::vector<std::string> models{"cally", "mannequin"};
+  std::vector<int> instances{1, 4};
+  std::string shared = SINEW_SHARED_DIR;
+  rt::TriangleTest triangle_test = rt::TriangleTest::kFast;
+  rt::BoneBoxMode bone_boxes = rt::BoneBoxMode::kExact;
+  std::string json_path;  // empty: no JSON
+  bool help = false;
+};
+
+const std::vector<editor::cli::FlagSpec>& bench_flags() {
+  static const std::vector<editor::cli::FlagSpec> flags = {
+      {"--help", false}, {"-h", false},  {"--size"},          {"--frames"},     {"--threads"}, {"--models"},
+      {"--instances"},   {"--shared"},   {"--triangle-test"}, {"--bone-boxes"}, {"--json"},
+  };
+  return flags;
+}
+
+Expected<std::vector<int>> parse_int_list(std::string_view flag, const std::string& text, int lo, int hi) {
+  SINEW_ASSIGN_OR_RETURN(const std::vector<std::string> items, editor::cli::parse_list(flag, text));
+  std::vector<int> values;
+  for (const std::string& item : items) {
+    SINEW_ASSIGN_OR_RETURN(const std::int64_t n, editor::cli::parse_int(flag, item, lo, hi));
+    values.push_back(static_cast<int>(n));
+  }
+  return values;
+}
+
+Expected<BenchOptions> parse_options(const std::vector<std::string>& args) {
+  namespace cli = editor::cli;
+  SINEW_ASSIGN_OR_RETURN(const cli::ParsedArgs parsed, cli::parse_args(args, bench_flags()));
+  BenchOptions o;
+  if (parsed.has("--help") || parsed.has("-h")) {
+    o.help = true;
+    return o;
+  }
+  if (!parsed.positionals.empty()) {
+    return invalid_argument("argument", parsed.positionals.front(), "unexpected argument");
+  }
+  if (const auto text = parsed.value("--size")) {
+    SINEW_ASSIGN_OR_RETURN(const cli::Size2 size, cli::parse_size("--size", *text, kMaxImageSide));
+    o.width = size.width;
+    o.height = size.height;
+  }
+  if (const auto text = parsed.value("--frames")) {
+    SINEW_ASSIGN_OR_RETURN(const std::int64_t n, cli::parse_int("--frames", *text, 1, 100000));
+    o.frames = static_cast<int>(n);
+  }
+  if (const auto text = parsed.value("--threads")) {
+    SINEW_ASSIGN_OR_RETURN(o.threads, parse_int_list("--threads", *text, 1, 1024));
+  }
+  if (const auto text = parsed.value("--instances")) {
+    SINEW_ASSIGN_OR_RETURN(o.instances, parse_int_list("--instances", *text, 1, 256));
+  }
+  if (const auto text = parsed.value("--models")) {
+    SINEW_ASSIGN_OR_RETURN(o.models, cli::parse_list("--models", *text));
+    for (const std::string& name : o.models) {
+      if (name != "cally" && name != "mannequin") {
+        return invalid_argument("--models", name, "unknown model (expected cally or mannequin)");
+      }
+    }
+  }
+  if (const auto text = parsed.value("--shared")) o.shared = *text;
+  if (const auto text = parsed.value("--triangle-test")) {
+    SINEW_ASSIGN_OR_RETURN(const int i, cli::parse_choice("--triangle-test", *text, {"fast", "watertight"}));
+    o.triangle_test = i == 0 ? rt::TriangleTest::kFast : rt::TriangleTest::kWatertight;
+  }
+  if (const auto text = parsed.value("--bone-boxes")) {
+    SINEW_ASSIGN_OR_RETURN(const int i, cli::parse_choice("--bone-boxes", *text, {"exact", "cheap"}));
+    o.bone_boxes = i == 0 ? rt::BoneBoxMode::kExact : rt::BoneBoxMode::kCheap;
+  }
+  if (const auto text = parsed.value("--json")) o.json_path = *text;
+  return o;
+}
+
+void print_usage(std::FILE* to) {
+  std::fprintf(to,
+               "usage: sinew-bench raytrace [--size WxH] [--frames N] [--threads LIST] [--models LIST]\n"
+               "                            [--instances LIST] [--shared DIR] [--triangle-test fast|watertight]\n"
+               "                            [--bone-boxes exact|cheap] [--json FILE]\n"
+               "  --size WxH            image size (default 1024x1024)\n"
+               "  --frames N            frames at 30 fps through the walk clip (default 30)\n"
+               "  --threads LIST        thread counts, e.g. 1,2 (default 1,2)\n"
+               "  --models LIST         cally and/or mannequin (default cally,mannequin)\n"
+               "  --instances LIST      instance counts (default 1,4)\n"
+               "  --shared DIR          the shared folder holding content/cal3d/cally\n"
+               "  --triangle-test T     fast|watertight (default fast)\n"
+               "  --bone-boxes B        exact|cheap (default exact)\n"
+               "  --json FILE           also write the numbers as JSON\n");
+}
+
+// --- machine -------------------------------------------------------------------
+
+std::string cpu_model() {
+  std::ifstream in("/proc/cpuinfo");
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind("model name", 0) != 0) continue;
+    const std::size_t colon = line.find(':');
+    if (colon == std::string::npos) break;
+    const std::size_t start = line.find_first_not_of(" \t", colon + 1);
+    return start == std::string::npos ? std::string() : line.substr(start);
+  }
+  return "unknown";
+}
+
+std::string utc_date() {
+  const std::time_t now = std::time(nullptr);
+  std::tm utc{};
+  gmtime_r(&now, &utc);
+  char text[32];
+  std::strftime(text, sizeof text, "%Y-%m-%d %H:%M:%S UTC", &utc);
+  return text;
+}
+
+std::string join_ints(const std::vector<int>& values) {
+  std::string out;
+  for (int v : values) out += (out.empty() ? "" : ",") + std::to_string(v);
+  return out;
+}
+
+// --- models --------------------------------------------------------------------
+
+struct BenchModel {
+  std::string name;
+  editor::ImportedModel model;
+  std::size_t walk_clip = 0;
+  editor::InMemoryBake bake;
+  int bake_threads = 0;
+};
+
+// Cally is optional content: a missing file is a note, not a failure, so the
+// benchmark still runs on a machine with only the procedural mannequin.
+Expected<std::optional<editor::ImportedModel>> load_model(const std::string& name, const std::string& shared,
+                                                          std::string& note) {
+  if (name == "mannequin") {
+    SINEW_ASSIGN_OR_RETURN(editor::ImportedModel model, content::make_mannequin());
+    return std::optional<editor::ImportedModel>(std::move(model));
+  }
+  const std::string cfg = shared + "/content/cal3d/cally/cally.cfg";
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(cfg, ec)) {
+    note = "cally skipped: " + cfg + " not found (pass --shared DIR)";
+    return std::optional<editor::ImportedModel>();
+  }
+  SINEW_ASSIGN_OR_RETURN(editor::ImportedModel model, editor::import_cal3d(cfg));
+  return std::optional<editor::ImportedModel>(std::move(model));
+}
+
+Expected<std::size_t> find_walk_clip(const editor::ImportedModel& model, const std::string& name) {
+  for (std::size_t i = 0; i < model.clips.size(); ++i) {
+    if (model.clips[i].name() == "walk") return i;
+  }
+  return make_error(ErrorCode::kNotFound, name, "clip", "walk", "the model has no walk clip");
+}
+
+// --- framing (the render command's conventions) ----------------------------------
+
+Vec3 axis_vector(int axis, float sign = 1.0f) {
+  Vec3 v(0.0f);
+  v[axis] = sign;
+  return v;
+}
+
+Vec3 front_of(int up) { return up == 1 ? axis_vector(2) : axis_vector(1, -1.0f); }
+
+float bounding_radius(const Aabb& box) { return std::max(0.5f * glm::length(box.extent()), 1e-6f); }
+
+Aabb posed_bounds(const rt::Scene& scene) {
+  Aabb box;
+  for (const rt::InstanceFrame& frame : scene.instances()) {
+    for (const Vec3& p : frame.positions) box.extend(p);
+  }
+  return box;
+}
+
+rt::CameraDesc frame_bounds(const Aabb& box, int up, int width, int height) {
+  const float half_fovy = glm::radians(0.5f * kFovyDegrees);
+  const float aspect = static_cast<float>(width) / static_cast<float>(height);
+  const float half_fovx = std::atan(std::tan(half_fovy) * aspect);
+  const float distance = kFramingMargin * bounding_radius(box) / std::sin(std::min(half_fovy, half_fovx));
+  const Vec3 view = glm::normalize(front_of(up) + 0.2f * axis_vector(up));
+  return {box.center() + distance * view, box.center(), axis_vector(up), kFovyDegrees};
+}
+
+Vec3 light_for(const Aabb& box, int up) {
+  return box.center() + bounding_radius(box) * (2.0f * front_of(up) + 3.0f * axis_vector(up) + axis_vector(0));
+}
+
+// --- one configuration ---------------------------------------------------------
+
+// The exact SAH kd-tree side, measured on a few frames only (its build is
+// the expensive part, and the point is the trace-time ratio, not its fps).
+struct ExactComparison {
+  std::vector<int> frames;
+  // "build", "trace primary", "trace shadow" of the exact tree, and the
+  // fuzzy scene's "fuzzy trace" on the same frames, one sample per frame.
+  PhaseTimers timers;
+  std::vector<double> ratios;  // per frame: fuzzy trace / exact trace (primary + shadow)
+  bool hits_match = true;      // both structures hit the same number of pixels every frame
+};
+
+struct RunResult {
+  int instances = 0;
+  int threads = 0;
+  // One sample per frame of every phase the scene and renderer record, plus
+  // "top level + fallback" and "total".
+  PhaseTimers timers;
+  std::vector<double> mrays_per_s;  // per frame: (primary + shadow rays) / trace time
+  std::uint64_t primary_rays = 0;   // last frame
+  std::uint64_t shadow_rays = 0;
+  std::size_t max_escaped_triangles = 0;
+  ExactComparison exact;
+};
+
+double phase_median(const PhaseTimers& timers, std::string_view phase) {
+  for (const PhaseSummary& s : timers.summarize()) {
+    if (s.name == phase) return s.median_ms;
+  }
+  return 0.0;
+}
+
+std::vector<int> comparison_frames(int frames) {
+  std::vector<int> picked{0, (frames - 1) / 2, frames - 1};
+  picked.erase(std::unique(picked.begin(), picked.end()), picked.end());
+  return picked;
+}
+
+// Builds a scene whose only character geometry is one static mesh of the
+// fuzzy scene's skinned world triangles, so the same rays meet the same
+// triangles through an SAH tree built for exactly this pose.
+Status compare_with_exact(const rt::Scene& fuzzy_scene, const SkinnedMesh& mesh, const rt::StaticMeshDesc& ground,
+                          const rt::PinholeCamera& camera, const rt::RenderSettings& settings,
+                          const rt::FrameBuffers& buffers, const rt::RenderStats& fuzzy, JobSystem& jobs,
+                          rt::Renderer& renderer, ExactComparison& out) {
+  rt::StaticMeshDesc skinned;
+  for (const rt::InstanceFrame& instance : fuzzy_scene.instances()) {
+    const auto base = static_cast<std::uint32_t>(skinned.positions.size());
+    skinned.positions.insert(skinned.positions.end(), instance.positions.begin(), instance.positions.end());
+    for (const auto& t : mesh.triangles) skinned.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
+  }
+  rt::Scene exact;
+  const Clock::time_point build_start = Clock::now();
+  SINEW_RETURN_IF_ERROR(status_of(exact.add_static_mesh(std::move(skinned))));
+  const double build_ms = ms_since(build_start);
+  SINEW_RETURN_IF_ERROR(status_of(exact.add_static_mesh(ground)));
+  SINEW_RETURN_IF_ERROR(status_of(exact.prepare_frame(rt::FrameOptions{}, jobs)));
+  SINEW_ASSIGN_OR_RETURN(const rt::RenderStats traced, renderer.render(exact, camera, settings, buffers, jobs));
+
+  const double fuzzy_trace = fuzzy.trace_primary_ms + fuzzy.trace_shadow_ms;
+  const double exact_trace = traced.trace_primary_ms + traced.trace_shadow_ms;
+  out.timers.record("build", build_ms);
+  out.timers.record("trace primary", traced.trace_primary_ms);
+  out.timers.record("trace shadow", traced.trace_shadow_ms);
+  out.timers.record("exact trace", exact_trace);
+  out.timers.record("fuzzy trace", fuzzy_trace);
+  if (exact_trace > 0.0) out.ratios.push_back(fuzzy_trace / exact_trace);
+  out.hits_match = out.hits_match && traced.primary_hits == fuzzy.primary_hits;
+  return {};
+}
+
+Expected<RunResult> run_configuration(const BenchModel& m, const BenchOptions& o, int instances, int threads) {
+  JobSystem jobs(threads);
+  const editor::ImportedModel& model = m.model;
+  const anim::Clip& walk = model.clips[m.walk_clip];
+  const Aabb rest = editor::rest_bounds(model);
+  const int up = editor::up_axis_of(rest);
+
+  rt::Scene scene;
+  SINEW_ASSIGN_OR_RETURN(const std::uint32_t character, scene.add_character(model.mesh, m.bake.fuzzy.view()));
+  std::vector<std::uint32_t> ids;
+  std::vector<Affine3> placements;
+  for (int i = 0; i < instances; ++i) {
+    SINEW_ASSIGN_OR_RETURN(const std::uint32_t id, scene.add_instance(character));
+    ids.push_back(id);
+    placements.push_back(editor::instance_placement(rest, i));
+  }
+  const rt::StaticMeshDesc ground = editor::ground_plane_for(rest, instances);
+  SINEW_RETURN_IF_ERROR(status_of(scene.add_static_mesh(ground)));
+
+  rt::FrameOptions frame_options;
+  frame_options.bone_boxes = o.bone_boxes;
+  rt::RenderSettings settings;
+  settings.triangle_test = o.triangle_test;
+  settings.shadows = true;
+  settings.light.kind = rt::Light::Kind::kPoint;
+
+  // Colour only: shading runs and writes it, and no other AOV adds work the
+  // table does not measure.
+  std::vector<std::uint8_t> color(4 * static_cast<std::size_t>(o.width) * static_cast<std::size_t>(o.height));
+  rt::FrameBuffers buffers;
+  buffers.width = o.width;
+  buffers.height = o.height;
+  buffers.color_rgba8 = color;
+
+  RunResult run;
+  run.instances = instances;
+  run.threads = threads;
+  run.exact.frames = comparison_frames(o.frames);
+  rt::Renderer renderer;
+  rt::Renderer exact_renderer;
+  std::optional<rt::PinholeCamera> camera;
+  for (int f = 0; f < o.frames; ++f) {
+    const double seconds = f / kFramesPerSecond;
+    PhaseTimers frame;
+    {
+      ScopedPhase animation(frame, "animation");
+      for (std::size_t i = 0; i < ids.size(); ++i) {
+        const double t = seconds + editor::instance_time_offset(static_cast<int>(i));
+        SINEW_ASSIGN_OR_RETURN(const std::vector<Affine3> bones, editor::clip_skinning(model, walk, t, placements[i]));
+        SINEW_RETURN_IF_ERROR(scene.set_bones(ids[i], bones));
+      }
+    }
+    SINEW_ASSIGN_OR_RETURN(const rt::FrameStats prepared, scene.prepare_frame(frame_options, jobs, &frame));
+    if (!camera) {
+      // Framed on the first frame's pose, as the render command does, so
+      // every frame and every configuration of this size shares the view.
+      const Aabb posed = posed_bounds(scene);
+      settings.light.position = light_for(posed, up);
+      SINEW_ASSIGN_OR_RETURN(camera,
+                             rt::PinholeCamera::create(frame_bounds(posed, up, o.width, o.height), o.width, o.height));
+    }
+    SINEW_ASSIGN_OR_RETURN(const rt::RenderStats rendered,
+                           renderer.render(scene, *camera, settings, buffers, jobs, &frame));
+
+    // Every phase has exactly one sample in `frame`, so its median is it.
+    double total = 0.0;
+    for (const PhaseSummary& phase : frame.summarize()) {
+      run.timers.record(phase.name, phase.median_ms);
+      total += phase.median_ms;
+    }
+    run.timers.record("top level + fallback", phase_median(frame, "top level") + phase_median(frame, "fallback"));
+    run.timers.record("total", total);
+    const double trace_ms = rendered.trace_primary_ms + rendered.trace_shadow_ms;
+    if (trace_ms > 0.0) {
+      run.mrays_per_s.push_back(static_cast<double>(rendered.primary_rays + rendered.shadow_rays) / (trace_ms * 1e3));
+    }
+    run.primary_rays = rendered.primary_rays;
+    run.shadow_rays = rendered.shadow_rays;
+    run.max_escaped_triangles = std::max(run.max_escaped_triangles, prepared.escaped_triangles);
+
+    if (std::find(run.exact.frames.begin(), run.exact.frames.end(), f) != run.exact.frames.end()) {
+      SINEW_RETURN_IF_ERROR(compare_with_exact(scene, model.mesh, ground, *camera, settings, buffers, rendered, jobs,
+                                               exact_renderer, run.exact));
+    }
+  }
+  return run;
+}
+
+// --- report --------------------------------------------------------------------
+
+double fps_of(const RunResult& run) {
+  const double total = phase_median(run.timers, "total");
+  return total > 0.0 ? 1000.0 / total : 0.0;
+}
+
+void print_model_header(const BenchModel& m) {
+  const rt::FuzzyBakeStats& b = m.bake.fuzzy.stats;
+  std::printf("\n%s: %zu triangles, %zu bones, %u pose samples (all clips, keys + 30 Hz)\n", m.name.c_str(),
+              m.model.mesh.triangle_count(), m.model.skeleton.joint_count(), b.sample_count);
+  std::printf("  bake (%d threads): pose sampling %.1f ms, sampling %.1f ms, assignment %.1f ms, build %.1f ms\n",
+              m.bake_threads, m.bake.pose_sampling_ms, b.sampling_ms, b.assignment_ms, b.build_ms);
+  std::printf("  fuzzy area %.4g (rest %.4g, ratio %.2f), %.2f triangles per leaf, max tree depth %d, %u nodes\n",
+              b.fuzzy_area, b.rest_area, b.rest_area > 0.0 ? b.fuzzy_area / b.rest_area : 0.0,
+              b.mean_items_per_leaf, b.max_depth, b.node_count);
+}
+
+void print_runs(const std::vector<RunResult>& runs) {
+  std::printf("  frame phases, median ms:\n");
+  std::printf("  %4s %3s %8s %8s %8s %8s %9s %9s %8s %9s %8s %7s\n", "inst", "thr", "anim", "skin", "boxes",
+              "top+fb", "primary", "shadow", "shade", "total", "Mrays/s", "fps");
+  for (const RunResult& r : runs) {
+    std::printf("  %4d %3d %8.2f %8.2f %8.2f %8.2f %9.2f %9.2f %8.2f %9.2f %8.2f %7.2f\n", r.instances, r.threads,
+                phase_median(r.timers, "animation"), phase_median(r.timers, "skinning"),
+                phase_median(r.timers, "boxes"), phase_median(r.timers, "top level + fallback"),
+                phase_median(r.timers, "trace primary"), phase_median(r.timers, "trace shadow"),
+                phase_median(r.timers, "shade"), phase_median(r.timers, "total"), median_of(r.mrays_per_s),
+                fps_of(r));
+  }
+  std::printf("  exact SAH kd-tree over the same skinned triangles, median ms:\n");
+  std::printf("  %4s %3s %-9s %9s %9s %9s %11s %11s %11s %5s\n", "inst", "thr", "frames", "build", "primary",
+              "shadow", "exact trace", "fuzzy trace", "fuzzy/exact", "hits");
+  for (const RunResult& r : runs) {
+    const ExactComparison& e = r.exact;
+    std::printf("  %4d %3d %-9s %9.2f %9.2f %9.2f %11.2f %11.2f %11.2f %5s\n", r.instances, r.threads,
+                join_ints(e.frames).c_str(), phase_median(e.timers, "build"), phase_median(e.timers, "trace primary"),
+                phase_median(e.timers, "trace shadow"), phase_median(e.timers, "exact trace"),
+                phase_median(e.timers, "fuzzy trace"), median_of(e.ratios), e.hits_match ? "same" : "DIFF");
+  }
+}
+
+Json bake_json(const BenchModel& m) {
+  const rt::FuzzyBakeStats& b = m.bake.fuzzy.stats;
+  return {{"threads", m.bake_threads},       {"pose_sampling_ms", m.bake.pose_sampling_ms},
+          {"sampling_ms", b.sampling_ms},    {"assignment_ms", b.assignment_ms},
+          {"build_ms", b.build_ms},          {"fuzzy_area", b.fuzzy_area},
+          {"rest_area", b.rest_area},        {"mean_triangles_per_leaf", b.mean_items_per_leaf},
+          {"max_depth", b.max_depth},        {"node_count", b.node_count},
+          {"samples", b.sample_count}};
+}
+
+Json run_json(const RunResult& r) {
+  const ExactComparison& e = r.exact;
+  Json phases = Json::parse(r.timers.json(), nullptr, false);
+  Json exact_phases = Json::parse(e.timers.json(), nullptr, false);
+  return {{"instances", r.instances},
+          {"threads", r.threads},
+          {"phases", phases},
+          {"mrays_per_s", median_of(r.mrays_per_s)},
+          {"fps", fps_of(r)},
+          {"primary_rays", r.primary_rays},
+          {"shadow_rays", r.shadow_rays},
+          {"max_escaped_triangles", r.max_escaped_triangles},
+          {"exact",
+           {{"frames", e.frames},
+            {"phases", exact_phases},
+            {"fuzzy_over_exact", median_of(e.ratios)},
+            {"primary_hits_match", e.hits_match}}}};
+}
+
+const char* triangle_test_name(rt::TriangleTest t) { return t == rt::TriangleTest::kFast ? "fast" : "watertight"; }
+const char* bone_boxes_name(rt::BoneBoxMode b) { return b == rt::BoneBoxMode::kExact ? "exact" : "cheap"; }
+
+}  // namespace
+
+int run_raytrace_bench(const std::vector<std::string>& args, const std::string& command_line) {
+  const auto parsed = parse_options(args);
+  if (!parsed.ok()) {
+    std::fprintf(stderr, "sinew-bench raytrace: %s\n", parsed.status().message().c_str());
+    print_usage(stderr);
+    return 2;
+  }
+  const BenchOptions& o = *parsed;
+  if (o.help) {
+    print_usage(stdout);
+    return 0;
+  }
+
+  const std::string cpu = cpu_model();
+  const std::string date = utc_date();
+  std::printf("sinew-bench raytrace\n");
+  std::printf("  command: %s\n", command_line.c_str());
+  std::printf("  cpu:     %s (%d hardware threads)\n", cpu.c_str(), JobSystem::hardware_threads());
+  std::printf("  threads: %s\n", join_ints(o.threads).c_str());
+  std::printf("  isa:     %s\n", std::string(build_isa()).c_str());
+  std::printf("  date:    %s\n", date.c_str());
+  std::printf("  %dx%d, %d frames at 30 fps through the walk clip (instance i %.2f s later), point light,\n"
+              "  shadows on, diffuse shading, triangle test %s, bone boxes %s, fallback on\n",
+              o.width, o.height, o.frames, editor::instance_time_offset(1), triangle_test_name(o.triangle_test),
+              bone_boxes_name(o.bone_boxes));
+  std::fflush(stdout);
+
+  Json doc;
+  doc["command"] = command_line;
+  doc["cpu"] = cpu;
+  doc["hardware_threads"] = JobSystem::hardware_threads();
+  doc["isa"] = std::string(build_isa());
+  doc["date"] = date;
+  doc["size"] = {o.width, o.height};
+  doc["frames"] = o.frames;
+  doc["threads"] = o.threads;
+  doc["triangle_test"] = triangle_test_name(o.triangle_test);
+  doc["bone_boxes"] = bone_boxes_name(o.bone_boxes);
+  doc["models"] = Json::array();
+  doc["notes"] = Json::array();
+
+  // The bake is timed once per model, on the most threads the run uses.
+  const int bake_threads = *std::max_element(o.threads.begin(), o.threads.end());
+  int exit_code = 0;
+  for (const std::string& name : o.models) {
+    const auto fail = [&](const Status& s) {
+      std::fprintf(stderr, "sinew-bench raytrace: %s: %s\n", name.c_str(), s.message().c_str());
+      exit_code = 1;
+    };
+    std::string note;
+    auto loaded = load_model(name, o.shared, note);
+    if (!loaded.ok()) {
+      fail(loaded.status());
+      continue;
+    }
+    if (!loaded->has_value()) {
+      std::printf("\n%s\n", note.c_str());
+      doc["notes"].push_back(note);
+      continue;
+    }
+    BenchModel m;
+    m.name = name;
+    m.model = std::move(**loaded);
+    const auto walk = find_walk_clip(m.model, name);
+    if (!walk.ok()) {
+      fail(walk.status());
+      continue;
+    }
+    m.walk_clip = *walk;
+    {
+      JobSystem jobs(bake_threads);
+      auto bake = editor::bake_in_memory(m.model, editor::BakeRequest{}, jobs);
+      if (!bake.ok()) {
+        fail(bake.status());
+        continue;
+      }
+      m.bake = std::move(*bake);
+      m.bake_threads = bake_threads;
+    }
+    print_model_header(m);
+    std::fflush(stdout);
+
+    std::vector<RunResult> runs;
+    for (int instances : o.instances) {
+      for (int threads : o.threads) {
+        auto run = run_configuration(m, o, instances, threads);
+        if (!run.ok()) {
+          fail(run.status());
+          continue;
+        }
+        runs.push_back(std::move(*run));
+      }
+    }
+    print_runs(runs);
+    std::fflush(stdout);
+
+    Json model_doc = {{"name", name},
+                      {"triangles", m.model.mesh.triangle_count()},
+                      {"bones", m.model.skeleton.joint_count()},
+                      {"bake", bake_json(m)},
+                      {"runs", Json::array()}};
+    for (const RunResult& r : runs) model_doc["runs"].push_back(run_json(r));
+    doc["models"].push_back(std::move(model_doc));
+  }
+
+  std::printf("\n  anim = clip_skinning + set_bones for all instances; top+fb = top-level build + fallback;\n"
+              "  Mrays/s = (primary + shadow rays) / (primary + shadow trace time); fps = 1000 / median total.\n"
+              "  The exact tree is rebuilt on the listed frames over the posed triangles (Wald-Havran SAH\n"
+              "  sweep over triangle boxes, the static-mesh builder); fuzzy/exact is the median ratio of trace\n"
+              "  times on those frames; hits = both found the same number of primary hits.\n");
+  if (!o.json_path.empty()) {
+    std::ofstream json(o.json_path);
+    json << doc.dump(2) << "\n";
+    if (!json) {
+      std::fprintf(stderr, "sinew-bench raytrace: cannot write --json %s\n", o.json_path.c_str());
+      return 1;
+    }
+  }
+  return exit_code;
+}
+
+}  // namespace sinew::bench
