@@ -218,13 +218,6 @@ Expected<const anim::Clip*> resolve_clip(const ImportedModel& model, const Rende
                     "no such clip (clips: " + (names.empty() ? std::string("none") : names) + ")");
 }
 
-Aabb posed_bounds(const rt::Scene& scene) {
-  Aabb box;
-  for (const rt::InstanceFrame& frame : scene.instances()) {
-    for (const Vec3& p : frame.positions) box.extend(p);
-  }
-  return box;
-}
 
 Vec3 axis_vector(int axis, float sign = 1.0f) {
   Vec3 v(0.0f);
@@ -236,20 +229,7 @@ Vec3 front_of(int up) { return up == 1 ? axis_vector(2) : axis_vector(1, -1.0f);
 
 float bounding_radius(const Aabb& box) { return std::max(0.5f * glm::length(box.extent()), 1e-6f); }
 
-rt::CameraDesc frame_bounds(const Aabb& box, int up, int width, int height) {
-  const float radius = bounding_radius(box);
-  const float half_fovy = glm::radians(0.5f * kDefaultFovyDegrees);
-  const float aspect = static_cast<float>(width) / static_cast<float>(height);
-  const float half_fovx = std::atan(std::tan(half_fovy) * aspect);
-  const float distance = 1.15f * radius / std::sin(std::min(half_fovy, half_fovx));
-  const Vec3 view = glm::normalize(front_of(up) + 0.2f * axis_vector(up));
-  return {box.center() + distance * view, box.center(), axis_vector(up), kDefaultFovyDegrees};
-}
 
-Vec3 default_light(const Aabb& box, int up) {
-  const float radius = bounding_radius(box);
-  return box.center() + radius * (2.0f * front_of(up) + 3.0f * axis_vector(up) + axis_vector(0));
-}
 
 // --- stats ----------------------------------------------------------------
 
@@ -317,6 +297,29 @@ void report(const RenderOptions& options, const std::string& line) {
 }  // namespace
 
 // --- conventions ------------------------------------------------------------
+
+Aabb posed_bounds(const rt::Scene& scene) {
+  Aabb box;
+  for (const rt::InstanceFrame& frame : scene.instances()) {
+    for (const Vec3& p : frame.positions) box.extend(p);
+  }
+  return box;
+}
+
+rt::CameraDesc default_camera(const Aabb& box, int up, int width, int height) {
+  const float radius = bounding_radius(box);
+  const float half_fovy = glm::radians(0.5f * kDefaultFovyDegrees);
+  const float aspect = static_cast<float>(width) / static_cast<float>(height);
+  const float half_fovx = std::atan(std::tan(half_fovy) * aspect);
+  const float distance = 1.15f * radius / std::sin(std::min(half_fovy, half_fovx));
+  const Vec3 view = glm::normalize(front_of(up) + 0.2f * axis_vector(up));
+  return {box.center() + distance * view, box.center(), axis_vector(up), kDefaultFovyDegrees};
+}
+
+Vec3 default_light(const Aabb& box, int up) {
+  const float radius = bounding_radius(box);
+  return box.center() + radius * (2.0f * front_of(up) + 3.0f * axis_vector(up) + axis_vector(0));
+}
 
 Aabb rest_bounds(const ImportedModel& model) {
   Aabb box;
@@ -503,7 +506,7 @@ Expected<RenderOutputs> render_model(const RenderOptions& options) {
     if (!camera) {
       // Framed once, on the first frame's pose, so every frame shares one view.
       const Aabb posed = posed_bounds(scene);
-      out.camera = options.camera ? *options.camera : frame_bounds(posed, up, options.width, options.height);
+      out.camera = options.camera ? *options.camera : default_camera(posed, up, options.width, options.height);
       out.light.position = options.light ? *options.light : default_light(posed, up);
       settings.light = out.light;
       SINEW_ASSIGN_OR_RETURN(camera, rt::PinholeCamera::create(out.camera, options.width, options.height));

@@ -122,6 +122,12 @@ double instance_time_offset(int index);
 // The ground quad under `rest` sized for `instances` instances.
 rt::StaticMeshDesc ground_plane_for(const Aabb& rest, int instances);
 rt::StaticMeshDesc ground_plane_for(const ImportedModel& model, int instances = 1);
+// The bounds of every instance's skinned vertices (after prepare_frame).
+Aabb posed_bounds(const rt::Scene& scene);
+// The default camera framing `box` from the front, slightly above, and the
+// default point light above-front-right of it (render --help).
+rt::CameraDesc default_camera(const Aabb& box, int up, int width, int height);
+Vec3 default_light(const Aabb& box, int up);
 
 // Runs the whole command in-process. Errors (user errors, exit code 1) name
 // the file, the field and the value.

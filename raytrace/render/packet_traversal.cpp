@@ -1,5 +1,7 @@
 #include "raytrace/render/packet_traversal.h"
 
+#include "raytrace/render/traversal_shared.h"
+
 #include <algorithm>
 #include <array>
 #include <bit>
@@ -39,53 +41,22 @@ void RayPacket::set(int lane, const Ray& r) {
 #if SINEW_PACKET_AVX2
 namespace {
 
+using detail::clip_to_box;
+using detail::finite;
+using detail::Mailbox;
+using detail::max_abs;
+using detail::valid_ray;
+
 constexpr int kLanes = kPacketSize;
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
 // The helpers below repeat the single-ray traversal's (render/traversal.cpp)
 // expression for expression: the packet must reach the very cells the single
 // ray reaches, so its slack and clipping must round the same way.
-float max_abs(const Vec3& v) { return std::max({std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)}); }
-float max_abs(const Aabb& box) { return std::max(max_abs(box.lower), max_abs(box.upper)); }
 
-bool finite(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
-bool valid_ray(const Ray& ray) {
-  return finite(ray.origin) && finite(ray.direction) && ray.direction != Vec3(0.0f) &&
-         !std::isnan(ray.t_min) && !std::isnan(ray.t_max) && ray.t_min < ray.t_max;
-}
 
-bool clip_to_box(const Aabb& box, float eps, const Vec3& o, const Vec3& d, const Vec3& inv_d, float& t0,
-                 float& t1) {
-  for (int a = 0; a < 3; ++a) {
-    const float lo = box.lower[a] - eps;
-    const float hi = box.upper[a] + eps;
-    if (d[a] == 0.0f) {
-      if (!(o[a] >= lo && o[a] <= hi)) return false;
-      continue;
-    }
-    float near = (lo - o[a]) * inv_d[a];
-    float far = (hi - o[a]) * inv_d[a];
-    if (near > far) std::swap(near, far);
-    t0 = std::max(t0, near);
-    t1 = std::min(t1, far);
-  }
-  return t0 <= t1;
-}
 
-class Mailbox {
- public:
-  void reset() { ids_.fill(kInvalidId); }
-  bool seen(std::uint32_t id) {
-    std::uint32_t& slot = ids_[id & (ids_.size() - 1)];
-    if (slot == id) return true;
-    slot = id;
-    return false;
-  }
-
- private:
-  std::array<std::uint32_t, 16> ids_{};
-};
 
 template <class Fn>
 void for_each_lane(std::uint32_t mask, Fn&& fn) {

@@ -1,5 +1,7 @@
 #include "raytrace/render/traversal.h"
 
+#include "raytrace/render/traversal_shared.h"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -9,50 +11,17 @@
 namespace sinew::rt {
 namespace {
 
+using detail::clip_to_box;
+using detail::finite;
+using detail::Mailbox;
+using detail::max_abs;
+using detail::valid_ray;
+
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
-float max_abs(const Vec3& v) { return std::max({std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)}); }
-float max_abs(const Aabb& box) { return std::max(max_abs(box.lower), max_abs(box.upper)); }
 
-bool finite(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
-// Clips [t0, t1] to the ray's passage through `box` grown by `eps` on every
-// side. The growth absorbs the rounding of the slab arithmetic, which is
-// relative to the magnitudes folded into `eps` by the callers.
-bool clip_to_box(const Aabb& box, float eps, const Vec3& o, const Vec3& d, const Vec3& inv_d, float& t0,
-                 float& t1) {
-  for (int a = 0; a < 3; ++a) {
-    const float lo = box.lower[a] - eps;
-    const float hi = box.upper[a] + eps;
-    if (d[a] == 0.0f) {
-      if (!(o[a] >= lo && o[a] <= hi)) return false;
-      continue;
-    }
-    float near = (lo - o[a]) * inv_d[a];
-    float far = (hi - o[a]) * inv_d[a];
-    if (near > far) std::swap(near, far);
-    t0 = std::max(t0, near);
-    t1 = std::min(t1, far);
-  }
-  return t0 <= t1;
-}
 
-// Per object, the triangles already tested: a triangle whose fuzzy box
-// straddles splits is listed in several leaves. Direct-mapped on the low bits
-// of the id, which neighbouring triangles in a leaf differ in.
-class Mailbox {
- public:
-  void reset() { ids_.fill(kInvalidId); }
-  bool seen(std::uint32_t id) {
-    std::uint32_t& slot = ids_[id & (ids_.size() - 1)];
-    if (slot == id) return true;
-    slot = id;
-    return false;
-  }
-
- private:
-  std::array<std::uint32_t, 16> ids_{};
-};
 
 struct StackEntry {
   std::uint32_t node;
@@ -302,10 +271,6 @@ class Query {
   TraversalCounters counters_;
 };
 
-bool valid_ray(const Ray& ray) {
-  return finite(ray.origin) && finite(ray.direction) && ray.direction != Vec3(0.0f) &&
-         !std::isnan(ray.t_min) && !std::isnan(ray.t_max) && ray.t_min < ray.t_max;
-}
 
 void accumulate(TraversalCounters* into, const TraversalCounters& from) {
   if (!into) return;

@@ -33,13 +33,6 @@ using Json = nlohmann::ordered_json;
 
 constexpr double kFramesPerSecond = 30.0;
 constexpr int kMaxImageSide = 16384;
-// The framing of `sinew-editor render`'s default camera (render_command.cpp
-// keeps its helpers private): fovy 40 degrees, the posed bounds' sphere
-// fitting the narrower field of view with 15% margin, seen from the front
-// and slightly above.
-constexpr float kFovyDegrees = 40.0f;
-constexpr float kFramingMargin = 1.15f;
-
 // The error of an Expected whose value the caller does not need.
 template <typename T>
 Status status_of(const Expected<T>& result) {
@@ -212,38 +205,6 @@ Expected<std::size_t> find_walk_clip(const editor::ImportedModel& model, const s
   return make_error(ErrorCode::kNotFound, name, "clip", "walk", "the model has no walk clip");
 }
 
-// --- framing (the render command's conventions) ----------------------------------
-
-Vec3 axis_vector(int axis, float sign = 1.0f) {
-  Vec3 v(0.0f);
-  v[axis] = sign;
-  return v;
-}
-
-Vec3 front_of(int up) { return up == 1 ? axis_vector(2) : axis_vector(1, -1.0f); }
-
-float bounding_radius(const Aabb& box) { return std::max(0.5f * glm::length(box.extent()), 1e-6f); }
-
-Aabb posed_bounds(const rt::Scene& scene) {
-  Aabb box;
-  for (const rt::InstanceFrame& frame : scene.instances()) {
-    for (const Vec3& p : frame.positions) box.extend(p);
-  }
-  return box;
-}
-
-rt::CameraDesc frame_bounds(const Aabb& box, int up, int width, int height) {
-  const float half_fovy = glm::radians(0.5f * kFovyDegrees);
-  const float aspect = static_cast<float>(width) / static_cast<float>(height);
-  const float half_fovx = std::atan(std::tan(half_fovy) * aspect);
-  const float distance = kFramingMargin * bounding_radius(box) / std::sin(std::min(half_fovy, half_fovx));
-  const Vec3 view = glm::normalize(front_of(up) + 0.2f * axis_vector(up));
-  return {box.center() + distance * view, box.center(), axis_vector(up), kFovyDegrees};
-}
-
-Vec3 light_for(const Aabb& box, int up) {
-  return box.center() + bounding_radius(box) * (2.0f * front_of(up) + 3.0f * axis_vector(up) + axis_vector(0));
-}
 
 // --- one configuration ---------------------------------------------------------
 
@@ -373,10 +334,10 @@ Expected<RunResult> run_configuration(const BenchModel& m, const BenchOptions& o
     if (!camera) {
       // Framed on the first frame's pose, as the render command does, so
       // every frame and every configuration of this size shares the view.
-      const Aabb posed = posed_bounds(scene);
-      settings.light.position = light_for(posed, up);
+      const Aabb posed = editor::posed_bounds(scene);
+      settings.light.position = editor::default_light(posed, up);
       SINEW_ASSIGN_OR_RETURN(camera,
-                             rt::PinholeCamera::create(frame_bounds(posed, up, o.width, o.height), o.width, o.height));
+                             rt::PinholeCamera::create(editor::default_camera(posed, up, o.width, o.height), o.width, o.height));
     }
     SINEW_ASSIGN_OR_RETURN(const rt::RenderStats rendered,
                            renderer.render(scene, *camera, settings, buffers, jobs, &frame));
