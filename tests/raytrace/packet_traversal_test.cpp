@@ -26,6 +26,7 @@
 #include "raytrace/scene/scene.h"
 #include "runtime/jobs/job_system.h"
 #include "tests/support/brute_force.h"
+#include "tests/support/idle_mannequin.h"
 
 namespace sinew {
 namespace {
@@ -40,31 +41,13 @@ constexpr TriangleTest kTests[] = {TriangleTest::kFast, TriangleTest::kWatertigh
 // 24 random bits to [0, 1): our own conversion, so the stream is the same everywhere.
 float unit(std::mt19937& g) { return static_cast<float>(g() >> 8) * 0x1.0p-24f; }
 
-struct Mannequin {
-  editor::ImportedModel model;
-  editor::InMemoryBake bake;
-};
+using Mannequin = testing_support::BakedModel;
+using testing_support::idle_mannequin;
 
-// Baked over the idle clip only, so a kick leaves the pose space.
-const Mannequin& idle_mannequin() {
-  static const Mannequin m = [] {
-    Mannequin out;
-    out.model = content::make_mannequin().value();
-    editor::BakeRequest request;
-    request.pose_space.mode = anim::PoseSpaceMode::kClip;
-    request.pose_space.clips = {"idle"};
-    request.pose_space.samples = 0;
-    request.pose_space.every_frame_30hz = false;
-    JobSystem jobs(2);
-    out.bake = editor::bake_in_memory(out.model, request, jobs).value();
-    return out;
-  }();
-  return m;
-}
 
 std::vector<Affine3> pose(const editor::ImportedModel& model, const std::string& clip, double t,
-                          const Affine3& instance) {
-  return editor::clip_skinning(model, *model.find_clip(clip), t, instance).value();
+                          const Affine3& instance = Affine3::identity()) {
+  return testing_support::clip_pose(model, clip, t, instance);
 }
 
 // Two mannequins side by side on a ground quad; the second one idles or,

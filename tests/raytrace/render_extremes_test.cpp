@@ -21,6 +21,7 @@
 #include "raytrace/scene/scene.h"
 #include "runtime/jobs/job_system.h"
 #include "tests/support/brute_force.h"
+#include "tests/support/idle_mannequin.h"
 
 namespace sinew {
 namespace {
@@ -34,30 +35,13 @@ float unit(std::mt19937_64& g) { return anim::unit_float(g()); }
 
 // The mannequin baked over one clip's keys: small and quick, and posing it
 // with another clip leaves that pose space.
-struct Mannequin {
-  editor::ImportedModel model;
-  editor::InMemoryBake bake;
-};
+using Mannequin = testing_support::BakedModel;
+using testing_support::idle_mannequin;
 
-const Mannequin& idle_mannequin() {
-  static const Mannequin m = [] {
-    Mannequin out;
-    out.model = content::make_mannequin().value();
-    editor::BakeRequest request;
-    request.pose_space.mode = anim::PoseSpaceMode::kClip;
-    request.pose_space.clips = {"idle"};
-    request.pose_space.samples = 0;
-    request.pose_space.every_frame_30hz = false;
-    JobSystem jobs(2);
-    out.bake = editor::bake_in_memory(out.model, request, jobs).value();
-    return out;
-  }();
-  return m;
-}
 
 std::vector<Affine3> pose(const editor::ImportedModel& model, const std::string& clip, double t,
                           const Affine3& instance = Affine3::identity()) {
-  return editor::clip_skinning(model, *model.find_clip(clip), t, instance).value();
+  return testing_support::clip_pose(model, clip, t, instance);
 }
 
 struct Checked {
