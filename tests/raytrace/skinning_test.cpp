@@ -376,6 +376,15 @@ HandBuiltScene hand_built_scene() {
   return s;
 }
 
+// The hand-built scene's first vertex, moved to `p`.
+SkinnedMesh one_vertex_mesh(const HandBuiltScene& s, const Vec3& p) {
+  SkinnedMesh mesh;
+  mesh.positions = {p};
+  mesh.joints = {s.mesh.joints[0]};
+  mesh.weights = {s.mesh.weights[0]};
+  return mesh;
+}
+
 TEST(SkinningEscape, HandBuiltChecks) {
   const HandBuiltScene s = hand_built_scene();
   ASSERT_FALSE(is_finite(s.bone_from_world[3]));  // the premise of the zero-scale cases
@@ -402,10 +411,7 @@ TEST(SkinningEscape, ToleranceIsPerBone) {
   std::vector<VertexCheck> checks{check_of(1, p + Vec3(0.1f, -0.5f, -0.5f), p + 0.5f),
                                   check_of(2, in_bone2 + Vec3(0.1f, -0.5f, -0.5f), in_bone2 + 0.5f)};
   std::vector<std::uint32_t> begin{0, 2};
-  SkinnedMesh mesh;
-  mesh.positions = {p};
-  mesh.joints = {s.mesh.joints[0]};
-  mesh.weights = {s.mesh.weights[0]};
+  const SkinnedMesh mesh = one_vertex_mesh(s, p);
   const EscapeCheckInput escape{begin, checks, s.bone_from_world, s.tolerance};
   const Skinned out = run_skinning(mesh, s.bones, SkinningPath::kAuto, nullptr, false, &escape);
   EXPECT_EQ(out.escaped, (std::vector<std::uint8_t>{1, 0}));
@@ -418,10 +424,7 @@ TEST(SkinningEscape, BoneWithoutTransformEscapes) {
   const Vec3 p(1.0f, 2.0f, 3.0f);
   std::vector<VertexCheck> checks{check_of(5, Vec3(-1e30f), Vec3(1e30f)), check_of(1, p - 0.5f, p + 0.5f)};
   std::vector<std::uint32_t> begin{0, 2};
-  SkinnedMesh mesh;
-  mesh.positions = {p};
-  mesh.joints = {s.mesh.joints[0]};
-  mesh.weights = {s.mesh.weights[0]};
+  const SkinnedMesh mesh = one_vertex_mesh(s, p);
   const EscapeCheckInput escape{begin, checks, s.bone_from_world, s.tolerance};
   const Skinned out = run_skinning(mesh, s.bones, SkinningPath::kAuto, nullptr, false, &escape);
   EXPECT_EQ(out.escaped, (std::vector<std::uint8_t>{1, 0}));
