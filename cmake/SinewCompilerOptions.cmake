@@ -7,6 +7,12 @@ target_compile_options(sinew_compile_options INTERFACE
   -Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor -Wcast-align
   -Woverloaded-virtual -Wnull-dereference -Wdouble-promotion -Wformat=2
   $<$<BOOL:${SINEW_WERROR}>:-Werror>)
+# Floating-point expressions are evaluated as written: no silent fusing of
+# a*b + c into an FMA (GCC's C++ default). The 8-wide packet kernels and the
+# single-ray code then round every lane exactly alike, so packets return
+# bit-identical hits, and results do not hinge on the compiler's contraction
+# choices. Kernels that want FMA say so with explicit intrinsics.
+target_compile_options(sinew_compile_options INTERFACE -ffp-contract=off)
 # GCC 12 reports false -Wrestrict positives inside libstdc++'s
 # std::string operator+ at -O2/-O3 (GCC bug 105329), which -Werror would
 # turn into build failures on Debian 12's default compiler.

@@ -14,11 +14,13 @@
 //
 // The two tests are defined inline here because they run in the innermost
 // loop of traversal; prepare_watertight (once per ray) lives in the .cpp.
-// The build lets GCC contract a*b - c*d into an FMA (-ffp-contract=fast is
-// GCC's C++ default), which rounds the two products differently and would
-// break the exact antisymmetry the watertight test needs; it therefore
-// computes its shear and edge products in double, where a product of two
-// floats is exact and fused or not gives the same result.
+// The fast test spells out every product and sum in a fixed order: its
+// 8-wide twin (triangle_intersect8.h) evaluates the same expressions lane
+// by lane, and the build turns FMA contraction off
+// (cmake/SinewCompilerOptions.cmake), so a packet lane and a single ray get
+// bit-identical results. The watertight test computes its shear and edge
+// products in double, where a product of two floats is exact: its exact
+// antisymmetry then holds even where a compiler does contract.
 #pragma once
 
 #include <cmath>
@@ -106,24 +108,31 @@ inline bool intersect_triangle_fast(const Ray& ray, float t_max, const Vec3& p0,
                                     const Vec3& p2, TriangleHit& hit) {
   const Vec3 e1 = p1 - p0;
   const Vec3 e2 = p2 - p0;
-  const Vec3 pvec = glm::cross(ray.direction, e2);
-  const float det = glm::dot(e1, pvec);
+  const Vec3& d = ray.direction;
+  // pvec = d x e2; det = e1 . pvec (written out: see the header comment).
+  const float px = d.y * e2.z - d.z * e2.y;
+  const float py = d.z * e2.x - d.x * e2.z;
+  const float pz = d.x * e2.y - d.y * e2.x;
+  const float det = (e1.x * px + e1.y * py) + e1.z * pz;
   // Exactly zero: parallel ray or zero-area triangle. Non-finite: an
   // infinite or NaN coordinate always makes det inf or NaN, so this one test
   // keeps such triangles from producing garbage hits.
   if (!detail::finite_nonzero(det)) return false;
   const float inv_det = 1.0f / det;
 
-  const Vec3 tvec = ray.origin - p0;
-  const float u = glm::dot(tvec, pvec) * inv_det;
+  const Vec3 tv = ray.origin - p0;
+  const float u = ((tv.x * px + tv.y * py) + tv.z * pz) * inv_det;
   // Written so that NaN fails every comparison and misses.
   if (!(u >= 0.0f && u <= 1.0f)) return false;
 
-  const Vec3 qvec = glm::cross(tvec, e1);
-  const float v = glm::dot(ray.direction, qvec) * inv_det;
+  // qvec = tvec x e1
+  const float qx = tv.y * e1.z - tv.z * e1.y;
+  const float qy = tv.z * e1.x - tv.x * e1.z;
+  const float qz = tv.x * e1.y - tv.y * e1.x;
+  const float v = ((d.x * qx + d.y * qy) + d.z * qz) * inv_det;
   if (!(v >= 0.0f && u + v <= 1.0f)) return false;
 
-  const float t = glm::dot(e2, qvec) * inv_det;
+  const float t = ((e2.x * qx + e2.y * qy) + e2.z * qz) * inv_det;
   if (!(t >= ray.t_min && t < t_max && t <= detail::kFloatMax)) return false;
   if (detail::zero_area(e1, e2)) return false;
   hit = {t, u, v};

@@ -1,5 +1,6 @@
 #include "raytrace/render/packet_traversal.h"
 
+#include "raytrace/geometry/triangle_intersect8.h"
 #include "raytrace/render/traversal_shared.h"
 
 #include <algorithm>
@@ -43,7 +44,6 @@ namespace {
 
 using detail::clip_to_box;
 using detail::finite;
-using detail::Mailbox;
 using detail::max_abs;
 using detail::valid_ray;
 
@@ -286,6 +286,32 @@ bool traverse_packet(const KdTreeView& tree, const FrameRays& r, std::uint32_t i
   }
 }
 
+// Per object, the triangles already tested and by which lanes: a triangle
+// whose fuzzy box straddles splits is listed in several leaves, and a lane
+// may reach it through each. Direct-mapped on the id's low bits like the
+// single ray's Mailbox; a lane that tests a triangle twice (after an
+// eviction) gets the same answer, which cannot beat its best t strictly.
+class PacketMailbox {
+ public:
+  void reset() { ids_.fill(kInvalidId); }
+  // Of `lanes`, those that have not tested `id` yet (marking them).
+  std::uint32_t untested(std::uint32_t id, std::uint32_t lanes) {
+    const std::size_t slot = id & (ids_.size() - 1);
+    if (ids_[slot] != id) {
+      ids_[slot] = id;
+      lanes_[slot] = lanes;
+      return lanes;
+    }
+    const std::uint32_t fresh = lanes & ~lanes_[slot];
+    lanes_[slot] |= lanes;
+    return fresh;
+  }
+
+ private:
+  std::array<std::uint32_t, 16> ids_{};
+  std::array<std::uint32_t, 16> lanes_{};
+};
+
 // One packet query: per lane the world ray, its triangle-test data and its
 // best (closest-hit) or first (any-hit) hit; per lane the same state the
 // single-ray Query keeps.
@@ -304,6 +330,7 @@ class PacketQuery {
       origin_magnitude_[lane] = max_abs(rays_[lane].origin);
       direction_magnitude_[lane] = max_abs(rays_[lane].direction);
       t_limit_[lane] = rays_[lane].t_max;
+      t_min_[lane] = rays_[lane].t_min;
       if constexpr (kTest == TriangleTest::kWatertight) watertight_[lane] = prepare_watertight(rays_[lane]);
     }
     valid_ = live_;
@@ -377,7 +404,7 @@ class PacketQuery {
     });
     const std::uint32_t mask = clip_lanes(object.box, eps, world_, lanes, span);
     if (mask == 0) return false;
-    for_each_lane(mask, [&](int lane) { mailbox_[lane].reset(); });
+    mailbox_.reset();
     counters_.object_visits += static_cast<std::uint64_t>(std::popcount(mask));
     switch (object.kind) {
       case TopLevelObject::Kind::kBone:
@@ -479,38 +506,49 @@ class PacketQuery {
   // Returns true when every lane is answered (any-hit).
   bool test(std::uint32_t lanes, const Vec3& p0, const Vec3& p1, const Vec3& p2, std::uint32_t triangle,
             std::uint32_t instance, std::uint32_t mail) {
-    for_each_lane(lanes & live_, [&](int lane) {
-      if (mailbox_[lane].seen(mail)) return;
-      ++counters_.triangle_tests;
-      TriangleHit h;
-      bool hit_found;
-      if constexpr (kTest == TriangleTest::kWatertight) {
-        hit_found = intersect_triangle_watertight(watertight_[lane], rays_[lane], t_limit_[lane], p0, p1, p2, h);
-      } else {
-        hit_found = intersect_triangle_fast(rays_[lane], t_limit_[lane], p0, p1, p2, h);
+    const std::uint32_t todo = mailbox_.untested(mail, lanes & live_);
+    if (todo == 0) return false;
+    counters_.triangle_tests += static_cast<std::uint64_t>(std::popcount(todo));
+    if constexpr (kTest == TriangleTest::kWatertight) {
+      for_each_lane(todo, [&](int lane) {
+        TriangleHit h;
+        if (intersect_triangle_watertight(watertight_[lane], rays_[lane], t_limit_[lane], p0, p1, p2, h)) {
+          record(lane, h.t, h.u, h.v, triangle, instance);
+        }
+      });
+    } else {
+      alignas(32) float t[kLanes], u[kLanes], v[kLanes];
+      const RayLanes8 lanes8{world_.o, world_.d, t_min_, t_limit_};
+      const std::uint32_t hit = intersect_triangle_fast8(lanes8, todo, p0, p1, p2, t, u, v);
+      // The scalar test's last check, once per triangle.
+      if (hit != 0 && !detail::zero_area(p1 - p0, p2 - p0)) {
+        for_each_lane(hit, [&](int lane) { record(lane, t[lane], u[lane], v[lane], triangle, instance); });
       }
-      if (!hit_found) return;
-      best_[lane] = Hit{h.t, h.u, h.v, triangle, instance};
-      if constexpr (kAnyHit) {
-        // Answered: retire the lane; -inf also prunes every cell left for it.
-        live_ &= ~(1u << lane);
-        t_limit_[lane] = -kInf;
-      } else {
-        t_limit_[lane] = h.t;
-      }
-    });
+    }
     return kAnyHit && live_ == 0;
+  }
+
+  void record(int lane, float t, float u, float v, std::uint32_t triangle, std::uint32_t instance) {
+    best_[lane] = Hit{t, u, v, triangle, instance};
+    if constexpr (kAnyHit) {
+      // Answered: retire the lane; -inf also prunes every cell left for it.
+      live_ &= ~(1u << lane);
+      t_limit_[lane] = -kInf;
+    } else {
+      t_limit_[lane] = t;
+    }
   }
 
   const Scene& scene_;
   std::array<Ray, kLanes> rays_;
   FrameRays world_;
   alignas(32) float t_limit_[kLanes];
+  alignas(32) float t_min_[kLanes];
   float origin_magnitude_[kLanes];
   float direction_magnitude_[kLanes];
   std::array<WatertightRay, kLanes> watertight_;
   std::array<Hit, kLanes> best_;
-  std::array<Mailbox, kLanes> mailbox_;
+  PacketMailbox mailbox_;
   // The first visited_count_ objects entered, and by which lanes.
   std::array<std::uint32_t, 64> visited_objects_;
   std::array<std::uint32_t, 64> visited_lanes_;

@@ -133,6 +133,50 @@ Vec3 offset_origin(const SurfacePoint& surface, const Vec3& toward) {
   return origin;
 }
 
+namespace {
+
+// One tile's working set, reused by each thread across tiles and frames:
+// the tile's hits, primary directions and surfaces stay in cache from the
+// primary rays through the shadow rays to the shading.
+struct TileScratch {
+  std::vector<Hit> hits;
+  std::vector<Vec3> directions;  // unit primary directions
+  std::vector<SurfacePoint> surfaces;
+  std::vector<std::uint8_t> lit;
+  void resize(std::size_t n) {
+    if (hits.size() < n) {
+      hits.resize(n);
+      directions.resize(n);
+      surfaces.resize(n);
+      lit.resize(n);
+    }
+  }
+};
+
+TileScratch& tile_scratch() {
+  thread_local TileScratch scratch;
+  return scratch;
+}
+
+using Clock = std::chrono::steady_clock;
+
+double nanoseconds(Clock::time_point from, Clock::time_point to) {
+  return std::chrono::duration<double, std::nano>(to - from).count();
+}
+
+// Per tile: time spent in each phase and what it counted.
+struct TileRecord {
+  TraversalCounters primary;
+  TraversalCounters shadow;
+  std::uint64_t hits = 0;
+  std::uint64_t shadowed = 0;
+  double primary_ns = 0.0;
+  double shadow_ns = 0.0;
+  double shade_ns = 0.0;
+};
+
+}  // namespace
+
 Expected<RenderStats> Renderer::render(const Scene& scene, const PinholeCamera& camera,
                                        const RenderSettings& settings, const FrameBuffers& buffers,
                                        JobSystem& jobs, PhaseTimers* timers) {
@@ -153,26 +197,28 @@ Expected<RenderStats> Renderer::render(const Scene& scene, const PinholeCamera& 
   SINEW_RETURN_IF_ERROR(check_buffer(buffers.instance_id.size(), pixels, "buffers.instance_id"));
 
   const bool want_color = !buffers.color_rgba8.empty() || !buffers.color_rgba32f.empty();
+  const bool want_surface = want_color || !buffers.normal.empty();
   const bool want_shadows = want_color && settings.shadows;
-  const int width = buffers.width;
+  const std::size_t width = static_cast<std::size_t>(buffers.width);
   const int tile = settings.tile_size;
   const int tiles_x = (buffers.width + tile - 1) / tile;
   const int tiles_y = (buffers.height + tile - 1) / tile;
   const std::size_t tile_count = static_cast<std::size_t>(tiles_x) * static_cast<std::size_t>(tiles_y);
-  std::vector<TraversalCounters> tile_counters(tile_count);
-  std::vector<std::uint64_t> tile_hits(tile_count, 0);
-  hits_.resize(pixels);
-  RenderStats stats;
+  std::vector<TileRecord> records(tile_count);
+  const std::array<std::uint8_t, 4> background_bytes = {to_byte(settings.background.x), to_byte(settings.background.y),
+                                                         to_byte(settings.background.z), 255};
 
-  // Pass 1: nearest hits.
-  auto start = std::chrono::steady_clock::now();
+  const auto start = Clock::now();
   jobs.parallel_for_tiles(buffers.width, buffers.height, tile, [&](const Tile& t) {
-    TraversalCounters counters;
-    std::uint64_t hits = 0;
-    const auto store = [&](int x, int y, const Hit& hit) {
-      hits += hit.valid() ? 1 : 0;
-      hits_[static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x)] = hit;
-    };
+    TileRecord& record = records[static_cast<std::size_t>(t.index)];
+    const int tw = t.x1 - t.x0;
+    const auto local = [&](int x, int y) { return static_cast<std::size_t>((y - t.y0) * tw + (x - t.x0)); };
+    const auto global = [&](int x, int y) { return static_cast<std::size_t>(y) * width + static_cast<std::size_t>(x); };
+    TileScratch& s = tile_scratch();
+    s.resize(static_cast<std::size_t>(tw * (t.y1 - t.y0)));
+
+    // Primary rays: nearest hits.
+    const auto t0 = Clock::now();
     if (settings.packets) {
       // 4x2 pixel blocks; lanes outside the tile stay inactive.
       for (int y = t.y0; y < t.y1; y += 2) {
@@ -183,148 +229,164 @@ Expected<RenderStats> Renderer::render(const Scene& scene, const PinholeCamera& 
             const int px = x + lane % 4;
             const int py = y + lane / 4;
             if (px >= t.x1 || py >= t.y1) continue;
-            packet.set(lane, camera.ray(px, py));
+            const Ray ray = camera.ray(px, py);
+            s.directions[local(px, py)] = ray.direction;
+            packet.set(lane, ray);
             packet.active = static_cast<std::uint8_t>(packet.active | (1u << lane));
           }
           Hit lane_hits[kPacketSize];
-          intersect_packet(scene, packet, settings.triangle_test, lane_hits, &counters);
+          intersect_packet(scene, packet, settings.triangle_test, lane_hits, &record.primary);
           for (int lane = 0; lane < kPacketSize; ++lane) {
-            if (packet.active & (1u << lane)) store(x + lane % 4, y + lane / 4, lane_hits[lane]);
+            if (packet.active & (1u << lane)) s.hits[local(x + lane % 4, y + lane / 4)] = lane_hits[lane];
           }
         }
       }
     } else {
       for (int y = t.y0; y < t.y1; ++y) {
-        for (int x = t.x0; x < t.x1; ++x) store(x, y, intersect(scene, camera.ray(x, y), settings.triangle_test, &counters));
+        for (int x = t.x0; x < t.x1; ++x) {
+          const Ray ray = camera.ray(x, y);
+          s.directions[local(x, y)] = ray.direction;
+          s.hits[local(x, y)] = intersect(scene, ray, settings.triangle_test, &record.primary);
+        }
       }
     }
-    tile_counters[static_cast<std::size_t>(t.index)] = counters;
-    tile_hits[static_cast<std::size_t>(t.index)] = hits;
-  });
-  stats.trace_primary_ms = elapsed_ms(start);
-  for (std::size_t i = 0; i < tile_count; ++i) {
-    add(stats.primary, tile_counters[i]);
-    stats.primary_hits += tile_hits[i];
-  }
-  stats.primary_rays = pixels;
+    const auto t1 = Clock::now();
 
-  // Pass 2: one shadow ray per hit that faces the light.
-  start = std::chrono::steady_clock::now();
-  lit_.assign(pixels, 1);
-  if (want_shadows) {
-    std::fill(tile_counters.begin(), tile_counters.end(), TraversalCounters{});
-    std::vector<std::uint64_t> tile_shadowed(tile_count, 0);
-    jobs.parallel_for_tiles(buffers.width, buffers.height, tile, [&](const Tile& t) {
-      TraversalCounters counters;
-      std::uint64_t shadowed = 0;
+    // Surfaces (shading work), then one shadow ray per hit that faces the light.
+    double shadow_ns = 0.0;
+    for (int y = t.y0; y < t.y1; ++y) {
+      for (int x = t.x0; x < t.x1; ++x) {
+        const std::size_t k = local(x, y);
+        s.lit[k] = 1;
+        if (!s.hits[k].valid()) continue;
+        ++record.hits;
+        if (want_surface) s.surfaces[k] = surface_at(scene, s.hits[k], settings.default_albedo);
+      }
+    }
+    if (want_shadows) {
+      const auto shadow_start = Clock::now();
       RayPacket pending;
       std::size_t pending_pixel[kPacketSize];
       int pending_count = 0;
       const auto flush = [&] {
         if (pending_count == 0) return;
         pending.active = static_cast<std::uint8_t>((1u << pending_count) - 1u);
-        const std::uint8_t blocked = occluded_packet(scene, pending, settings.triangle_test, &counters);
+        const std::uint8_t blocked = occluded_packet(scene, pending, settings.triangle_test, &record.shadow);
         for (int lane = 0; lane < pending_count; ++lane) {
           if (blocked & (1u << lane)) {
-            lit_[pending_pixel[lane]] = 0;
-            ++shadowed;
+            s.lit[pending_pixel[lane]] = 0;
+            ++record.shadowed;
           }
         }
         pending_count = 0;
       };
       for (int y = t.y0; y < t.y1; ++y) {
         for (int x = t.x0; x < t.x1; ++x) {
-          const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x);
-          const Hit& hit = hits_[i];
-          if (!hit.valid()) continue;
-          const SurfacePoint s = surface_at(scene, hit, settings.default_albedo);
-          const Ray primary = camera.ray(x, y);
-          Vec3 facing = s.geometric_normal;
-          if (glm::dot(facing, primary.direction) > 0.0f) facing = -facing;
-          const Vec3 to_light = light_vector(settings.light, s.position);
+          const std::size_t k = local(x, y);
+          if (!s.hits[k].valid()) continue;
+          const SurfacePoint& surface = s.surfaces[k];
+          Vec3 facing = surface.geometric_normal;
+          if (glm::dot(facing, s.directions[k]) > 0.0f) facing = -facing;
+          const Vec3 to_light = light_vector(settings.light, surface.position);
           if (glm::dot(facing, to_light) <= 0.0f) {
-            lit_[i] = 0;  // the light is behind the surface: no ray needed
+            s.lit[k] = 0;  // the light is behind the surface: no ray needed
             continue;
           }
           Ray shadow;
-          shadow.origin = offset_origin(s, facing);
+          shadow.origin = offset_origin(surface, facing);
           shadow.direction = light_vector(settings.light, shadow.origin);
           shadow.t_min = 0.0f;
           shadow.t_max = settings.light.kind == Light::Kind::kPoint ? 1.0f : kInf;
           if (!settings.packets) {
-            if (occluded(scene, shadow, settings.triangle_test, &counters)) {
-              lit_[i] = 0;
-              ++shadowed;
+            if (occluded(scene, shadow, settings.triangle_test, &record.shadow)) {
+              s.lit[k] = 0;
+              ++record.shadowed;
             }
             continue;
           }
           // Hits of a tile in scan order fill packets of eight shadow rays.
           pending.set(pending_count, shadow);
-          pending_pixel[pending_count++] = i;
+          pending_pixel[pending_count++] = k;
           if (pending_count == kPacketSize) flush();
         }
       }
       flush();
-      tile_counters[static_cast<std::size_t>(t.index)] = counters;
-      tile_shadowed[static_cast<std::size_t>(t.index)] = shadowed;
-    });
-    for (std::size_t i = 0; i < tile_count; ++i) {
-      add(stats.shadow, tile_counters[i]);
-      stats.shadowed += tile_shadowed[i];
+      shadow_ns = nanoseconds(shadow_start, Clock::now());
     }
-    stats.shadow_rays = stats.shadow.rays;
-  }
-  stats.trace_shadow_ms = elapsed_ms(start);
 
-  // Pass 3: shading and the requested outputs.
-  start = std::chrono::steady_clock::now();
-  jobs.parallel_for_tiles(buffers.width, buffers.height, tile, [&](const Tile& t) {
+    // Shading and the requested outputs.
     for (int y = t.y0; y < t.y1; ++y) {
       for (int x = t.x0; x < t.x1; ++x) {
-        const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x);
-        const Hit& hit = hits_[i];
+        const std::size_t k = local(x, y);
+        const std::size_t i = global(x, y);
+        const Hit& hit = s.hits[k];
         if (!buffers.triangle_id.empty()) buffers.triangle_id[i] = hit.triangle_id;
         if (!buffers.instance_id.empty()) buffers.instance_id[i] = hit.instance_id;
         if (!hit.valid()) {
           if (!buffers.depth.empty()) buffers.depth[i] = kInf;
           if (!buffers.normal.empty()) buffers.normal[i] = Vec3(0.0f);
-          if (want_color) {
-            const Vec4 c(settings.background, 1.0f);
-            if (!buffers.color_rgba32f.empty()) {
-              for (int k = 0; k < 4; ++k) buffers.color_rgba32f[4 * i + static_cast<std::size_t>(k)] = c[k];
-            }
-            if (!buffers.color_rgba8.empty()) {
-              for (int k = 0; k < 3; ++k) buffers.color_rgba8[4 * i + static_cast<std::size_t>(k)] = to_byte(c[k]);
-              buffers.color_rgba8[4 * i + 3] = 255;
-            }
+          if (!buffers.color_rgba32f.empty()) {
+            for (int c = 0; c < 3; ++c) buffers.color_rgba32f[4 * i + static_cast<std::size_t>(c)] = settings.background[c];
+            buffers.color_rgba32f[4 * i + 3] = 1.0f;
+          }
+          if (!buffers.color_rgba8.empty()) {
+            for (int c = 0; c < 4; ++c) buffers.color_rgba8[4 * i + static_cast<std::size_t>(c)] = background_bytes[static_cast<std::size_t>(c)];
           }
           continue;
         }
-        const Ray primary = camera.ray(x, y);
-        if (!buffers.depth.empty()) buffers.depth[i] = hit.t * glm::length(primary.direction);
-        if (!want_color && buffers.normal.empty()) continue;
-        const SurfacePoint s = surface_at(scene, hit, settings.default_albedo);
-        Vec3 facing = s.geometric_normal;
-        if (glm::dot(facing, primary.direction) > 0.0f) facing = -facing;
-        Vec3 n = s.shading_normal;
+        if (!buffers.depth.empty()) buffers.depth[i] = hit.t * glm::length(s.directions[k]);
+        if (!want_surface) continue;
+        const SurfacePoint& surface = s.surfaces[k];
+        Vec3 facing = surface.geometric_normal;
+        if (glm::dot(facing, s.directions[k]) > 0.0f) facing = -facing;
+        Vec3 n = surface.shading_normal;
         if (glm::dot(n, facing) < 0.0f) n = -n;
         if (!buffers.normal.empty()) buffers.normal[i] = n;
         if (!want_color) continue;
-        const Vec3 l = glm::normalize(light_vector(settings.light, s.position));
-        const float lambert = lit_[i] ? std::max(0.0f, glm::dot(n, l)) : 0.0f;
-        const Vec3 linear = s.albedo * (settings.ambient + settings.light.color * lambert);
+        const Vec3 l = glm::normalize(light_vector(settings.light, surface.position));
+        const float lambert = s.lit[k] ? std::max(0.0f, glm::dot(n, l)) : 0.0f;
+        const Vec3 linear = surface.albedo * (settings.ambient + settings.light.color * lambert);
         if (!buffers.color_rgba32f.empty()) {
-          for (int k = 0; k < 3; ++k) buffers.color_rgba32f[4 * i + static_cast<std::size_t>(k)] = linear[k];
+          for (int c = 0; c < 3; ++c) buffers.color_rgba32f[4 * i + static_cast<std::size_t>(c)] = linear[c];
           buffers.color_rgba32f[4 * i + 3] = 1.0f;
         }
         if (!buffers.color_rgba8.empty()) {
-          for (int k = 0; k < 3; ++k) buffers.color_rgba8[4 * i + static_cast<std::size_t>(k)] = to_byte(linear[k]);
+          for (int c = 0; c < 3; ++c) buffers.color_rgba8[4 * i + static_cast<std::size_t>(c)] = to_byte(linear[c]);
           buffers.color_rgba8[4 * i + 3] = 255;
         }
       }
     }
+    const auto t3 = Clock::now();
+    record.primary_ns = nanoseconds(t0, t1);
+    record.shadow_ns = shadow_ns;
+    record.shade_ns = nanoseconds(t1, t3) - shadow_ns;
   });
-  stats.shade_ms = elapsed_ms(start);
+  const double wall_ms = elapsed_ms(start);
+
+  // Tile order keeps the sums deterministic.
+  RenderStats stats;
+  double primary_ns = 0.0, shadow_ns = 0.0, shade_ns = 0.0;
+  for (const TileRecord& r : records) {
+    add(stats.primary, r.primary);
+    add(stats.shadow, r.shadow);
+    stats.primary_hits += r.hits;
+    stats.shadowed += r.shadowed;
+    primary_ns += r.primary_ns;
+    shadow_ns += r.shadow_ns;
+    shade_ns += r.shade_ns;
+  }
+  stats.primary_rays = pixels;
+  stats.shadow_rays = stats.shadow.rays;
+  // The phases interleave within each tile: the wall time of the whole
+  // render is split in proportion to the time the tiles spent in each.
+  const double busy_ns = primary_ns + shadow_ns + shade_ns;
+  if (busy_ns > 0.0) {
+    stats.trace_primary_ms = wall_ms * primary_ns / busy_ns;
+    stats.trace_shadow_ms = wall_ms * shadow_ns / busy_ns;
+    stats.shade_ms = wall_ms * shade_ns / busy_ns;
+  } else {
+    stats.shade_ms = wall_ms;
+  }
 
   if (timers) {
     timers->record("trace primary", stats.trace_primary_ms);

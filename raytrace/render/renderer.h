@@ -2,12 +2,14 @@
 // in parallel (paper section 4.1), writing only the outputs (AOVs) the
 // caller asks for.
 //
-// A frame runs as three passes, each a timed phase ("trace primary",
-// "trace shadow", "shade"): nearest hits for every pixel, then one shadow ray
-// per lit hit, then shading and writing the AOVs. Separating them keeps the
-// phase timings honest and lets each pass run a coherent kind of ray. Tiles
-// are fixed squares processed in any order; every pixel's result depends
-// only on the scene, so images are identical for any thread count.
+// Each tile runs the whole frame for its pixels: nearest hits, surfaces,
+// one shadow ray per hit that faces the light, shading and the AOVs. The
+// tile's hits and surfaces stay in cache from one step to the next (three
+// image-wide passes spent a third of the frame re-reading and re-deriving
+// them). The phases ("trace primary", "trace shadow", "shade") are timed per
+// tile and the render's wall time is split in their proportion. Tiles are
+// fixed squares processed in any order; every pixel's result depends only on
+// the scene, so images are identical for any thread count.
 #pragma once
 
 #include <cstdint>
@@ -83,10 +85,6 @@ class Renderer {
   Expected<RenderStats> render(const Scene& scene, const PinholeCamera& camera,
                                const RenderSettings& settings, const FrameBuffers& buffers,
                                JobSystem& jobs, PhaseTimers* timers = nullptr);
-
- private:
-  std::vector<Hit> hits_;            // per pixel, pass 1
-  std::vector<std::uint8_t> lit_;    // per pixel, pass 2: 1 = the light reaches the hit
 };
 
 // The shading inputs at a hit, in world space.

@@ -1,0 +1,85 @@
+// The fast (Moller-Trumbore) triangle test for eight rays against one
+// triangle at once, AVX2. Per lane it evaluates exactly the expressions of
+// intersect_triangle_fast (triangle_intersect.h) in the same order, and the
+// build disables FMA contraction, so every lane's hit, t, u and v are
+// bit-identical to the scalar test's: packets and single rays agree.
+#pragma once
+
+#if defined(__AVX2__)
+#include <immintrin.h>
+
+#include <cstdint>
+
+#include "raytrace/geometry/triangle_intersect.h"
+
+namespace sinew::rt {
+
+// The rays, structure of arrays, 32-byte aligned: origin o[axis][lane],
+// direction d[axis][lane], and per lane t_min and the exclusive t_max.
+struct RayLanes8 {
+  const float (*o)[8];
+  const float (*d)[8];
+  const float* t_min;
+  const float* t_max;
+};
+
+// Returns the lanes of `lanes` that hit (t_min <= t < t_max, finite t, u, v),
+// with their t, u, v in the out arrays (other lanes' entries are garbage).
+// Zero-area triangles are the caller's check (detail::zero_area), once per
+// triangle, as the scalar test does on its hit path.
+inline std::uint32_t intersect_triangle_fast8(const RayLanes8& r, std::uint32_t lanes, const Vec3& p0,
+                                              const Vec3& p1, const Vec3& p2, float* t_out, float* u_out,
+                                              float* v_out) {
+  const Vec3 e1s = p1 - p0;
+  const Vec3 e2s = p2 - p0;
+  const __m256 e1x = _mm256_set1_ps(e1s.x), e1y = _mm256_set1_ps(e1s.y), e1z = _mm256_set1_ps(e1s.z);
+  const __m256 e2x = _mm256_set1_ps(e2s.x), e2y = _mm256_set1_ps(e2s.y), e2z = _mm256_set1_ps(e2s.z);
+  const __m256 dx = _mm256_load_ps(r.d[0]), dy = _mm256_load_ps(r.d[1]), dz = _mm256_load_ps(r.d[2]);
+  const auto mul = [](__m256 a, __m256 b) { return _mm256_mul_ps(a, b); };
+  const auto add = [](__m256 a, __m256 b) { return _mm256_add_ps(a, b); };
+  const auto sub = [](__m256 a, __m256 b) { return _mm256_sub_ps(a, b); };
+
+  const __m256 px = sub(mul(dy, e2z), mul(dz, e2y));
+  const __m256 py = sub(mul(dz, e2x), mul(dx, e2z));
+  const __m256 pz = sub(mul(dx, e2y), mul(dy, e2x));
+  const __m256 det = add(add(mul(e1x, px), mul(e1y, py)), mul(e1z, pz));
+  // finite_nonzero(det): 0 < |det| <= FLT_MAX, NaN excluded.
+  const __m256 abs_det = _mm256_andnot_ps(_mm256_set1_ps(-0.0f), det);
+  __m256 ok = _mm256_and_ps(_mm256_cmp_ps(abs_det, _mm256_setzero_ps(), _CMP_GT_OQ),
+                            _mm256_cmp_ps(abs_det, _mm256_set1_ps(detail::kFloatMax), _CMP_LE_OQ));
+  if (_mm256_testz_ps(ok, ok) != 0) return 0;
+  const __m256 inv_det = _mm256_div_ps(_mm256_set1_ps(1.0f), det);
+
+  const __m256 tx = sub(_mm256_load_ps(r.o[0]), _mm256_set1_ps(p0.x));
+  const __m256 ty = sub(_mm256_load_ps(r.o[1]), _mm256_set1_ps(p0.y));
+  const __m256 tz = sub(_mm256_load_ps(r.o[2]), _mm256_set1_ps(p0.z));
+  const __m256 u = mul(add(add(mul(tx, px), mul(ty, py)), mul(tz, pz)), inv_det);
+  const __m256 zero = _mm256_setzero_ps();
+  const __m256 one = _mm256_set1_ps(1.0f);
+  ok = _mm256_and_ps(ok, _mm256_and_ps(_mm256_cmp_ps(u, zero, _CMP_GE_OQ), _mm256_cmp_ps(u, one, _CMP_LE_OQ)));
+  if (_mm256_testz_ps(ok, ok) != 0) return 0;
+
+  const __m256 qx = sub(mul(ty, e1z), mul(tz, e1y));
+  const __m256 qy = sub(mul(tz, e1x), mul(tx, e1z));
+  const __m256 qz = sub(mul(tx, e1y), mul(ty, e1x));
+  const __m256 v = mul(add(add(mul(dx, qx), mul(dy, qy)), mul(dz, qz)), inv_det);
+  ok = _mm256_and_ps(ok, _mm256_and_ps(_mm256_cmp_ps(v, zero, _CMP_GE_OQ),
+                                       _mm256_cmp_ps(add(u, v), one, _CMP_LE_OQ)));
+  if (_mm256_testz_ps(ok, ok) != 0) return 0;
+
+  const __m256 t = mul(add(add(mul(e2x, qx), mul(e2y, qy)), mul(e2z, qz)), inv_det);
+  ok = _mm256_and_ps(ok, _mm256_cmp_ps(t, _mm256_load_ps(r.t_min), _CMP_GE_OQ));
+  ok = _mm256_and_ps(ok, _mm256_cmp_ps(t, _mm256_load_ps(r.t_max), _CMP_LT_OQ));
+  ok = _mm256_and_ps(ok, _mm256_cmp_ps(t, _mm256_set1_ps(detail::kFloatMax), _CMP_LE_OQ));
+  const std::uint32_t hit = static_cast<std::uint32_t>(_mm256_movemask_ps(ok)) & lanes;
+  if (hit != 0) {
+    _mm256_storeu_ps(t_out, t);
+    _mm256_storeu_ps(u_out, u);
+    _mm256_storeu_ps(v_out, v);
+  }
+  return hit;
+}
+
+}  // namespace sinew::rt
+
+#endif  // __AVX2__
