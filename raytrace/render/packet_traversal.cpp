@@ -67,6 +67,13 @@ void for_each_lane(std::uint32_t mask, Fn&& fn) {
   }
 }
 
+// All-ones in the lanes of `mask`, zero elsewhere.
+inline __m256 lane_mask(std::uint32_t mask) {
+  const __m256i bits = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+  return _mm256_castsi256_ps(
+      _mm256_cmpeq_epi32(_mm256_and_si256(_mm256_set1_epi32(static_cast<int>(mask)), bits), bits));
+}
+
 // The packet's rays in the frame of the tree being walked (world or a
 // bone's), with each lane's slack.
 struct alignas(32) FrameRays {
@@ -319,39 +326,63 @@ template <TriangleTest kTest, bool kAnyHit>
 class PacketQuery {
  public:
   PacketQuery(const Scene& scene, const RayPacket& packet) : scene_(scene) {
-    for (int lane = 0; lane < kLanes; ++lane) {
-      // Inactive lanes get a harmless ray so the eight-wide arithmetic stays finite.
-      const Ray ray = (packet.active >> lane & 1u) ? packet.ray(lane) : Ray{};
-      const bool valid = (packet.active >> lane & 1u) && valid_ray(ray);
-      rays_[lane] = valid ? ray : Ray{};
-      if (valid) live_ |= 1u << lane;
-      world_.set(lane, rays_[lane].origin, rays_[lane].direction);
-      world_.eps[lane] = 0.0f;
-      origin_magnitude_[lane] = max_abs(rays_[lane].origin);
-      direction_magnitude_[lane] = max_abs(rays_[lane].direction);
-      t_limit_[lane] = rays_[lane].t_max;
-      t_min_[lane] = rays_[lane].t_min;
-      if constexpr (kTest == TriangleTest::kWatertight) watertight_[lane] = prepare_watertight(rays_[lane]);
+    // valid_ray() for eight lanes: finite origin and direction, a non-zero
+    // direction, t_min < t_max (false for NaN).
+    const __m256 max = _mm256_set1_ps(std::numeric_limits<float>::max());
+    const __m256 sign = _mm256_set1_ps(-0.0f);
+    const __m256 zero = _mm256_setzero_ps();
+    const float* const origin[3] = {packet.ox, packet.oy, packet.oz};
+    const float* const direction[3] = {packet.dx, packet.dy, packet.dz};
+    __m256 o[3], d[3];
+    __m256 valid = _mm256_cmp_ps(_mm256_loadu_ps(packet.t_min), _mm256_loadu_ps(packet.t_max), _CMP_LT_OQ);
+    __m256 nonzero = _mm256_setzero_ps();
+    for (int a = 0; a < 3; ++a) {
+      o[a] = _mm256_loadu_ps(origin[a]);
+      d[a] = _mm256_loadu_ps(direction[a]);
+      valid = _mm256_and_ps(valid, _mm256_cmp_ps(_mm256_andnot_ps(sign, o[a]), max, _CMP_LE_OQ));
+      valid = _mm256_and_ps(valid, _mm256_cmp_ps(_mm256_andnot_ps(sign, d[a]), max, _CMP_LE_OQ));
+      nonzero = _mm256_or_ps(nonzero, _mm256_cmp_ps(d[a], zero, _CMP_NEQ_OQ));
     }
+    live_ = static_cast<std::uint32_t>(_mm256_movemask_ps(_mm256_and_ps(valid, nonzero))) & packet.active;
     valid_ = live_;
+    // Other lanes get the default Ray{}, so the eight-wide arithmetic stays finite.
+    const __m256 use = lane_mask(live_);
+    const Ray none{};
+    __m256 o_mag = zero, d_mag = zero;
+    for (int a = 0; a < 3; ++a) {
+      o[a] = _mm256_blendv_ps(_mm256_set1_ps(none.origin[a]), o[a], use);
+      d[a] = _mm256_blendv_ps(_mm256_set1_ps(none.direction[a]), d[a], use);
+      _mm256_store_ps(world_.o[a], o[a]);
+      _mm256_store_ps(world_.d[a], d[a]);
+      // 1 / d, correctly rounded like the single ray's.
+      _mm256_store_ps(world_.inv[a], _mm256_div_ps(_mm256_set1_ps(1.0f), d[a]));
+      o_mag = _mm256_max_ps(o_mag, _mm256_andnot_ps(sign, o[a]));
+      d_mag = _mm256_max_ps(d_mag, _mm256_andnot_ps(sign, d[a]));
+    }
+    _mm256_store_ps(world_.eps, zero);
+    _mm256_store_ps(origin_magnitude_, o_mag);
+    _mm256_store_ps(direction_magnitude_, d_mag);
+    _mm256_store_ps(t_min_, _mm256_blendv_ps(_mm256_set1_ps(none.t_min), _mm256_loadu_ps(packet.t_min), use));
+    _mm256_store_ps(t_limit_, _mm256_blendv_ps(_mm256_set1_ps(none.t_max), _mm256_loadu_ps(packet.t_max), use));
+    if constexpr (kTest == TriangleTest::kWatertight) {
+      for (int lane = 0; lane < kLanes; ++lane) watertight_[lane] = prepare_watertight(ray(lane));
+    }
   }
 
   void run() {
     const KdTreeView top = scene_.top_level().view();
     if (top.empty() || live_ == 0) return;
-    Intervals span{};
-    std::uint32_t mask = 0;
-    for_each_lane(live_, [&](int lane) {
-      float t0 = rays_[lane].t_min;
-      float t1 = rays_[lane].t_max;
-      const Vec3 o = world_.origin(lane), d = world_.direction(lane), inv = world_.inverse(lane);
-      if (!clip_to_box(top.bounds, world_eps(lane, max_abs(top.bounds), 0.0f), o, d, inv, t0, t1)) return;
-      world_.eps[lane] = world_eps(lane, max_abs(top.bounds), t1);
-      span.t0[lane] = t0;
-      span.t1[lane] = t1;
-      mask |= 1u << lane;
-    });
+    // The whole scene's box: slack for the box alone, then for the ray's
+    // reach to its far side (the single-ray query's two steps).
+    const float box_magnitude = max_abs(top.bounds);
+    Intervals span;
+    _mm256_store_ps(span.t0, _mm256_load_ps(t_min_));
+    _mm256_store_ps(span.t1, _mm256_load_ps(t_limit_));
+    alignas(32) float eps[kLanes];
+    _mm256_store_ps(eps, world_eps8(box_magnitude, _mm256_setzero_ps()));
+    const std::uint32_t mask = clip_lanes(top.bounds, eps, world_, live_, span);
     if (mask == 0) return;
+    _mm256_store_ps(world_.eps, world_eps8(box_magnitude, _mm256_load_ps(span.t1)));
     auto leaf = [this](std::span<const std::uint32_t> objects, std::uint32_t lanes) {
       for (const std::uint32_t object : objects) {
         const std::uint32_t entering = lanes_entering(object, lanes & live_);
@@ -367,10 +398,27 @@ class PacketQuery {
   const TraversalCounters& counters() const { return counters_; }
 
  private:
-  // `box_magnitude`: max_abs(box), the same for every lane.
-  float world_eps(int lane, float box_magnitude, float t_end) const {
-    const float reach = std::isfinite(t_end) ? t_end * direction_magnitude_[lane] : 0.0f;
-    return kFrameRelativeSlack * (origin_magnitude_[lane] + reach + box_magnitude);
+  // Per lane the single-ray query's slack for a world-space box of
+  // magnitude max_abs(box) reached up to t_end: kFrameRelativeSlack *
+  // ((|origin| + t_end * |direction|) + box_magnitude), the reach taken as 0
+  // for an infinite t_end.
+  __m256 world_eps8(float box_magnitude, __m256 t_end) const {
+    const __m256 finite_end = _mm256_cmp_ps(_mm256_andnot_ps(_mm256_set1_ps(-0.0f), t_end),
+                                            _mm256_set1_ps(std::numeric_limits<float>::max()), _CMP_LE_OQ);
+    const __m256 reach =
+        _mm256_and_ps(finite_end, _mm256_mul_ps(t_end, _mm256_load_ps(direction_magnitude_)));
+    const __m256 sum = _mm256_add_ps(_mm256_add_ps(_mm256_load_ps(origin_magnitude_), reach),
+                                     _mm256_set1_ps(box_magnitude));
+    return _mm256_mul_ps(_mm256_set1_ps(kFrameRelativeSlack), sum);
+  }
+
+  Ray ray(int lane) const {
+    Ray r;
+    r.origin = world_.origin(lane);
+    r.direction = world_.direction(lane);
+    r.t_min = t_min_[lane];
+    r.t_max = t_limit_[lane];
+    return r;
   }
 
   // Of `lanes`, those that have not entered `object` yet (marking them).
@@ -394,14 +442,12 @@ class PacketQuery {
   }
 
   bool visit(const TopLevelObject& object, std::uint32_t lanes) {
-    Intervals span{};
-    alignas(32) float eps[kLanes] = {};
-    const float box_magnitude = max_abs(object.box);
-    for_each_lane(lanes, [&](int lane) {
-      span.t0[lane] = rays_[lane].t_min;
-      span.t1[lane] = t_limit_[lane];
-      eps[lane] = world_eps(lane, box_magnitude, t_limit_[lane]);
-    });
+    Intervals span;
+    alignas(32) float eps[kLanes];
+    const __m256 t_limit = _mm256_load_ps(t_limit_);
+    _mm256_store_ps(span.t0, _mm256_load_ps(t_min_));
+    _mm256_store_ps(span.t1, t_limit);
+    _mm256_store_ps(eps, world_eps8(max_abs(object.box), t_limit));
     const std::uint32_t mask = clip_lanes(object.box, eps, world_, lanes, span);
     if (mask == 0) return false;
     mailbox_.reset();
@@ -422,27 +468,42 @@ class PacketQuery {
     const KdTreeView tree = character.fuzzy.bone_tree(bone);
     const Affine3& to_bone = frame.bone_from_world[bone];
     const InstanceFrame::BoneCarry& carry = frame.bone_carry[bone];
+    // Per lane Affine3::transform_point / transform_vector, term by term in
+    // the same order; inactive lanes get o = 0, d = 1 and no slack.
     FrameRays local;
-    for (int lane = 0; lane < kLanes; ++lane) {
-      Vec3 o(0.0f), d(1.0f);
-      local.eps[lane] = 0.0f;
-      if (lanes >> lane & 1u) {
-        o = to_bone.transform_point(rays_[lane].origin);
-        d = to_bone.transform_vector(rays_[lane].direction);
-        const float carried = carry.linear_norm * origin_magnitude_[lane] + carry.translation_magnitude;
-        const float t1 = span.t1[lane];
-        local.eps[lane] = 2.0f * frame.tolerance[bone] +
-                          kFrameRelativeSlack * (carried + max_abs(o) + t1 * max_abs(d) + carry.bounds_magnitude);
-      }
-      for (int a = 0; a < 3; ++a) {
-        local.o[a][lane] = o[a];
-        local.d[a][lane] = d[a];
-      }
-    }
-    // 1 / d, correctly rounded like the single ray's.
+    const __m256 use = lane_mask(lanes);
+    const __m256 sign = _mm256_set1_ps(-0.0f);
+    const __m256 wo[3] = {_mm256_load_ps(world_.o[0]), _mm256_load_ps(world_.o[1]), _mm256_load_ps(world_.o[2])};
+    const __m256 wd[3] = {_mm256_load_ps(world_.d[0]), _mm256_load_ps(world_.d[1]), _mm256_load_ps(world_.d[2])};
+    __m256 o_mag = _mm256_setzero_ps(), d_mag = _mm256_setzero_ps();
     for (int a = 0; a < 3; ++a) {
-      _mm256_store_ps(local.inv[a], _mm256_div_ps(_mm256_set1_ps(1.0f), _mm256_load_ps(local.d[a])));
+      const Vec4& row = to_bone.rows[a];
+      const __m256 rx = _mm256_set1_ps(row.x), ry = _mm256_set1_ps(row.y), rz = _mm256_set1_ps(row.z);
+      const __m256 linear_o =
+          _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(rx, wo[0]), _mm256_mul_ps(ry, wo[1])), _mm256_mul_ps(rz, wo[2]));
+      const __m256 o = _mm256_and_ps(use, _mm256_add_ps(linear_o, _mm256_set1_ps(row.w)));
+      const __m256 d = _mm256_blendv_ps(
+          _mm256_set1_ps(1.0f),
+          _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(rx, wd[0]), _mm256_mul_ps(ry, wd[1])), _mm256_mul_ps(rz, wd[2])),
+          use);
+      _mm256_store_ps(local.o[a], o);
+      _mm256_store_ps(local.d[a], d);
+      // 1 / d, correctly rounded like the single ray's.
+      _mm256_store_ps(local.inv[a], _mm256_div_ps(_mm256_set1_ps(1.0f), d));
+      o_mag = _mm256_max_ps(o_mag, _mm256_andnot_ps(sign, o));
+      d_mag = _mm256_max_ps(d_mag, _mm256_andnot_ps(sign, d));
     }
+    // 2 tolerance + slack * (((carried + |o|) + t1 |d|) + |bounds|), with
+    // carried = linear_norm * |world origin| + translation magnitude.
+    const __m256 carried = _mm256_add_ps(
+        _mm256_mul_ps(_mm256_set1_ps(carry.linear_norm), _mm256_load_ps(origin_magnitude_)),
+        _mm256_set1_ps(carry.translation_magnitude));
+    const __m256 sum = _mm256_add_ps(
+        _mm256_add_ps(_mm256_add_ps(carried, o_mag), _mm256_mul_ps(_mm256_load_ps(span.t1), d_mag)),
+        _mm256_set1_ps(carry.bounds_magnitude));
+    const __m256 eps = _mm256_add_ps(_mm256_set1_ps(2.0f * frame.tolerance[bone]),
+                                     _mm256_mul_ps(_mm256_set1_ps(kFrameRelativeSlack), sum));
+    _mm256_store_ps(local.eps, _mm256_and_ps(use, eps));
     const std::uint32_t mask = clip_lanes(tree.bounds, local.eps, local, lanes, span);
     if (mask == 0) return false;
     const SkinnedMesh& mesh = *character.mesh;
@@ -496,8 +557,7 @@ class PacketQuery {
   template <class LeafFn>
   bool walk_world_tree(const KdTreeView& tree, std::uint32_t lanes, const Intervals& span, LeafFn& leaf) {
     FrameRays rays = world_;
-    const float box_magnitude = max_abs(tree.bounds);
-    for_each_lane(lanes, [&](int lane) { rays.eps[lane] = world_eps(lane, box_magnitude, span.t1[lane]); });
+    _mm256_store_ps(rays.eps, world_eps8(max_abs(tree.bounds), _mm256_load_ps(span.t1)));
     return traverse_packet(tree, rays, 0, lanes, span, t_limit_, live_, counters_.node_visits, leaf);
   }
 
@@ -512,7 +572,7 @@ class PacketQuery {
     if constexpr (kTest == TriangleTest::kWatertight) {
       for_each_lane(todo, [&](int lane) {
         TriangleHit h;
-        if (intersect_triangle_watertight(watertight_[lane], rays_[lane], t_limit_[lane], p0, p1, p2, h)) {
+        if (intersect_triangle_watertight(watertight_[lane], ray(lane), t_limit_[lane], p0, p1, p2, h)) {
           record(lane, h.t, h.u, h.v, triangle, instance);
         }
       });
@@ -540,12 +600,11 @@ class PacketQuery {
   }
 
   const Scene& scene_;
-  std::array<Ray, kLanes> rays_;
   FrameRays world_;
   alignas(32) float t_limit_[kLanes];
   alignas(32) float t_min_[kLanes];
-  float origin_magnitude_[kLanes];
-  float direction_magnitude_[kLanes];
+  alignas(32) float origin_magnitude_[kLanes];
+  alignas(32) float direction_magnitude_[kLanes];
   std::array<WatertightRay, kLanes> watertight_;
   std::array<Hit, kLanes> best_;
   PacketMailbox mailbox_;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -55,14 +56,24 @@ class SrgbTable {
   std::array<std::uint8_t, 16384> bytes_{};
 };
 
-const SrgbTable& srgb_table() {
-  static const SrgbTable table;
-  return table;
-}
+// Built once at start-up, not behind a function-local static's guard, which
+// every one of the three lookups per pixel paid.
+const SrgbTable kSrgbTable;
 
 std::uint8_t to_byte(float linear) {
   if (!(linear > 0.0f)) return 0;  // also NaN
-  return srgb_table()(linear);
+  return kSrgbTable(linear);
+}
+
+// The next float towards +inf (up) or -inf; infinities and NaN unchanged.
+// std::nextafter's result for finite x, without the libm call per axis per
+// shadow ray.
+float next_float(float x, bool up) {
+  if (!std::isfinite(x)) return x;
+  if (x == 0.0f) return up ? std::numeric_limits<float>::denorm_min() : -std::numeric_limits<float>::denorm_min();
+  std::uint32_t bits = std::bit_cast<std::uint32_t>(x);
+  bits = (x > 0.0f) == up ? bits + 1 : bits - 1;
+  return std::bit_cast<float>(bits);
 }
 
 Vec3 light_vector(const Light& light, const Vec3& from) {
@@ -127,8 +138,8 @@ Vec3 offset_origin(const SurfacePoint& surface, const Vec3& toward) {
   Vec3 origin = surface.position + offset;
   // The addition itself rounds: step one more float away from the surface.
   for (int a = 0; a < 3; ++a) {
-    if (offset[a] > 0.0f) origin[a] = std::nextafter(origin[a], kInf);
-    if (offset[a] < 0.0f) origin[a] = std::nextafter(origin[a], -kInf);
+    if (offset[a] > 0.0f) origin[a] = next_float(origin[a], true);
+    if (offset[a] < 0.0f) origin[a] = next_float(origin[a], false);
   }
   return origin;
 }
