@@ -46,6 +46,13 @@ std::vector<PhaseSummary> PhaseTimers::summarize() const {
   return out;
 }
 
+std::vector<std::pair<std::string, double>> PhaseTimers::latest() const {
+  std::vector<std::pair<std::string, double>> row;
+  row.reserve(phases_.size());
+  for (const Phase& p : phases_) row.emplace_back(p.name, p.samples_ms.empty() ? 0.0 : p.samples_ms.back());
+  return row;
+}
+
 double PhaseTimers::median_total_ms() const {
   double total = 0.0;
   for (const PhaseSummary& s : summarize()) total += s.median_ms;

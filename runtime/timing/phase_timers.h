@@ -11,6 +11,7 @@
 #include <cstddef>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 namespace sinew {
@@ -36,6 +37,10 @@ class PhaseTimers {
   std::string table() const;
   // {"phase": {"median_ms": .., "min_ms": .., "max_ms": .., "samples": ..}, ...}
   std::string json() const;
+
+  // The phases in first-use order and each one's latest sample (0 for a
+  // phase not recorded yet): one frame's row for per-frame logs.
+  std::vector<std::pair<std::string, double>> latest() const;
 
   void clear() { phases_.clear(); }
 

@@ -54,3 +54,23 @@ TEST(PhaseTimers, ScopedPhaseRecordsOnce) {
 
 }  // namespace
 }  // namespace sinew
+
+namespace sinew {
+namespace {
+
+TEST(PhaseTimers, LatestGivesEachPhasesNewestSampleInFirstUseOrder) {
+  PhaseTimers t;
+  EXPECT_TRUE(t.latest().empty());
+  t.record("trace", 3.0);
+  t.record("shade", 1.0);
+  t.record("trace", 5.0);
+  const auto row = t.latest();
+  ASSERT_EQ(row.size(), 2u);
+  EXPECT_EQ(row[0].first, "trace");
+  EXPECT_EQ(row[0].second, 5.0);
+  EXPECT_EQ(row[1].first, "shade");
+  EXPECT_EQ(row[1].second, 1.0);
+}
+
+}  // namespace
+}  // namespace sinew
