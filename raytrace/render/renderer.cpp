@@ -76,6 +76,8 @@ float next_float(float x, bool up) {
   return std::bit_cast<float>(bits);
 }
 
+float max_abs_coordinate(const Vec3& v) { return std::max({std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)}); }
+
 Vec3 light_vector(const Light& light, const Vec3& from) {
   return light.kind == Light::Kind::kPoint ? light.position - from : light.direction;
 }
@@ -120,7 +122,13 @@ SurfacePoint surface_at(const Scene& scene, const Hit& hit, const Vec3& default_
     if (m < mesh.material_colors.size()) s.albedo = mesh.material_colors[m];
   }
   s.position = w * p[0] + hit.u * p[1] + hit.v * p[2];
-  s.error = gamma(7) * (glm::abs(w * p[0]) + glm::abs(hit.u * p[1]) + glm::abs(hit.v * p[2]));
+  // Bounds the rounding of `position` and, more to the point, of a triangle
+  // test started from it: Moller-Trumbore forms origin - p0 in every axis,
+  // so its error is relative to the largest vertex coordinate in any axis.
+  // A per-axis bound is 0 across a floor at exactly y = 0, and a shadow ray
+  // started one float above it hit the floor itself at t = -0.
+  const float magnitude = std::max({max_abs_coordinate(p[0]), max_abs_coordinate(p[1]), max_abs_coordinate(p[2])});
+  s.error = Vec3(gamma(7) * magnitude);
   const Vec3 n = glm::cross(p[1] - p[0], p[2] - p[0]);
   const float length = glm::length(n);
   s.geometric_normal = length > 0.0f && std::isfinite(length) ? n / length : Vec3(0.0f, 0.0f, 1.0f);

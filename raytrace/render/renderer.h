@@ -93,7 +93,7 @@ struct SurfacePoint {
   Vec3 geometric_normal{0.0f};  // unit
   Vec3 shading_normal{0.0f};    // unit; the geometric normal where no vertex normals exist
   Vec3 albedo{0.0f};
-  Vec3 error{0.0f};  // a bound on the rounding error of `position`, per axis
+  Vec3 error{0.0f};  // per axis, a bound on the rounding of `position` and of a triangle test started there
 };
 SurfacePoint surface_at(const Scene& scene, const Hit& hit, const Vec3& default_albedo);
 

@@ -17,6 +17,7 @@
 #include "editor/bake/in_memory_bake.h"
 #include "raytrace/camera/camera.h"
 #include "raytrace/render/renderer.h"
+#include "raytrace/render/packet_traversal.h"
 #include "raytrace/render/traversal.h"
 #include "raytrace/scene/scene.h"
 #include "runtime/jobs/job_system.h"
@@ -370,6 +371,105 @@ TEST(Renderer, RejectsMismatchedBuffers) {
   auto stats = renderer.render(scene, *camera, {}, buffers, jobs);
   ASSERT_FALSE(stats.ok());
   EXPECT_EQ(stats.status().field(), "buffers.depth");
+}
+
+}  // namespace
+}  // namespace sinew
+
+namespace sinew {
+namespace {
+
+// A floor and a box floating above it in ONE static mesh: a shadow ray from
+// the floor under the box toward a light above must be blocked by the
+// box's own triangles (the demo arena's case: floor and obstacles share a
+// mesh), for single rays and packets, both triangle tests.
+TEST(RenderStatic, AStaticMeshShadowsItself) {
+  rt::StaticMeshDesc mesh;
+  const auto quad = [&](Vec3 a, Vec3 b, Vec3 c, Vec3 d) {
+    const auto base = static_cast<std::uint32_t>(mesh.positions.size());
+    mesh.positions.insert(mesh.positions.end(), {a, b, c, d});
+    mesh.triangles.push_back({base, base + 1, base + 2});
+    mesh.triangles.push_back({base, base + 2, base + 3});
+  };
+  // Floor tiles of 2 m over [-8, 8]^2, so the mesh has a real kd-tree.
+  for (int j = 0; j < 8; ++j) {
+    for (int i = 0; i < 8; ++i) {
+      const float x = -8.0f + 2.0f * static_cast<float>(i), z = -8.0f + 2.0f * static_cast<float>(j);
+      quad(Vec3(x, 0, z), Vec3(x, 0, z + 2), Vec3(x + 2, 0, z + 2), Vec3(x + 2, 0, z));
+    }
+  }
+  // The box's bottom face at y = 2 over [-1, 1]^2 (enough to block).
+  quad(Vec3(-1, 2, -1), Vec3(1, 2, -1), Vec3(1, 2, 1), Vec3(-1, 2, 1));
+  rt::Scene scene;
+  ASSERT_TRUE(scene.add_static_mesh(mesh).ok());
+  JobSystem jobs(1);
+  ASSERT_TRUE(scene.prepare_frame(rt::FrameOptions{}, jobs).ok());
+  for (const TriangleTest test : {TriangleTest::kFast, TriangleTest::kWatertight}) {
+    rt::RayPacket packet;
+    for (int lane = 0; lane < rt::kPacketSize; ++lane) {
+      Ray shadow;
+      shadow.origin = Vec3(-0.5f + 0.1f * static_cast<float>(lane), 1e-4f, 0.3f);
+      shadow.direction = Vec3(0.0f, 10.0f, 0.0f) - shadow.origin;  // a point light at (0, 10, 0)
+      shadow.t_min = 0.0f;
+      shadow.t_max = 1.0f;
+      EXPECT_TRUE(rt::occluded(scene, shadow, test)) << "lane " << lane;
+      packet.set(lane, shadow);
+    }
+    EXPECT_EQ(rt::occluded_packet(scene, packet, test), 0xFF);
+    // Beside the box the light is visible.
+    Ray free;
+    free.origin = Vec3(4.0f, 1e-4f, 4.0f);
+    free.direction = Vec3(0.0f, 10.0f, 0.0f) - free.origin;
+    free.t_max = 1.0f;
+    EXPECT_FALSE(rt::occluded(scene, free, test));
+  }
+}
+
+}  // namespace
+}  // namespace sinew
+
+namespace sinew {
+namespace {
+
+// A floor at exactly y = 0 under a light, nothing in between: no pixel may
+// be shadowed (a shadow ray must not hit the floor it starts on). Before the
+// shadow offset accounted for the triangle test's own rounding, a floor at
+// y = 0 had a zero error bound and shadowed itself everywhere.
+TEST(RenderStatic, AFloorAtExactlyZeroDoesNotShadowItself) {
+  rt::StaticMeshDesc floor;
+  for (int j = 0; j < 4; ++j) {
+    for (int i = 0; i < 4; ++i) {
+      const float x = -16.0f + 8.0f * static_cast<float>(i), z = -16.0f + 8.0f * static_cast<float>(j);
+      const auto base = static_cast<std::uint32_t>(floor.positions.size());
+      floor.positions.insert(floor.positions.end(),
+                             {Vec3(x, 0, z), Vec3(x, 0, z + 8), Vec3(x + 8, 0, z + 8), Vec3(x + 8, 0, z)});
+      floor.triangles.push_back({base, base + 1, base + 2});
+      floor.triangles.push_back({base, base + 2, base + 3});
+    }
+  }
+  rt::Scene scene;
+  ASSERT_TRUE(scene.add_static_mesh(floor).ok());
+  JobSystem jobs(1);
+  ASSERT_TRUE(scene.prepare_frame(rt::FrameOptions{}, jobs).ok());
+  rt::CameraDesc desc;
+  desc.eye = Vec3(0.0f, 6.0f, -12.0f);
+  desc.target = Vec3(0.0f, 0.0f, 0.0f);
+  auto camera = rt::PinholeCamera::create(desc, 64, 64);
+  ASSERT_TRUE(camera.ok());
+  for (const bool packets : {true, false}) {
+    rt::RenderSettings settings;
+    settings.light.position = Vec3(6.0f, 12.0f, 4.0f);
+    settings.packets = packets;
+    std::vector<std::uint8_t> color(64 * 64 * 4);
+    rt::FrameBuffers buffers;
+    buffers.width = buffers.height = 64;
+    buffers.color_rgba8 = color;
+    rt::Renderer renderer;
+    auto stats = renderer.render(scene, *camera, settings, buffers, jobs);
+    ASSERT_TRUE(stats.ok());
+    EXPECT_GT(stats->shadow_rays, 1000u);
+    EXPECT_EQ(stats->shadowed, 0u) << (packets ? "packets" : "single rays");
+  }
 }
 
 }  // namespace
