@@ -22,12 +22,16 @@ Expected<T> parse_number(const std::string& flag, const std::string& text, T lo,
 
 std::string demo_usage() {
   return "usage: sinew-demo [--headless] [--frames N] [--out DIR] [--threads N]\n"
-         "                  [--size WxH] [--seed S]\n"
-         "  --headless   no window: render frames to DIR (default out/demo)\n"
-         "  --frames N   frames to run (headless default 120; windowed: until Esc)\n"
-         "  --threads N  worker threads (default: all cores)\n"
-         "  --size WxH   frame size (default 1024x1024)\n"
-         "  --seed S     seed of the scripted run\n";
+         "                  [--size WxH] [--seed S] [--characters N] [--model PATH]\n"
+         "  --headless      no window: a scripted, deterministic run writing frames to DIR\n"
+         "  --frames N      frames to run (headless default 120; windowed: until Esc)\n"
+         "  --out DIR       where headless frames and timings.json go (default out/demo)\n"
+         "  --threads N     worker threads (default: all cores)\n"
+         "  --size WxH      frame size (default 1024x1024)\n"
+         "  --seed S        seed of the arena and the characters' wandering (default 1)\n"
+         "  --characters N  characters in the arena, one of them yours (default 6)\n"
+         "  --model PATH    the character: glTF (.gltf, .glb) or Cal3D (.cfg); default the\n"
+         "                  procedural mannequin\n";
 }
 
 Expected<DemoOptions> parse_demo_options(const std::vector<std::string>& args) {
@@ -52,6 +56,11 @@ Expected<DemoOptions> parse_demo_options(const std::vector<std::string>& args) {
       SINEW_ASSIGN_OR_RETURN(std::string v, next());
       SINEW_ASSIGN_OR_RETURN(o.seed, parse_number<std::uint32_t>(
                                           a, v, 0, std::numeric_limits<std::uint32_t>::max()));
+    } else if (a == "--characters") {
+      SINEW_ASSIGN_OR_RETURN(std::string v, next());
+      SINEW_ASSIGN_OR_RETURN(o.characters, parse_number<int>(a, v, 1, 256));
+    } else if (a == "--model") {
+      SINEW_ASSIGN_OR_RETURN(o.model_path, next());
     } else if (a == "--out") {
       SINEW_ASSIGN_OR_RETURN(o.out_dir, next());
     } else if (a == "--size") {

@@ -19,6 +19,8 @@ struct DemoOptions {
   int width = 1024;
   int height = 1024;
   std::uint32_t seed = 1;
+  int characters = 6;
+  std::string model_path;  // empty: the procedural mannequin
   bool help = false;
 };
 

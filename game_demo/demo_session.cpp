@@ -1,0 +1,149 @@
+#include "game_demo/demo_session.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+
+#include "content/mannequin/mannequin.h"
+#include "editor/bake/in_memory_bake.h"
+#include "editor/cli/render_command.h"
+#include "editor/import/cal3d_importer.h"
+#include "editor/import/gltf_importer.h"
+
+namespace sinew::demo {
+namespace {
+
+constexpr float kCharacterHeight = 1.8f;
+constexpr int kObstacles = 8;
+
+std::string lower_extension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext;
+}
+
+Expected<editor::ImportedModel> load_model(const std::string& path) {
+  if (path.empty()) return content::make_mannequin();
+  const std::string ext = lower_extension(path);
+  if (ext == ".cfg") return editor::import_cal3d(path);
+  if (ext == ".gltf" || ext == ".glb") return editor::import_gltf(path);
+  if (ext == ".pack") {
+    return make_error(ErrorCode::kInvalidArgument, path, "--model", ext,
+                      "content packs are not readable yet (editor issue); pass the source model (.gltf, .glb, .cfg)");
+  }
+  return make_error(ErrorCode::kInvalidArgument, path, "--model", ext,
+                    "unknown model type: expected .gltf, .glb or .cfg (Cal3D)");
+}
+
+double ms_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
+Affine3 model_to_world(const editor::ImportedModel& model) {
+  const Aabb rest = editor::rest_bounds(model);
+  const int up = editor::up_axis_of(rest);
+  const float height = std::max(rest.extent()[up], 1e-6f);
+  const float scale = kCharacterHeight / height;
+  // Z-up to Y-up: (x, y, z) -> (x, z, -y), so a model facing -Y faces +Z.
+  Affine3 axes = Affine3::identity();
+  if (up == 2) {
+    axes.rows[1] = Vec4(0.0f, 0.0f, 1.0f, 0.0f);
+    axes.rows[2] = Vec4(0.0f, -1.0f, 0.0f, 0.0f);
+  }
+  const Vec3 centre = rest.center();
+  const Vec3 feet = axes.transform_point(Vec3(centre.x, centre.y, centre.z)) * scale;
+  const float floor = (up == 2 ? rest.lower.z : rest.lower.y) * scale;
+  const Affine3 scaled = Affine3::from_trs(Vec3(-feet.x, -floor, -feet.z), Quat(1.0f, 0.0f, 0.0f, 0.0f), Vec3(scale));
+  return scaled * axes;
+}
+
+rt::CameraDesc follow_camera_desc(const FollowCamera& camera, const Vec3& target) {
+  const Vec3 look_at = target + Vec3(0.0f, 1.1f, 0.0f);
+  const Vec3 forward(std::sin(camera.yaw) * std::cos(camera.pitch), -std::sin(camera.pitch),
+                     std::cos(camera.yaw) * std::cos(camera.pitch));
+  rt::CameraDesc desc;
+  desc.eye = look_at - camera.distance * forward;
+  desc.eye.y = std::max(desc.eye.y, 0.2f);  // never below the floor
+  desc.target = look_at;
+  desc.up = Vec3(0.0f, 1.0f, 0.0f);
+  desc.fovy_degrees = camera.fovy_degrees;
+  return desc;
+}
+
+DemoSession::DemoSession(SessionOptions options, editor::ImportedModel model, World world)
+    : options_(std::move(options)), model_(std::move(model)), world_(std::move(world)) {}
+
+DemoSession::~DemoSession() = default;
+
+Expected<std::unique_ptr<DemoSession>> DemoSession::create(const SessionOptions& options, JobSystem& jobs) {
+  if (options.width < 1 || options.height < 1) {
+    return invalid_argument("--size", std::to_string(options.width) + "x" + std::to_string(options.height),
+                            "must be at least 1x1");
+  }
+  SINEW_ASSIGN_OR_RETURN(editor::ImportedModel model, load_model(options.model_path));
+  const Arena arena = Arena::generate(options.seed, kObstacles);
+  WorldOptions world_options;
+  world_options.characters = options.characters;
+  world_options.seed = options.seed;
+  world_options.arena_half_size = arena.walk_half_size;
+  world_options.obstacles = arena.obstacles;
+  world_options.model_to_world = model_to_world(model);
+  SINEW_ASSIGN_OR_RETURN(World world, World::create(model, world_options));
+
+  std::unique_ptr<DemoSession> session(new DemoSession(options, std::move(model), std::move(world)));
+  DemoSession& s = *session;
+  s.arena_ = arena;
+  const auto bake_start = std::chrono::steady_clock::now();
+  SINEW_ASSIGN_OR_RETURN(editor::InMemoryBake bake, editor::bake_in_memory(s.model_, editor::BakeRequest{}, jobs));
+  s.fuzzy_ = std::move(bake.fuzzy);
+  s.bake_info_.model = options.model_path.empty() ? "mannequin (procedural)" : options.model_path;
+  s.bake_info_.triangles = s.model_.mesh.triangle_count();
+  s.bake_info_.bones = s.model_.skeleton.joint_count();
+  s.bake_info_.pose_samples = s.fuzzy_.stats.sample_count;
+  s.bake_info_.bake_ms = ms_since(bake_start);
+  s.bake_info_.fuzzy_area_ratio =
+      s.fuzzy_.stats.rest_area > 0.0 ? s.fuzzy_.stats.fuzzy_area / s.fuzzy_.stats.rest_area : 0.0;
+
+  SINEW_ASSIGN_OR_RETURN(const std::uint32_t character, s.scene_.add_character(s.model_.mesh, s.fuzzy_.view()));
+  SINEW_ASSIGN_OR_RETURN(const std::uint32_t arena_mesh, s.scene_.add_static_mesh(s.arena_.static_mesh()));
+  (void)arena_mesh;  // hits report it as an instance id; nothing to keep
+  for (int i = 0; i < s.world_.character_count(); ++i) {
+    SINEW_ASSIGN_OR_RETURN(const std::uint32_t instance, s.scene_.add_instance(character));
+    s.instances_.push_back(instance);
+  }
+  s.settings_.shadows = options.shadows;
+  s.settings_.triangle_test = options.triangle_test;
+  s.settings_.light.kind = rt::Light::Kind::kPoint;
+  s.settings_.light.position = s.arena_.light_position;
+  s.settings_.background = Vec3(0.30f, 0.38f, 0.50f);
+  s.rgba_.assign(static_cast<std::size_t>(options.width) * static_cast<std::size_t>(options.height) * 4, 0);
+  return session;
+}
+
+Expected<FrameReport> DemoSession::frame(float dt, PlayerInput input, const FollowCamera& camera, JobSystem& jobs) {
+  input.camera_yaw = camera.yaw;
+  {
+    ScopedPhase phase(timers_, "animation");
+    world_.step(dt, input);
+    for (int i = 0; i < world_.character_count(); ++i) {
+      SINEW_RETURN_IF_ERROR(scene_.set_bones(instances_[static_cast<std::size_t>(i)], world_.skinning(i)));
+    }
+  }
+  FrameReport report;
+  SINEW_ASSIGN_OR_RETURN(report.scene, scene_.prepare_frame(rt::FrameOptions{}, jobs, &timers_));
+  const Vec3 target = world_.character(world_.player()).position;
+  SINEW_ASSIGN_OR_RETURN(rt::PinholeCamera cam,
+                         rt::PinholeCamera::create(follow_camera_desc(camera, target), options_.width, options_.height));
+  camera_ = cam;
+  rt::FrameBuffers buffers;
+  buffers.width = options_.width;
+  buffers.height = options_.height;
+  buffers.color_rgba8 = rgba_;
+  SINEW_ASSIGN_OR_RETURN(report.render, renderer_.render(scene_, *camera_, settings_, buffers, jobs, &timers_));
+  return report;
+}
+
+}  // namespace sinew::demo
