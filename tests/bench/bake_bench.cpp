@@ -1,4 +1,5 @@
 #include "tests/bench/bake_bench.h"
+#include "tests/bench/bench_support.h"
 
 #include <sys/resource.h>
 
@@ -122,28 +123,6 @@ void print_usage(std::FILE* to) {
 
 // --- machine -------------------------------------------------------------------
 
-std::string cpu_model() {
-  std::ifstream in("/proc/cpuinfo");
-  std::string line;
-  while (std::getline(in, line)) {
-    if (line.rfind("model name", 0) != 0) continue;
-    const std::size_t colon = line.find(':');
-    if (colon == std::string::npos) break;
-    const std::size_t start = line.find_first_not_of(" \t", colon + 1);
-    return start == std::string::npos ? std::string() : line.substr(start);
-  }
-  return "unknown";
-}
-
-std::string utc_date() {
-  const std::time_t now = std::time(nullptr);
-  std::tm utc{};
-  gmtime_r(&now, &utc);
-  char text[32];
-  std::strftime(text, sizeof text, "%Y-%m-%d %H:%M:%S UTC", &utc);
-  return text;
-}
-
 // The process's resident high-water mark since it started (ru_maxrss, KiB on
 // Linux). It never goes down, so it only shows a bake's footprint when that
 // bake is the largest so far.
@@ -174,28 +153,6 @@ std::optional<double> status_kib(std::string_view key) {
 
 // --- real models ---------------------------------------------------------------
 
-Expected<std::optional<editor::ImportedModel>> load_model(const std::string& name, const std::string& shared,
-                                                          std::string& note) {
-  if (name == "mannequin") {
-    SINEW_ASSIGN_OR_RETURN(editor::ImportedModel model, content::make_mannequin());
-    return std::optional<editor::ImportedModel>(std::move(model));
-  }
-  const std::string cfg = shared + "/content/cal3d/cally/cally.cfg";
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(cfg, ec)) {
-    note = "cally skipped: " + cfg + " not found (pass --shared DIR)";
-    return std::optional<editor::ImportedModel>();
-  }
-  SINEW_ASSIGN_OR_RETURN(editor::ImportedModel model, editor::import_cal3d(cfg));
-  return std::optional<editor::ImportedModel>(std::move(model));
-}
-
-Expected<std::size_t> find_walk_clip(const editor::ImportedModel& model, const std::string& name) {
-  for (std::size_t i = 0; i < model.clips.size(); ++i) {
-    if (model.clips[i].name() == "walk") return i;
-  }
-  return make_error(ErrorCode::kNotFound, name, "clip", "walk", "the model has no walk clip");
-}
 
 // One candidate mode on one model: the last of its bakes (kept for the
 // renders), every bake's times, and every render's trace times.
