@@ -566,11 +566,11 @@ class PacketQuery {
   // Returns true when every lane is answered (any-hit).
   bool test(std::uint32_t lanes, const Vec3& p0, const Vec3& p1, const Vec3& p2, std::uint32_t triangle,
             std::uint32_t instance, std::uint32_t mail) {
-    const std::uint32_t todo = mailbox_.untested(mail, lanes & live_);
-    if (todo == 0) return false;
-    counters_.triangle_tests += static_cast<std::uint64_t>(std::popcount(todo));
+    const std::uint32_t untested_lanes = mailbox_.untested(mail, lanes & live_);
+    if (untested_lanes == 0) return false;
+    counters_.triangle_tests += static_cast<std::uint64_t>(std::popcount(untested_lanes));
     if constexpr (kTest == TriangleTest::kWatertight) {
-      for_each_lane(todo, [&](int lane) {
+      for_each_lane(untested_lanes, [&](int lane) {
         TriangleHit h;
         if (intersect_triangle_watertight(watertight_[lane], ray(lane), t_limit_[lane], p0, p1, p2, h)) {
           record(lane, h.t, h.u, h.v, triangle, instance);
@@ -579,7 +579,7 @@ class PacketQuery {
     } else {
       alignas(32) float t[kLanes], u[kLanes], v[kLanes];
       const RayLanes8 lanes8{world_.o, world_.d, t_min_, t_limit_};
-      const std::uint32_t hit = intersect_triangle_fast8(lanes8, todo, p0, p1, p2, t, u, v);
+      const std::uint32_t hit = intersect_triangle_fast8(lanes8, untested_lanes, p0, p1, p2, t, u, v);
       // The scalar test's last check, once per triangle.
       if (hit != 0 && !detail::zero_area(p1 - p0, p2 - p0)) {
         for_each_lane(hit, [&](int lane) { record(lane, t[lane], u[lane], v[lane], triangle, instance); });
