@@ -17,6 +17,9 @@ find_package(TinyGLTF CONFIG REQUIRED)
 if(SINEW_BUILD_DISPLAY)
   find_package(glfw3 CONFIG REQUIRED)
   find_package(OpenGL REQUIRED)
+  # Debian's libimgui-dev: a static library with the GLFW and OpenGL 2
+  # backends built in; its headers under /usr/include/imgui.
+  pkg_check_modules(IMGUI REQUIRED IMPORTED_TARGET imgui)
 endif()
 
 if(SINEW_BUILD_TESTS)

@@ -23,6 +23,7 @@ Expected<T> parse_number(const std::string& flag, const std::string& text, T lo,
 std::string demo_usage() {
   return "usage: sinew-demo [--headless] [--frames N] [--out DIR] [--threads N]\n"
          "                  [--size WxH] [--seed S] [--characters N] [--model PATH]\n"
+         "                  [--script FILE] [--screenshot PATH] [--no-hud]\n"
          "  --headless      no window: a scripted, deterministic run writing frames to DIR\n"
          "  --frames N      frames to run (headless default 120; windowed: until Esc)\n"
          "  --out DIR       where headless frames and timings.json go (default out/demo)\n"
@@ -31,7 +32,11 @@ std::string demo_usage() {
          "  --seed S        seed of the arena and the characters' wandering (default 1)\n"
          "  --characters N  characters in the arena, one of them yours (default 6)\n"
          "  --model PATH    the character: glTF (.gltf, .glb) or Cal3D (.cfg); default the\n"
-         "                  procedural mannequin\n";
+         "                  procedural mannequin\n"
+         "  --script FILE   take the keys from an input script (frame key down|up|tap per\n"
+         "                  line) with fixed 1/30 s steps, windowed or headless\n"
+         "  --screenshot PATH  windowed: write the last frame as shown (HUD included) as PNG\n"
+         "  --no-hud        windowed: start with the HUD hidden (F1 shows it)\n";
 }
 
 Expected<DemoOptions> parse_demo_options(const std::vector<std::string>& args) {
@@ -61,6 +66,12 @@ Expected<DemoOptions> parse_demo_options(const std::vector<std::string>& args) {
       SINEW_ASSIGN_OR_RETURN(o.characters, parse_number<int>(a, v, 1, 256));
     } else if (a == "--model") {
       SINEW_ASSIGN_OR_RETURN(o.model_path, next());
+    } else if (a == "--script") {
+      SINEW_ASSIGN_OR_RETURN(o.script_path, next());
+    } else if (a == "--screenshot") {
+      SINEW_ASSIGN_OR_RETURN(o.screenshot_path, next());
+    } else if (a == "--no-hud") {
+      o.hud = false;
     } else if (a == "--out") {
       SINEW_ASSIGN_OR_RETURN(o.out_dir, next());
     } else if (a == "--size") {

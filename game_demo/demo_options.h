@@ -21,6 +21,9 @@ struct DemoOptions {
   std::uint32_t seed = 1;
   int characters = 6;
   std::string model_path;  // empty: the procedural mannequin
+  std::string script_path;      // keys from this input script (input_script.h), fixed 1/30 s steps
+  std::string screenshot_path;  // windowed: the last frame as shown, HUD included, as PNG
+  bool hud = true;              // windowed: HUD shown at start
   bool help = false;
 };
 

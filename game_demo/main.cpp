@@ -7,26 +7,25 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "game_demo/demo_options.h"
 #include "game_demo/demo_session.h"
+#include "game_demo/input_script.h"
 #include "runtime/cpu/cpu_features.h"
 #include "runtime/image/image_io.h"
 #include "runtime/io/atomic_file.h"
 
 #ifdef SINEW_HAVE_DISPLAY
-#include <GLFW/glfw3.h>
-
-#include "runtime/display/pixel_display.h"
+#include "game_demo/window_loop.h"
 #include "runtime/display/window.h"
 #endif
 
 namespace sinew::demo {
 namespace {
-
-constexpr float kFrameSeconds = 1.0f / 30.0f;  // the headless run's fixed step
 
 std::string json_number(double v) {
   char text[32];
@@ -65,7 +64,7 @@ int fail(const Status& s) {
   return 1;
 }
 
-int run_headless(const DemoOptions& opt, DemoSession& session, JobSystem& jobs) {
+int run_headless(const DemoOptions& opt, const InputScript* script, DemoSession& session, JobSystem& jobs) {
   std::error_code ec;
   std::filesystem::create_directories(opt.out_dir, ec);
   if (ec) {
@@ -77,21 +76,37 @@ int run_headless(const DemoOptions& opt, DemoSession& session, JobSystem& jobs) 
   std::vector<std::string> written;
   std::uint64_t escaped = 0;
   FollowCamera camera;
+  auto write_frame = [&](int frame) -> Status {
+    char name[64];
+    std::snprintf(name, sizeof name, "/frame_%04d.png", frame);
+    const std::string path = opt.out_dir + name;
+    SINEW_RETURN_IF_ERROR(write_png(path, session.width(), session.height(), 4, session.rgba()));
+    written.push_back(path);
+    return Status();
+  };
+  int frames_run = 0;
   for (int frame = 0; frame < opt.frames; ++frame) {
-    const PlayerInput input = scripted_input(frame);
-    camera.yaw = input.camera_yaw;
-    auto report = session.frame(kFrameSeconds, input, camera, jobs);
+    PlayerInput input;
+    if (script != nullptr) {
+      const ControlResult control = script_controls(*script, frame, camera);
+      if (control.quit) break;  // the script pressed Esc
+      input = control.input;
+    } else {
+      input = scripted_input(frame);
+      camera.yaw = input.camera_yaw;
+    }
+    auto report = session.frame(kScriptStepSeconds, input, camera, jobs);
     if (!report.ok()) return fail(report.status());
+    frames_run = frame + 1;
     escaped += report->scene.escaped_triangles;
     rows.push_back(session.timers().latest());
     // The first, middle and last frame: enough to see the characters move.
-    if (frame == 0 || frame == opt.frames / 2 || frame == opt.frames - 1) {
-      char name[64];
-      std::snprintf(name, sizeof name, "/frame_%04d.png", frame);
-      const std::string path = opt.out_dir + name;
-      if (Status s = write_png(path, session.width(), session.height(), 4, session.rgba()); !s.ok()) return fail(s);
-      written.push_back(path);
+    if (frame == 0 || frame == opt.frames / 2) {
+      if (Status s = write_frame(frame); !s.ok()) return fail(s);
     }
+  }
+  if (frames_run > 1 && frames_run - 1 != opt.frames / 2) {
+    if (Status s = write_frame(frames_run - 1); !s.ok()) return fail(s);
   }
   const std::string timings_path = opt.out_dir + "/timings.json";
   if (Status s = write_file_atomic(timings_path, timings_json(rows, session.timers(), session, jobs.thread_count(), escaped));
@@ -102,7 +117,7 @@ int run_headless(const DemoOptions& opt, DemoSession& session, JobSystem& jobs) 
   std::printf("sinew-demo: %d characters (%s, %zu triangles, %u pose samples baked in %.0f ms), %d frames at %dx%d "
               "on %d threads (headless)\n",
               session.world().character_count(), bake.model.c_str(), bake.triangles, bake.pose_samples, bake.bake_ms,
-              opt.frames, session.width(), session.height(), jobs.thread_count());
+              frames_run, session.width(), session.height(), jobs.thread_count());
   std::printf("%s", session.timers().table().c_str());
   std::printf("fps (1000 / sum of phase medians): %.1f; escaped triangles over the run: %llu\n",
               1000.0 / session.timers().median_total_ms(), static_cast<unsigned long long>(escaped));
@@ -113,24 +128,8 @@ int run_headless(const DemoOptions& opt, DemoSession& session, JobSystem& jobs) 
 }
 
 #ifdef SINEW_HAVE_DISPLAY
-// Key state with press edges (Space and Tab act once per press).
-class Keys {
- public:
-  explicit Keys(const Window& window) : window_(window) {}
-  bool down(int key) const { return window_.key_down(key); }
-  bool pressed(int key) {
-    const bool now = window_.key_down(key);
-    const bool was = previous_[static_cast<std::size_t>(key)];
-    previous_[static_cast<std::size_t>(key)] = now;
-    return now && !was;
-  }
-
- private:
-  const Window& window_;
-  std::vector<bool> previous_ = std::vector<bool>(GLFW_KEY_LAST + 1, false);
-};
-
-int run_windowed(const DemoOptions& opt, DemoSession& session, JobSystem& jobs) {
+int run_windowed(const DemoOptions& opt, const InputScript* script, DemoSession& session,
+                 std::unique_ptr<JobSystem>& jobs) {
   WindowOptions wo;
   wo.width = opt.width;
   wo.height = opt.height;
@@ -140,40 +139,26 @@ int run_windowed(const DemoOptions& opt, DemoSession& session, JobSystem& jobs) 
     std::fprintf(stderr, "sinew-demo: %s (try --headless)\n", window.status().message().c_str());
     return 1;
   }
-  Window& win = **window;
-  PixelDisplay display;
-  Keys keys(win);
-  FollowCamera camera;
-  int frame = 0;
-  auto last = std::chrono::steady_clock::now();
-  while (!win.should_close() && (opt.frames == 0 || frame < opt.frames)) {
-    win.poll_events();
-    if (keys.down(GLFW_KEY_ESCAPE)) win.request_close();
-    const auto now = std::chrono::steady_clock::now();
-    const float dt = std::min(0.1f, std::chrono::duration<float>(now - last).count());
-    last = now;
-    PlayerInput input;
-    input.forward = (keys.down(GLFW_KEY_W) || keys.down(GLFW_KEY_UP) ? 1.0f : 0.0f) -
-                    (keys.down(GLFW_KEY_S) || keys.down(GLFW_KEY_DOWN) ? 1.0f : 0.0f);
-    input.right = (keys.down(GLFW_KEY_D) || keys.down(GLFW_KEY_RIGHT) ? 1.0f : 0.0f) -
-                  (keys.down(GLFW_KEY_A) || keys.down(GLFW_KEY_LEFT) ? 1.0f : 0.0f);
-    input.run = keys.down(GLFW_KEY_LEFT_SHIFT) || keys.down(GLFW_KEY_RIGHT_SHIFT);
-    input.action = keys.pressed(GLFW_KEY_SPACE);
-    input.next_character = keys.pressed(GLFW_KEY_TAB);
-    const float turn = (keys.down(GLFW_KEY_E) ? 1.0f : 0.0f) - (keys.down(GLFW_KEY_Q) ? 1.0f : 0.0f);
-    camera.yaw += turn * 2.0f * dt;
-    auto report = session.frame(dt, input, camera, jobs);
-    if (!report.ok()) return fail(report.status());
-    int vw = 0, vh = 0;
-    win.framebuffer_size(&vw, &vh);
-    {
-      ScopedPhase phase(session.timers(), "display");
-      if (Status s = display.present(session.width(), session.height(), session.rgba(), vw, vh); !s.ok()) return fail(s);
-      win.swap_buffers();
+  WindowRunOptions run;
+  run.frames = opt.frames;
+  run.script = script;
+  run.hud = opt.hud;
+  run.keep_last_shown = !opt.screenshot_path.empty();
+  auto result = run_window(session, jobs, **window, run);
+  if (!result.ok()) return fail(result.status());
+  std::printf("sinew-demo: %d frames\n%s", result->frames, session.timers().table().c_str());
+  if (!opt.screenshot_path.empty()) {
+    if (result->last_shown.empty()) {
+      std::fprintf(stderr, "sinew-demo: %s: no frame was shown, so there is no screenshot\n",
+                   opt.screenshot_path.c_str());
+      return 1;
     }
-    ++frame;
+    if (Status s = write_png(opt.screenshot_path, result->shown_width, result->shown_height, 4, result->last_shown);
+        !s.ok()) {
+      return fail(s);
+    }
+    std::printf("screenshot: %s\n", opt.screenshot_path.c_str());
   }
-  std::printf("sinew-demo: %d frames\n%s", frame, session.timers().table().c_str());
   return 0;
 }
 #endif
@@ -190,7 +175,14 @@ int run(const std::vector<std::string>& args) {
     return 0;
   }
   if (Status s = check_cpu_supports_build(); !s.ok()) return fail(s);
-  JobSystem jobs(opt.threads);
+  std::optional<InputScript> script;
+  if (!opt.script_path.empty()) {
+    auto loaded = InputScript::load(opt.script_path);
+    if (!loaded.ok()) return fail(loaded.status());
+    script = std::move(*loaded);
+  }
+  const InputScript* script_ptr = script ? &*script : nullptr;
+  auto jobs = std::make_unique<JobSystem>(opt.threads);
   SessionOptions so;
   so.model_path = opt.model_path;
   so.characters = opt.characters;
@@ -199,17 +191,17 @@ int run(const std::vector<std::string>& args) {
   so.height = opt.height;
   std::printf("sinew-demo: baking %s...\n", opt.model_path.empty() ? "the mannequin" : opt.model_path.c_str());
   std::fflush(stdout);
-  auto session = DemoSession::create(so, jobs);
+  auto session = DemoSession::create(so, *jobs);
   if (!session.ok()) return fail(session.status());
 #ifdef SINEW_HAVE_DISPLAY
   if (!opt.headless) {
-    if (Window::display_available()) return run_windowed(opt, **session, jobs);
+    if (Window::display_available()) return run_windowed(opt, script_ptr, **session, jobs);
     std::printf("sinew-demo: no display available: running headless\n");
   }
 #endif
   DemoOptions headless = opt;
   if (headless.frames == 0) headless.frames = 120;
-  return run_headless(headless, **session, jobs);
+  return run_headless(headless, script_ptr, **session, *jobs);
 }
 
 }  // namespace

@@ -1,7 +1,9 @@
 #include "runtime/display/window.h"
 
 #include <GLFW/glfw3.h>
+#include <GL/gl.h>
 
+#include <algorithm>
 #include <cstdlib>
 
 namespace sinew {
@@ -67,5 +69,26 @@ void Window::framebuffer_size(int* width, int* height) const {
   glfwGetFramebufferSize(window_, width, height);
 }
 bool Window::key_down(int glfw_key) const { return glfwGetKey(window_, glfw_key) == GLFW_PRESS; }
+bool Window::mouse_button_down(int glfw_button) const {
+  return glfwGetMouseButton(window_, glfw_button) == GLFW_PRESS;
+}
+void Window::cursor_position(double* x, double* y) const { glfwGetCursorPos(window_, x, y); }
+
+std::vector<std::uint8_t> Window::read_back_buffer(int* width, int* height) const {
+  framebuffer_size(width, height);
+  const auto w = static_cast<std::size_t>(*width);
+  const auto h = static_cast<std::size_t>(*height);
+  std::vector<std::uint8_t> bottom_up(w * h * 4);
+  glFinish();
+  glReadBuffer(GL_BACK);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadPixels(0, 0, *width, *height, GL_RGBA, GL_UNSIGNED_BYTE, bottom_up.data());
+  // GL rows start at the bottom; images here start at the top.
+  std::vector<std::uint8_t> top_down(bottom_up.size());
+  for (std::size_t y = 0; y < h; ++y) {
+    std::copy_n(bottom_up.data() + (h - 1 - y) * w * 4, w * 4, top_down.data() + y * w * 4);
+  }
+  return top_down;
+}
 
 }  // namespace sinew

@@ -3,8 +3,10 @@
 // never link GLFW or GL.
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "runtime/core/expected.h"
 
@@ -35,6 +37,12 @@ class Window {
   void swap_buffers();
   void framebuffer_size(int* width, int* height) const;
   bool key_down(int glfw_key) const;
+  bool mouse_button_down(int glfw_button) const;
+  // Cursor position in window coordinates (pixels from the top-left).
+  void cursor_position(double* x, double* y) const;
+  // Reads the back buffer (what the next swap_buffers() shows) as RGBA8,
+  // row 0 at the top: a screenshot of exactly what was drawn.
+  std::vector<std::uint8_t> read_back_buffer(int* width, int* height) const;
 
   GLFWwindow* handle() const { return window_; }
 
