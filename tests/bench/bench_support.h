@@ -2,13 +2,17 @@
 // their header lines, and the models they measure.
 #pragma once
 
+#include <cstdint>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <optional>
 #include <string>
+#include <string_view>
+#include <vector>
 
 #include "content/mannequin/mannequin.h"
+#include "editor/cli/cli_args.h"
 #include "editor/import/cal3d_importer.h"
 #include "runtime/core/expected.h"
 
@@ -35,6 +39,17 @@ inline std::string utc_date() {
   char text[32];
   std::strftime(text, sizeof text, "%Y-%m-%d %H:%M:%S UTC", &utc);
   return text;
+}
+
+// A comma-separated list of integers in [lo, hi] ("1,6,12").
+inline Expected<std::vector<int>> parse_int_list(std::string_view flag, const std::string& text, int lo, int hi) {
+  SINEW_ASSIGN_OR_RETURN(const std::vector<std::string> items, editor::cli::parse_list(flag, text));
+  std::vector<int> values;
+  for (const std::string& item : items) {
+    SINEW_ASSIGN_OR_RETURN(const std::int64_t n, editor::cli::parse_int(flag, item, lo, hi));
+    values.push_back(static_cast<int>(n));
+  }
+  return values;
 }
 
 // "mannequin" (procedural) or "cally" (from SHARED/content/cal3d/cally).

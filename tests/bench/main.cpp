@@ -7,6 +7,7 @@
 #include "runtime/cpu/cpu_features.h"
 #include "tests/bench/animation_bench.h"
 #include "tests/bench/bake_bench.h"
+#include "tests/bench/demo_bench.h"
 #include "tests/bench/raytrace_bench.h"
 
 namespace {
@@ -17,6 +18,8 @@ void usage() {
       "  animation [--frames N] [--shared DIR]   animation + skinning vs the Cal3D library\n"
       "  bake [--models LIST] [--shared DIR] [--threads N] [--large on|off] [--json FILE]\n"
       "           fuzzy bake cost per candidate-bone mode, its trace effect, and its memory bound\n"
+      "  demo [--characters LIST] [--size WxH] [--threads N] [--frames N] [--warmup N]\n"
+      "           [--shadows on|off] [--model PATH] [--json FILE]   the game demo's fps and phases\n"
       "  raytrace [--size WxH] [--frames N] [--threads LIST] [--models LIST] [--instances LIST]\n"
       "           [--shared DIR] [--triangle-test fast|watertight] [--bone-boxes exact|cheap]\n"
       "           [--json FILE]   ray tracer frame phases, and fuzzy vs exact kd-tree trace time\n");
@@ -49,6 +52,7 @@ int main(int argc, char** argv) {
   const std::vector<std::string> args(argv + 2, argv + argc);
   if (what == "animation") return sinew::bench::run_animation_bench(args);
   if (what == "bake") return sinew::bench::run_bake_bench(args, command_line(argc, argv));
+  if (what == "demo") return sinew::bench::run_demo_bench(args, command_line(argc, argv));
   if (what == "raytrace") return sinew::bench::run_raytrace_bench(args, command_line(argc, argv));
   if (what == "--help" || what == "-h" || what == "help") {
     usage();

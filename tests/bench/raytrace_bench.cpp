@@ -68,16 +68,6 @@ const std::vector<editor::cli::FlagSpec>& bench_flags() {
   return flags;
 }
 
-Expected<std::vector<int>> parse_int_list(std::string_view flag, const std::string& text, int lo, int hi) {
-  SINEW_ASSIGN_OR_RETURN(const std::vector<std::string> items, editor::cli::parse_list(flag, text));
-  std::vector<int> values;
-  for (const std::string& item : items) {
-    SINEW_ASSIGN_OR_RETURN(const std::int64_t n, editor::cli::parse_int(flag, item, lo, hi));
-    values.push_back(static_cast<int>(n));
-  }
-  return values;
-}
-
 Expected<BenchOptions> parse_options(const std::vector<std::string>& args) {
   namespace cli = editor::cli;
   SINEW_ASSIGN_OR_RETURN(const cli::ParsedArgs parsed, cli::parse_args(args, bench_flags()));

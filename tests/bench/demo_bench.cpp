@@ -1,0 +1,196 @@
+#include "tests/bench/demo_bench.h"
+
+#include <cstdio>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "editor/cli/cli_args.h"
+#include "game_demo/demo_session.h"
+#include "game_demo/world.h"
+#include "runtime/jobs/job_system.h"
+#include "runtime/timing/phase_timers.h"
+#include "tests/bench/bench_support.h"
+
+namespace sinew::bench {
+namespace {
+
+using Json = nlohmann::ordered_json;
+
+struct DemoBenchOptions {
+  std::vector<int> characters{1, 6, 12};
+  int width = 1024;
+  int height = 1024;
+  int threads = 2;
+  int frames = 30;
+  int warmup = 5;
+  bool shadows = true;
+  std::string model_path;  // empty: the mannequin
+  std::string json_path;
+  bool help = false;
+};
+
+const std::vector<editor::cli::FlagSpec>& demo_flags() {
+  static const std::vector<editor::cli::FlagSpec> flags = {
+      {"--help", false}, {"-h", false}, {"--characters"}, {"--size"},  {"--threads"},
+      {"--frames"},      {"--warmup"},  {"--shadows"},    {"--model"}, {"--json"},
+  };
+  return flags;
+}
+
+Expected<DemoBenchOptions> parse_options(const std::vector<std::string>& args) {
+  namespace cli = editor::cli;
+  SINEW_ASSIGN_OR_RETURN(const cli::ParsedArgs parsed, cli::parse_args(args, demo_flags()));
+  DemoBenchOptions o;
+  if (parsed.has("--help") || parsed.has("-h")) {
+    o.help = true;
+    return o;
+  }
+  if (!parsed.positionals.empty()) {
+    return invalid_argument("argument", parsed.positionals.front(), "unexpected argument");
+  }
+  if (const auto text = parsed.value("--characters")) {
+    SINEW_ASSIGN_OR_RETURN(o.characters, parse_int_list("--characters", *text, 1, 256));
+  }
+  if (const auto text = parsed.value("--size")) {
+    SINEW_ASSIGN_OR_RETURN(const cli::Size2 size, cli::parse_size("--size", *text, 8192));
+    o.width = size.width;
+    o.height = size.height;
+  }
+  if (const auto text = parsed.value("--threads")) {
+    SINEW_ASSIGN_OR_RETURN(const std::int64_t n, cli::parse_int("--threads", *text, 1, 1024));
+    o.threads = static_cast<int>(n);
+  }
+  if (const auto text = parsed.value("--frames")) {
+    SINEW_ASSIGN_OR_RETURN(const std::int64_t n, cli::parse_int("--frames", *text, 1, 100000));
+    o.frames = static_cast<int>(n);
+  }
+  if (const auto text = parsed.value("--warmup")) {
+    SINEW_ASSIGN_OR_RETURN(const std::int64_t n, cli::parse_int("--warmup", *text, 0, 100000));
+    o.warmup = static_cast<int>(n);
+  }
+  if (const auto text = parsed.value("--shadows")) {
+    SINEW_ASSIGN_OR_RETURN(o.shadows, cli::parse_on_off("--shadows", *text));
+  }
+  if (const auto text = parsed.value("--model")) o.model_path = *text;
+  if (const auto text = parsed.value("--json")) o.json_path = *text;
+  return o;
+}
+
+void print_usage(std::FILE* to) {
+  std::fprintf(to,
+               "usage: sinew-bench demo [--characters LIST] [--size WxH] [--threads N] [--frames N]\n"
+               "                        [--warmup N] [--shadows on|off] [--model PATH] [--json FILE]\n"
+               "  --characters LIST  character counts to measure (default 1,6,12)\n"
+               "  --size WxH         frame size (default 1024x1024)\n"
+               "  --threads N        worker threads (default 2)\n"
+               "  --frames N         measured frames per count (default 30), after\n"
+               "  --warmup N         unmeasured frames (default 5)\n"
+               "  --shadows on|off   shadow rays (default on)\n"
+               "  --model PATH       glTF or Cal3D character (default the procedural mannequin)\n"
+               "  --json FILE        also write the numbers as JSON\n");
+}
+
+struct CountResult {
+  int characters = 0;
+  std::vector<PhaseSummary> phases;
+  double frame_ms = 0.0;  // sum of the phase medians
+  double rays_per_frame = 0.0;
+  std::uint64_t escaped_triangles = 0;
+  std::size_t triangles = 0;
+};
+
+Expected<CountResult> measure(const DemoBenchOptions& o, int characters, JobSystem& jobs) {
+  demo::SessionOptions so;
+  so.model_path = o.model_path;
+  so.characters = characters;
+  so.width = o.width;
+  so.height = o.height;
+  so.shadows = o.shadows;
+  SINEW_ASSIGN_OR_RETURN(std::unique_ptr<demo::DemoSession> session, demo::DemoSession::create(so, jobs));
+  CountResult r;
+  r.characters = characters;
+  r.triangles = session->bake_info().triangles;
+  demo::FollowCamera camera;
+  std::uint64_t rays = 0;
+  for (int f = 0; f < o.warmup + o.frames; ++f) {
+    if (f == o.warmup) session->timers().clear();
+    const demo::PlayerInput input = demo::scripted_input(f);
+    camera.yaw = input.camera_yaw;
+    SINEW_ASSIGN_OR_RETURN(const demo::FrameReport report, session->frame(1.0f / 30.0f, input, camera, jobs));
+    if (f >= o.warmup) {
+      rays += report.render.primary_rays + report.render.shadow_rays;
+      r.escaped_triangles += report.scene.escaped_triangles;
+    }
+  }
+  r.phases = session->timers().summarize();
+  r.frame_ms = session->timers().median_total_ms();
+  r.rays_per_frame = static_cast<double>(rays) / o.frames;
+  return r;
+}
+
+void print_table(const DemoBenchOptions& o, const std::vector<CountResult>& results) {
+  if (results.empty()) return;
+  std::printf("\n| characters | fps |");
+  for (const PhaseSummary& p : results.front().phases) std::printf(" %s |", p.name.c_str());
+  std::printf(" frame ms | M rays/s | escaped tris/frame |\n|---:|---:|");
+  for (std::size_t i = 0; i < results.front().phases.size(); ++i) std::printf("---:|");
+  std::printf("---:|---:|---:|\n");
+  for (const CountResult& r : results) {
+    std::printf("| %d | %.1f |", r.characters, r.frame_ms > 0.0 ? 1000.0 / r.frame_ms : 0.0);
+    for (const PhaseSummary& p : r.phases) std::printf(" %.2f |", p.median_ms);
+    std::printf(" %.1f | %.1f | %.1f |\n", r.frame_ms, r.frame_ms > 0.0 ? r.rays_per_frame / (r.frame_ms * 1e3) : 0.0,
+                static_cast<double>(r.escaped_triangles) / o.frames);
+  }
+  std::printf("\nPhase columns are per-frame medians in ms over %d frames after %d warm-up frames; fps = 1000 /"
+              " their sum. M rays/s counts primary and shadow rays over the whole frame time.\n",
+              o.frames, o.warmup);
+}
+
+}  // namespace
+
+int run_demo_bench(const std::vector<std::string>& args, const std::string& command_line) {
+  auto parsed = parse_options(args);
+  if (!parsed.ok()) {
+    std::fprintf(stderr, "sinew-bench demo: %s\n", parsed.status().message().c_str());
+    print_usage(stderr);
+    return 2;
+  }
+  const DemoBenchOptions& o = *parsed;
+  if (o.help) {
+    print_usage(stdout);
+    return 0;
+  }
+  JobSystem jobs(o.threads);
+  std::printf("# sinew-bench demo\n\n`%s`\n\n%s, %d threads, %s, %dx%d, shadows %s\n", command_line.c_str(),
+              cpu_model().c_str(), jobs.thread_count(), utc_date().c_str(), o.width, o.height,
+              o.shadows ? "on" : "off");
+  std::vector<CountResult> results;
+  for (int characters : o.characters) {
+    std::fprintf(stderr, "measuring %d characters...\n", characters);
+    auto r = measure(o, characters, jobs);
+    if (!r.ok()) {
+      std::fprintf(stderr, "sinew-bench demo: %s\n", r.status().message().c_str());
+      return 1;
+    }
+    results.push_back(std::move(*r));
+  }
+  std::printf("model: %s (%zu triangles)\n", o.model_path.empty() ? "mannequin (procedural)" : o.model_path.c_str(),
+              results.empty() ? std::size_t{0} : results.front().triangles);
+  print_table(o, results);
+  if (!o.json_path.empty()) {
+    Json out = {{"command", command_line}, {"cpu", cpu_model()}, {"date", utc_date()}, {"threads", jobs.thread_count()},
+                {"size", {o.width, o.height}}, {"shadows", o.shadows}, {"counts", Json::array()}};
+    for (const CountResult& r : results) {
+      Json phases = Json::object();
+      for (const PhaseSummary& p : r.phases) phases[p.name] = p.median_ms;
+      out["counts"].push_back({{"characters", r.characters}, {"fps", r.frame_ms > 0.0 ? 1000.0 / r.frame_ms : 0.0},
+                               {"frame_ms", r.frame_ms}, {"phases_ms", phases},
+                               {"rays_per_frame", r.rays_per_frame}});
+    }
+    std::ofstream(o.json_path) << out.dump(2) << "\n";
+  }
+  return 0;
+}
+
+}  // namespace sinew::bench
