@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "animation/skeleton.h"
 
@@ -52,7 +53,10 @@ Status validate_track(Track<T>& track, std::string_view source, const std::strin
         return make_error(ErrorCode::kInvalidData, source, field + ".values[" + std::to_string(v) + "]",
                           "0", "zero-length rotation quaternion");
       }
-      if (is_value) track.values[v] = track.values[v] / len;
+      // Already unit (within rounding): kept as is, so that building a clip
+      // from stored, normalised keys (a content pack) keeps their bits.
+      constexpr float kUnitTolerance = 4.0f * std::numeric_limits<float>::epsilon();
+      if (is_value && std::fabs(len - 1.0f) > kUnitTolerance) track.values[v] = track.values[v] / len;
     }
   }
   return {};

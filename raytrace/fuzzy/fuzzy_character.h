@@ -18,7 +18,12 @@
 #include <vector>
 
 #include "raytrace/kdtree/kd_tree.h"
+#include "runtime/core/status.h"
 #include "runtime/math/aabb.h"
+
+namespace sinew {
+struct SkinnedMesh;
+}
 
 namespace sinew::rt {
 
@@ -99,5 +104,14 @@ struct FuzzyCharacterData {
             triangle_checks};
   }
 };
+
+// Checks what traversal, skinning and the escape check rely on, so that a
+// corrupt pack or a bake of another mesh cannot make them read out of bounds
+// or loop: array sizes against the mesh, bone and vertex indices, each
+// triangle corner's check, tree slices, node links (children after their
+// parent, no cycles), depth within kMaxTraversalDepth, leaf item ranges,
+// finite splits, and no NaN in any box. Errors (kInvalidData) name the
+// array and the index.
+Status validate_fuzzy_character(const SkinnedMesh& mesh, const FuzzyCharacterView& fuzzy);
 
 }  // namespace sinew::rt

@@ -1,0 +1,529 @@
+#include "editor/pack/character_pack.h"
+
+#include <cmath>
+#include <cstring>
+#include <utility>
+
+#include "runtime/pack/pack_writer.h"
+#include "runtime/pack/section_codec.h"
+
+namespace sinew::editor {
+namespace {
+
+// Section ids and the payload versions this build writes and reads.
+constexpr SectionId kSkeleton = make_section_id("SKEL");
+constexpr SectionId kMesh = make_section_id("MESH");
+constexpr SectionId kClips = make_section_id("CLIP");
+constexpr SectionId kLimits = make_section_id("LIMT");
+constexpr SectionId kPoseSpace = make_section_id("POSE");
+constexpr SectionId kProvenance = make_section_id("PROV");
+constexpr SectionId kFuzzyHeader = make_section_id("FZHD");
+constexpr SectionId kTriangleBone = make_section_id("FTBN");
+constexpr SectionId kBoneTrees = make_section_id("FBTR");
+constexpr SectionId kNodes = make_section_id("FNOD");
+constexpr SectionId kItems = make_section_id("FITM");
+constexpr SectionId kVertexCheckBegin = make_section_id("FVCB");
+constexpr SectionId kVertexChecks = make_section_id("FVCK");
+constexpr SectionId kTriangleChecks = make_section_id("FTCK");
+constexpr std::uint32_t kSectionVersion = 1;
+
+// Counts a pack may declare: beyond them a file is refused before any
+// allocation (a corrupt count must not exhaust memory).
+constexpr std::uint32_t kMaxClips = 65536;
+constexpr std::uint32_t kMaxMaterials = 65536;
+
+bool finite(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+bool finite(const Vec2& v) { return std::isfinite(v.x) && std::isfinite(v.y); }
+
+// --- encoding ------------------------------------------------------------------
+
+std::vector<std::byte> encode_skeleton(const anim::Skeleton& skeleton) {
+  SectionEncoder e;
+  e.put(static_cast<std::uint32_t>(skeleton.joint_count()));
+  for (std::size_t j = 0; j < skeleton.joint_count(); ++j) {
+    e.put_string(skeleton.names()[j]);
+    e.put(static_cast<std::int32_t>(skeleton.parents()[j]));
+    const anim::JointTransform& rest = skeleton.rest_pose()[j];
+    e.put(rest.translation);
+    e.put(rest.rotation);
+    e.put(rest.scale);
+    e.put(skeleton.inverse_bind()[j]);
+  }
+  return std::move(e.bytes());
+}
+
+std::vector<std::byte> encode_mesh(const ImportedModel& model) {
+  const SkinnedMesh& m = model.mesh;
+  SectionEncoder e;
+  e.put(static_cast<std::uint32_t>(m.vertex_count()));
+  e.put(static_cast<std::uint32_t>(m.triangle_count()));
+  e.put(static_cast<std::uint32_t>(m.material_colors.size()));
+  e.put(static_cast<std::uint8_t>(!m.normals.empty()));
+  e.put(static_cast<std::uint8_t>(!m.uvs.empty()));
+  e.put(static_cast<std::uint8_t>(!m.triangle_material.empty()));
+  e.put(static_cast<std::uint8_t>(!model.material_names.empty()));
+  e.put_array<Vec3>(m.positions);
+  e.put_array<Vec3>(m.normals);
+  e.put_array<Vec2>(m.uvs);
+  e.put_array<std::array<std::uint16_t, kMaxInfluences>>(m.joints);
+  e.put_array<std::array<float, kMaxInfluences>>(m.weights);
+  e.put_array<std::array<std::uint32_t, 3>>(m.triangles);
+  e.put_array<std::uint32_t>(m.triangle_material);
+  e.put_array<Vec3>(m.material_colors);
+  for (const std::string& name : model.material_names) e.put_string(name);
+  return std::move(e.bytes());
+}
+
+template <typename T>
+void encode_track(SectionEncoder& e, const anim::Track<T>& track) {
+  e.put(static_cast<std::uint8_t>(track.interpolation));
+  e.put(static_cast<std::uint32_t>(track.times.size()));
+  e.put(static_cast<std::uint32_t>(track.values.size()));
+  e.put_array<float>(track.times);
+  e.put_array<T>(track.values);
+}
+
+std::vector<std::byte> encode_clips(std::span<const anim::Clip> clips) {
+  SectionEncoder e;
+  e.put(static_cast<std::uint32_t>(clips.size()));
+  for (const anim::Clip& clip : clips) {
+    e.put_string(clip.name());
+    e.put(static_cast<std::uint32_t>(clip.tracks().size()));
+    for (const anim::JointTracks& jt : clip.tracks()) {
+      e.put(static_cast<std::int32_t>(jt.joint));
+      encode_track(e, jt.translation);
+      encode_track(e, jt.rotation);
+      encode_track(e, jt.scale);
+    }
+  }
+  return std::move(e.bytes());
+}
+
+std::vector<std::byte> encode_pose_space(const PoseSpaceRecord& r) {
+  SectionEncoder e;
+  e.put(static_cast<std::uint8_t>(r.desc.mode));
+  e.put(static_cast<std::uint8_t>(r.desc.every_frame_30hz));
+  e.put(static_cast<std::uint8_t>(r.candidates));
+  e.put(std::uint8_t{0});
+  e.put(static_cast<std::int32_t>(r.desc.samples));
+  e.put(static_cast<std::uint64_t>(r.desc.seed));
+  e.put(r.padding);
+  e.put(static_cast<std::uint32_t>(r.desc.clips.size()));
+  for (const std::string& name : r.desc.clips) e.put_string(name);
+  return std::move(e.bytes());
+}
+
+std::vector<std::byte> encode_provenance(const Provenance& p) {
+  SectionEncoder e;
+  e.put_string(p.source_name);
+  e.put(p.source_hash);
+  e.put_string(p.tool_version);
+  e.put(p.bake_unix_time);
+  e.put(p.pose_sampling_ms);
+  e.put(p.sampling_ms);
+  e.put(p.assignment_ms);
+  e.put(p.build_ms);
+  return std::move(e.bytes());
+}
+
+// The fuzzy header: counts and the bake's quality figures (timings live in
+// the provenance, so that they can be zeroed for reproducible bakes).
+struct FuzzyHeader {
+  std::uint32_t bone_count;
+  std::uint32_t sample_count;
+  std::uint32_t vertex_count;
+  std::uint32_t triangle_count;
+  std::uint32_t node_count;
+  std::int32_t max_depth;
+  std::uint8_t candidates;
+  std::uint8_t reserved[7];
+  double fuzzy_area;
+  double rest_area;
+  double mean_items_per_leaf;
+};
+static_assert(sizeof(FuzzyHeader) == 56 && std::is_trivially_copyable_v<FuzzyHeader>);
+
+template <typename T>
+std::span<const std::byte> bytes_of(std::span<const T> values) {
+  return std::as_bytes(values);
+}
+
+// --- decoding ------------------------------------------------------------------
+
+Expected<anim::Skeleton> decode_skeleton(SectionDecoder& d) {
+  std::uint32_t count = 0;
+  SINEW_RETURN_IF_ERROR(d.get(count, "joint_count"));
+  if (count > anim::kMaxJoints) {
+    return d.error("joint_count", std::to_string(count), "more than " + std::to_string(anim::kMaxJoints) + " joints",
+                   ErrorCode::kLimitExceeded);
+  }
+  anim::RawSkeleton raw;
+  raw.joints.resize(count);
+  for (std::uint32_t j = 0; j < count; ++j) {
+    const std::string f = "joints[" + std::to_string(j) + "]";
+    anim::RawJoint& joint = raw.joints[j];
+    std::int32_t parent = 0;
+    SINEW_RETURN_IF_ERROR(d.get_string(joint.name, f + ".name"));
+    SINEW_RETURN_IF_ERROR(d.get(parent, f + ".parent"));
+    // Stored parent-first: a loaded skeleton keeps the indices the mesh,
+    // the clips and the fuzzy data refer to.
+    if (parent < anim::kNoParent || parent >= static_cast<std::int32_t>(j)) {
+      return d.error(f + ".parent", std::to_string(parent), "not an earlier joint (joints are stored parent first)",
+                     ErrorCode::kOutOfBounds);
+    }
+    joint.parent = parent;
+    SINEW_RETURN_IF_ERROR(d.get(joint.rest.translation, f + ".translation"));
+    SINEW_RETURN_IF_ERROR(d.get(joint.rest.rotation, f + ".rotation"));
+    SINEW_RETURN_IF_ERROR(d.get(joint.rest.scale, f + ".scale"));
+    SINEW_RETURN_IF_ERROR(d.get(joint.inverse_bind, f + ".inverse_bind"));
+  }
+  SINEW_RETURN_IF_ERROR(d.finish());
+  // Parent-first input keeps its order exactly (Skeleton::build).
+  auto skeleton = anim::Skeleton::build(raw, d.pack() + " " + d.section());
+  if (!skeleton.ok()) return skeleton.status();
+  return std::move(*skeleton);
+}
+
+Status decode_mesh(SectionDecoder& d, std::size_t joint_count, ImportedModel& model) {
+  SkinnedMesh& m = model.mesh;
+  std::uint32_t vertices = 0, triangles = 0, materials = 0;
+  std::uint8_t has_normals = 0, has_uvs = 0, has_triangle_material = 0, has_names = 0;
+  SINEW_RETURN_IF_ERROR(d.get(vertices, "vertex_count"));
+  SINEW_RETURN_IF_ERROR(d.get(triangles, "triangle_count"));
+  SINEW_RETURN_IF_ERROR(d.get(materials, "material_count"));
+  SINEW_RETURN_IF_ERROR(d.get(has_normals, "has_normals"));
+  SINEW_RETURN_IF_ERROR(d.get(has_uvs, "has_uvs"));
+  SINEW_RETURN_IF_ERROR(d.get(has_triangle_material, "has_triangle_material"));
+  SINEW_RETURN_IF_ERROR(d.get(has_names, "has_material_names"));
+  if (materials > kMaxMaterials) {
+    return d.error("material_count", std::to_string(materials), "more than " + std::to_string(kMaxMaterials),
+                   ErrorCode::kLimitExceeded);
+  }
+  SINEW_RETURN_IF_ERROR(d.get_array(vertices, m.positions, "positions"));
+  SINEW_RETURN_IF_ERROR(d.get_array(has_normals ? vertices : 0u, m.normals, "normals"));
+  SINEW_RETURN_IF_ERROR(d.get_array(has_uvs ? vertices : 0u, m.uvs, "uvs"));
+  SINEW_RETURN_IF_ERROR(d.get_array(vertices, m.joints, "joints"));
+  SINEW_RETURN_IF_ERROR(d.get_array(vertices, m.weights, "weights"));
+  SINEW_RETURN_IF_ERROR(d.get_array(triangles, m.triangles, "triangles"));
+  SINEW_RETURN_IF_ERROR(d.get_array(has_triangle_material ? triangles : 0u, m.triangle_material, "triangle_material"));
+  SINEW_RETURN_IF_ERROR(d.get_array(materials, m.material_colors, "material_colors"));
+  model.material_names.assign(has_names ? materials : 0u, std::string());
+  for (std::size_t i = 0; i < model.material_names.size(); ++i) {
+    SINEW_RETURN_IF_ERROR(d.get_string(model.material_names[i], "material_names[" + std::to_string(i) + "]"));
+  }
+  SINEW_RETURN_IF_ERROR(d.finish());
+
+  for (std::size_t v = 0; v < vertices; ++v) {
+    const std::string f = "[" + std::to_string(v) + "]";
+    if (!finite(m.positions[v])) return d.error("positions" + f, "", "not finite");
+    if (!m.normals.empty() && !finite(m.normals[v])) return d.error("normals" + f, "", "not finite");
+    if (!m.uvs.empty() && !finite(m.uvs[v])) return d.error("uvs" + f, "", "not finite");
+    for (std::size_t k = 0; k < kMaxInfluences; ++k) {
+      if (m.joints[v][k] >= joint_count) {
+        return d.error("joints" + f, std::to_string(m.joints[v][k]), "no such joint", ErrorCode::kOutOfBounds);
+      }
+      const float w = m.weights[v][k];
+      if (!std::isfinite(w) || w < 0.0f) return d.error("weights" + f, std::to_string(w), "not a finite weight >= 0");
+    }
+  }
+  for (std::size_t t = 0; t < triangles; ++t) {
+    for (const std::uint32_t v : m.triangles[t]) {
+      if (v >= vertices) {
+        return d.error("triangles[" + std::to_string(t) + "]", std::to_string(v), "no such vertex",
+                       ErrorCode::kOutOfBounds);
+      }
+    }
+    if (!m.triangle_material.empty() && m.triangle_material[t] >= materials) {
+      return d.error("triangle_material[" + std::to_string(t) + "]", std::to_string(m.triangle_material[t]),
+                     "no such material", ErrorCode::kOutOfBounds);
+    }
+  }
+  for (std::size_t i = 0; i < materials; ++i) {
+    if (!finite(m.material_colors[i])) return d.error("material_colors[" + std::to_string(i) + "]", "", "not finite");
+  }
+  return {};
+}
+
+template <typename T>
+Status decode_track(SectionDecoder& d, const std::string& field, anim::Track<T>& track) {
+  std::uint8_t interpolation = 0;
+  std::uint32_t keys = 0, values = 0;
+  SINEW_RETURN_IF_ERROR(d.get(interpolation, field + ".interpolation"));
+  if (interpolation > static_cast<std::uint8_t>(anim::Interpolation::kCubicSpline)) {
+    return d.error(field + ".interpolation", std::to_string(interpolation), "unknown interpolation");
+  }
+  track.interpolation = static_cast<anim::Interpolation>(interpolation);
+  SINEW_RETURN_IF_ERROR(d.get(keys, field + ".key_count"));
+  SINEW_RETURN_IF_ERROR(d.get(values, field + ".value_count"));
+  SINEW_RETURN_IF_ERROR(d.get_array(keys, track.times, field + ".times"));
+  SINEW_RETURN_IF_ERROR(d.get_array(values, track.values, field + ".values"));
+  return {};  // Clip::build checks times, counts and values
+}
+
+Expected<std::vector<anim::Clip>> decode_clips(SectionDecoder& d, const anim::Skeleton& skeleton) {
+  std::uint32_t count = 0;
+  SINEW_RETURN_IF_ERROR(d.get(count, "clip_count"));
+  if (count > kMaxClips) {
+    return d.error("clip_count", std::to_string(count), "more than " + std::to_string(kMaxClips),
+                   ErrorCode::kLimitExceeded);
+  }
+  std::vector<anim::Clip> clips;
+  for (std::uint32_t c = 0; c < count; ++c) {
+    const std::string f = "clips[" + std::to_string(c) + "]";
+    anim::RawClip raw;
+    std::uint32_t tracks = 0;
+    SINEW_RETURN_IF_ERROR(d.get_string(raw.name, f + ".name"));
+    SINEW_RETURN_IF_ERROR(d.get(tracks, f + ".track_count"));
+    if (tracks > skeleton.joint_count()) {
+      return d.error(f + ".track_count", std::to_string(tracks), "more tracks than joints", ErrorCode::kOutOfBounds);
+    }
+    raw.tracks.resize(tracks);
+    for (std::uint32_t t = 0; t < tracks; ++t) {
+      const std::string tf = f + ".tracks[" + std::to_string(t) + "]";
+      std::int32_t joint = 0;
+      SINEW_RETURN_IF_ERROR(d.get(joint, tf + ".joint"));
+      raw.tracks[t].joint = joint;
+      SINEW_RETURN_IF_ERROR(decode_track(d, tf + ".translation", raw.tracks[t].translation));
+      SINEW_RETURN_IF_ERROR(decode_track(d, tf + ".rotation", raw.tracks[t].rotation));
+      SINEW_RETURN_IF_ERROR(decode_track(d, tf + ".scale", raw.tracks[t].scale));
+    }
+    auto clip = anim::Clip::build(std::move(raw), skeleton, d.pack() + " " + d.section() + "." + f);
+    if (!clip.ok()) return clip.status();
+    clips.push_back(std::move(*clip));
+  }
+  SINEW_RETURN_IF_ERROR(d.finish());
+  return clips;
+}
+
+Expected<PoseSpaceRecord> decode_pose_space(SectionDecoder& d) {
+  PoseSpaceRecord r;
+  std::uint8_t mode = 0, every_frame = 0, candidates = 0, reserved = 0;
+  std::int32_t samples = 0;
+  std::uint64_t seed = 0;
+  std::uint32_t clip_names = 0;
+  SINEW_RETURN_IF_ERROR(d.get(mode, "mode"));
+  SINEW_RETURN_IF_ERROR(d.get(every_frame, "every_frame_30hz"));
+  SINEW_RETURN_IF_ERROR(d.get(candidates, "candidates"));
+  SINEW_RETURN_IF_ERROR(d.get(reserved, "reserved"));
+  SINEW_RETURN_IF_ERROR(d.get(samples, "samples"));
+  SINEW_RETURN_IF_ERROR(d.get(seed, "seed"));
+  SINEW_RETURN_IF_ERROR(d.get(r.padding, "padding"));
+  SINEW_RETURN_IF_ERROR(d.get(clip_names, "clip_count"));
+  if (mode > static_cast<std::uint8_t>(anim::PoseSpaceMode::kClip)) {
+    return d.error("mode", std::to_string(mode), "unknown pose-space mode");
+  }
+  if (every_frame > 1 || reserved != 0) return d.error("every_frame_30hz", std::to_string(every_frame), "not 0 or 1");
+  if (candidates > static_cast<std::uint8_t>(rt::CandidateBones::kInfluencing)) {
+    return d.error("candidates", std::to_string(candidates), "unknown candidate-bone mode");
+  }
+  if (samples < 0 || samples > anim::kMaxPoseSamples) {
+    return d.error("samples", std::to_string(samples), "outside [0, " + std::to_string(anim::kMaxPoseSamples) + "]");
+  }
+  if (!std::isfinite(r.padding) || r.padding < 0.0f) return d.error("padding", std::to_string(r.padding), "not >= 0");
+  if (clip_names > kMaxClips) {
+    return d.error("clip_count", std::to_string(clip_names), "more than " + std::to_string(kMaxClips),
+                   ErrorCode::kLimitExceeded);
+  }
+  r.desc.mode = static_cast<anim::PoseSpaceMode>(mode);
+  r.desc.every_frame_30hz = every_frame != 0;
+  r.candidates = static_cast<rt::CandidateBones>(candidates);
+  r.desc.samples = samples;
+  r.desc.seed = seed;
+  r.desc.clips.resize(clip_names);
+  for (std::size_t i = 0; i < clip_names; ++i) {
+    SINEW_RETURN_IF_ERROR(d.get_string(r.desc.clips[i], "clips[" + std::to_string(i) + "]"));
+  }
+  SINEW_RETURN_IF_ERROR(d.finish());
+  return r;
+}
+
+Expected<Provenance> decode_provenance(SectionDecoder& d) {
+  Provenance p;
+  SINEW_RETURN_IF_ERROR(d.get_string(p.source_name, "source_name"));
+  SINEW_RETURN_IF_ERROR(d.get(p.source_hash, "source_hash"));
+  SINEW_RETURN_IF_ERROR(d.get_string(p.tool_version, "tool_version"));
+  SINEW_RETURN_IF_ERROR(d.get(p.bake_unix_time, "bake_unix_time"));
+  SINEW_RETURN_IF_ERROR(d.get(p.pose_sampling_ms, "pose_sampling_ms"));
+  SINEW_RETURN_IF_ERROR(d.get(p.sampling_ms, "sampling_ms"));
+  SINEW_RETURN_IF_ERROR(d.get(p.assignment_ms, "assignment_ms"));
+  SINEW_RETURN_IF_ERROR(d.get(p.build_ms, "build_ms"));
+  SINEW_RETURN_IF_ERROR(d.finish());
+  return p;
+}
+
+// A section viewed in place as T; a missing section is an error naming it.
+template <typename T>
+Expected<std::span<const T>> view_section(const PackReader& reader, SectionId id) {
+  auto view = reader.section_as<T>(id);
+  if (!view.ok()) return view.status();
+  return *view;
+}
+
+Status check_version(const PackReader& reader, SectionId id) {
+  const SectionInfo* info = reader.find(id);
+  if (info == nullptr) {
+    return make_error(ErrorCode::kNotFound, reader.name(), section_id_name(id), "", "section missing");
+  }
+  if (info->version != kSectionVersion) {
+    return make_error(ErrorCode::kUnsupportedVersion, reader.name(), section_id_name(id) + ".version",
+                      std::to_string(info->version), "this build reads version " + std::to_string(kSectionVersion));
+  }
+  return {};
+}
+
+SectionDecoder decoder(const PackReader& reader, SectionId id) {
+  return SectionDecoder(reader.section_bytes(*reader.find(id)), reader.name(), id);
+}
+
+}  // namespace
+
+bool is_pack_path(const std::string& path) {
+  return path.size() >= 5 && path.compare(path.size() - 5, 5, ".pack") == 0;
+}
+
+namespace {
+
+Expected<PackWriter> character_pack_writer(const CharacterPackContents& c) {
+  if (c.model == nullptr) return invalid_argument("contents.model", "null", "a pack needs a model");
+  PackWriter w;
+  SINEW_RETURN_IF_ERROR(w.add_section(kSkeleton, kSectionVersion, encode_skeleton(c.model->skeleton)));
+  SINEW_RETURN_IF_ERROR(w.add_section(kMesh, kSectionVersion, encode_mesh(*c.model)));
+  SINEW_RETURN_IF_ERROR(w.add_section(kClips, kSectionVersion, encode_clips(c.model->clips)));
+  if (!c.limits.empty()) {
+    const std::string json = anim::joint_limits_to_json(c.limits, c.model->skeleton);
+    SINEW_RETURN_IF_ERROR(w.add_section(kLimits, kSectionVersion, std::as_bytes(std::span(json.data(), json.size()))));
+  }
+  SINEW_RETURN_IF_ERROR(w.add_section(kPoseSpace, kSectionVersion, encode_pose_space(c.pose_space)));
+  SINEW_RETURN_IF_ERROR(w.add_section(kProvenance, kSectionVersion, encode_provenance(c.provenance)));
+  if (c.fuzzy != nullptr) {
+    const rt::FuzzyCharacterData& f = *c.fuzzy;
+    FuzzyHeader h{};
+    h.bone_count = f.bone_count;
+    h.sample_count = f.stats.sample_count;
+    h.vertex_count = f.stats.vertex_count;
+    h.triangle_count = f.stats.triangle_count;
+    h.node_count = f.stats.node_count;
+    h.max_depth = f.stats.max_depth;
+    h.candidates = static_cast<std::uint8_t>(f.stats.candidates);
+    h.fuzzy_area = f.stats.fuzzy_area;
+    h.rest_area = f.stats.rest_area;
+    h.mean_items_per_leaf = f.stats.mean_items_per_leaf;
+    SINEW_RETURN_IF_ERROR(w.add_section(kFuzzyHeader, kSectionVersion, std::as_bytes(std::span(&h, 1))));
+    SINEW_RETURN_IF_ERROR(w.add_section(kTriangleBone, kSectionVersion, bytes_of<std::uint16_t>(f.triangle_bone)));
+    SINEW_RETURN_IF_ERROR(w.add_section(kBoneTrees, kSectionVersion, bytes_of<rt::BoneTree>(f.bone_trees)));
+    SINEW_RETURN_IF_ERROR(w.add_section(kNodes, kSectionVersion, bytes_of<rt::KdNode>(f.nodes)));
+    SINEW_RETURN_IF_ERROR(w.add_section(kItems, kSectionVersion, bytes_of<std::uint32_t>(f.items)));
+    SINEW_RETURN_IF_ERROR(
+        w.add_section(kVertexCheckBegin, kSectionVersion, bytes_of<std::uint32_t>(f.vertex_check_begin)));
+    SINEW_RETURN_IF_ERROR(w.add_section(kVertexChecks, kSectionVersion, bytes_of<rt::VertexCheck>(f.vertex_checks)));
+    SINEW_RETURN_IF_ERROR(w.add_section(kTriangleChecks, kSectionVersion,
+                                        bytes_of<std::array<std::uint32_t, 3>>(f.triangle_checks)));
+  }
+  return w;
+}
+
+}  // namespace
+
+Expected<std::vector<std::byte>> serialize_character_pack(const CharacterPackContents& contents) {
+  SINEW_ASSIGN_OR_RETURN(const PackWriter writer, character_pack_writer(contents));
+  return writer.serialize();
+}
+
+Status write_character_pack(const std::string& path, const CharacterPackContents& contents) {
+  SINEW_ASSIGN_OR_RETURN(const PackWriter writer, character_pack_writer(contents));
+  return writer.write(path);
+}
+
+Expected<CharacterPack> CharacterPack::open(const std::string& path) {
+  SINEW_ASSIGN_OR_RETURN(PackReader reader, PackReader::open(path));
+  return load(std::move(reader));
+}
+
+Expected<CharacterPack> CharacterPack::from_bytes(std::span<const std::byte> bytes, const std::string& name) {
+  SINEW_ASSIGN_OR_RETURN(PackReader reader, PackReader::from_bytes(bytes, name));
+  return load(std::move(reader));
+}
+
+Expected<CharacterPack> CharacterPack::load(PackReader reader) {
+  CharacterPack pack(std::move(reader));
+  const PackReader& r = pack.reader_;
+  for (SectionId id : {kSkeleton, kMesh, kClips, kPoseSpace, kProvenance}) SINEW_RETURN_IF_ERROR(check_version(r, id));
+  pack.model_.source = r.name();
+  {
+    SectionDecoder d = decoder(r, kSkeleton);
+    SINEW_ASSIGN_OR_RETURN(pack.model_.skeleton, decode_skeleton(d));
+  }
+  {
+    SectionDecoder d = decoder(r, kMesh);
+    SINEW_RETURN_IF_ERROR(decode_mesh(d, pack.model_.skeleton.joint_count(), pack.model_));
+  }
+  {
+    SectionDecoder d = decoder(r, kClips);
+    SINEW_ASSIGN_OR_RETURN(pack.model_.clips, decode_clips(d, pack.model_.skeleton));
+  }
+  if (r.contains(kLimits)) {
+    SINEW_RETURN_IF_ERROR(check_version(r, kLimits));
+    const auto bytes = r.section_bytes(*r.find(kLimits));
+    const std::string_view json(reinterpret_cast<const char*>(bytes.data()), bytes.size());
+    SINEW_ASSIGN_OR_RETURN(pack.limits_, anim::parse_joint_limits(json, pack.model_.skeleton, r.name() + " LIMT"));
+  }
+  {
+    SectionDecoder d = decoder(r, kPoseSpace);
+    SINEW_ASSIGN_OR_RETURN(pack.pose_space_, decode_pose_space(d));
+  }
+  {
+    SectionDecoder d = decoder(r, kProvenance);
+    SINEW_ASSIGN_OR_RETURN(pack.provenance_, decode_provenance(d));
+  }
+  if (!r.contains(kFuzzyHeader)) return pack;
+
+  for (SectionId id : {kFuzzyHeader, kTriangleBone, kBoneTrees, kNodes, kItems, kVertexCheckBegin, kVertexChecks,
+                       kTriangleChecks}) {
+    SINEW_RETURN_IF_ERROR(check_version(r, id));
+  }
+  FuzzyHeader h{};
+  {
+    SectionDecoder d = decoder(r, kFuzzyHeader);
+    SINEW_RETURN_IF_ERROR(d.get(h, "header"));
+    SINEW_RETURN_IF_ERROR(d.finish());
+  }
+  if (h.bone_count != pack.model_.skeleton.joint_count()) {
+    return make_error(ErrorCode::kInvalidData, r.name(), "FZHD.bone_count", std::to_string(h.bone_count),
+                      "differs from the skeleton's " + std::to_string(pack.model_.skeleton.joint_count()) + " joints");
+  }
+  if (h.candidates > static_cast<std::uint8_t>(rt::CandidateBones::kInfluencing)) {
+    return make_error(ErrorCode::kInvalidData, r.name(), "FZHD.candidates", std::to_string(h.candidates),
+                      "unknown candidate-bone mode");
+  }
+  rt::FuzzyCharacterView& v = pack.fuzzy_;
+  v.bone_count = h.bone_count;
+  SINEW_ASSIGN_OR_RETURN(v.triangle_bone, view_section<std::uint16_t>(r, kTriangleBone));
+  SINEW_ASSIGN_OR_RETURN(v.bone_trees, view_section<rt::BoneTree>(r, kBoneTrees));
+  SINEW_ASSIGN_OR_RETURN(v.nodes, view_section<rt::KdNode>(r, kNodes));
+  SINEW_ASSIGN_OR_RETURN(v.items, view_section<std::uint32_t>(r, kItems));
+  SINEW_ASSIGN_OR_RETURN(v.vertex_check_begin, view_section<std::uint32_t>(r, kVertexCheckBegin));
+  SINEW_ASSIGN_OR_RETURN(v.vertex_checks, view_section<rt::VertexCheck>(r, kVertexChecks));
+  using Corners = std::array<std::uint32_t, 3>;
+  SINEW_ASSIGN_OR_RETURN(v.triangle_checks, view_section<Corners>(r, kTriangleChecks));
+  if (Status s = rt::validate_fuzzy_character(pack.model_.mesh, v); !s.ok()) {
+    return make_error(s.code(), r.name(), "fuzzy " + std::string(s.field()), s.value(), s.detail());
+  }
+  rt::FuzzyBakeStats& st = pack.stats_;
+  st.sample_count = h.sample_count;
+  st.vertex_count = h.vertex_count;
+  st.triangle_count = h.triangle_count;
+  st.bone_count = h.bone_count;
+  st.candidates = static_cast<rt::CandidateBones>(h.candidates);
+  st.fuzzy_area = h.fuzzy_area;
+  st.rest_area = h.rest_area;
+  st.mean_items_per_leaf = h.mean_items_per_leaf;
+  st.max_depth = h.max_depth;
+  st.node_count = h.node_count;
+  st.sampling_ms = pack.provenance_.sampling_ms;
+  st.assignment_ms = pack.provenance_.assignment_ms;
+  st.build_ms = pack.provenance_.build_ms;
+  pack.has_fuzzy_ = true;
+  return pack;
+}
+
+}  // namespace sinew::editor

@@ -1,0 +1,422 @@
+// The character pack end to end: bake -> write -> load renders the same
+// image as the in-memory bake, bit for bit; the same inputs give the same
+// bytes; and every kind of corruption of a real pack is refused with an
+// error naming the section and field, never a crash (this suite also runs
+// under ASan + UBSan).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <functional>
+#include <limits>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "content/mannequin/mannequin.h"
+#include "editor/bake/in_memory_bake.h"
+#include "editor/cli/render_command.h"
+#include "editor/pack/character_pack.h"
+#include "raytrace/camera/camera.h"
+#include "raytrace/render/renderer.h"
+#include "raytrace/scene/scene.h"
+#include "runtime/jobs/job_system.h"
+#include "runtime/pack/pack_writer.h"
+#if SINEW_HAVE_CAL3D
+#include "editor/import/cal3d_importer.h"
+#endif
+
+namespace sinew::editor {
+namespace {
+
+struct Baked {
+  ImportedModel model;
+  rt::FuzzyCharacterData fuzzy;
+  PoseSpaceRecord pose_space;
+};
+
+Baked bake(ImportedModel model, JobSystem& jobs, const BakeRequest& request = {}) {
+  Baked b;
+  auto baked = bake_in_memory(model, request, jobs);
+  EXPECT_TRUE(baked.ok()) << baked.status().message();
+  if (baked.ok()) b.fuzzy = std::move(baked->fuzzy);
+  b.pose_space.desc = request.pose_space;
+  b.pose_space.padding = request.fuzzy.padding;
+  b.pose_space.candidates = request.fuzzy.candidates;
+  b.model = std::move(model);
+  return b;
+}
+
+CharacterPackContents contents_of(const Baked& b) {
+  CharacterPackContents c;
+  c.model = &b.model;
+  c.fuzzy = &b.fuzzy;
+  c.pose_space = b.pose_space;
+  c.provenance.source_name = "test";
+  c.provenance.tool_version = "sinew-editor test";
+  return c;
+}
+
+std::vector<std::byte> pack_bytes(const Baked& b) {
+  auto bytes = serialize_character_pack(contents_of(b));
+  EXPECT_TRUE(bytes.ok()) << bytes.status().message();
+  return bytes.ok() ? std::move(*bytes) : std::vector<std::byte>{};
+}
+
+// Colour and triangle ids of the model posed by its first clip (or the
+// rest pose), seen by the render command's default camera.
+struct Image {
+  std::vector<std::uint8_t> rgba;
+  std::vector<std::uint32_t> triangles;
+  bool operator==(const Image&) const = default;
+};
+
+// `strict`: every step must succeed. Damaged packs that still load may pose
+// the character anywhere (huge but finite matrices): then only the absence
+// of crashes and sanitizer reports is asserted.
+Image render(const ImportedModel& model, const rt::FuzzyCharacterView& fuzzy, JobSystem& jobs, bool strict = true) {
+  constexpr int kSize = 96;
+  Image image;
+  rt::Scene scene;
+  auto character = scene.add_character(model.mesh, fuzzy);
+  EXPECT_TRUE(!strict || character.ok()) << character.status().message();
+  if (!character.ok()) return image;
+  auto instance = scene.add_instance(*character);
+  EXPECT_TRUE(instance.ok());
+  if (!model.clips.empty()) {
+    auto skinning = clip_skinning(model, model.clips.front(), 0.37);
+    EXPECT_TRUE(!strict || skinning.ok()) << skinning.status().message();
+    if (!skinning.ok()) return image;
+    const Status bones = scene.set_bones(*instance, *skinning);
+    EXPECT_TRUE(!strict || bones.ok()) << bones.message();
+  }
+  const auto frame = scene.prepare_frame(rt::FrameOptions{}, jobs);
+  EXPECT_TRUE(!strict || frame.ok());
+  if (!frame.ok()) return image;
+  const int up = up_axis_of(rest_bounds(model));
+  auto camera = rt::PinholeCamera::create(default_camera(posed_bounds(scene), up, kSize, kSize), kSize, kSize);
+  EXPECT_TRUE(!strict || camera.ok()) << camera.status().message();
+  if (!camera.ok()) return image;
+  image.rgba.resize(kSize * kSize * 4);
+  image.triangles.resize(kSize * kSize);
+  rt::FrameBuffers buffers;
+  buffers.width = kSize;
+  buffers.height = kSize;
+  buffers.color_rgba8 = image.rgba;
+  buffers.triangle_id = image.triangles;
+  rt::RenderSettings settings;
+  settings.light.position = default_light(posed_bounds(scene), up);
+  auto stats = rt::Renderer().render(scene, *camera, settings, buffers, jobs);
+  EXPECT_TRUE(!strict || stats.ok()) << stats.status().message();
+  return image;
+}
+
+void expect_same_model(const ImportedModel& a, const ImportedModel& b) {
+  ASSERT_EQ(a.skeleton.joint_count(), b.skeleton.joint_count());
+  for (std::size_t j = 0; j < a.skeleton.joint_count(); ++j) {
+    EXPECT_EQ(a.skeleton.names()[j], b.skeleton.names()[j]);
+    EXPECT_EQ(a.skeleton.parents()[j], b.skeleton.parents()[j]);
+    EXPECT_EQ(0, std::memcmp(&a.skeleton.inverse_bind()[j], &b.skeleton.inverse_bind()[j], sizeof(Affine3)));
+  }
+  EXPECT_EQ(a.mesh.positions, b.mesh.positions);
+  EXPECT_EQ(a.mesh.normals, b.mesh.normals);
+  EXPECT_EQ(a.mesh.uvs, b.mesh.uvs);
+  EXPECT_EQ(a.mesh.joints, b.mesh.joints);
+  EXPECT_EQ(a.mesh.weights, b.mesh.weights);
+  EXPECT_EQ(a.mesh.triangles, b.mesh.triangles);
+  EXPECT_EQ(a.mesh.triangle_material, b.mesh.triangle_material);
+  EXPECT_EQ(a.mesh.material_colors, b.mesh.material_colors);
+  EXPECT_EQ(a.material_names, b.material_names);
+  ASSERT_EQ(a.clips.size(), b.clips.size());
+  for (std::size_t c = 0; c < a.clips.size(); ++c) {
+    EXPECT_EQ(a.clips[c].name(), b.clips[c].name());
+    EXPECT_EQ(a.clips[c].duration(), b.clips[c].duration());
+    ASSERT_EQ(a.clips[c].tracks().size(), b.clips[c].tracks().size());
+    for (std::size_t t = 0; t < a.clips[c].tracks().size(); ++t) {
+      const anim::JointTracks& x = a.clips[c].tracks()[t];
+      const anim::JointTracks& y = b.clips[c].tracks()[t];
+      EXPECT_EQ(x.joint, y.joint);
+      EXPECT_EQ(x.rotation.times, y.rotation.times);
+      EXPECT_EQ(x.rotation.values, y.rotation.values);
+      EXPECT_EQ(x.translation.values, y.translation.values);
+      EXPECT_EQ(x.scale.values, y.scale.values);
+    }
+  }
+}
+
+void check_round_trip(ImportedModel model) {
+  JobSystem jobs(2);
+  const Baked baked = bake(std::move(model), jobs);
+  const Image in_memory = render(baked.model, baked.fuzzy.view(), jobs);
+
+  // Through a file, mapped.
+  const std::string path = (std::filesystem::temp_directory_path() / "sinew_character_pack_test.pack").string();
+  ASSERT_TRUE(write_character_pack(path, contents_of(baked)).ok());
+  auto pack = CharacterPack::open(path);
+  ASSERT_TRUE(pack.ok()) << pack.status().message();
+  ASSERT_TRUE(pack->has_fuzzy());
+  expect_same_model(baked.model, pack->model());
+  EXPECT_EQ(pack->fuzzy_stats().fuzzy_area, baked.fuzzy.stats.fuzzy_area);
+  EXPECT_EQ(pack->fuzzy_stats().sample_count, baked.fuzzy.stats.sample_count);
+  // The fuzzy data is used in place: the view points into the mapping.
+  const auto mapped = pack->reader().bytes();
+  EXPECT_GE(static_cast<const void*>(pack->fuzzy().nodes.data()), static_cast<const void*>(mapped.data()));
+  EXPECT_LT(static_cast<const void*>(pack->fuzzy().nodes.data()),
+            static_cast<const void*>(mapped.data() + mapped.size()));
+  const Image from_pack = render(pack->model(), pack->fuzzy(), jobs);
+  EXPECT_TRUE(from_pack == in_memory) << "rendering from the pack differs from the in-memory bake";
+  std::size_t hits = 0;
+  for (std::uint32_t t : in_memory.triangles) hits += t != kInvalidId ? 1 : 0;
+  EXPECT_GT(hits, 500u) << "the character should fill part of the image";
+  std::filesystem::remove(path);
+}
+
+TEST(CharacterPack, MannequinRoundTripRendersBitIdentically) {
+  auto model = content::make_mannequin();
+  ASSERT_TRUE(model.ok());
+  check_round_trip(std::move(*model));
+}
+
+TEST(CharacterPack, CallyRoundTripRendersBitIdentically) {
+#if SINEW_HAVE_CAL3D
+  const std::string cfg = std::string(SINEW_SHARED_DIR) + "/content/cal3d/cally/cally.cfg";
+  if (!std::filesystem::exists(cfg)) GTEST_SKIP() << cfg << " not found (shared content)";
+  auto model = import_cal3d(cfg);
+  ASSERT_TRUE(model.ok()) << model.status().message();
+  check_round_trip(std::move(*model));
+#else
+  GTEST_SKIP() << "built without libcal3d";
+#endif
+}
+
+TEST(CharacterPack, TheSameInputsAndSeedGiveTheSameBytes) {
+  JobSystem jobs(2);
+  BakeRequest request;
+  request.pose_space.mode = anim::PoseSpaceMode::kArbitrary;
+  request.pose_space.samples = 40;
+  request.pose_space.seed = 7;
+  request.fuzzy.padding = 0.01f;
+  auto model = content::make_mannequin();
+  ASSERT_TRUE(model.ok());
+  const auto a = pack_bytes(bake(*model, jobs, request));
+  JobSystem one(1);
+  const auto b = pack_bytes(bake(*model, one, request));
+  ASSERT_FALSE(a.empty());
+  EXPECT_TRUE(a == b) << "two bakes of the same inputs differ";
+  request.pose_space.seed = 8;
+  EXPECT_FALSE(a == pack_bytes(bake(*model, jobs, request)));
+}
+
+TEST(CharacterPack, PoseSpaceAndProvenanceRoundTrip) {
+  JobSystem jobs(2);
+  auto model = content::make_mannequin();
+  ASSERT_TRUE(model.ok());
+  BakeRequest request;
+  request.pose_space.mode = anim::PoseSpaceMode::kClip;
+  request.pose_space.clips = {model->clips.front().name()};
+  request.pose_space.samples = 0;
+  request.pose_space.every_frame_30hz = true;
+  request.fuzzy.candidates = rt::CandidateBones::kInfluencing;
+  Baked baked = bake(std::move(*model), jobs, request);
+  CharacterPackContents c = contents_of(baked);
+  c.provenance.source_name = "mannequin.glb";
+  c.provenance.source_hash = 0x0123456789abcdefull;
+  c.provenance.bake_unix_time = 1'700'000'000;
+  c.provenance.build_ms = 12.5;
+  auto bytes = serialize_character_pack(c);
+  ASSERT_TRUE(bytes.ok());
+  auto pack = CharacterPack::from_bytes(*bytes, "mem.pack");
+  ASSERT_TRUE(pack.ok()) << pack.status().message();
+  EXPECT_EQ(pack->pose_space().desc.mode, anim::PoseSpaceMode::kClip);
+  EXPECT_EQ(pack->pose_space().desc.clips, request.pose_space.clips);
+  EXPECT_TRUE(pack->pose_space().desc.every_frame_30hz);
+  EXPECT_EQ(pack->pose_space().candidates, rt::CandidateBones::kInfluencing);
+  EXPECT_EQ(pack->provenance().source_name, "mannequin.glb");
+  EXPECT_EQ(pack->provenance().source_hash, 0x0123456789abcdefull);
+  EXPECT_EQ(pack->provenance().bake_unix_time, 1'700'000'000);
+  EXPECT_EQ(pack->provenance().build_ms, 12.5);
+  // A model-only pack loads without fuzzy data.
+  c.fuzzy = nullptr;
+  auto model_only = serialize_character_pack(c);
+  ASSERT_TRUE(model_only.ok());
+  auto loaded = CharacterPack::from_bytes(*model_only, "model.pack");
+  ASSERT_TRUE(loaded.ok()) << loaded.status().message();
+  EXPECT_FALSE(loaded->has_fuzzy());
+  expect_same_model(baked.model, loaded->model());
+}
+
+// --- corruption ------------------------------------------------------------------
+
+class CorruptPack : public testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    JobSystem jobs(2);
+    auto model = content::make_mannequin();
+    ASSERT_TRUE(model.ok());
+    baked_ = new Baked(bake(std::move(*model), jobs));
+    bytes_ = new std::vector<std::byte>(pack_bytes(*baked_));
+  }
+  static void TearDownTestSuite() {
+    delete baked_;
+    delete bytes_;
+  }
+
+  // The pack with section `id`'s payload replaced by mutate(payload), the
+  // container's checksums recomputed: only the section's own decoding and
+  // validation stand between the bytes and the renderer.
+  static std::vector<std::byte> repack(SectionId id, const std::function<void(std::vector<std::byte>&)>& mutate) {
+    auto reader = PackReader::from_bytes(*bytes_, "pristine");
+    EXPECT_TRUE(reader.ok());
+    PackWriter w;
+    for (const SectionInfo& s : reader->sections()) {
+      const auto payload = reader->section_bytes(s);
+      std::vector<std::byte> copy(payload.begin(), payload.end());
+      if (s.id == id) mutate(copy);
+      EXPECT_TRUE(w.add_section(s.id, s.version, std::move(copy)).ok());
+    }
+    auto out = w.serialize();
+    EXPECT_TRUE(out.ok());
+    return std::move(*out);
+  }
+
+  template <typename T>
+  static void overwrite(std::vector<std::byte>& payload, std::size_t index, const T& value) {
+    ASSERT_LE((index + 1) * sizeof(T), payload.size());
+    std::memcpy(payload.data() + index * sizeof(T), &value, sizeof(T));
+  }
+
+  // Loading must fail, naming `section` in the message.
+  static void expect_rejected(const std::vector<std::byte>& bytes, const std::string& section) {
+    auto pack = CharacterPack::from_bytes(bytes, "corrupt.pack");
+    ASSERT_FALSE(pack.ok()) << "a corrupt " << section << " was accepted";
+    EXPECT_NE(pack.status().message().find("corrupt.pack"), std::string::npos) << pack.status().message();
+    EXPECT_NE(pack.status().message().find(section), std::string::npos) << pack.status().message();
+  }
+
+  static inline Baked* baked_ = nullptr;
+  static inline std::vector<std::byte>* bytes_ = nullptr;
+};
+
+TEST_F(CorruptPack, ThePristinePackLoads) {
+  auto pack = CharacterPack::from_bytes(*bytes_, "pristine.pack");
+  ASSERT_TRUE(pack.ok()) << pack.status().message();
+}
+
+TEST_F(CorruptPack, TruncationAtEverySectionIsRefused) {
+  auto reader = PackReader::from_bytes(*bytes_, "pristine");
+  ASSERT_TRUE(reader.ok());
+  for (const SectionInfo& s : reader->sections()) {
+    for (std::uint64_t cut : {s.offset, s.offset + s.size / 2}) {
+      std::vector<std::byte> cut_bytes(bytes_->begin(), bytes_->begin() + static_cast<std::ptrdiff_t>(cut));
+      auto pack = CharacterPack::from_bytes(cut_bytes, "cut.pack");
+      EXPECT_FALSE(pack.ok()) << "cut at " << cut << " in " << section_id_name(s.id);
+    }
+  }
+}
+
+TEST_F(CorruptPack, AFlippedByteInEverySectionIsRefusedByItsChecksum) {
+  auto reader = PackReader::from_bytes(*bytes_, "pristine");
+  ASSERT_TRUE(reader.ok());
+  for (const SectionInfo& s : reader->sections()) {
+    if (s.size == 0) continue;
+    std::vector<std::byte> flipped = *bytes_;
+    flipped[s.offset + s.size / 3] ^= std::byte{0x40};
+    auto pack = CharacterPack::from_bytes(flipped, "flipped.pack");
+    ASSERT_FALSE(pack.ok()) << section_id_name(s.id);
+    EXPECT_EQ(pack.status().code(), ErrorCode::kChecksumMismatch) << pack.status().message();
+  }
+}
+
+TEST_F(CorruptPack, KdNodeLinksOutsideTheTreeAreRefused) {
+  // An inner node whose above child points past the bone's slice.
+  std::size_t inner = 0;
+  while (inner < baked_->fuzzy.nodes.size() && baked_->fuzzy.nodes[inner].is_leaf()) ++inner;
+  ASSERT_LT(inner, baked_->fuzzy.nodes.size());
+  rt::KdNode bad = baked_->fuzzy.nodes[inner];
+  bad.word1 = (rt::KdNode::kMaxIndex << 2) | (bad.word1 & 3u);
+  expect_rejected(repack(make_section_id("FNOD"), [&](auto& p) { overwrite(p, inner, bad); }), "fuzzy");
+  // A child pointing back at its parent: a cycle.
+  bad.word1 = (static_cast<std::uint32_t>(0) << 2) | (bad.word1 & 3u);
+  expect_rejected(repack(make_section_id("FNOD"), [&](auto& p) { overwrite(p, inner, bad); }), "fuzzy");
+}
+
+TEST_F(CorruptPack, LeafListsPastTheEndAreRefused) {
+  std::size_t leaf = 0;
+  while (leaf < baked_->fuzzy.nodes.size() && !baked_->fuzzy.nodes[leaf].is_leaf()) ++leaf;
+  ASSERT_LT(leaf, baked_->fuzzy.nodes.size());
+  const rt::KdNode bad = rt::KdNode::leaf(static_cast<std::uint32_t>(baked_->fuzzy.items.size()), 3);
+  expect_rejected(repack(make_section_id("FNOD"), [&](auto& p) { overwrite(p, leaf, bad); }), "fuzzy");
+  // An item that is not a triangle of the mesh.
+  expect_rejected(repack(make_section_id("FITM"), [&](auto& p) { overwrite(p, 0, std::uint32_t{0xfffffff0u}); }), "fuzzy");
+}
+
+TEST_F(CorruptPack, NanBoxesAreRefused) {
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  rt::BoneTree tree = baked_->fuzzy.bone_trees[1];
+  tree.bounds.upper.y = nan;
+  expect_rejected(repack(make_section_id("FBTR"), [&](auto& p) { overwrite(p, 1, tree); }), "bounds");
+  rt::VertexCheck check = baked_->fuzzy.vertex_checks[5];
+  check.box.lower.x = nan;
+  expect_rejected(repack(make_section_id("FVCK"), [&](auto& p) { overwrite(p, 5, check); }), "box");
+}
+
+TEST_F(CorruptPack, BadMeshSkeletonAndClipDataAreRefused) {
+  // MESH: after 16 bytes of counts and flags come the positions; a NaN there.
+  expect_rejected(repack(make_section_id("MESH"), [](auto& p) { overwrite(p, 4, std::numeric_limits<float>::quiet_NaN()); }),
+                  "MESH.positions[0]");
+  // A vertex count far beyond the section: refused before allocating.
+  expect_rejected(repack(make_section_id("MESH"), [](auto& p) { overwrite(p, 0, std::uint32_t{0xffffffffu}); }), "MESH.positions");
+  // SKEL: a joint count beyond the limit.
+  expect_rejected(repack(make_section_id("SKEL"), [](auto& p) { overwrite(p, 0, std::uint32_t{1u << 30}); }), "SKEL.joint_count");
+  // CLIP: a clip count far beyond the section.
+  expect_rejected(repack(make_section_id("CLIP"), [](auto& p) { overwrite(p, 0, std::uint32_t{60000}); }), "CLIP");
+  // FTBN: a triangle assigned to a bone that does not exist.
+  expect_rejected(repack(make_section_id("FTBN"), [](auto& p) { overwrite(p, 0, std::uint16_t{999}); }), "triangle_bone");
+  // A section of the wrong size.
+  expect_rejected(repack(make_section_id("FNOD"), [](auto& p) { p.resize(p.size() - 4); }), "FNOD");
+  // Trailing bytes after a decoded section.
+  expect_rejected(repack(make_section_id("POSE"), [](auto& p) { p.push_back(std::byte{0}); }), "POSE.size");
+  // A missing required section.
+  auto reader = PackReader::from_bytes(*bytes_, "pristine");
+  ASSERT_TRUE(reader.ok());
+  PackWriter w;
+  for (const SectionInfo& s : reader->sections()) {
+    if (s.id != make_section_id("FBTR")) {
+      ASSERT_TRUE(w.add_section(s.id, s.version, reader->section_bytes(s)).ok());
+    }
+  }
+  auto missing = w.serialize();
+  ASSERT_TRUE(missing.ok());
+  expect_rejected(*missing, "FBTR");
+}
+
+// Random byte changes inside each section, checksums recomputed: whatever
+// the loader accepts must render without tripping the sanitizers.
+TEST_F(CorruptPack, RandomDamageNeverCrashes) {
+  auto reader = PackReader::from_bytes(*bytes_, "pristine");
+  ASSERT_TRUE(reader.ok());
+  std::mt19937 random(1234);
+  JobSystem jobs(1);
+  int accepted = 0, refused = 0;
+  for (const SectionInfo& s : reader->sections()) {
+    if (s.size == 0) continue;
+    for (int trial = 0; trial < 12; ++trial) {
+      const auto bytes = repack(s.id, [&](std::vector<std::byte>& p) {
+        for (int k = 0; k < 3; ++k) p[random() % p.size()] = static_cast<std::byte>(random() & 0xffu);
+      });
+      auto pack = CharacterPack::from_bytes(bytes, "damaged.pack");
+      if (!pack.ok()) {
+        ++refused;
+        continue;
+      }
+      ++accepted;
+      if (pack->has_fuzzy()) render(pack->model(), pack->fuzzy(), jobs, /*strict=*/false);
+    }
+  }
+  EXPECT_GT(refused, 0);
+  RecordProperty("accepted", accepted);
+}
+
+}  // namespace
+}  // namespace sinew::editor
