@@ -4,12 +4,12 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <optional>
 
 #include "content/mannequin/mannequin.h"
 #include "editor/bake/in_memory_bake.h"
 #include "editor/cli/render_command.h"
-#include "editor/import/cal3d_importer.h"
-#include "editor/import/gltf_importer.h"
+#include "editor/import/model_loader.h"
 
 namespace sinew::demo {
 namespace {
@@ -17,23 +17,9 @@ namespace {
 constexpr float kCharacterHeight = 1.8f;
 constexpr int kObstacles = 8;
 
-std::string lower_extension(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return ext;
-}
-
 Expected<editor::ImportedModel> load_model(const std::string& path) {
   if (path.empty()) return content::make_mannequin();
-  const std::string ext = lower_extension(path);
-  if (ext == ".cfg") return editor::import_cal3d(path);
-  if (ext == ".gltf" || ext == ".glb") return editor::import_gltf(path);
-  if (ext == ".pack") {
-    return make_error(ErrorCode::kInvalidArgument, path, "--model", ext,
-                      "content packs are not readable yet (editor issue); pass the source model (.gltf, .glb, .cfg)");
-  }
-  return make_error(ErrorCode::kInvalidArgument, path, "--model", ext,
-                    "unknown model type: expected .gltf, .glb or .cfg (Cal3D)");
+  return editor::load_model(path);
 }
 
 double ms_since(std::chrono::steady_clock::time_point start) {
@@ -83,7 +69,15 @@ Expected<std::unique_ptr<DemoSession>> DemoSession::create(const SessionOptions&
     return invalid_argument("--size", std::to_string(options.width) + "x" + std::to_string(options.height),
                             "must be at least 1x1");
   }
-  SINEW_ASSIGN_OR_RETURN(editor::ImportedModel model, load_model(options.model_path));
+  // A baked pack brings its fuzzy trees (used in place); anything else,
+  // a model-only pack included, is baked in memory below.
+  std::optional<editor::CharacterPack> pack;
+  if (editor::is_pack_path(options.model_path)) {
+    SINEW_ASSIGN_OR_RETURN(editor::CharacterPack loaded, editor::CharacterPack::open(options.model_path));
+    if (loaded.has_fuzzy()) pack.emplace(std::move(loaded));
+  }
+  SINEW_ASSIGN_OR_RETURN(editor::ImportedModel model,
+                         pack ? Expected<editor::ImportedModel>(pack->model()) : load_model(options.model_path));
   const Arena arena = Arena::generate(options.seed, kObstacles);
   WorldOptions world_options;
   world_options.characters = options.characters;
@@ -97,17 +91,25 @@ Expected<std::unique_ptr<DemoSession>> DemoSession::create(const SessionOptions&
   DemoSession& s = *session;
   s.arena_ = arena;
   const auto bake_start = std::chrono::steady_clock::now();
-  SINEW_ASSIGN_OR_RETURN(editor::InMemoryBake bake, editor::bake_in_memory(s.model_, editor::BakeRequest{}, jobs));
-  s.fuzzy_ = std::move(bake.fuzzy);
+  rt::FuzzyCharacterView fuzzy;
+  if (pack) {
+    s.pack_ = std::move(pack);
+    fuzzy = s.pack_->fuzzy();
+    s.bake_info_.from_pack = true;
+  } else {
+    SINEW_ASSIGN_OR_RETURN(editor::InMemoryBake bake, editor::bake_in_memory(s.model_, editor::BakeRequest{}, jobs));
+    s.fuzzy_ = std::move(bake.fuzzy);
+    fuzzy = s.fuzzy_.view();
+  }
+  const rt::FuzzyBakeStats& stats = s.pack_ ? s.pack_->fuzzy_stats() : s.fuzzy_.stats;
   s.bake_info_.model = options.model_path.empty() ? "mannequin (procedural)" : options.model_path;
   s.bake_info_.triangles = s.model_.mesh.triangle_count();
   s.bake_info_.bones = s.model_.skeleton.joint_count();
-  s.bake_info_.pose_samples = s.fuzzy_.stats.sample_count;
+  s.bake_info_.pose_samples = stats.sample_count;
   s.bake_info_.bake_ms = ms_since(bake_start);
-  s.bake_info_.fuzzy_area_ratio =
-      s.fuzzy_.stats.rest_area > 0.0 ? s.fuzzy_.stats.fuzzy_area / s.fuzzy_.stats.rest_area : 0.0;
+  s.bake_info_.fuzzy_area_ratio = stats.rest_area > 0.0 ? stats.fuzzy_area / stats.rest_area : 0.0;
 
-  SINEW_ASSIGN_OR_RETURN(const std::uint32_t character, s.scene_.add_character(s.model_.mesh, s.fuzzy_.view()));
+  SINEW_ASSIGN_OR_RETURN(const std::uint32_t character, s.scene_.add_character(s.model_.mesh, fuzzy));
   SINEW_ASSIGN_OR_RETURN(const std::uint32_t arena_mesh, s.scene_.add_static_mesh(s.arena_.static_mesh()));
   (void)arena_mesh;  // hits report it as an instance id; nothing to keep
   for (int i = 0; i < s.world_.character_count(); ++i) {

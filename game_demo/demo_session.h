@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "editor/import/imported_model.h"
+#include "editor/pack/character_pack.h"
 #include "game_demo/arena.h"
 #include "game_demo/world.h"
 #include "raytrace/camera/camera.h"
@@ -60,15 +61,17 @@ struct BakeInfo {
   std::size_t triangles = 0;
   std::size_t bones = 0;
   std::uint32_t pose_samples = 0;
-  double bake_ms = 0.0;
+  double bake_ms = 0.0;            // the in-memory bake, or loading the pack
   double fuzzy_area_ratio = 0.0;  // fuzzy area / rest area
+  bool from_pack = false;         // the fuzzy trees came from a content pack
 };
 
 class DemoSession {
  public:
-  // Loads the model (glTF .gltf/.glb or Cal3D .cfg; the mannequin when
-  // options.model_path is empty), bakes it over all its clips, builds the
-  // arena and the world. Errors name the file and what was wrong.
+  // Loads the model (glTF .gltf/.glb, Cal3D .cfg, or a content pack; the
+  // mannequin when options.model_path is empty), bakes it over all its clips
+  // unless a baked pack brings its fuzzy trees, builds the arena and the
+  // world. Errors name the file and what was wrong.
   static Expected<std::unique_ptr<DemoSession>> create(const SessionOptions& options, JobSystem& jobs);
 
   // Steps the world by dt with `input` (input.camera_yaw is taken from
@@ -98,7 +101,8 @@ class DemoSession {
   // The model and the bake are referenced by the scene: they stay put
   // (the session is heap-allocated and never moves).
   editor::ImportedModel model_;
-  rt::FuzzyCharacterData fuzzy_;
+  rt::FuzzyCharacterData fuzzy_;               // an in-memory bake, or
+  std::optional<editor::CharacterPack> pack_;  // a baked pack's trees, in place
   Arena arena_;
   World world_;
   rt::Scene scene_;

@@ -31,7 +31,11 @@ bool draw_hud(const HudFrame& frame, const BakeInfo& bake, HudControls& controls
     if (ImGui::CollapsingHeader("pose space", ImGuiTreeNodeFlags_DefaultOpen)) {
       ImGui::Text("%s", bake.model.c_str());
       ImGui::Text("%zu triangles, %zu bones", bake.triangles, bake.bones);
-      ImGui::Text("%u pose samples (all clips), baked in %.0f ms", bake.pose_samples, bake.bake_ms);
+      if (bake.from_pack) {
+        ImGui::Text("%u pose samples, from the pack (loaded in %.0f ms)", bake.pose_samples, bake.bake_ms);
+      } else {
+        ImGui::Text("%u pose samples (all clips), baked in %.0f ms", bake.pose_samples, bake.bake_ms);
+      }
       ImGui::Text("fuzzy area %.2fx the rest pose's", bake.fuzzy_area_ratio);
     }
     if (ImGui::CollapsingHeader("settings", ImGuiTreeNodeFlags_DefaultOpen)) {

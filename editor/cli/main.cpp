@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "editor/cli/pack_commands.h"
 #include "editor/cli/render_command.h"
 
 namespace {
@@ -16,7 +17,11 @@ const char* const kUsage =
 void print_help(std::ostream& out) {
   out << kUsage
       << "\ncommands:\n"
-         "  render   import, bake in memory, pose with one clip and ray trace a model\n";
+         "  bake     bake a model's fuzzy kd-trees into a content pack\n"
+         "  inspect  sizes, counts, pose space, fuzzy area, tree depths, provenance of a pack\n"
+         "  validate check a pack completely (exit 0 when valid)\n"
+         "  subdivide  split every triangle into four, L times (the paper's larger Cally variants)\n"
+         "  render   pose with one clip and ray trace a model or a pack\n";
 }
 
 }  // namespace
@@ -33,6 +38,10 @@ int main(int argc, char** argv) {
     print_help(std::cout);
     return 0;
   }
+  if (command == "bake") return sinew::editor::run_bake(rest, std::cout, std::cerr);
+  if (command == "subdivide") return sinew::editor::run_subdivide(rest, std::cout, std::cerr);
+  if (command == "inspect") return sinew::editor::run_inspect(rest, std::cout, std::cerr);
+  if (command == "validate") return sinew::editor::run_validate(rest, std::cout, std::cerr);
   if (command == "render") return sinew::editor::run_render(rest, std::cout, std::cerr);
   std::cerr << "sinew-editor: unknown command '" << command << "'\n" << kUsage;
   return 2;

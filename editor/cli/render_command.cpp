@@ -6,6 +6,7 @@
 #include <cctype>
 #include <cmath>
 #include <filesystem>
+#include <optional>
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -14,7 +15,8 @@
 #include "animation/pose.h"
 #include "editor/bake/in_memory_bake.h"
 #include "editor/cli/cli_args.h"
-#include "editor/import/gltf_importer.h"
+#include "editor/import/model_loader.h"
+#include "editor/pack/character_pack.h"
 #include "raytrace/render/renderer.h"
 #include "raytrace/skinning/skinning.h"
 #include "runtime/image/image_io.h"
@@ -161,34 +163,6 @@ Status parse_run(const cli::ParsedArgs& args, RenderOptions& o) {
 }
 
 // --- model, pose and scene --------------------------------------------------
-
-std::string lower_extension(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return ext;
-}
-
-Expected<ImportedModel> load_model(const std::string& path) {
-  const std::string ext = lower_extension(path);
-  if (ext == ".pack") {
-    return make_error(ErrorCode::kInvalidArgument, path, "", "", "packs are not supported yet (editor issue)");
-  }
-  const bool gltf = ext == ".gltf" || ext == ".glb";
-  if (!gltf && ext != ".cfg") {
-    return make_error(ErrorCode::kInvalidArgument, path, "extension", ext.empty() ? "(none)" : ext,
-                      "unsupported model format (expected .gltf, .glb or .cfg)");
-  }
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) {
-    return make_error(ErrorCode::kNotFound, path, "", "", "no such file");
-  }
-  if (gltf) return import_gltf(path);
-#if SINEW_HAVE_CAL3D
-  return import_cal3d(path);
-#else
-  return make_error(ErrorCode::kInvalidArgument, path, "", "", "this sinew-editor was built without Cal3D");
-#endif
-}
 
 Expected<std::vector<Affine3>> rest_skinning(const ImportedModel& model, const Affine3& placement) {
   const std::size_t joints = model.skeleton.joint_count();
@@ -428,21 +402,38 @@ Expected<RenderOutputs> render_model(const RenderOptions& options) {
     return invalid_argument("options", std::to_string(options.width) + "x" + std::to_string(options.height),
                             "size, instances and frames must be at least 1");
   }
-  report(options, "importing " + options.model_path);
-  SINEW_ASSIGN_OR_RETURN(const ImportedModel model, load_model(options.model_path));
+  // A baked pack renders from its own fuzzy trees, in place; any other
+  // model (or a model-only pack) is baked in memory first.
+  std::optional<CharacterPack> pack;
+  InMemoryBake bake;
+  JobSystem jobs(options.threads);
+  if (is_pack_path(options.model_path)) {
+    report(options, "loading " + options.model_path);
+    SINEW_ASSIGN_OR_RETURN(CharacterPack loaded, CharacterPack::open(options.model_path));
+    pack.emplace(std::move(loaded));
+  }
+  ImportedModel imported;
+  if (!pack) {
+    report(options, "importing " + options.model_path);
+    SINEW_ASSIGN_OR_RETURN(imported, load_model(options.model_path));
+  }
+  const ImportedModel& model = pack ? pack->model() : imported;
   if (model.mesh.triangle_count() == 0) {
     return make_error(ErrorCode::kInvalidData, options.model_path, "triangles", "0", "the model has no triangles");
   }
   SINEW_ASSIGN_OR_RETURN(const anim::Clip* clip, resolve_clip(model, options));
 
-  BakeRequest request;
-  request.pose_space = options.pose_space;
-  if (!options.limits_path.empty()) {
-    SINEW_ASSIGN_OR_RETURN(request.limits, anim::load_joint_limits(options.limits_path, model.skeleton));
+  if (!pack || !pack->has_fuzzy()) {
+    BakeRequest request;
+    request.pose_space = options.pose_space;
+    if (!options.limits_path.empty()) {
+      SINEW_ASSIGN_OR_RETURN(request.limits, anim::load_joint_limits(options.limits_path, model.skeleton));
+    }
+    report(options, "baking (" + std::string(anim::pose_space_mode_name(request.pose_space.mode)) + " pose space)");
+    SINEW_ASSIGN_OR_RETURN(bake, bake_in_memory(model, request, jobs));
   }
-  JobSystem jobs(options.threads);
-  report(options, "baking (" + std::string(anim::pose_space_mode_name(request.pose_space.mode)) + " pose space)");
-  SINEW_ASSIGN_OR_RETURN(const InMemoryBake bake, bake_in_memory(model, request, jobs));
+  const rt::FuzzyCharacterView fuzzy = pack && pack->has_fuzzy() ? pack->fuzzy() : bake.fuzzy.view();
+  if (pack && pack->has_fuzzy()) bake.fuzzy.stats = pack->fuzzy_stats();  // reported in stats.json
 
   RenderOutputs out;
   out.width = options.width;
@@ -453,7 +444,7 @@ Expected<RenderOutputs> render_model(const RenderOptions& options) {
 
   // Scene: the instances first (ids 0..n-1), then the ground.
   rt::Scene scene;
-  SINEW_ASSIGN_OR_RETURN(const std::uint32_t character, scene.add_character(model.mesh, bake.fuzzy.view()));
+  SINEW_ASSIGN_OR_RETURN(const std::uint32_t character, scene.add_character(model.mesh, fuzzy));
   std::vector<std::uint32_t> instance_ids;
   for (int i = 0; i < options.instances; ++i) {
     SINEW_ASSIGN_OR_RETURN(const std::uint32_t id, scene.add_instance(character));

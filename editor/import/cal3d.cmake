@@ -17,6 +17,7 @@ endif()
 if(TARGET Cal3D::cal3d)
   target_sources(sinew_editor PRIVATE ${CMAKE_CURRENT_LIST_DIR}/cal3d_importer.cpp)
   target_link_libraries(sinew_editor PRIVATE Cal3D::cal3d)
+  target_compile_definitions(sinew_editor PRIVATE SINEW_HAVE_CAL3D=1)
   # UBSan's vptr check (asan preset) references the typeinfo of Cal3D's
   # polymorphic classes, which the shared libcal3d does not export: the link
   # fails. The check is off for the one file that touches Cal3D objects.

@@ -3,8 +3,13 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
+#include <filesystem>
+#include <string>
 #include <vector>
 
+#include "content/mannequin/mannequin.h"
+#include "editor/bake/in_memory_bake.h"
+#include "editor/pack/character_pack.h"
 #include "game_demo/demo_session.h"
 #include "runtime/jobs/job_system.h"
 
@@ -100,6 +105,35 @@ TEST(DemoSession, BadModelPathsAreClearErrors) {
   auto unknown = DemoSession::create(options, jobs);
   ASSERT_FALSE(unknown.ok());
   EXPECT_NE(unknown.status().message().find(".fbx"), std::string::npos);
+}
+
+// The mannequin baked into a pack with the demo's own settings (every clip,
+// keys + 30 Hz) plays exactly as the mannequin baked at start-up.
+TEST(DemoSession, ABakedPackPlaysLikeTheInMemoryBake) {
+  JobSystem jobs(2);
+  auto mannequin = content::make_mannequin();
+  ASSERT_TRUE(mannequin.ok());
+  auto baked = editor::bake_in_memory(*mannequin, editor::BakeRequest{}, jobs);
+  ASSERT_TRUE(baked.ok());
+  editor::CharacterPackContents contents;
+  contents.model = &*mannequin;
+  contents.fuzzy = &baked->fuzzy;
+  contents.pose_space.desc = editor::BakeRequest{}.pose_space;
+  const std::string path = (std::filesystem::path(testing::TempDir()) / "demo_mannequin.pack").string();
+  ASSERT_TRUE(editor::write_character_pack(path, contents).ok());
+
+  SessionOptions options;
+  options.width = 96;
+  options.height = 96;
+  options.model_path = path;
+  auto from_pack = DemoSession::create(options, jobs);
+  ASSERT_TRUE(from_pack.ok()) << from_pack.status().message();
+  EXPECT_TRUE((*from_pack)->bake_info().from_pack);
+  auto in_memory = make_session(jobs);
+  ASSERT_TRUE(in_memory);
+  EXPECT_FALSE(in_memory->bake_info().from_pack);
+  EXPECT_EQ(run_frames(**from_pack, jobs, 0, 20), run_frames(*in_memory, jobs, 0, 20));
+  std::filesystem::remove(path);
 }
 
 }  // namespace

@@ -1,0 +1,537 @@
+#include "editor/cli/pack_commands.h"
+
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <ctime>
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "animation/joint_limits.h"
+#include "editor/bake/in_memory_bake.h"
+#include "editor/cli/cli_args.h"
+#include "editor/import/model_loader.h"
+#include "editor/mesh/subdivide.h"
+#include "editor/pack/character_pack.h"
+#include "runtime/io/mapped_file.h"
+#include "runtime/jobs/job_system.h"
+#include "runtime/pack/checksum.h"
+
+namespace sinew::editor {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using Json = nlohmann::ordered_json;
+
+// --- bake options ---------------------------------------------------------------
+
+struct BakeOptions {
+  std::string model_path;
+  std::string out_path;
+  anim::PoseSpaceDesc pose_space = default_pose_space();
+  std::string limits_path;
+  float padding = 0.0f;
+  rt::CandidateBones candidates = rt::CandidateBones::kAll;
+  int threads = 0;
+  bool help = false;
+};
+
+std::string bake_usage() {
+  return "usage: sinew-editor bake MODEL -o OUT.pack [options]\n"
+         "  MODEL                 .gltf, .glb, .cfg (Cal3D) or a model-only .pack\n"
+         "  -o, --out OUT.pack    the pack to write (atomically: an existing file is replaced\n"
+         "                        only by a complete new pack)\n"
+         "  --pose-space MODE     arbitrary | limits | clips | clip:NAME (default clips: every\n"
+         "                        key of every clip, and every 1/30 s)\n"
+         "  --clips a,b,c         the clips of --pose-space clips (default all)\n"
+         "  --samples N           poses: arbitrary/limits need N > 0 (default 1000); clip modes:\n"
+         "                        at most N of the key times (0 = all)\n"
+         "  --seed S              random pose seed (default 1)\n"
+         "  --limits FILE.json    joint limits (needed by --pose-space limits; stored in the pack)\n"
+         "  --pad FRACTION        grow every fuzzy box by this fraction of the model's size (default 0)\n"
+         "  --candidates MODE     all (the paper's) | influencing (faster; default all)\n"
+         "  --threads N           worker threads (default all cores)\n"
+         "Set SOURCE_DATE_EPOCH for a reproducible pack (fixed date, no timings).\n";
+}
+
+const std::vector<cli::FlagSpec>& bake_flags() {
+  static const std::vector<cli::FlagSpec> flags = {
+      {"--help", false}, {"-h", false},      {"--out"},     {"--pose-space"}, {"--clips"},
+      {"--samples"},     {"--seed"},         {"--limits"}, {"--pad"},  {"--candidates"}, {"--threads"},
+  };
+  return flags;
+}
+
+Expected<BakeOptions> parse_bake_options(std::vector<std::string> args) {
+  // -o is the short form of --out (the option parser knows long flags only).
+  for (std::string& a : args) {
+    if (a == "-o") a = "--out";
+  }
+  SINEW_ASSIGN_OR_RETURN(const cli::ParsedArgs parsed, cli::parse_args(args, bake_flags()));
+  BakeOptions o;
+  if (parsed.has("--help") || parsed.has("-h")) {
+    o.help = true;
+    return o;
+  }
+  if (parsed.positionals.size() != 1) {
+    return invalid_argument("MODEL", std::to_string(parsed.positionals.size()) + " given", "expected one model file");
+  }
+  o.model_path = parsed.positionals.front();
+  if (auto v = parsed.value("--out")) o.out_path = *v;
+  if (o.out_path.empty()) return invalid_argument("-o", "", "missing: where to write the pack");
+  if (!is_pack_path(o.out_path)) return invalid_argument("-o", o.out_path, "expected a .pack file name");
+  bool samples_given = false;
+  if (auto v = parsed.value("--pose-space")) {
+    const std::string mode = *v;
+    if (mode == "arbitrary") {
+      o.pose_space.mode = anim::PoseSpaceMode::kArbitrary;
+    } else if (mode == "limits") {
+      o.pose_space.mode = anim::PoseSpaceMode::kLimits;
+    } else if (mode == "clips") {
+      o.pose_space.mode = anim::PoseSpaceMode::kClips;
+    } else if (mode.rfind("clip:", 0) == 0 && mode.size() > 5) {
+      o.pose_space.mode = anim::PoseSpaceMode::kClip;
+      o.pose_space.clips = {mode.substr(5)};
+    } else {
+      return invalid_argument("--pose-space", mode, "expected arbitrary, limits, clips or clip:NAME");
+    }
+  }
+  if (auto v = parsed.value("--clips")) {
+    if (o.pose_space.mode != anim::PoseSpaceMode::kClips) {
+      return invalid_argument("--clips", *v, "only with --pose-space clips");
+    }
+    SINEW_ASSIGN_OR_RETURN(o.pose_space.clips, cli::parse_list("--clips", *v));
+  }
+  if (auto v = parsed.value("--samples")) {
+    SINEW_ASSIGN_OR_RETURN(const std::int64_t n, cli::parse_int("--samples", *v, 0, anim::kMaxPoseSamples));
+    o.pose_space.samples = static_cast<int>(n);
+    samples_given = true;
+  }
+  const bool random_mode =
+      o.pose_space.mode == anim::PoseSpaceMode::kArbitrary || o.pose_space.mode == anim::PoseSpaceMode::kLimits;
+  if (random_mode && samples_given && o.pose_space.samples == 0) {
+    return invalid_argument("--samples", "0", "random pose spaces need at least one sample");
+  }
+  if (!random_mode && !samples_given) o.pose_space.samples = 0;
+  if (random_mode) o.pose_space.every_frame_30hz = false;
+  if (random_mode && !samples_given) o.pose_space.samples = 1000;
+  if (auto v = parsed.value("--seed")) {
+    SINEW_ASSIGN_OR_RETURN(o.pose_space.seed, cli::parse_uint64("--seed", *v));
+  }
+  if (auto v = parsed.value("--limits")) o.limits_path = *v;
+  if (o.pose_space.mode == anim::PoseSpaceMode::kLimits && o.limits_path.empty()) {
+    return invalid_argument("--limits", "", "--pose-space limits needs a joint-limits file");
+  }
+  if (auto v = parsed.value("--pad")) {
+    SINEW_ASSIGN_OR_RETURN(const double pad, cli::parse_double("--pad", *v, 0.0, 1.0));
+    o.padding = static_cast<float>(pad);
+  }
+  if (auto v = parsed.value("--candidates")) {
+    SINEW_ASSIGN_OR_RETURN(const int c, cli::parse_choice("--candidates", *v, {"all", "influencing"}));
+    o.candidates = c == 0 ? rt::CandidateBones::kAll : rt::CandidateBones::kInfluencing;
+  }
+  if (auto v = parsed.value("--threads")) {
+    SINEW_ASSIGN_OR_RETURN(const std::int64_t n, cli::parse_int("--threads", *v, 1, 1024));
+    o.threads = static_cast<int>(n);
+  }
+  return o;
+}
+
+// --- progress and interruption -----------------------------------------------------
+
+// SIGINT during a bake cancels it through the progress callback: the bake
+// stops, nothing is written, and an existing OUT.pack is untouched.
+std::atomic<bool> g_interrupted{false};
+extern "C" void on_interrupt(int) { g_interrupted.store(true); }
+
+class ScopedInterruptHandler {
+ public:
+  ScopedInterruptHandler() {
+    g_interrupted.store(false);
+    previous_ = std::signal(SIGINT, on_interrupt);
+  }
+  ~ScopedInterruptHandler() { std::signal(SIGINT, previous_); }
+  ScopedInterruptHandler(const ScopedInterruptHandler&) = delete;
+  ScopedInterruptHandler& operator=(const ScopedInterruptHandler&) = delete;
+
+ private:
+  void (*previous_)(int) = SIG_DFL;
+};
+
+// A bar with percent, phase and ETA on a terminal; plain lines otherwise
+// (one per phase and per 25%), so logs stay readable.
+class ProgressReporter {
+ public:
+  explicit ProgressReporter(std::ostream& err)
+      : err_(err), terminal_(&err == &std::cerr && isatty(STDERR_FILENO) != 0), start_(Clock::now()) {}
+
+  bool update(std::string_view phase, double fraction) {
+    if (g_interrupted.load()) return false;
+    const double seconds = std::chrono::duration<double>(Clock::now() - start_).count();
+    const int percent = static_cast<int>(fraction * 100.0);
+    if (terminal_) {
+      constexpr int kWidth = 30;
+      const int filled = static_cast<int>(fraction * kWidth);
+      std::ostringstream line;
+      line << "\r[" << std::string(static_cast<std::size_t>(filled), '#')
+           << std::string(static_cast<std::size_t>(kWidth - filled), ' ') << "] " << std::setw(3) << percent << "% "
+           << std::left << std::setw(10) << phase << std::right;
+      if (fraction > 0.02) line << " ETA " << std::fixed << std::setprecision(0) << seconds * (1.0 / fraction - 1.0) << " s  ";
+      err_ << line.str() << std::flush;
+    } else if (phase != last_phase_ || percent >= next_percent_) {
+      err_ << "bake: " << percent << "% " << phase << " (" << std::fixed << std::setprecision(1) << seconds << " s)\n";
+      next_percent_ = (percent / 25 + 1) * 25;
+    }
+    last_phase_ = std::string(phase);
+    return true;
+  }
+  void done() {
+    if (terminal_) err_ << "\n";
+  }
+
+ private:
+  std::ostream& err_;
+  bool terminal_;
+  Clock::time_point start_;
+  std::string last_phase_;
+  int next_percent_ = 0;
+};
+
+// SOURCE_DATE_EPOCH (reproducible-builds.org): a fixed bake date, and no
+// timings, so the same inputs give a byte-identical pack.
+std::optional<std::int64_t> source_date_epoch() {
+  const char* text = std::getenv("SOURCE_DATE_EPOCH");
+  if (text == nullptr || *text == '\0') return std::nullopt;
+  char* end = nullptr;
+  const long long value = std::strtoll(text, &end, 10);
+  if (end == nullptr || *end != '\0' || value < 0) return std::nullopt;
+  return static_cast<std::int64_t>(value);
+}
+
+Expected<std::uint64_t> file_hash(const std::string& path) {
+  SINEW_ASSIGN_OR_RETURN(const MappedFile file, MappedFile::open(path));
+  return checksum64(file.bytes());
+}
+
+// Who made a pack from which file, and when (SOURCE_DATE_EPOCH when set).
+Expected<Provenance> provenance_for(const std::string& model_path) {
+  Provenance p;
+  p.source_name = std::filesystem::path(model_path).filename().string();
+  SINEW_ASSIGN_OR_RETURN(p.source_hash, file_hash(model_path));
+  p.tool_version = std::string("sinew-editor ") + SINEW_VERSION;
+  const auto epoch = source_date_epoch();
+  p.bake_unix_time = epoch ? *epoch : static_cast<std::int64_t>(std::time(nullptr));
+  return p;
+}
+
+double ms_since(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+int fail(std::ostream& err, std::string_view command, const Status& s) {
+  err << "sinew-editor " << command << ": " << s.message() << "\n";
+  return 1;
+}
+
+int usage_error(std::ostream& err, std::string_view command, const Status& s, const std::string& usage) {
+  err << "sinew-editor " << command << ": " << s.message() << "\n" << usage;
+  return 2;
+}
+
+// --- inspect ------------------------------------------------------------------------
+
+struct TreeFigures {
+  int max_depth = 0;
+  double mean_depth_of_leaves = 0.0;
+  std::size_t leaves = 0;
+};
+
+// Depths of one bone's tree (iterative: loaded trees are already validated).
+TreeFigures tree_figures(const rt::KdTreeView& tree) {
+  TreeFigures f;
+  if (tree.nodes.empty()) return f;
+  std::vector<std::pair<std::uint32_t, int>> stack{{0u, 0}};
+  double depth_sum = 0.0;
+  while (!stack.empty()) {
+    const auto [node, depth] = stack.back();
+    stack.pop_back();
+    f.max_depth = std::max(f.max_depth, depth);
+    const rt::KdNode& n = tree.nodes[node];
+    if (n.is_leaf()) {
+      ++f.leaves;
+      depth_sum += depth;
+      continue;
+    }
+    stack.push_back({node + 1, depth + 1});
+    stack.push_back({n.above_child(), depth + 1});
+  }
+  f.mean_depth_of_leaves = f.leaves ? depth_sum / static_cast<double>(f.leaves) : 0.0;
+  return f;
+}
+
+std::string utc_text(std::int64_t unix_time) {
+  const std::time_t t = static_cast<std::time_t>(unix_time);
+  std::tm utc{};
+  gmtime_r(&t, &utc);
+  char text[32];
+  std::strftime(text, sizeof text, "%Y-%m-%d %H:%M:%S UTC", &utc);
+  return text;
+}
+
+Json inspect_json(const CharacterPack& pack) {
+  const ImportedModel& m = pack.model();
+  Json sections = Json::array();
+  for (const SectionInfo& s : pack.reader().sections()) {
+    sections.push_back({{"id", section_id_name(s.id)}, {"version", s.version}, {"bytes", s.size}});
+  }
+  Json clips = Json::array();
+  for (const anim::Clip& c : m.clips) clips.push_back({{"name", c.name()}, {"seconds", c.duration()}});
+  const PoseSpaceRecord& ps = pack.pose_space();
+  const Provenance& p = pack.provenance();
+  Json out = {
+      {"file", pack.reader().name()},
+      {"bytes", pack.reader().bytes().size()},
+      {"format_version", std::to_string(pack.reader().version().major) + "." +
+                             std::to_string(pack.reader().version().minor)},
+      {"sections", sections},
+      {"model", {{"joints", m.skeleton.joint_count()}, {"vertices", m.mesh.vertex_count()},
+                 {"triangles", m.mesh.triangle_count()}, {"materials", m.mesh.material_colors.size()},
+                 {"clips", clips}, {"joint_limits", !pack.limits().empty()}}},
+      {"pose_space", {{"mode", std::string(anim::pose_space_mode_name(ps.desc.mode))}, {"clips", ps.desc.clips},
+                      {"samples_requested", ps.desc.samples}, {"every_frame_30hz", ps.desc.every_frame_30hz},
+                      {"seed", ps.desc.seed}, {"padding", ps.padding},
+                      {"candidates", ps.candidates == rt::CandidateBones::kAll ? "all" : "influencing"}}},
+      {"provenance", {{"source", p.source_name}, {"source_xxh3", p.source_hash}, {"tool", p.tool_version},
+                      {"bake_date", utc_text(p.bake_unix_time)}, {"bake_unix_time", p.bake_unix_time},
+                      {"pose_sampling_ms", p.pose_sampling_ms}, {"sampling_ms", p.sampling_ms},
+                      {"assignment_ms", p.assignment_ms}, {"build_ms", p.build_ms}}},
+  };
+  if (!pack.has_fuzzy()) {
+    out["fuzzy"] = nullptr;
+    return out;
+  }
+  const rt::FuzzyBakeStats& st = pack.fuzzy_stats();
+  const rt::FuzzyCharacterView& f = pack.fuzzy();
+  Json bones = Json::array();
+  int max_depth = 0;
+  double depth_sum = 0.0;
+  std::size_t leaves = 0;
+  for (std::uint32_t b = 0; b < f.bone_count; ++b) {
+    const TreeFigures t = tree_figures(f.bone_tree(b));
+    max_depth = std::max(max_depth, t.max_depth);
+    depth_sum += t.mean_depth_of_leaves * static_cast<double>(t.leaves);
+    leaves += t.leaves;
+    bones.push_back({{"bone", m.skeleton.names()[b]}, {"triangles", f.bone_trees[b].triangle_count},
+                     {"nodes", f.bone_trees[b].node_count}, {"max_depth", t.max_depth}});
+  }
+  out["fuzzy"] = {{"pose_samples", st.sample_count},
+                  {"fuzzy_area", st.fuzzy_area},
+                  {"rest_area", st.rest_area},
+                  {"fuzzy_area_ratio", st.rest_area > 0.0 ? st.fuzzy_area / st.rest_area : 0.0},
+                  {"triangles_per_leaf", st.mean_items_per_leaf},
+                  {"nodes", f.nodes.size()},
+                  {"leaf_items", f.items.size()},
+                  {"max_depth", max_depth},
+                  {"mean_leaf_depth", leaves ? depth_sum / static_cast<double>(leaves) : 0.0},
+                  {"bones", bones}};
+  return out;
+}
+
+void print_inspect(const Json& j, std::ostream& out) {
+  out << j["file"].get<std::string>() << ": " << j["bytes"] << " bytes, pack format " << j["format_version"].get<std::string>()
+      << ", " << j["sections"].size() << " sections\n";
+  for (const Json& s : j["sections"]) {
+    out << "  " << s["id"].get<std::string>() << " v" << s["version"] << "  " << s["bytes"] << " bytes\n";
+  }
+  const Json& m = j["model"];
+  out << "model: " << m["joints"] << " joints, " << m["vertices"] << " vertices, " << m["triangles"] << " triangles, "
+      << m["materials"] << " materials, " << m["clips"].size() << " clips"
+      << (m["joint_limits"].get<bool>() ? ", joint limits" : "") << "\n";
+  for (const Json& c : m["clips"]) out << "  clip " << c["name"].get<std::string>() << " (" << c["seconds"] << " s)\n";
+  const Json& ps = j["pose_space"];
+  out << "pose space: " << ps["mode"].get<std::string>() << ", samples requested " << ps["samples_requested"]
+      << ", seed " << ps["seed"] << ", padding " << ps["padding"] << ", candidates "
+      << ps["candidates"].get<std::string>() << "\n";
+  const Json& p = j["provenance"];
+  out << "provenance: " << p["source"].get<std::string>() << " (xxh3 " << std::hex << p["source_xxh3"].get<std::uint64_t>()
+      << std::dec << "), " << p["tool"].get<std::string>() << ", baked " << p["bake_date"].get<std::string>() << "\n"
+      << "bake times: pose sampling " << p["pose_sampling_ms"] << " ms, boxes " << p["sampling_ms"]
+      << " ms, assignment " << p["assignment_ms"] << " ms, trees " << p["build_ms"] << " ms\n";
+  if (j["fuzzy"].is_null()) {
+    out << "fuzzy trees: none (a model-only pack)\n";
+    return;
+  }
+  const Json& f = j["fuzzy"];
+  out << "fuzzy trees: " << f["pose_samples"] << " pose samples, fuzzy area " << f["fuzzy_area_ratio"]
+      << "x the rest pose's, " << f["triangles_per_leaf"] << " triangles per leaf, " << f["nodes"] << " nodes, depth "
+      << f["max_depth"] << " max / " << f["mean_leaf_depth"] << " mean leaf\n";
+}
+
+}  // namespace
+
+int run_bake(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
+  auto parsed = parse_bake_options(args);
+  if (!parsed.ok()) return usage_error(err, "bake", parsed.status(), bake_usage());
+  const BakeOptions& o = *parsed;
+  if (o.help) {
+    out << bake_usage();
+    return 0;
+  }
+  const auto start = Clock::now();
+  auto model = load_model(o.model_path);
+  if (!model.ok()) return fail(err, "bake", model.status());
+  BakeRequest request;
+  request.pose_space = o.pose_space;
+  request.fuzzy.padding = o.padding;
+  request.fuzzy.candidates = o.candidates;
+  if (!o.limits_path.empty()) {
+    auto limits = anim::load_joint_limits(o.limits_path, model->skeleton);
+    if (!limits.ok()) return fail(err, "bake", limits.status());
+    request.limits = std::move(*limits);
+  }
+  ProgressReporter progress(err);
+  request.fuzzy.progress = [&](std::string_view phase, double fraction) { return progress.update(phase, fraction); };
+  JobSystem jobs(o.threads);
+  out << "baking " << o.model_path << " (" << model->mesh.triangle_count() << " triangles, "
+      << model->skeleton.joint_count() << " joints) over the " << anim::pose_space_mode_name(o.pose_space.mode)
+      << " pose space on " << jobs.thread_count() << " threads\n"
+      << std::flush;
+  Expected<InMemoryBake> bake = [&] {
+    ScopedInterruptHandler interrupts;
+    return bake_in_memory(*model, request, jobs);
+  }();
+  progress.done();
+  if (!bake.ok()) {
+    if (bake.status().code() == ErrorCode::kCancelled) {
+      err << "sinew-editor bake: interrupted; " << o.out_path << " was not written (an existing file is unchanged)\n";
+      return 1;
+    }
+    return fail(err, "bake", bake.status());
+  }
+
+  CharacterPackContents contents;
+  contents.model = &*model;
+  contents.limits = request.limits;
+  contents.fuzzy = &bake->fuzzy;
+  contents.pose_space.desc = o.pose_space;
+  contents.pose_space.padding = o.padding;
+  contents.pose_space.candidates = o.candidates;
+  auto provenance = provenance_for(o.model_path);
+  if (!provenance.ok()) return fail(err, "bake", provenance.status());
+  Provenance& p = contents.provenance = std::move(*provenance);
+  if (!source_date_epoch()) {  // reproducible bakes record no timings
+    p.pose_sampling_ms = bake->pose_sampling_ms;
+    p.sampling_ms = bake->fuzzy.stats.sampling_ms;
+    p.assignment_ms = bake->fuzzy.stats.assignment_ms;
+    p.build_ms = bake->fuzzy.stats.build_ms;
+  }
+  if (Status s = write_character_pack(o.out_path, contents); !s.ok()) return fail(err, "bake", s);
+  const rt::FuzzyBakeStats& st = bake->fuzzy.stats;
+  out << "wrote " << o.out_path << ": " << std::filesystem::file_size(o.out_path) << " bytes, " << st.sample_count
+      << " pose samples, fuzzy area " << std::fixed << std::setprecision(3)
+      << (st.rest_area > 0.0 ? st.fuzzy_area / st.rest_area : 0.0) << "x rest, " << std::setprecision(2)
+      << st.mean_items_per_leaf << " triangles per leaf, " << std::setprecision(0) << ms_since(start) << " ms\n";
+  return 0;
+}
+
+int run_subdivide(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
+  const std::string usage =
+      "usage: sinew-editor subdivide MODEL --levels L -o OUT.pack\n"
+      "  splits every triangle into four at its edge midpoints, L times (1..8); shared edges\n"
+      "  share their midpoint (no cracks), midpoints average the attributes and merge the skin\n"
+      "  weights. Writes a model-only pack, which `bake` takes as its MODEL.\n";
+  std::vector<std::string> renamed = args;
+  for (std::string& a : renamed) {
+    if (a == "-o") a = "--out";
+  }
+  auto parsed = cli::parse_args(renamed, {{"--help", false}, {"-h", false}, {"--levels"}, {"--out"}});
+  if (!parsed.ok()) return usage_error(err, "subdivide", parsed.status(), usage);
+  if (parsed->has("--help") || parsed->has("-h")) {
+    out << usage;
+    return 0;
+  }
+  if (parsed->positionals.size() != 1) {
+    return usage_error(err, "subdivide", invalid_argument("MODEL", "", "expected one model file"), usage);
+  }
+  const auto levels_text = parsed->value("--levels");
+  const auto out_path = parsed->value("--out");
+  if (!levels_text) return usage_error(err, "subdivide", invalid_argument("--levels", "", "missing"), usage);
+  if (!out_path || !is_pack_path(*out_path)) {
+    return usage_error(err, "subdivide", invalid_argument("-o", out_path.value_or(""), "expected a .pack file name"),
+                       usage);
+  }
+  auto levels = cli::parse_int("--levels", *levels_text, 1, kMaxSubdivisionLevels);
+  if (!levels.ok()) return usage_error(err, "subdivide", levels.status(), usage);
+  const std::string& model_path = parsed->positionals.front();
+  auto model = load_model(model_path);
+  if (!model.ok()) return fail(err, "subdivide", model.status());
+  auto finer = subdivide(*model, static_cast<int>(*levels));
+  if (!finer.ok()) return fail(err, "subdivide", finer.status());
+  CharacterPackContents contents;
+  contents.model = &*finer;
+  auto provenance = provenance_for(model_path);
+  if (!provenance.ok()) return fail(err, "subdivide", provenance.status());
+  contents.provenance = std::move(*provenance);
+  if (Status s = write_character_pack(*out_path, contents); !s.ok()) return fail(err, "subdivide", s);
+  out << "wrote " << *out_path << ": " << finer->mesh.vertex_count() << " vertices, " << finer->mesh.triangle_count()
+      << " triangles (from " << model->mesh.triangle_count() << ", " << *levels << " levels)\n";
+  return 0;
+}
+
+int run_inspect(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
+  const std::string usage = "usage: sinew-editor inspect PACK [--json]\n";
+  auto parsed = cli::parse_args(args, {{"--help", false}, {"-h", false}, {"--json", false}});
+  if (!parsed.ok()) return usage_error(err, "inspect", parsed.status(), usage);
+  if (parsed->has("--help") || parsed->has("-h")) {
+    out << usage;
+    return 0;
+  }
+  if (parsed->positionals.size() != 1) {
+    return usage_error(err, "inspect", invalid_argument("PACK", "", "expected one pack file"), usage);
+  }
+  auto pack = CharacterPack::open(parsed->positionals.front());
+  if (!pack.ok()) return fail(err, "inspect", pack.status());
+  const Json j = inspect_json(*pack);
+  if (parsed->has("--json")) {
+    out << j.dump(2) << "\n";
+  } else {
+    print_inspect(j, out);
+  }
+  return 0;
+}
+
+int run_validate(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
+  const std::string usage =
+      "usage: sinew-editor validate PACK\n"
+      "  checks the container (checksums, bounds, alignment) and every section's contents\n"
+      "  (counts, indices, finite values, kd-tree links and depth); exit 0 when valid\n";
+  auto parsed = cli::parse_args(args, {{"--help", false}, {"-h", false}});
+  if (!parsed.ok()) return usage_error(err, "validate", parsed.status(), usage);
+  if (parsed->has("--help") || parsed->has("-h")) {
+    out << usage;
+    return 0;
+  }
+  if (parsed->positionals.size() != 1) {
+    return usage_error(err, "validate", invalid_argument("PACK", "", "expected one pack file"), usage);
+  }
+  const auto start = Clock::now();
+  auto pack = CharacterPack::open(parsed->positionals.front());
+  const double load_ms = ms_since(start);
+  if (!pack.ok()) return fail(err, "validate", pack.status());
+  out << parsed->positionals.front() << ": valid, checked in " << std::fixed << std::setprecision(1) << load_ms
+      << " ms (" << pack->reader().section_count() << " sections, "
+      << pack->model().mesh.triangle_count() << " triangles, "
+      << (pack->has_fuzzy() ? "fuzzy trees of " + std::to_string(pack->fuzzy().bone_count) + " bones"
+                            : std::string("model only"))
+      << ")\n";
+  return 0;
+}
+
+}  // namespace sinew::editor

@@ -1,0 +1,44 @@
+#include "editor/import/model_loader.h"
+
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
+
+#include "editor/import/gltf_importer.h"
+#include "editor/pack/character_pack.h"
+#if SINEW_HAVE_CAL3D
+#include "editor/import/cal3d_importer.h"
+#endif
+
+namespace sinew::editor {
+
+std::string lower_extension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext;
+}
+
+Expected<ImportedModel> load_model(const std::string& path) {
+  const std::string ext = lower_extension(path);
+  const bool gltf = ext == ".gltf" || ext == ".glb";
+  if (!gltf && ext != ".cfg" && ext != ".pack") {
+    return make_error(ErrorCode::kInvalidArgument, path, "extension", ext.empty() ? "(none)" : ext,
+                      "unsupported model format (expected .gltf, .glb, .cfg or .pack)");
+  }
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) {
+    return make_error(ErrorCode::kNotFound, path, "", "", "no such file");
+  }
+  if (gltf) return import_gltf(path);
+  if (ext == ".pack") {
+    SINEW_ASSIGN_OR_RETURN(CharacterPack pack, CharacterPack::open(path));
+    return pack.model();
+  }
+#if SINEW_HAVE_CAL3D
+  return import_cal3d(path);
+#else
+  return make_error(ErrorCode::kInvalidArgument, path, "", "", "this build has no Cal3D importer (libcal3d missing)");
+#endif
+}
+
+}  // namespace sinew::editor

@@ -1,0 +1,205 @@
+// sinew-editor bake, subdivide, inspect and validate, run in-process on real
+// models: exit codes, the files they write, reproducible bytes, an existing
+// pack kept when a bake fails, and rendering from a pack equal to rendering
+// after an in-memory bake of the same pose space.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "editor/cli/pack_commands.h"
+#include "editor/cli/render_command.h"
+#include "runtime/io/mapped_file.h"
+#include "runtime/pack/checksum.h"
+
+namespace sinew::editor {
+namespace {
+
+const std::string kCesiumMan = std::string(SINEW_SHARED_DIR) + "/content/gltf/CesiumMan/CesiumMan.glb";
+
+struct CommandRun {
+  int code = -1;
+  std::string out;
+  std::string err;
+};
+
+CommandRun run(int (*command)(const std::vector<std::string>&, std::ostream&, std::ostream&),
+        const std::vector<std::string>& args) {
+  std::ostringstream out, err;
+  CommandRun r;
+  r.code = command(args, out, err);
+  r.out = out.str();
+  r.err = err.str();
+  return r;
+}
+
+std::string fresh_dir(const std::string& name) {
+  const auto dir = std::filesystem::path(::testing::TempDir()) / ("sinew_pack_commands_" + name);
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir.string();
+}
+
+std::string read_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+class PackCommands : public testing::Test {
+ protected:
+  void SetUp() override {
+    if (!std::filesystem::exists(kCesiumMan)) GTEST_SKIP() << kCesiumMan << " not found (shared content)";
+  }
+};
+
+TEST_F(PackCommands, BakeWritesAPackThatValidatesAndInspects) {
+  const std::string dir = fresh_dir("bake");
+  const std::string pack = dir + "/cesium.pack";
+  const CommandRun bake = run(run_bake, {kCesiumMan, "-o", pack, "--pose-space", "arbitrary", "--samples", "30",
+                                  "--seed", "5", "--pad", "0.01", "--candidates", "influencing", "--threads", "2"});
+  ASSERT_EQ(bake.code, 0) << bake.err;
+  EXPECT_NE(bake.out.find("wrote " + pack), std::string::npos) << bake.out;
+  EXPECT_NE(bake.err.find("100% build"), std::string::npos) << "progress lines: " << bake.err;
+
+  const CommandRun valid = run(run_validate, {pack});
+  EXPECT_EQ(valid.code, 0) << valid.err;
+  EXPECT_NE(valid.out.find("valid"), std::string::npos);
+
+  const CommandRun inspect = run(run_inspect, {pack, "--json"});
+  ASSERT_EQ(inspect.code, 0) << inspect.err;
+  const auto j = nlohmann::json::parse(inspect.out);
+  EXPECT_EQ(j["pose_space"]["mode"], "arbitrary");
+  EXPECT_EQ(j["pose_space"]["samples_requested"], 30);
+  EXPECT_EQ(j["pose_space"]["seed"], 5);
+  EXPECT_FLOAT_EQ(j["pose_space"]["padding"].get<float>(), 0.01f);
+  EXPECT_EQ(j["pose_space"]["candidates"], "influencing");
+  EXPECT_EQ(j["fuzzy"]["pose_samples"], 30);
+  EXPECT_GT(j["fuzzy"]["fuzzy_area_ratio"].get<double>(), 1.0);  // the fuzzy boxes hold every pose
+  EXPECT_GT(j["fuzzy"]["triangles_per_leaf"].get<double>(), 0.0);
+  EXPECT_EQ(j["provenance"]["source"], "CesiumMan.glb");
+  auto file = MappedFile::open(kCesiumMan);
+  ASSERT_TRUE(file.ok());
+  EXPECT_EQ(j["provenance"]["source_xxh3"].get<std::uint64_t>(), checksum64(file->bytes()));
+  EXPECT_EQ(j["model"]["triangles"].get<int>() > 0, true);
+  // The text form names the same facts.
+  const CommandRun text = run(run_inspect, {pack});
+  ASSERT_EQ(text.code, 0);
+  EXPECT_NE(text.out.find("pose space: arbitrary"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("FNOD"), std::string::npos);
+}
+
+TEST_F(PackCommands, SourceDateEpochMakesBakesByteIdentical) {
+  const std::string dir = fresh_dir("reproducible");
+  ASSERT_EQ(setenv("SOURCE_DATE_EPOCH", "1700000000", 1), 0);
+  const CommandRun a = run(run_bake, {kCesiumMan, "-o", dir + "/a.pack", "--samples", "8", "--threads", "2"});
+  const CommandRun b = run(run_bake, {kCesiumMan, "-o", dir + "/b.pack", "--samples", "8", "--threads", "1"});
+  unsetenv("SOURCE_DATE_EPOCH");
+  ASSERT_EQ(a.code, 0) << a.err;
+  ASSERT_EQ(b.code, 0) << b.err;
+  const std::string bytes_a = read_file(dir + "/a.pack");
+  EXPECT_FALSE(bytes_a.empty());
+  EXPECT_TRUE(bytes_a == read_file(dir + "/b.pack")) << "same inputs, different packs";
+  const CommandRun inspect = run(run_inspect, {dir + "/a.pack", "--json"});
+  const auto j = nlohmann::json::parse(inspect.out);
+  EXPECT_EQ(j["provenance"]["bake_unix_time"], 1700000000);
+  EXPECT_EQ(j["provenance"]["bake_date"], "2023-11-14 22:13:20 UTC");
+  EXPECT_EQ(j["provenance"]["build_ms"], 0.0);
+}
+
+TEST_F(PackCommands, AFailedBakeLeavesTheExistingPackAlone) {
+  const std::string dir = fresh_dir("keep");
+  const std::string pack = dir + "/keep.pack";
+  std::ofstream(pack) << "the previous pack";
+  const CommandRun bad = run(run_bake, {kCesiumMan, "-o", pack, "--pose-space", "clip:no_such_clip"});
+  EXPECT_EQ(bad.code, 1);
+  EXPECT_NE(bad.err.find("no_such_clip"), std::string::npos) << bad.err;
+  EXPECT_EQ(read_file(pack), "the previous pack");
+  // No temporary files left beside it either.
+  int files = 0;
+  for ([[maybe_unused]] const auto& entry : std::filesystem::directory_iterator(dir)) ++files;
+  EXPECT_EQ(files, 1);
+}
+
+TEST_F(PackCommands, RenderingFromThePackEqualsTheInMemoryBake) {
+  const std::string dir = fresh_dir("render");
+  const std::string pack = dir + "/cesium.pack";
+  ASSERT_EQ(run(run_bake, {kCesiumMan, "-o", pack, "--pose-space", "arbitrary", "--samples", "16"}).code, 0);
+  RenderOptions o;
+  o.width = 80;
+  o.height = 80;
+  o.threads = 2;
+  o.time_seconds = 0.4;
+  o.pose_space.mode = anim::PoseSpaceMode::kArbitrary;
+  o.pose_space.samples = 16;
+  o.pose_space.every_frame_30hz = false;
+  o.model_path = kCesiumMan;
+  const auto in_memory = render_model(o);
+  ASSERT_TRUE(in_memory.ok()) << in_memory.status().message();
+  o.model_path = pack;
+  const auto from_pack = render_model(o);
+  ASSERT_TRUE(from_pack.ok()) << from_pack.status().message();
+  EXPECT_TRUE(in_memory->color_rgba8 == from_pack->color_rgba8);
+  EXPECT_TRUE(in_memory->triangle_id == from_pack->triangle_id);
+  EXPECT_EQ(from_pack->stats.pose_samples, 16u);
+}
+
+TEST_F(PackCommands, SubdivideWritesAModelOnlyPackThatBakes) {
+  const std::string dir = fresh_dir("subdivide");
+  const CommandRun sub = run(run_subdivide, {kCesiumMan, "--levels", "1", "-o", dir + "/fine.pack"});
+  ASSERT_EQ(sub.code, 0) << sub.err;
+  const CommandRun inspect = run(run_inspect, {dir + "/fine.pack", "--json"});
+  ASSERT_EQ(inspect.code, 0) << inspect.err;
+  const auto fine = nlohmann::json::parse(inspect.out);
+  EXPECT_TRUE(fine["fuzzy"].is_null());
+  // Four times the triangles of the source.
+  ASSERT_EQ(run(run_bake, {kCesiumMan, "-o", dir + "/coarse.pack", "--samples", "4"}).code, 0);
+  const auto coarse = nlohmann::json::parse(run(run_inspect, {dir + "/coarse.pack", "--json"}).out);
+  EXPECT_EQ(fine["model"]["triangles"].get<int>(), 4 * coarse["model"]["triangles"].get<int>());
+  const CommandRun bake = run(run_bake, {dir + "/fine.pack", "-o", dir + "/fine_baked.pack", "--samples", "4"});
+  EXPECT_EQ(bake.code, 0) << bake.err;
+  EXPECT_EQ(run(run_validate, {dir + "/fine_baked.pack"}).code, 0);
+}
+
+TEST_F(PackCommands, UsageAndUserErrorsHaveTheirExitCodes) {
+  const std::string dir = fresh_dir("errors");
+  struct Case {
+    std::vector<std::string> args;
+    int code;
+    std::string message;
+  };
+  const std::vector<Case> bake_cases = {
+      {{kCesiumMan}, 2, "-o"},
+      {{kCesiumMan, "-o", dir + "/x.glb"}, 2, "expected a .pack file name"},
+      {{kCesiumMan, "-o", dir + "/x.pack", "--pose-space", "wild"}, 2, "--pose-space = wild"},
+      {{kCesiumMan, "-o", dir + "/x.pack", "--pose-space", "arbitrary", "--clips", "a"}, 2,
+       "only with --pose-space clips"},
+      {{kCesiumMan, "-o", dir + "/x.pack", "--clips", "a"}, 1, "pose_space.clips[0] = a: no clip of that name"},
+      {{kCesiumMan, "-o", dir + "/x.pack", "--pose-space", "limits"}, 2, "--limits"},
+      {{kCesiumMan, "-o", dir + "/x.pack", "--pose-space", "arbitrary", "--samples", "0"}, 2, "--samples = 0"},
+      {{kCesiumMan, "-o", dir + "/x.pack", "--pad", "-1"}, 2, "--pad = -1"},
+      {{dir + "/missing.glb", "-o", dir + "/x.pack"}, 1, "missing.glb: no such file"},
+  };
+  for (const Case& c : bake_cases) {
+    const CommandRun r = run(run_bake, c.args);
+    EXPECT_EQ(r.code, c.code) << r.err;
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << "expected '" << c.message << "' in: " << r.err;
+  }
+  std::ofstream(dir + "/garbage.pack") << "not a pack at all, but long enough to hold a header...................";
+  const CommandRun garbage = run(run_validate, {dir + "/garbage.pack"});
+  EXPECT_EQ(garbage.code, 1);
+  EXPECT_NE(garbage.err.find("garbage.pack"), std::string::npos) << garbage.err;
+  EXPECT_EQ(run(run_validate, {}).code, 2);
+  EXPECT_EQ(run(run_inspect, {dir + "/none.pack"}).code, 1);
+  EXPECT_EQ(run(run_subdivide, {kCesiumMan, "--levels", "9", "-o", dir + "/y.pack"}).code, 2);
+  EXPECT_EQ(run(run_bake, {"--help"}).code, 0);
+}
+
+}  // namespace
+}  // namespace sinew::editor
