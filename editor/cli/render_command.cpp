@@ -349,9 +349,10 @@ rt::StaticMeshDesc ground_plane_for(const ImportedModel& model, int instances) {
 std::string render_usage() {
   return usage_line() +
          "\n\n"
-         "Imports a glTF (.gltf/.glb) or Cal3D (.cfg) model, bakes it in memory, poses it with one\n"
-         "clip and ray traces it. Writes DIR/color.png, DIR/depth.exr, DIR/triangle_id.exr and\n"
-         "DIR/stats.json.\n\n"
+         "Imports a glTF (.gltf/.glb) or Cal3D (.cfg) model and bakes it in memory, or loads a\n"
+         "content pack (.pack) and uses its baked trees in place (the --pose-space options then\n"
+         "do not apply); poses it with one clip and ray traces it. Writes DIR/color.png,\n"
+         "DIR/depth.exr, DIR/triangle_id.exr and DIR/stats.json.\n\n"
          "  --out DIR                 output folder (created if missing; required)\n"
          "  --clip NAME|#I            the clip, by name or index (default: the first; rest pose without clips)\n"
          "  --time SECONDS            playback time, looping (default 0)\n"

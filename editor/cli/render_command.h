@@ -1,5 +1,6 @@
-// `sinew-editor render`: import a model, bake it in memory, pose it with one
-// clip, ray trace it and write the image, its AOVs and timing stats.
+// `sinew-editor render`: import a model and bake it in memory (or load a
+// baked content pack and use its trees in place), pose it with one clip, ray
+// trace it and write the image, its AOVs and timing stats.
 //
 //   sinew-editor render MODEL [--clip NAME] [--time SECONDS] [--camera ex,ey,ez,tx,ty,tz,ux,uy,uz,fovy_deg]
 //       [--size WxH] --out DIR [--pose-space arbitrary|limits|clips|clip:NAME] [--clips a,b,c]
