@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
+#include <optional>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -20,6 +21,7 @@
 #include "editor/import/model_loader.h"
 #include "editor/mesh/subdivide.h"
 #include "editor/pack/character_pack.h"
+#include "editor/scene/scene_recipe.h"
 #include "runtime/io/mapped_file.h"
 #include "runtime/jobs/job_system.h"
 #include "runtime/pack/checksum.h"
@@ -33,7 +35,8 @@ using Json = nlohmann::ordered_json;
 // --- bake options ---------------------------------------------------------------
 
 struct BakeOptions {
-  std::string model_path;
+  std::string model_path;  // may come from the scene recipe
+  std::optional<SceneRecipe> scene;
   std::string out_path;
   anim::PoseSpaceDesc pose_space = default_pose_space();
   std::string limits_path;
@@ -45,7 +48,10 @@ struct BakeOptions {
 
 std::string bake_usage() {
   return "usage: sinew-editor bake MODEL -o OUT.pack [options]\n"
+         "       sinew-editor bake --scene RECIPE.json [MODEL] -o OUT.pack [options]\n"
          "  MODEL                 .gltf, .glb, .cfg (Cal3D) or a model-only .pack\n"
+         "  --scene RECIPE.json   bake only what a scene needs: the pose space of the recipe's\n"
+         "                        clips, and only those clips in the pack (content/scenes/)\n"
          "  -o, --out OUT.pack    the pack to write (atomically: an existing file is replaced\n"
          "                        only by a complete new pack)\n"
          "  --pose-space MODE     arbitrary | limits | clips | clip:NAME (default clips: every\n"
@@ -65,6 +71,7 @@ const std::vector<cli::FlagSpec>& bake_flags() {
   static const std::vector<cli::FlagSpec> flags = {
       {"--help", false}, {"-h", false},      {"--out"},     {"--pose-space"}, {"--clips"},
       {"--samples"},     {"--seed"},         {"--limits"}, {"--pad"},  {"--candidates"}, {"--threads"},
+      {"--scene"},
   };
   return flags;
 }
@@ -80,10 +87,23 @@ Expected<BakeOptions> parse_bake_options(std::vector<std::string> args) {
     o.help = true;
     return o;
   }
-  if (parsed.positionals.size() != 1) {
+  if (auto v = parsed.value("--scene")) {
+    if (parsed.has("--pose-space") || parsed.has("--clips")) {
+      return invalid_argument("--scene", *v, "the recipe sets the pose space: drop --pose-space and --clips");
+    }
+    SINEW_ASSIGN_OR_RETURN(SceneRecipe recipe, load_scene_recipe(*v));
+    o.model_path = recipe.model_path;
+    o.pose_space.mode = anim::PoseSpaceMode::kClips;
+    o.pose_space.clips = recipe.clips;
+    o.pose_space.samples = recipe.samples;
+    o.pose_space.every_frame_30hz = recipe.every_frame_30hz;
+    o.padding = recipe.padding;
+    o.scene = std::move(recipe);
+  }
+  if (parsed.positionals.size() > 1 || (parsed.positionals.empty() && o.model_path.empty())) {
     return invalid_argument("MODEL", std::to_string(parsed.positionals.size()) + " given", "expected one model file");
   }
-  o.model_path = parsed.positionals.front();
+  if (!parsed.positionals.empty()) o.model_path = parsed.positionals.front();
   if (auto v = parsed.value("--out")) o.out_path = *v;
   if (o.out_path.empty()) return invalid_argument("-o", "", "missing: where to write the pack");
   if (!is_pack_path(o.out_path)) return invalid_argument("-o", o.out_path, "expected a .pack file name");
@@ -119,7 +139,7 @@ Expected<BakeOptions> parse_bake_options(std::vector<std::string> args) {
   if (random_mode && samples_given && o.pose_space.samples == 0) {
     return invalid_argument("--samples", "0", "random pose spaces need at least one sample");
   }
-  if (!random_mode && !samples_given) o.pose_space.samples = 0;
+  if (!random_mode && !samples_given && !o.scene) o.pose_space.samples = 0;
   if (random_mode) o.pose_space.every_frame_30hz = false;
   if (random_mode && !samples_given) o.pose_space.samples = 1000;
   if (auto v = parsed.value("--seed")) {
@@ -356,7 +376,10 @@ void print_inspect(const Json& j, std::ostream& out) {
       << (m["joint_limits"].get<bool>() ? ", joint limits" : "") << "\n";
   for (const Json& c : m["clips"]) out << "  clip " << c["name"].get<std::string>() << " (" << c["seconds"] << " s)\n";
   const Json& ps = j["pose_space"];
-  out << "pose space: " << ps["mode"].get<std::string>() << ", samples requested " << ps["samples_requested"]
+  std::string clip_names;
+  for (const Json& c : ps["clips"]) clip_names += (clip_names.empty() ? " (" : ", ") + c.get<std::string>();
+  if (!clip_names.empty()) clip_names += ")";
+  out << "pose space: " << ps["mode"].get<std::string>() << clip_names << ", samples requested " << ps["samples_requested"]
       << ", seed " << ps["seed"] << ", padding " << ps["padding"] << ", candidates "
       << ps["candidates"].get<std::string>() << "\n";
   const Json& p = j["provenance"];
@@ -387,6 +410,11 @@ int run_bake(const std::vector<std::string>& args, std::ostream& out, std::ostre
   const auto start = Clock::now();
   auto model = load_model(o.model_path);
   if (!model.ok()) return fail(err, "bake", model.status());
+  if (o.scene) {  // model only what the scene plays
+    auto kept = keep_recipe_clips(*model, *o.scene);
+    if (!kept.ok()) return fail(err, "bake", kept.status());
+    model = std::move(kept);
+  }
   BakeRequest request;
   request.pose_space = o.pose_space;
   request.fuzzy.padding = o.padding;

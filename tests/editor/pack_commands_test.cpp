@@ -167,6 +167,26 @@ TEST_F(PackCommands, SubdivideWritesAModelOnlyPackThatBakes) {
   EXPECT_EQ(run(run_validate, {dir + "/fine_baked.pack"}).code, 0);
 }
 
+TEST_F(PackCommands, ASceneRecipeBakesOnlyItsClips) {
+  const std::string dir = fresh_dir("scene");
+  const std::string recipe = dir + "/scene.json";
+  std::ofstream(recipe) << R"({"model": ")" << kCesiumMan << R"(", "clips": ["animation_0"],
+                               "pose_space": {"samples": 10, "every_frame_30hz": false}})";
+  const CommandRun bake = run(run_bake, {"--scene", recipe, "-o", dir + "/scene.pack"});
+  ASSERT_EQ(bake.code, 0) << bake.err;
+  const auto j = nlohmann::json::parse(run(run_inspect, {dir + "/scene.pack", "--json"}).out);
+  EXPECT_EQ(j["pose_space"]["mode"], "clips");
+  EXPECT_EQ(j["pose_space"]["clips"], nlohmann::json::array({"animation_0"}));
+  EXPECT_EQ(j["fuzzy"]["pose_samples"], 10);
+  ASSERT_EQ(j["model"]["clips"].size(), 1u);
+  // The recipe owns the pose space.
+  EXPECT_EQ(run(run_bake, {"--scene", recipe, "-o", dir + "/x.pack", "--pose-space", "arbitrary"}).code, 2);
+  std::ofstream(dir + "/bad.json") << R"({"clips": ["no_such_clip"]})";
+  const CommandRun bad = run(run_bake, {kCesiumMan, "--scene", dir + "/bad.json", "-o", dir + "/y.pack"});
+  EXPECT_EQ(bad.code, 1);
+  EXPECT_NE(bad.err.find("no_such_clip"), std::string::npos) << bad.err;
+}
+
 TEST_F(PackCommands, UsageAndUserErrorsHaveTheirExitCodes) {
   const std::string dir = fresh_dir("errors");
   struct Case {

@@ -1,0 +1,1 @@
+#include "editor/gui/editor_app.h"

@@ -1,0 +1,2 @@
+// (being written) The editor window.
+#pragma once
