@@ -18,6 +18,7 @@
 #include "content/mannequin/mannequin.h"
 #include "editor/bake/in_memory_bake.h"
 #include "editor/import/gltf_importer.h"
+#include "editor/mesh/subdivide.h"
 #include "raytrace/camera/camera.h"
 #include "raytrace/render/renderer.h"
 #include "raytrace/render/traversal.h"
@@ -265,6 +266,64 @@ TEST_P(RenderOracle, PosesInsideThePoseSpaceMatchBruteForce) {
   RecordProperty("poses", static_cast<int>(poses));
   RecordProperty("primary_rays", static_cast<int>(primary.checked));
   RecordProperty("random_rays", static_cast<int>(rays.checked));
+}
+
+// The paper's larger Cally variants (sinew-editor subdivide): every level
+// traces like brute force. A smaller budget than the suite above (one clip's
+// poses, small images, few random rays), as the reference costs grow with
+// the 855k triangles of level 4.
+TEST(SubdividedCallyOracle, LevelsOneToFourMatchBruteForce) {
+#if SINEW_HAVE_CAL3D
+  const std::string cfg = std::string(SINEW_SHARED_DIR) + "/content/cal3d/cally/cally.cfg";
+  auto cally = editor::import_cal3d(cfg);
+  if (!cally.ok()) GTEST_SKIP() << cally.status().message();
+  JobSystem jobs(2);
+  for (int level = 1; level <= 4; ++level) {
+    SCOPED_TRACE("level " + std::to_string(level));
+    auto model = editor::subdivide(*cally, level);
+    ASSERT_TRUE(model.ok()) << model.status().message();
+    editor::BakeRequest request;
+    request.pose_space.mode = anim::PoseSpaceMode::kClip;
+    request.pose_space.clips = {"walk"};
+    request.pose_space.samples = 6;
+    request.pose_space.every_frame_30hz = false;
+    auto samples = editor::pose_space_skinning(*model, request.pose_space, {});
+    ASSERT_TRUE(samples.ok()) << samples.status().message();
+    auto baked = editor::bake_in_memory(*model, request, jobs);
+    ASSERT_TRUE(baked.ok()) << baked.status().message();
+    const std::size_t bones = model->skeleton.joint_count();
+    const std::size_t sample_count = samples->size() / bones;
+    ASSERT_GT(sample_count, 2u);
+
+    rt::Scene scene;
+    auto character = scene.add_character(model->mesh, baked->fuzzy.view());
+    ASSERT_TRUE(character.ok()) << character.status().message();
+    ASSERT_TRUE(scene.add_instance(*character).ok());
+    const Aabb rest = bounds_of(model->mesh.positions);
+    ASSERT_TRUE(scene.add_static_mesh(ground_under(rest, 2)).ok());
+    Random random(0xc0ffee + static_cast<std::uint64_t>(level));
+    Mismatch primary, rays;
+    std::size_t escapes = 0;
+    for (std::size_t k = 0; k < 3; ++k) {
+      const std::size_t s = k * sample_count / 3;
+      ASSERT_TRUE(scene.set_bones(0, std::span(*samples).subspan(s * bones, bones)).ok());
+      auto stats = scene.prepare_frame(rt::FrameOptions{}, jobs);
+      ASSERT_TRUE(stats.ok()) << stats.status().message();
+      escapes += stats->escaped_checks;
+      const std::vector<SoupTriangle> soup = testing_support::world_triangles(scene);
+      const Aabb posed = bounds_of(scene.instances()[0].positions);
+      const auto cameras = cameras_around(posed, 2);
+      for (const TriangleTest test : kTests) compare_primary(scene, soup, cameras[k % cameras.size()], 48, test, primary);
+      compare_random(scene, soup, posed, 100, random, rays);
+    }
+    EXPECT_EQ(escapes, 0u) << "a sampled pose left its fuzzy boxes";
+    EXPECT_EQ(primary.wrong, 0u) << primary.checked << " primary rays; first: " << primary.first;
+    EXPECT_EQ(rays.wrong, 0u) << rays.checked << " random rays; first: " << rays.first;
+    EXPECT_EQ(model->mesh.triangle_count(), cally->mesh.triangle_count() << (2 * level));
+  }
+#else
+  GTEST_SKIP() << "built without Cal3D";
+#endif
 }
 
 std::vector<Subject> subjects() {
