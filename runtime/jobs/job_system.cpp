@@ -1,25 +1,34 @@
 #include "runtime/jobs/job_system.h"
 
 #include <algorithm>
+#include <cstdlib>
+#include <string_view>
 
-#include <tbb/blocked_range.h>
 #include <tbb/info.h>
-#include <tbb/parallel_for.h>
-#include <tbb/partitioner.h>
-#include <tbb/task_arena.h>
 
 namespace sinew {
 
-struct JobSystem::Arena {
-  explicit Arena(int threads) : arena(threads) {}
-  tbb::task_arena arena;
-};
-
 int JobSystem::hardware_threads() { return std::max(1, tbb::info::default_concurrency()); }
 
-JobSystem::JobSystem(int threads)
-    : threads_(threads > 0 ? threads : hardware_threads()),
-      arena_(std::make_unique<Arena>(threads_)) {}
+const char* JobSystem::default_executor_name() {
+  const char* env = std::getenv("SINEW_EXECUTOR");
+  if (env != nullptr && std::string_view(env) == "threads") return "threads";
+  if (env != nullptr && std::string_view(env) == "tbb") return "tbb";
+#ifdef SINEW_DEFAULT_EXECUTOR_THREADS
+  return "threads";
+#else
+  return "tbb";
+#endif
+}
+
+JobSystem::JobSystem(int threads) : threads_(threads > 0 ? threads : hardware_threads()) {
+  executor_ = std::string_view(default_executor_name()) == "threads" ? make_thread_pool_executor(threads_)
+                                                                     : make_tbb_executor(threads_);
+}
+
+JobSystem::JobSystem(std::unique_ptr<Executor> executor)
+    : threads_(executor ? executor->concurrency() : 1),
+      executor_(executor ? std::move(executor) : make_thread_pool_executor(1)) {}
 
 JobSystem::~JobSystem() = default;
 
@@ -36,18 +45,11 @@ void JobSystem::parallel_for(std::size_t begin, std::size_t end, std::size_t gra
     }
     return;
   }
-  // Iterate over chunk numbers with a simple partitioner so every chunk is
-  // exactly the one the serial loop above would produce.
-  arena_->arena.execute([&] {
-    tbb::parallel_for(
-        tbb::blocked_range<std::size_t>(0, chunks, 1),
-        [&](const tbb::blocked_range<std::size_t>& r) {
-          for (std::size_t c = r.begin(); c != r.end(); ++c) {
-            const std::size_t b = begin + c * grain;
-            fn(Range{b, std::min(end, b + grain)});
-          }
-        },
-        tbb::simple_partitioner());
+  // One task per chunk: every chunk is exactly the one the serial loop
+  // above would produce, whatever the executor.
+  executor_->run(chunks, [&](std::size_t c) {
+    const std::size_t b = begin + c * grain;
+    fn(Range{b, std::min(end, b + grain)});
   });
 }
 

@@ -1,16 +1,21 @@
-// JobSystem: data-parallel loops on TBB with an explicit thread count.
+// JobSystem: data-parallel loops with an explicit thread count.
 //
 // Every program takes `--threads N` (default: all cores) and creates one
-// JobSystem; work runs inside its own tbb::task_arena so the count is exact
-// and does not leak into a host engine's TBB usage. Work is split into
-// chunks whose boundaries depend only on the range and the grain, never on
-// timing, so per-chunk results are reproducible (DESIGN.md section 4,
-// determinism).
+// JobSystem. Its tasks run on an Executor (runtime/jobs/executor.h): TBB in
+// its own task_arena by default, so the count is exact and does not leak
+// into a host engine's TBB usage; a std::thread pool when the environment
+// says SINEW_EXECUTOR=threads or the build defines SINEW_DEFAULT_EXECUTOR_THREADS
+// (the ThreadSanitizer preset); or a host's own scheduler. Work is split
+// into chunks whose boundaries depend only on the range and the grain, never
+// on timing or the executor, so per-chunk results are reproducible
+// (DESIGN.md section 4, determinism).
 #pragma once
 
 #include <cstddef>
 #include <functional>
 #include <memory>
+
+#include "runtime/jobs/executor.h"
 
 namespace sinew {
 
@@ -33,6 +38,8 @@ class JobSystem {
  public:
   // threads <= 0 means every core the process may use.
   explicit JobSystem(int threads = 0);
+  // Runs on `executor` (a host's scheduler, or a specific back end).
+  explicit JobSystem(std::unique_ptr<Executor> executor);
   ~JobSystem();
   JobSystem(const JobSystem&) = delete;
   JobSystem& operator=(const JobSystem&) = delete;
@@ -52,10 +59,12 @@ class JobSystem {
   // The number of cores available to this process.
   static int hardware_threads();
 
+  // "tbb" or "threads": the executor JobSystem(int) picks.
+  static const char* default_executor_name();
+
  private:
-  struct Arena;
   int threads_ = 1;
-  std::unique_ptr<Arena> arena_;
+  std::unique_ptr<Executor> executor_;
 };
 
 }  // namespace sinew

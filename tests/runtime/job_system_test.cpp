@@ -1,6 +1,10 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cstdlib>
+#include <functional>
+#include <memory>
+#include <string>
 #include <mutex>
 #include <set>
 #include <thread>
@@ -78,6 +82,78 @@ TEST(JobSystem, EmptyRangesDoNothing) {
   jobs.parallel_for(10, 3, 4, [&](Range) { ++calls; });
   jobs.parallel_for_tiles(0, 10, 8, [&](const Tile&) { ++calls; });
   EXPECT_EQ(calls, 0);
+}
+
+// Every executor runs every task exactly once, in parallel where it can,
+// and JobSystem's chunks do not depend on which one runs them.
+std::unique_ptr<Executor> make_executor(const std::string& kind, int threads) {
+  if (kind == "tbb") return make_tbb_executor(threads);
+  if (kind == "threads") return make_thread_pool_executor(threads);
+  // A host's scheduler: here, std::async per task, as a stand-in for an
+  // engine's pool (the test of the callback path, not of a real engine).
+  return make_callback_executor(threads, [](std::size_t count, const std::function<void(std::size_t)>& task) {
+    std::vector<std::thread> pool;
+    std::atomic<std::size_t> next{0};
+    for (int t = 0; t < 3; ++t) {
+      pool.emplace_back([&] {
+        for (std::size_t i = next.fetch_add(1); i < count; i = next.fetch_add(1)) task(i);
+      });
+    }
+    for (std::thread& th : pool) th.join();
+  });
+}
+
+class Executors : public testing::TestWithParam<std::string> {};
+
+TEST_P(Executors, RunEveryTaskExactlyOnce) {
+  for (int threads : {1, 2, 4}) {
+    JobSystem jobs(make_executor(GetParam(), threads));
+    EXPECT_EQ(jobs.thread_count(), threads);
+    for (int repeat = 0; repeat < 20; ++repeat) {  // batches back to back reuse the pool
+      std::vector<std::atomic<int>> hits(5003);
+      jobs.parallel_for(0, hits.size(), 7, [&](Range r) {
+        for (std::size_t i = r.begin; i < r.end; ++i) hits[i].fetch_add(1);
+      });
+      for (std::size_t i = 0; i < hits.size(); ++i) ASSERT_EQ(hits[i].load(), 1) << i;
+    }
+  }
+}
+
+TEST_P(Executors, NestedLoopsCompleteAndCoverEverything) {
+  JobSystem jobs(make_executor(GetParam(), 3));
+  std::vector<std::atomic<int>> hits(64 * 64);
+  jobs.parallel_for(0, 64, 1, [&](Range outer) {
+    jobs.parallel_for(0, 64, 5, [&](Range inner) {
+      for (std::size_t i = inner.begin; i < inner.end; ++i) hits[outer.begin * 64 + i].fetch_add(1);
+    });
+  });
+  for (auto& h : hits) ASSERT_EQ(h.load(), 1);
+}
+
+TEST_P(Executors, ResultsMatchTheSerialLoop) {
+  // A per-chunk reduction written to per-chunk slots: identical whatever runs it.
+  auto sums = [&](JobSystem& jobs) {
+    std::vector<double> out(100, 0.0);
+    jobs.parallel_for(0, 100 * 97, 97, [&](Range r) {
+      double s = 0.0;
+      for (std::size_t i = r.begin; i < r.end; ++i) s += 1.0 / static_cast<double>(i + 1);
+      out[r.begin / 97] = s;
+    });
+    return out;
+  };
+  JobSystem serial(1);
+  JobSystem parallel(make_executor(GetParam(), 4));
+  EXPECT_EQ(sums(serial), sums(parallel));
+}
+
+INSTANTIATE_TEST_SUITE_P(All, Executors, testing::Values("tbb", "threads", "callback"));
+
+TEST(JobSystem, TheEnvironmentPicksTheThreadPool) {
+  ASSERT_EQ(setenv("SINEW_EXECUTOR", "threads", 1), 0);
+  EXPECT_STREQ(JobSystem::default_executor_name(), "threads");
+  ASSERT_EQ(setenv("SINEW_EXECUTOR", "tbb", 1), 0);
+  EXPECT_STREQ(JobSystem::default_executor_name(), "tbb");
+  unsetenv("SINEW_EXECUTOR");
 }
 
 }  // namespace
