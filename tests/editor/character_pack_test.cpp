@@ -374,7 +374,7 @@ TEST_F(CorruptPack, BadMeshSkeletonAndClipDataAreRefused) {
   // FTBN: a triangle assigned to a bone that does not exist.
   expect_rejected(repack(make_section_id("FTBN"), [](auto& p) { overwrite(p, 0, std::uint16_t{999}); }), "triangle_bone");
   // A section of the wrong size.
-  expect_rejected(repack(make_section_id("FNOD"), [](auto& p) { p.resize(p.size() - 4); }), "FNOD");
+  expect_rejected(repack(make_section_id("FNOD"), [](auto& p) { p.erase(p.end() - 4, p.end()); }), "FNOD");
   // Trailing bytes after a decoded section.
   expect_rejected(repack(make_section_id("POSE"), [](auto& p) { p.push_back(std::byte{0}); }), "POSE.size");
   // A missing required section.
