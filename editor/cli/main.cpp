@@ -8,6 +8,9 @@
 
 #include "editor/cli/pack_commands.h"
 #include "editor/cli/render_command.h"
+#ifdef SINEW_HAVE_GUI
+#include "editor/gui/editor_app.h"
+#endif
 
 namespace {
 
@@ -21,7 +24,8 @@ void print_help(std::ostream& out) {
          "  inspect  sizes, counts, pose space, fuzzy area, tree depths, provenance of a pack\n"
          "  validate check a pack completely (exit 0 when valid)\n"
          "  subdivide  split every triangle into four, L times (the paper's larger Cally variants)\n"
-         "  render   pose with one clip and ray trace a model or a pack\n";
+         "  render   pose with one clip and ray trace a model or a pack\n"
+         "  gui      the editor window: clips, bake, joint limits, overlays, stats\n";
 }
 
 }  // namespace
@@ -42,6 +46,14 @@ int main(int argc, char** argv) {
   if (command == "subdivide") return sinew::editor::run_subdivide(rest, std::cout, std::cerr);
   if (command == "inspect") return sinew::editor::run_inspect(rest, std::cout, std::cerr);
   if (command == "validate") return sinew::editor::run_validate(rest, std::cout, std::cerr);
+  if (command == "gui") {
+#ifdef SINEW_HAVE_GUI
+    return sinew::editor::run_gui(rest, std::cout, std::cerr);
+#else
+    std::cerr << "sinew-editor: this build has no window (configured with SINEW_BUILD_DISPLAY=OFF)\n";
+    return 1;
+#endif
+  }
   if (command == "render") return sinew::editor::run_render(rest, std::cout, std::cerr);
   std::cerr << "sinew-editor: unknown command '" << command << "'\n" << kUsage;
   return 2;

@@ -1,0 +1,82 @@
+// Viewport: the editor's ray-traced view of one character on a ground quad:
+// the scene, the camera, the render and the overlays. No GL: it produces
+// the RGBA8 image the window shows, so it also runs headless in tests.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "editor/gui/overlays.h"
+#include "editor/import/imported_model.h"
+#include "raytrace/render/renderer.h"
+#include "raytrace/scene/scene.h"
+#include "runtime/core/expected.h"
+
+namespace sinew {
+class JobSystem;
+class PhaseTimers;
+}  // namespace sinew
+
+namespace sinew::editor::gui {
+
+struct ViewportFrame {
+  rt::FrameStats scene;
+  rt::RenderStats render;
+  std::size_t escaped_pixels = 0;  // painted by the escapes overlay
+};
+
+class Viewport {
+ public:
+  // (Re)builds the scene over `model` (mesh) and `fuzzy`; both must outlive
+  // the viewport or the next reset. Keeps the camera unless `reframe`.
+  Status reset(const ImportedModel& model, const rt::FuzzyCharacterView& fuzzy, bool reframe);
+  void resize(int width, int height);
+
+  // Poses the character, renders and draws the overlay into image().
+  Expected<ViewportFrame> render(std::span<const Affine3> skinning, JobSystem& jobs, PhaseTimers* timers);
+
+  // Orbits the camera about its target: yaw about the model's up axis,
+  // pitch about the camera's right axis (kept away from the poles).
+  void orbit(float yaw_radians, float pitch_radians);
+  // Frames the current pose with default_camera on the next render.
+  void request_reframe() { reframe_ = true; }
+
+  Overlay overlay = Overlay::kNone;
+  std::uint32_t bone = 0;  // for the boxes overlay
+  rt::RenderSettings settings;
+  rt::FrameOptions frame_options;
+
+  int width() const { return width_; }
+  int height() const { return height_; }
+  const rt::CameraDesc& camera() const { return camera_; }
+  void set_camera(const rt::CameraDesc& camera) { camera_ = camera; reframe_ = false; }
+  std::span<const std::uint8_t> image() const { return image_; }          // with the overlay
+  std::span<const std::uint8_t> raw_image() const { return raw_; }        // as rendered
+  std::span<const std::uint32_t> triangle_ids() const { return triangle_id_; }
+  std::span<const std::uint32_t> instance_ids() const { return instance_id_; }
+  std::uint32_t character_instance() const { return instance_; }
+  const rt::Scene* scene() const { return scene_.get(); }
+
+ private:
+  void apply_overlay(std::span<const Affine3> skinning, ViewportFrame& frame);
+
+  const ImportedModel* model_ = nullptr;
+  rt::FuzzyCharacterView fuzzy_;
+  std::unique_ptr<rt::Scene> scene_;
+  std::uint32_t instance_ = 0;
+  int up_ = 1;
+  std::vector<std::uint32_t> heat_;
+  rt::CameraDesc camera_;
+  bool reframe_ = true;
+  int width_ = 640;
+  int height_ = 480;
+  std::vector<std::uint8_t> raw_;
+  std::vector<std::uint8_t> image_;
+  std::vector<std::uint32_t> triangle_id_;
+  std::vector<std::uint32_t> instance_id_;
+  rt::Renderer renderer_;
+};
+
+}  // namespace sinew::editor::gui
