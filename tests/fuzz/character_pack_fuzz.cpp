@@ -41,6 +41,7 @@
 #include "runtime/jobs/job_system.h"
 #include "runtime/pack/checksum.h"
 #include "runtime/pack/pack_format.h"
+#include "tests/fuzz/reseal_pack.h"
 
 namespace {
 
@@ -79,30 +80,6 @@ class AlignedBytes {
   std::size_t size_;
   std::unique_ptr<std::byte[], AlignedFree> data_;
 };
-
-// Makes file_size and every checksum agree with the bytes. Reads only what it
-// has proved to be inside `all` (the harness must not be what overflows).
-void reseal(std::span<std::byte> all) {
-  if (all.size() < kHeaderSize) return;
-  PackHeader header = load_pack_header(all.first<kHeaderSize>());
-  const std::uint64_t size = all.size();
-  header.file_size = size;
-  const std::uint64_t table_size = std::uint64_t{header.section_count} * kSectionEntrySize;
-  if (header.section_count <= kMaxSections && header.table_offset <= size &&
-      table_size <= size - header.table_offset) {
-    for (std::uint64_t i = 0; i < header.section_count; ++i) {
-      const auto raw = all.subspan(header.table_offset + i * kSectionEntrySize).first<kSectionEntrySize>();
-      SectionEntry entry = load_section_entry(raw);
-      if (entry.offset <= size && entry.size <= size - entry.offset) {
-        entry.checksum = checksum64(all.subspan(entry.offset, entry.size));
-        store_section_entry(entry, raw);
-      }
-    }
-    header.table_checksum = checksum64(all.subspan(header.table_offset, table_size));
-  }
-  header.header_checksum = pack_header_checksum(header);
-  store_pack_header(header, all.first<kHeaderSize>());
-}
 
 JobSystem& serial_jobs() {
   // One thread: deterministic, and no worker threads for libFuzzer to juggle.
@@ -158,7 +135,7 @@ void render(const editor::CharacterPack& pack) {
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   AlignedBytes bytes(std::span(data, size));
-  reseal(bytes.span());
+  sinew::fuzz::reseal_pack(bytes.span());
 
   auto pack = editor::CharacterPack::from_bytes(bytes.span(), "fuzz.pack");
   if (!pack.ok()) {

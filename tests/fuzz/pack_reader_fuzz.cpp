@@ -19,6 +19,7 @@
 #include "runtime/pack/checksum.h"
 #include "runtime/pack/pack_format.h"
 #include "runtime/pack/pack_reader.h"
+#include "tests/fuzz/reseal_pack.h"
 
 namespace {
 
@@ -27,34 +28,6 @@ using sinew::PackReader;
 
 void require(bool condition) {
   if (!condition) __builtin_trap();
-}
-
-// Makes the checksums and file_size agree with the bytes, so the reader's
-// structural checks get to judge the rest. Reads only what it has proved to
-// be inside `bytes` (the harness must not be the thing that overflows).
-void reseal(std::vector<std::byte>& bytes) {
-  using namespace sinew;
-  if (bytes.size() < kHeaderSize) return;
-  const auto all = std::span(bytes);
-  PackHeader header = load_pack_header(all.first<kHeaderSize>());
-  header.file_size = bytes.size();
-  const std::uint64_t size = bytes.size();
-  const std::uint64_t table_size = std::uint64_t{header.section_count} * kSectionEntrySize;
-  if (header.section_count <= kMaxSections && header.table_offset <= size &&
-      table_size <= size - header.table_offset) {
-    for (std::uint64_t i = 0; i < header.section_count; ++i) {
-      const auto raw = all.subspan(header.table_offset + i * kSectionEntrySize)
-                           .first<kSectionEntrySize>();
-      SectionEntry entry = load_section_entry(raw);
-      if (entry.offset <= size && entry.size <= size - entry.offset) {
-        entry.checksum = checksum64(all.subspan(entry.offset, entry.size));
-        store_section_entry(entry, raw);
-      }
-    }
-    header.table_checksum = checksum64(all.subspan(header.table_offset, table_size));
-  }
-  header.header_checksum = pack_header_checksum(header);
-  store_pack_header(header, all.first<kHeaderSize>());
 }
 
 // Opens `bytes` and, when they are accepted, reads everything a loader could.
@@ -99,7 +72,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
 
   if (size >= sinew::kHeaderSize) {
     std::vector<std::byte> sealed(bytes.begin(), bytes.end());
-    reseal(sealed);
+    sinew::fuzz::reseal_pack(sealed);
     exercise(sealed);
   }
   return 0;
