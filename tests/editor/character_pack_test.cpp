@@ -23,6 +23,7 @@
 #include "raytrace/scene/scene.h"
 #include "runtime/jobs/job_system.h"
 #include "runtime/pack/pack_writer.h"
+#include "tests/support/same_model.h"
 #if SINEW_HAVE_CAL3D
 #include "editor/import/cal3d_importer.h"
 #endif
@@ -112,39 +113,6 @@ Image render(const ImportedModel& model, const rt::FuzzyCharacterView& fuzzy, Jo
   return image;
 }
 
-void expect_same_model(const ImportedModel& a, const ImportedModel& b) {
-  ASSERT_EQ(a.skeleton.joint_count(), b.skeleton.joint_count());
-  for (std::size_t j = 0; j < a.skeleton.joint_count(); ++j) {
-    EXPECT_EQ(a.skeleton.names()[j], b.skeleton.names()[j]);
-    EXPECT_EQ(a.skeleton.parents()[j], b.skeleton.parents()[j]);
-    EXPECT_EQ(0, std::memcmp(&a.skeleton.inverse_bind()[j], &b.skeleton.inverse_bind()[j], sizeof(Affine3)));
-  }
-  EXPECT_EQ(a.mesh.positions, b.mesh.positions);
-  EXPECT_EQ(a.mesh.normals, b.mesh.normals);
-  EXPECT_EQ(a.mesh.uvs, b.mesh.uvs);
-  EXPECT_EQ(a.mesh.joints, b.mesh.joints);
-  EXPECT_EQ(a.mesh.weights, b.mesh.weights);
-  EXPECT_EQ(a.mesh.triangles, b.mesh.triangles);
-  EXPECT_EQ(a.mesh.triangle_material, b.mesh.triangle_material);
-  EXPECT_EQ(a.mesh.material_colors, b.mesh.material_colors);
-  EXPECT_EQ(a.material_names, b.material_names);
-  ASSERT_EQ(a.clips.size(), b.clips.size());
-  for (std::size_t c = 0; c < a.clips.size(); ++c) {
-    EXPECT_EQ(a.clips[c].name(), b.clips[c].name());
-    EXPECT_EQ(a.clips[c].duration(), b.clips[c].duration());
-    ASSERT_EQ(a.clips[c].tracks().size(), b.clips[c].tracks().size());
-    for (std::size_t t = 0; t < a.clips[c].tracks().size(); ++t) {
-      const anim::JointTracks& x = a.clips[c].tracks()[t];
-      const anim::JointTracks& y = b.clips[c].tracks()[t];
-      EXPECT_EQ(x.joint, y.joint);
-      EXPECT_EQ(x.rotation.times, y.rotation.times);
-      EXPECT_EQ(x.rotation.values, y.rotation.values);
-      EXPECT_EQ(x.translation.values, y.translation.values);
-      EXPECT_EQ(x.scale.values, y.scale.values);
-    }
-  }
-}
-
 void check_round_trip(ImportedModel model) {
   JobSystem jobs(2);
   const Baked baked = bake(std::move(model), jobs);
@@ -156,7 +124,7 @@ void check_round_trip(ImportedModel model) {
   auto pack = CharacterPack::open(path);
   ASSERT_TRUE(pack.ok()) << pack.status().message();
   ASSERT_TRUE(pack->has_fuzzy());
-  expect_same_model(baked.model, pack->model());
+  testing_support::expect_same_model(baked.model, pack->model());
   EXPECT_EQ(pack->fuzzy_stats().fuzzy_area, baked.fuzzy.stats.fuzzy_area);
   EXPECT_EQ(pack->fuzzy_stats().sample_count, baked.fuzzy.stats.sample_count);
   // The fuzzy data is used in place: the view points into the mapping.
@@ -243,7 +211,7 @@ TEST(CharacterPack, PoseSpaceAndProvenanceRoundTrip) {
   auto loaded = CharacterPack::from_bytes(*model_only, "model.pack");
   ASSERT_TRUE(loaded.ok()) << loaded.status().message();
   EXPECT_FALSE(loaded->has_fuzzy());
-  expect_same_model(baked.model, loaded->model());
+  testing_support::expect_same_model(baked.model, loaded->model());
 }
 
 // --- corruption ------------------------------------------------------------------

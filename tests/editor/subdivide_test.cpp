@@ -19,6 +19,7 @@
 #include "content/mannequin/mannequin.h"
 #include "editor/bake/in_memory_bake.h"
 #include "editor/mesh/subdivide.h"
+#include "tests/support/same_model.h"
 #include "runtime/jobs/job_system.h"
 
 #if SINEW_HAVE_CAL3D
@@ -494,17 +495,7 @@ TEST(Subdivide, LevelZeroIsAnIdenticalCopy) {
   const ImportedModel& model = mannequin();
   const ImportedModel copy = subdivided(model, 0);
   EXPECT_EQ(copy.source, model.source);
-  EXPECT_EQ(copy.mesh.positions, model.mesh.positions);
-  EXPECT_EQ(copy.mesh.normals, model.mesh.normals);
-  EXPECT_EQ(copy.mesh.uvs, model.mesh.uvs);
-  EXPECT_EQ(copy.mesh.joints, model.mesh.joints);
-  EXPECT_EQ(copy.mesh.weights, model.mesh.weights);
-  EXPECT_EQ(copy.mesh.triangles, model.mesh.triangles);
-  EXPECT_EQ(copy.mesh.triangle_material, model.mesh.triangle_material);
-  EXPECT_EQ(copy.mesh.material_colors, model.mesh.material_colors);
-  EXPECT_EQ(copy.material_names, model.material_names);
-  EXPECT_EQ(copy.clips.size(), model.clips.size());
-  EXPECT_EQ(copy.skeleton.joint_count(), model.skeleton.joint_count());
+  testing_support::expect_same_model(model, copy);
 }
 
 TEST(Subdivide, EmptyMeshStaysEmpty) {
