@@ -106,6 +106,9 @@ Status validate_fuzzy_character(const SkinnedMesh& mesh, const FuzzyCharacterVie
       return bad_character("vertex_checks[" + std::to_string(c) + "].bone",
                            std::to_string(fuzzy.vertex_checks[c].bone), "no such bone");
     }
+    if (has_nan(fuzzy.vertex_checks[c].box)) {
+      return bad_character("vertex_checks[" + std::to_string(c) + "].box", "NaN", "box is not a number");
+    }
   }
   for (std::size_t t = 0; t < triangles; ++t) {
     if (fuzzy.triangle_bone[t] >= fuzzy.bone_count) {
@@ -125,11 +128,6 @@ Status validate_fuzzy_character(const SkinnedMesh& mesh, const FuzzyCharacterVie
         return bad_character("triangle_checks[" + std::to_string(t) + "]", std::to_string(c),
                              "not the corner vertex's check in the triangle's bone");
       }
-    }
-  }
-  for (std::size_t c = 0; c < fuzzy.vertex_checks.size(); ++c) {
-    if (has_nan(fuzzy.vertex_checks[c].box)) {
-      return bad_character("vertex_checks[" + std::to_string(c) + "].box", "NaN", "box is not a number");
     }
   }
   for (std::uint32_t b = 0; b < fuzzy.bone_count; ++b) {
