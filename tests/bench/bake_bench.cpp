@@ -618,12 +618,7 @@ int run_bake_bench(const std::vector<std::string>& args, const std::string& comm
 
   const std::string cpu = cpu_model();
   const std::string date = utc_date();
-  std::printf("sinew-bench bake\n");
-  std::printf("  command: %s\n", command_line.c_str());
-  std::printf("  cpu:     %s (%d hardware threads)\n", cpu.c_str(), JobSystem::hardware_threads());
-  std::printf("  threads: %d\n", o.threads);
-  std::printf("  isa:     %s\n", std::string(build_isa()).c_str());
-  std::printf("  date:    %s\n", date.c_str());
+  print_bench_header("bake", command_line, std::to_string(o.threads), cpu, date);
   std::fflush(stdout);
 
   Json doc;

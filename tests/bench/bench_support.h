@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <cstdio>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
@@ -15,6 +16,8 @@
 #include "editor/cli/cli_args.h"
 #include "editor/import/cal3d_importer.h"
 #include "runtime/core/expected.h"
+#include "runtime/cpu/cpu_features.h"
+#include "runtime/jobs/job_system.h"
 
 namespace sinew::bench {
 
@@ -39,6 +42,17 @@ inline std::string utc_date() {
   char text[32];
   std::strftime(text, sizeof text, "%Y-%m-%d %H:%M:%S UTC", &utc);
   return text;
+}
+
+// The lines every benchmark table starts with: what ran, where, when.
+inline void print_bench_header(const char* name, const std::string& command_line, const std::string& threads,
+                               const std::string& cpu, const std::string& date) {
+  std::printf("sinew-bench %s\n", name);
+  std::printf("  command: %s\n", command_line.c_str());
+  std::printf("  cpu:     %s (%d hardware threads)\n", cpu.c_str(), JobSystem::hardware_threads());
+  std::printf("  threads: %s\n", threads.c_str());
+  std::printf("  isa:     %s\n", std::string(build_isa()).c_str());
+  std::printf("  date:    %s\n", date.c_str());
 }
 
 // A comma-separated list of integers in [lo, hi] ("1,6,12").

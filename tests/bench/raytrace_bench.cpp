@@ -400,12 +400,7 @@ int run_raytrace_bench(const std::vector<std::string>& args, const std::string& 
 
   const std::string cpu = cpu_model();
   const std::string date = utc_date();
-  std::printf("sinew-bench raytrace\n");
-  std::printf("  command: %s\n", command_line.c_str());
-  std::printf("  cpu:     %s (%d hardware threads)\n", cpu.c_str(), JobSystem::hardware_threads());
-  std::printf("  threads: %s\n", join_ints(o.threads).c_str());
-  std::printf("  isa:     %s\n", std::string(build_isa()).c_str());
-  std::printf("  date:    %s\n", date.c_str());
+  print_bench_header("raytrace", command_line, join_ints(o.threads), cpu, date);
   std::printf("  %dx%d, %d frames at 30 fps through the walk clip (instance i %.2f s later), point light,\n"
               "  shadows on, diffuse shading, triangle test %s, bone boxes %s, fallback on\n",
               o.width, o.height, o.frames, editor::instance_time_offset(1), triangle_test_name(o.triangle_test),
