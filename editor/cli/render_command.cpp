@@ -41,6 +41,7 @@ const std::vector<cli::FlagSpec>& render_flags() {
       {"--size"},        {"--out"},              {"--pose-space"}, {"--clips"},        {"--samples"},
       {"--seed"},        {"--shadows"},          {"--light"},      {"--threads"},      {"--instances"},
       {"--frames"},      {"--triangle-test"},    {"--bone-boxes"}, {"--fallback"},     {"--limits"},
+      {"--ground"},
   };
   return flags;
 }
@@ -140,6 +141,9 @@ Status parse_run(const cli::ParsedArgs& args, RenderOptions& o) {
   }
   if (const auto text = args.value("--fallback")) {
     SINEW_ASSIGN_OR_RETURN(o.fallback, cli::parse_on_off("--fallback", *text));
+  }
+  if (const auto text = args.value("--ground")) {
+    SINEW_ASSIGN_OR_RETURN(o.ground, cli::parse_on_off("--ground", *text));
   }
   if (const auto text = args.value("--triangle-test")) {
     SINEW_ASSIGN_OR_RETURN(const int i, cli::parse_choice("--triangle-test", *text, {"fast", "watertight"}));
@@ -374,9 +378,10 @@ std::string render_usage() {
          "  --triangle-test fast|watertight   ray-triangle test (default fast)\n"
          "  --bone-boxes exact|cheap  per-frame bone boxes (default exact)\n"
          "  --fallback on|off         exact rendering of triangles outside their fuzzy boxes (default on)\n"
+         "  --ground on|off           the ground quad under the model (default on)\n"
          "  --help                    this text\n"
          "The model's up axis is the larger of its rest bounds' Y and Z extents; a ground quad lies\n"
-         "under the rest bounds on that axis.\n";
+         "under the rest bounds on that axis (unless --ground off).\n";
 }
 
 Expected<RenderOptions> parse_render_options(const std::vector<std::string>& args) {
@@ -452,8 +457,11 @@ Expected<RenderOutputs> render_model(const RenderOptions& options) {
     instance_ids.push_back(id);
     out.instance_placements.push_back(instance_placement(rest, i));
   }
-  out.ground = ground_plane_for(rest, options.instances);
-  SINEW_ASSIGN_OR_RETURN(out.ground_instance_id, scene.add_static_mesh(out.ground));
+  out.ground_instance_id = kInvalidId;
+  if (options.ground) {
+    out.ground = ground_plane_for(rest, options.instances);
+    SINEW_ASSIGN_OR_RETURN(out.ground_instance_id, scene.add_static_mesh(out.ground));
+  }
 
   rt::FrameOptions frame_options;
   frame_options.bone_boxes = options.bone_boxes;

@@ -6,7 +6,7 @@
 //       [--size WxH] --out DIR [--pose-space arbitrary|limits|clips|clip:NAME] [--clips a,b,c]
 //       [--samples N] [--seed S] [--shadows on|off] [--light x,y,z] [--threads N] [--instances N]
 //       [--frames N] [--triangle-test fast|watertight] [--bone-boxes exact|cheap]
-//       [--fallback on|off] [--limits FILE.json]
+//       [--fallback on|off] [--ground on|off] [--limits FILE.json]
 //
 // Writes DIR/color.png (RGBA8, sRGB), DIR/depth.exr (float32: distance along
 // the unit primary ray, +inf on a miss), DIR/triangle_id.exr (uint32,
@@ -70,6 +70,7 @@ struct RenderOptions {
   rt::TriangleTest triangle_test = rt::TriangleTest::kFast;
   rt::BoneBoxMode bone_boxes = rt::BoneBoxMode::kExact;
   bool fallback = true;
+  bool ground = true;  // the ground quad under the model (--ground off: characters alone)
   // Called with one line per step (import, bake, frames, write); null: quiet.
   std::function<void(std::string_view)> progress;
   bool help = false;
@@ -108,7 +109,7 @@ struct RenderOutputs {
   double last_frame_seconds = 0.0;  // playback time of instance 0 in the written frame
   std::vector<Affine3> instance_placements;  // per instance: model -> world
   rt::StaticMeshDesc ground;                 // world space
-  std::uint32_t ground_instance_id = 0;      // Hit::instance_id of the ground
+  std::uint32_t ground_instance_id = 0;      // Hit::instance_id of the ground (kInvalidId: none)
   PhaseTimers timers;                        // one sample per phase per frame
   RenderStatsSummary stats;
   std::string stats_json;  // what stats.json holds

@@ -20,9 +20,55 @@ double elapsed_ms(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - since).count();
 }
 
-Status check_buffer(std::size_t size, std::size_t expected, std::string_view name) {
-  if (size == 0 || size == expected) return {};
-  return invalid_argument(name, std::to_string(size), "expected " + std::to_string(expected) + " entries");
+// One requested output: where pixel (x, y)'s `channels` elements start.
+// Rows are `pitch` bytes apart, packed or the host's padded layout.
+template <class T>
+struct OutputPlane {
+  std::byte* base = nullptr;  // null: not requested
+  std::size_t pitch = 0;
+  std::size_t channels = 1;
+
+  bool wanted() const { return base != nullptr; }
+  T* at(int x, int y) const {
+    return reinterpret_cast<T*>(base + static_cast<std::size_t>(y) * pitch) + static_cast<std::size_t>(x) * channels;
+  }
+};
+
+template <class T>
+Expected<OutputPlane<T>> output_plane(std::span<T> span, std::size_t pitch, std::size_t channels, int width,
+                                      int height, std::string_view name) {
+  OutputPlane<T> plane;
+  if (span.empty()) return plane;
+  const std::size_t w = static_cast<std::size_t>(width);
+  const std::size_t h = static_cast<std::size_t>(height);
+  const std::size_t row_bytes = w * channels * sizeof(T);
+  if (pitch == 0) {
+    // Packed rows: the span is exactly the image.
+    if (span.size() != w * h * channels) {
+      return invalid_argument(name, std::to_string(span.size()),
+                              "expected " + std::to_string(w * h * channels) + " entries");
+    }
+    pitch = row_bytes;
+  } else {
+    const std::string pitch_field = "row_pitch." + std::string(name.substr(name.find('.') + 1));
+    if (pitch < row_bytes) {
+      return invalid_argument(pitch_field, std::to_string(pitch),
+                              "below one row of " + std::to_string(row_bytes) + " bytes");
+    }
+    if (pitch % alignof(T) != 0) {
+      return invalid_argument(pitch_field, std::to_string(pitch),
+                              "not a multiple of the element alignment " + std::to_string(alignof(T)));
+    }
+    const std::size_t needed = (h - 1) * pitch + row_bytes;
+    if (span.size_bytes() < needed) {
+      return invalid_argument(name, std::to_string(span.size_bytes()) + " bytes",
+                              "the rows need " + std::to_string(needed) + " bytes at this pitch");
+    }
+  }
+  plane.base = reinterpret_cast<std::byte*>(span.data());
+  plane.pitch = pitch;
+  plane.channels = channels;
+  return plane;
 }
 
 // pbrt's gamma(n): a bound on n successive float roundings.
@@ -161,7 +207,7 @@ struct TileScratch {
   std::vector<Hit> hits;
   std::vector<Vec3> directions;  // unit primary directions
   std::vector<SurfacePoint> surfaces;
-  std::vector<std::uint8_t> lit;
+  std::vector<std::uint8_t> lit;  // bit l: light l reaches the hit
   void resize(std::size_t n) {
     if (hits.size() < n) {
       hits.resize(n);
@@ -207,18 +253,31 @@ Expected<RenderStats> Renderer::render(const Scene& scene, const PinholeCamera& 
   if (settings.tile_size < 1) {
     return invalid_argument("settings.tile_size", std::to_string(settings.tile_size), "must be at least 1");
   }
+  const std::span<const Light> lights =
+      settings.lights.empty() ? std::span<const Light>(&settings.light, 1) : settings.lights;
+  if (lights.size() > kMaxLights) {
+    return invalid_argument("settings.lights", std::to_string(lights.size()),
+                            "at most " + std::to_string(kMaxLights) + " lights");
+  }
   const std::size_t pixels = static_cast<std::size_t>(buffers.width) * static_cast<std::size_t>(buffers.height);
-  SINEW_RETURN_IF_ERROR(check_buffer(buffers.color_rgba8.size(), 4 * pixels, "buffers.color_rgba8"));
-  SINEW_RETURN_IF_ERROR(check_buffer(buffers.color_rgba32f.size(), 4 * pixels, "buffers.color_rgba32f"));
-  SINEW_RETURN_IF_ERROR(check_buffer(buffers.depth.size(), pixels, "buffers.depth"));
-  SINEW_RETURN_IF_ERROR(check_buffer(buffers.normal.size(), pixels, "buffers.normal"));
-  SINEW_RETURN_IF_ERROR(check_buffer(buffers.triangle_id.size(), pixels, "buffers.triangle_id"));
-  SINEW_RETURN_IF_ERROR(check_buffer(buffers.instance_id.size(), pixels, "buffers.instance_id"));
+  const int w = buffers.width;
+  const int h = buffers.height;
+  const FrameBuffers::RowPitches& pitch = buffers.row_pitch;
+  SINEW_ASSIGN_OR_RETURN(const auto out_rgba8,
+                         output_plane(buffers.color_rgba8, pitch.color_rgba8, 4, w, h, "buffers.color_rgba8"));
+  SINEW_ASSIGN_OR_RETURN(const auto out_rgba32f,
+                         output_plane(buffers.color_rgba32f, pitch.color_rgba32f, 4, w, h, "buffers.color_rgba32f"));
+  SINEW_ASSIGN_OR_RETURN(const auto out_depth, output_plane(buffers.depth, pitch.depth, 1, w, h, "buffers.depth"));
+  SINEW_ASSIGN_OR_RETURN(const auto out_normal, output_plane(buffers.normal, pitch.normal, 1, w, h, "buffers.normal"));
+  SINEW_ASSIGN_OR_RETURN(const auto out_triangle,
+                         output_plane(buffers.triangle_id, pitch.triangle_id, 1, w, h, "buffers.triangle_id"));
+  SINEW_ASSIGN_OR_RETURN(const auto out_instance,
+                         output_plane(buffers.instance_id, pitch.instance_id, 1, w, h, "buffers.instance_id"));
 
-  const bool want_color = !buffers.color_rgba8.empty() || !buffers.color_rgba32f.empty();
-  const bool want_surface = want_color || !buffers.normal.empty();
+  const bool want_color = out_rgba8.wanted() || out_rgba32f.wanted();
+  const bool want_surface = want_color || out_normal.wanted();
   const bool want_shadows = want_color && settings.shadows;
-  const std::size_t width = static_cast<std::size_t>(buffers.width);
+  const std::uint8_t all_lights = static_cast<std::uint8_t>((1u << lights.size()) - 1u);
   const int tile = settings.tile_size;
   const int tiles_x = (buffers.width + tile - 1) / tile;
   const int tiles_y = (buffers.height + tile - 1) / tile;
@@ -232,7 +291,6 @@ Expected<RenderStats> Renderer::render(const Scene& scene, const PinholeCamera& 
     TileRecord& record = records[static_cast<std::size_t>(t.index)];
     const int tw = t.x1 - t.x0;
     const auto local = [&](int x, int y) { return static_cast<std::size_t>((y - t.y0) * tw + (x - t.x0)); };
-    const auto global = [&](int x, int y) { return static_cast<std::size_t>(y) * width + static_cast<std::size_t>(x); };
     TileScratch& s = tile_scratch();
     s.resize(static_cast<std::size_t>(tw * (t.y1 - t.y0)));
 
@@ -271,12 +329,13 @@ Expected<RenderStats> Renderer::render(const Scene& scene, const PinholeCamera& 
     }
     const auto t1 = Clock::now();
 
-    // Surfaces (shading work), then one shadow ray per hit that faces the light.
+    // Surfaces (shading work), then per light one shadow ray per hit that
+    // faces it.
     double shadow_ns = 0.0;
     for (int y = t.y0; y < t.y1; ++y) {
       for (int x = t.x0; x < t.x1; ++x) {
         const std::size_t k = local(x, y);
-        s.lit[k] = 1;
+        s.lit[k] = all_lights;
         if (!s.hits[k].valid()) continue;
         ++record.hits;
         if (want_surface) s.surfaces[k] = surface_at(scene, s.hits[k], settings.default_albedo);
@@ -284,52 +343,56 @@ Expected<RenderStats> Renderer::render(const Scene& scene, const PinholeCamera& 
     }
     if (want_shadows) {
       const auto shadow_start = Clock::now();
-      RayPacket pending;
-      std::size_t pending_pixel[kPacketSize];
-      int pending_count = 0;
-      const auto flush = [&] {
-        if (pending_count == 0) return;
-        pending.active = static_cast<std::uint8_t>((1u << pending_count) - 1u);
-        const std::uint8_t blocked = occluded_packet(scene, pending, settings.triangle_test, &record.shadow);
-        for (int lane = 0; lane < pending_count; ++lane) {
-          if (blocked & (1u << lane)) {
-            s.lit[pending_pixel[lane]] = 0;
-            ++record.shadowed;
-          }
-        }
-        pending_count = 0;
-      };
-      for (int y = t.y0; y < t.y1; ++y) {
-        for (int x = t.x0; x < t.x1; ++x) {
-          const std::size_t k = local(x, y);
-          if (!s.hits[k].valid()) continue;
-          const SurfacePoint& surface = s.surfaces[k];
-          Vec3 facing = surface.geometric_normal;
-          if (glm::dot(facing, s.directions[k]) > 0.0f) facing = -facing;
-          const Vec3 to_light = light_vector(settings.light, surface.position);
-          if (glm::dot(facing, to_light) <= 0.0f) {
-            s.lit[k] = 0;  // the light is behind the surface: no ray needed
-            continue;
-          }
-          Ray shadow;
-          shadow.origin = offset_origin(surface, facing);
-          shadow.direction = light_vector(settings.light, shadow.origin);
-          shadow.t_min = 0.0f;
-          shadow.t_max = settings.light.kind == Light::Kind::kPoint ? 1.0f : kInf;
-          if (!settings.packets) {
-            if (occluded(scene, shadow, settings.triangle_test, &record.shadow)) {
-              s.lit[k] = 0;
+      for (std::size_t l = 0; l < lights.size(); ++l) {
+        const Light& light = lights[l];
+        const std::uint8_t dark = static_cast<std::uint8_t>(~(1u << l));
+        RayPacket pending;
+        std::size_t pending_pixel[kPacketSize];
+        int pending_count = 0;
+        const auto flush = [&] {
+          if (pending_count == 0) return;
+          pending.active = static_cast<std::uint8_t>((1u << pending_count) - 1u);
+          const std::uint8_t blocked = occluded_packet(scene, pending, settings.triangle_test, &record.shadow);
+          for (int lane = 0; lane < pending_count; ++lane) {
+            if (blocked & (1u << lane)) {
+              s.lit[pending_pixel[lane]] &= dark;
               ++record.shadowed;
             }
-            continue;
           }
-          // Hits of a tile in scan order fill packets of eight shadow rays.
-          pending.set(pending_count, shadow);
-          pending_pixel[pending_count++] = k;
-          if (pending_count == kPacketSize) flush();
+          pending_count = 0;
+        };
+        for (int y = t.y0; y < t.y1; ++y) {
+          for (int x = t.x0; x < t.x1; ++x) {
+            const std::size_t k = local(x, y);
+            if (!s.hits[k].valid()) continue;
+            const SurfacePoint& surface = s.surfaces[k];
+            Vec3 facing = surface.geometric_normal;
+            if (glm::dot(facing, s.directions[k]) > 0.0f) facing = -facing;
+            const Vec3 to_light = light_vector(light, surface.position);
+            if (glm::dot(facing, to_light) <= 0.0f) {
+              s.lit[k] &= dark;  // the light is behind the surface: no ray needed
+              continue;
+            }
+            Ray shadow;
+            shadow.origin = offset_origin(surface, facing);
+            shadow.direction = light_vector(light, shadow.origin);
+            shadow.t_min = 0.0f;
+            shadow.t_max = light.kind == Light::Kind::kPoint ? 1.0f : kInf;
+            if (!settings.packets) {
+              if (occluded(scene, shadow, settings.triangle_test, &record.shadow)) {
+                s.lit[k] &= dark;
+                ++record.shadowed;
+              }
+              continue;
+            }
+            // Hits of a tile in scan order fill packets of eight shadow rays.
+            pending.set(pending_count, shadow);
+            pending_pixel[pending_count++] = k;
+            if (pending_count == kPacketSize) flush();
+          }
         }
+        flush();
       }
-      flush();
       shadow_ns = nanoseconds(shadow_start, Clock::now());
     }
 
@@ -337,41 +400,48 @@ Expected<RenderStats> Renderer::render(const Scene& scene, const PinholeCamera& 
     for (int y = t.y0; y < t.y1; ++y) {
       for (int x = t.x0; x < t.x1; ++x) {
         const std::size_t k = local(x, y);
-        const std::size_t i = global(x, y);
         const Hit& hit = s.hits[k];
-        if (!buffers.triangle_id.empty()) buffers.triangle_id[i] = hit.triangle_id;
-        if (!buffers.instance_id.empty()) buffers.instance_id[i] = hit.instance_id;
+        if (out_triangle.wanted()) *out_triangle.at(x, y) = hit.triangle_id;
+        if (out_instance.wanted()) *out_instance.at(x, y) = hit.instance_id;
         if (!hit.valid()) {
-          if (!buffers.depth.empty()) buffers.depth[i] = kInf;
-          if (!buffers.normal.empty()) buffers.normal[i] = Vec3(0.0f);
-          if (!buffers.color_rgba32f.empty()) {
-            for (int c = 0; c < 3; ++c) buffers.color_rgba32f[4 * i + static_cast<std::size_t>(c)] = settings.background[c];
-            buffers.color_rgba32f[4 * i + 3] = 1.0f;
+          if (out_depth.wanted()) *out_depth.at(x, y) = kInf;
+          if (out_normal.wanted()) *out_normal.at(x, y) = Vec3(0.0f);
+          if (out_rgba32f.wanted()) {
+            float* rgba = out_rgba32f.at(x, y);
+            for (int c = 0; c < 3; ++c) rgba[c] = settings.background[c];
+            rgba[3] = 1.0f;
           }
-          if (!buffers.color_rgba8.empty()) {
-            for (int c = 0; c < 4; ++c) buffers.color_rgba8[4 * i + static_cast<std::size_t>(c)] = background_bytes[static_cast<std::size_t>(c)];
+          if (out_rgba8.wanted()) {
+            std::uint8_t* rgba = out_rgba8.at(x, y);
+            for (std::size_t c = 0; c < 4; ++c) rgba[c] = background_bytes[c];
           }
           continue;
         }
-        if (!buffers.depth.empty()) buffers.depth[i] = hit.t * glm::length(s.directions[k]);
+        if (out_depth.wanted()) *out_depth.at(x, y) = hit.t * glm::length(s.directions[k]);
         if (!want_surface) continue;
         const SurfacePoint& surface = s.surfaces[k];
         Vec3 facing = surface.geometric_normal;
         if (glm::dot(facing, s.directions[k]) > 0.0f) facing = -facing;
         Vec3 n = surface.shading_normal;
         if (glm::dot(n, facing) < 0.0f) n = -n;
-        if (!buffers.normal.empty()) buffers.normal[i] = n;
+        if (out_normal.wanted()) *out_normal.at(x, y) = n;
         if (!want_color) continue;
-        const Vec3 l = glm::normalize(light_vector(settings.light, surface.position));
-        const float lambert = s.lit[k] ? std::max(0.0f, glm::dot(n, l)) : 0.0f;
-        const Vec3 linear = surface.albedo * (settings.ambient + settings.light.color * lambert);
-        if (!buffers.color_rgba32f.empty()) {
-          for (int c = 0; c < 3; ++c) buffers.color_rgba32f[4 * i + static_cast<std::size_t>(c)] = linear[c];
-          buffers.color_rgba32f[4 * i + 3] = 1.0f;
+        Vec3 radiance = settings.ambient;
+        for (std::size_t l = 0; l < lights.size(); ++l) {
+          if (!(s.lit[k] & (1u << l))) continue;
+          const Vec3 to_light = glm::normalize(light_vector(lights[l], surface.position));
+          radiance += lights[l].color * std::max(0.0f, glm::dot(n, to_light));
         }
-        if (!buffers.color_rgba8.empty()) {
-          for (int c = 0; c < 3; ++c) buffers.color_rgba8[4 * i + static_cast<std::size_t>(c)] = to_byte(linear[c]);
-          buffers.color_rgba8[4 * i + 3] = 255;
+        const Vec3 linear = surface.albedo * radiance;
+        if (out_rgba32f.wanted()) {
+          float* rgba = out_rgba32f.at(x, y);
+          for (int c = 0; c < 3; ++c) rgba[c] = linear[c];
+          rgba[3] = 1.0f;
+        }
+        if (out_rgba8.wanted()) {
+          std::uint8_t* rgba = out_rgba8.at(x, y);
+          for (int c = 0; c < 3; ++c) rgba[c] = to_byte(linear[c]);
+          rgba[3] = 255;
         }
       }
     }

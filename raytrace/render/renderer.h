@@ -38,10 +38,16 @@ struct Light {
   Vec3 color{1.0f};                  // linear RGB radiance scale (no distance falloff)
 };
 
+// Lights one render shades with, each with its own shadow ray.
+inline constexpr std::size_t kMaxLights = 8;
+
 struct RenderSettings {
   TriangleTest triangle_test = TriangleTest::kFast;
   bool shadows = true;
   Light light;
+  // When non-empty, these lights (1 to kMaxLights; kept by the caller for
+  // the render's duration) replace `light`.
+  std::span<const Light> lights;
   Vec3 ambient{0.18f};
   Vec3 background{0.32f, 0.36f, 0.42f};
   Vec3 default_albedo{0.7f};  // meshes without material colors
@@ -53,7 +59,8 @@ struct RenderSettings {
 
 // Host-owned outputs; an empty span means "not requested" and is neither
 // computed nor written. Each non-empty span holds width * height entries
-// (colour: 4 bytes per pixel, sRGB-encoded RGBA8), row-major, y = 0 on top.
+// (colour: 4 bytes per pixel, sRGB-encoded RGBA8), row-major, y = 0 on top,
+// unless a row pitch is given for it.
 struct FrameBuffers {
   int width = 0;
   int height = 0;
@@ -63,6 +70,22 @@ struct FrameBuffers {
   std::span<Vec3> normal;          // unit shading normal facing the camera; 0 on a miss
   std::span<std::uint32_t> triangle_id;  // kInvalidId on a miss
   std::span<std::uint32_t> instance_id;  // kInvalidId on a miss
+
+  // Bytes from the start of one row to the next, per output (a host's
+  // texture or staging buffer with padded rows); 0: rows packed. A pitch
+  // holds at least a row and is a multiple of the element's alignment (4
+  // bytes for every output but color_rgba8). With a pitch, the span reaches
+  // at least to the end of the last row's last pixel; the padding between
+  // rows is never written.
+  struct RowPitches {
+    std::size_t color_rgba8 = 0;
+    std::size_t color_rgba32f = 0;
+    std::size_t depth = 0;
+    std::size_t normal = 0;
+    std::size_t triangle_id = 0;
+    std::size_t instance_id = 0;
+  };
+  RowPitches row_pitch;
 };
 
 struct RenderStats {
@@ -80,8 +103,9 @@ struct RenderStats {
 class Renderer {
  public:
   // Errors: kInvalidArgument when a buffer's size does not match
-  // width x height, the camera's size differs from the buffers', or the tile
-  // size is below 1.
+  // width x height (or its row pitch), a row pitch is too small or
+  // misaligned, the camera's size differs from the buffers', the tile size
+  // is below 1, or there are more than kMaxLights lights.
   Expected<RenderStats> render(const Scene& scene, const PinholeCamera& camera,
                                const RenderSettings& settings, const FrameBuffers& buffers,
                                JobSystem& jobs, PhaseTimers* timers = nullptr);

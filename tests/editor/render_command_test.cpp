@@ -302,6 +302,22 @@ TEST(RenderCommand, InstancesStandSideBySideWithDifferentPoses) {
   EXPECT_TRUE(differ);
 }
 
+TEST(RenderCommand, GroundOffLeavesTheCharactersAlone) {
+  auto parsed = parse_render_options({"m.glb", "--out", "o", "--ground", "off"});
+  ASSERT_TRUE(parsed.ok()) << parsed.status().message();
+  EXPECT_FALSE(parsed->ground);
+  EXPECT_FALSE(parse_render_options({"m.glb", "--out", "o", "--ground", "maybe"}).ok());
+
+  RenderOptions o = small_options(kCesiumMan);
+  o.ground = false;
+  const auto outputs = render_model(o);
+  ASSERT_TRUE(outputs.ok()) << outputs.status().message();
+  EXPECT_EQ(outputs->ground_instance_id, kInvalidId);
+  EXPECT_TRUE(outputs->ground.triangles.empty());
+  const std::set<std::uint32_t> seen(outputs->instance_id.begin(), outputs->instance_id.end());
+  EXPECT_EQ(seen, (std::set<std::uint32_t>{0u, kInvalidId})) << "the character and misses only";
+}
+
 TEST(RenderCommand, UpAxisIsTheLargerOfYAndZ) {
   EXPECT_EQ(up_axis_of(Aabb{Vec3(0.0f), Vec3(5.0f, 2.0f, 1.0f)}), 1);
   EXPECT_EQ(up_axis_of(Aabb{Vec3(0.0f), Vec3(5.0f, 1.0f, 2.0f)}), 2);

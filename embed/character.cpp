@@ -1,0 +1,98 @@
+// sinew::api::Character over editor::CharacterPack.
+#include <string>
+
+#include "animation/pose_space.h"
+#include "embed/api_errors.h"
+#include "embed/character_impl.h"
+#include "embed/convert.h"
+#include "runtime/pack/pack_format.h"
+#include "sinew/version.h"
+
+namespace sinew::api {
+Result<Character> CharacterFactory::make(editor::CharacterPack pack, std::string name) {
+  if (!pack.has_fuzzy()) {
+    return detail::api_error(ErrorCode::kUnsupported,
+                             name + ": a model-only pack (no fuzzy kd-trees): bake it first "
+                                    "(sinew-editor bake MODEL -o OUT.pack)");
+  }
+  auto impl = std::make_shared<Character::Impl>(std::move(pack));
+  impl->name = std::move(name);
+  return Character(std::move(impl));
+}
+
+namespace {
+
+Result<Character> adopt(Expected<editor::CharacterPack> pack, std::string name) {
+  if (!pack.ok()) return detail::to_api_error(pack.status());
+  return CharacterFactory::make(std::move(*pack), std::move(name));
+}
+
+}  // namespace
+
+Result<Character> Character::load(std::string_view path) noexcept {
+  return detail::guarded("Character::load", [&]() -> Result<Character> {
+    const std::string p(path);
+    return adopt(editor::CharacterPack::open(p), p);
+  });
+}
+
+Result<Character> Character::from_memory(std::span<const std::byte> bytes, std::string_view name) noexcept {
+  return detail::guarded("Character::from_memory", [&]() -> Result<Character> {
+    const std::string n(name);
+    return adopt(editor::CharacterPack::from_bytes(bytes, n), n);
+  });
+}
+
+std::size_t Character::bone_count() const noexcept { return impl_->model().skeleton.joint_count(); }
+
+std::string_view Character::bone_name(std::size_t bone) const noexcept {
+  const auto names = impl_->model().skeleton.names();
+  return bone < names.size() ? std::string_view(names[bone]) : std::string_view();
+}
+
+Result<std::size_t> Character::find_bone(std::string_view name) const noexcept {
+  return detail::guarded("Character::find_bone", [&]() -> Result<std::size_t> {
+    if (const auto index = impl_->model().skeleton.find(name)) return static_cast<std::size_t>(*index);
+    return detail::api_error(ErrorCode::kNotFound, impl_->name + ": bone '" + std::string(name) + "': no such bone");
+  });
+}
+
+Matrix3x4 Character::bind_pose(std::size_t bone) const noexcept {
+  const auto inverse_bind = impl_->model().skeleton.inverse_bind();
+  if (bone >= inverse_bind.size()) return Matrix3x4::identity();
+  return detail::to_api(inverse(inverse_bind[bone]));
+}
+
+int Character::bone_parent(std::size_t bone) const noexcept {
+  const auto parents = impl_->model().skeleton.parents();
+  return bone < parents.size() ? parents[bone] : -1;
+}
+
+std::size_t Character::clip_count() const noexcept { return impl_->model().clips.size(); }
+
+std::string_view Character::clip_name(std::size_t clip) const noexcept {
+  const auto& clips = impl_->model().clips;
+  return clip < clips.size() ? std::string_view(clips[clip].name()) : std::string_view();
+}
+
+float Character::clip_duration(std::size_t clip) const noexcept {
+  const auto& clips = impl_->model().clips;
+  return clip < clips.size() ? clips[clip].duration() : 0.0f;
+}
+
+std::size_t Character::vertex_count() const noexcept { return impl_->model().mesh.vertex_count(); }
+std::size_t Character::triangle_count() const noexcept { return impl_->model().mesh.triangle_count(); }
+
+std::string Character::pose_space() const {
+  const auto& record = impl_->pack.pose_space();
+  return std::string(anim::pose_space_mode_name(record.desc.mode)) + " (" +
+         std::to_string(impl_->pack.fuzzy_stats().sample_count) + " samples)";
+}
+
+std::string_view Character::source_name() const noexcept { return impl_->name; }
+
+Version library_version() noexcept { return {SINEW_VERSION_MAJOR, SINEW_VERSION_MINOR, SINEW_VERSION_PATCH}; }
+
+Version pack_format_version() noexcept { return {kPackVersionMajor, kPackVersionMinor, 0}; }
+
+}  // namespace sinew::api

@@ -1,0 +1,42 @@
+// World's state: the ray tracer's Scene plus, per instance, who drives it
+// and (for the mixer) its animation state.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "animation/blend.h"
+#include "animation/clip.h"
+#include "animation/mixer.h"
+#include "embed/character_impl.h"
+#include "raytrace/scene/scene.h"
+#include "runtime/math/affine.h"
+#include "sinew/world.h"
+
+namespace sinew::api {
+
+struct World::Impl {
+  struct Instance {
+    bool is_static = false;
+    std::shared_ptr<const Character::Impl> core;  // null for static meshes
+    Driver driver = Driver::kMixer;
+    Affine3 transform = Affine3::identity();
+    bool limits = false;
+    // Mixer-driven only.
+    std::unique_ptr<anim::Mixer> mixer;
+    std::vector<anim::SamplingCache> caches;
+    std::vector<anim::JointTransform> local;
+    std::vector<Affine3> model_pose;
+    std::vector<Affine3> skin;
+    anim::BlendScratch scratch;
+  };
+
+  // Declared before the scene: the scene points into these cores' meshes
+  // and trees, so it must go first.
+  std::vector<std::shared_ptr<const Character::Impl>> cores;  // by scene character index
+  rt::Scene scene;
+  std::vector<Instance> instances;  // by InstanceId (the scene's numbering)
+};
+
+}  // namespace sinew::api

@@ -1,0 +1,127 @@
+// Shared by the public-API tests: the mannequin baked and written as a
+// pack once per test binary, and the internal renderer as the reference
+// the API's pass must reproduce.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "editor/pack/character_pack.h"
+#include "raytrace/camera/camera.h"
+#include "raytrace/render/renderer.h"
+#include "raytrace/scene/scene.h"
+#include "runtime/jobs/job_system.h"
+#include "sinew/sinew.h"
+#include "tests/support/idle_mannequin.h"
+
+namespace sinew::testing_support {
+
+// The idle-baked mannequin as a pack file (written once).
+inline const std::string& mannequin_pack_path() {
+  static const std::string path = [] {
+    const BakedModel& baked = idle_mannequin();
+    editor::CharacterPackContents contents;
+    contents.model = &baked.model;
+    contents.fuzzy = &baked.bake.fuzzy;
+    contents.pose_space.desc.mode = anim::PoseSpaceMode::kClip;
+    contents.pose_space.desc.clips = {"idle"};
+    contents.provenance.source_name = "mannequin";
+    contents.provenance.tool_version = "api test";
+    const std::string p = (std::filesystem::temp_directory_path() /
+                           ("sinew_api_test_mannequin_" + std::to_string(::getpid()) + ".pack"))
+                              .string();
+    EXPECT_TRUE(editor::write_character_pack(p, contents).ok());
+    return p;
+  }();
+  return path;
+}
+
+// Every output of one frame, packed rows.
+struct Frame {
+  int width = 0;
+  int height = 0;
+  std::vector<std::uint8_t> rgba8;
+  std::vector<float> rgba32f;
+  std::vector<float> depth;
+  std::vector<Vec3> normal;
+  std::vector<std::uint32_t> instance_id;
+  std::vector<std::uint32_t> triangle_id;
+
+  Frame(int w, int h)
+      : width(w),
+        height(h),
+        rgba8(4 * pixels()),
+        rgba32f(4 * pixels()),
+        depth(pixels()),
+        normal(pixels()),
+        instance_id(pixels()),
+        triangle_id(pixels()) {}
+  std::size_t pixels() const { return static_cast<std::size_t>(width) * static_cast<std::size_t>(height); }
+
+  rt::FrameBuffers buffers() {
+    rt::FrameBuffers b;
+    b.width = width;
+    b.height = height;
+    b.color_rgba8 = rgba8;
+    b.color_rgba32f = rgba32f;
+    b.depth = depth;
+    b.normal = normal;
+    b.instance_id = instance_id;
+    b.triangle_id = triangle_id;
+    return b;
+  }
+  api::PassOutputs outputs() {
+    api::PassOutputs o;
+    o.color_rgba8 = {rgba8.data(), 0};
+    o.color_rgba32f = {rgba32f.data(), 0};
+    o.depth = {depth.data(), 0};
+    o.normal = {normal.data(), 0};
+    o.instance_id = {instance_id.data(), 0};
+    o.triangle_id = {triangle_id.data(), 0};
+    return o;
+  }
+};
+
+inline constexpr api::OutputMask kEveryOutput =
+    api::Output::kColorRgba8 | api::Output::kColorRgba32f | api::Output::kDepth | api::Output::kNormal |
+    api::Output::kInstanceId | api::Output::kTriangleId;
+
+// The camera and light the API tests use, in both vocabularies.
+inline api::Camera test_camera() { return {{0.4f, 1.1f, 3.2f}, {0.0f, 0.9f, 0.0f}, {0.0f, 1.0f, 0.0f}, 45.0f}; }
+inline rt::CameraDesc test_camera_internal() {
+  const api::Camera c = test_camera();
+  return {{c.eye.x, c.eye.y, c.eye.z}, {c.target.x, c.target.y, c.target.z}, {c.up.x, c.up.y, c.up.z}, c.fovy_degrees};
+}
+inline api::Light test_light() {
+  api::Light l;
+  l.position = {2.0f, 4.0f, 3.0f};
+  return l;
+}
+
+// The reference: the internal Scene and Renderer over the same baked data.
+inline Frame render_internal(const editor::CharacterPack& pack, const std::vector<std::vector<Affine3>>& poses,
+                             int width, int height, bool shadows = true) {
+  Frame frame(width, height);
+  rt::Scene scene;
+  const auto character = scene.add_character(pack.model().mesh, pack.fuzzy());
+  EXPECT_TRUE(character.ok());
+  for (const auto& pose : poses) {
+    const auto id = scene.add_instance(*character);
+    EXPECT_TRUE(id.ok());
+    EXPECT_TRUE(scene.set_bones(*id, pose).ok());
+  }
+  JobSystem jobs(2);
+  EXPECT_TRUE(scene.prepare_frame({}, jobs).ok());
+  rt::RenderSettings settings;
+  settings.shadows = shadows;
+  settings.light.position = Vec3(2.0f, 4.0f, 3.0f);
+  const auto camera = rt::PinholeCamera::create(test_camera_internal(), width, height);
+  EXPECT_TRUE(camera.ok());
+  rt::Renderer renderer;
+  EXPECT_TRUE(renderer.render(scene, *camera, settings, frame.buffers(), jobs).ok());
+  return frame;
+}
+
+}  // namespace sinew::testing_support
