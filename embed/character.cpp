@@ -5,6 +5,7 @@
 #include "embed/api_errors.h"
 #include "embed/character_impl.h"
 #include "embed/convert.h"
+#include "runtime/math/aabb.h"
 #include "runtime/pack/pack_format.h"
 #include "sinew/version.h"
 
@@ -78,6 +79,14 @@ std::string_view Character::clip_name(std::size_t clip) const noexcept {
 float Character::clip_duration(std::size_t clip) const noexcept {
   const auto& clips = impl_->model().clips;
   return clip < clips.size() ? clips[clip].duration() : 0.0f;
+}
+
+Character::Bounds Character::bind_bounds() const noexcept {
+  const auto& positions = impl_->model().mesh.positions;
+  if (positions.empty()) return {};
+  Aabb box;
+  for (const Vec3& p : positions) box.extend(p);
+  return {detail::to_api(box.lower), detail::to_api(box.upper)};
 }
 
 std::size_t Character::vertex_count() const noexcept { return impl_->model().mesh.vertex_count(); }

@@ -19,8 +19,9 @@ namespace sinew::api {
 namespace {
 
 constexpr int kMaxSide = 16384;
-constexpr OutputMask kAllOutputs = Output::kColorRgba8 | Output::kColorRgba32f | Output::kDepth | Output::kNormal |
-                                   Output::kInstanceId | Output::kTriangleId;
+constexpr std::uint32_t kAllOutputs = (Output::kColorRgba8 | Output::kColorRgba32f | Output::kDepth |
+                                      Output::kNormal | Output::kInstanceId | Output::kTriangleId)
+                                         .bits();
 
 struct OutputInfo {
   Output output;
@@ -100,8 +101,8 @@ Result<RayTracePass> RayTracePass::create(const PassDesc& desc) noexcept {
     if (desc.width < 1 || desc.height < 1 || desc.width > kMaxSide || desc.height > kMaxSide) {
       return bad("desc.width x height = " + size + ": expected 1 to " + std::to_string(kMaxSide) + " a side");
     }
-    if (desc.outputs == 0 || (desc.outputs & ~kAllOutputs) != 0) {
-      return bad("desc.outputs = " + std::to_string(desc.outputs) + ": expected a non-empty set of Output bits");
+    if (desc.outputs.empty() || (desc.outputs.bits() & ~kAllOutputs) != 0) {
+      return bad("desc.outputs = " + std::to_string(desc.outputs.bits()) + ": expected a non-empty set of Output bits");
     }
     if (desc.threads < 0) return bad("desc.threads = " + std::to_string(desc.threads) + ": expected >= 0");
     auto impl = std::make_unique<Impl>();
@@ -113,7 +114,7 @@ Result<RayTracePass> RayTracePass::create(const PassDesc& desc) noexcept {
         {"static_geometry", ResourceDecl::Access::kRead, true, 0},
     };
     for (const OutputInfo& o : kOutputs) {
-      if (has(desc.outputs, o.output)) {
+      if (desc.outputs.has(o.output)) {
         impl->resources.push_back({o.name, ResourceDecl::Access::kWrite, false, o.bytes_per_pixel});
       }
     }
@@ -134,11 +135,11 @@ Result<PassStats> RayTracePass::execute(World& world, const PassInputs& inputs, 
 
     // Outputs: every requested one needs a buffer; the others are ignored.
     for (const OutputInfo& o : kOutputs) {
-      if (has(desc.outputs, o.output) && (outputs.*(o.buffer)).data == nullptr) {
+      if (desc.outputs.has(o.output) && (outputs.*(o.buffer)).data == nullptr) {
         return bad(std::string("outputs.") + o.name + ".data: null, but the pass's desc.outputs asks for it");
       }
     }
-    const auto wanted = [&](Output o) { return has(desc.outputs, o); };
+    const auto wanted = [&](Output o) { return desc.outputs.has(o); };
     rt::FrameBuffers buffers;
     buffers.width = w;
     buffers.height = h;

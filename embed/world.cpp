@@ -216,7 +216,12 @@ Status World::play_cycle(InstanceId id, std::string_view clip, float weight, flo
     if (!found.ok()) return found.error();
     const auto index = clip_index(**found, clip);
     if (!index.ok()) return index.error();
-    return detail::to_api_status((*found)->mixer->blend_cycle(*index, weight, fade_seconds));
+    anim::Mixer& mixer = *(*found)->mixer;
+    const bool idle = mixer.animation_duration() == 0.0f;
+    SINEW_RETURN_IF_ERROR_API(mixer.blend_cycle(*index, weight, fade_seconds));
+    // Start the clock now, so the host's next advance(dt) is dt of playing.
+    if (idle) mixer.update(0.0f);
+    return Status();
   });
 }
 

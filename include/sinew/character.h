@@ -44,6 +44,14 @@ class SINEW_API Character {
   std::string_view clip_name(std::size_t clip) const noexcept;  // "" past the end
   float clip_duration(std::size_t clip) const noexcept;         // seconds; 0 past the end
 
+  // The mesh as stored (its bind pose), in model space: for framing a
+  // camera, culling, or putting a ground under it.
+  struct Bounds {
+    Float3 min;
+    Float3 max;
+  };
+  Bounds bind_bounds() const noexcept;
+
   std::size_t vertex_count() const noexcept;
   std::size_t triangle_count() const noexcept;
   // What the trees were baked over, e.g. "clips (566 samples)". Poses

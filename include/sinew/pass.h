@@ -38,10 +38,23 @@ enum class Output : std::uint32_t {
   kInstanceId = 1u << 4,    // uint32: World's InstanceId; kNoHit on a miss
   kTriangleId = 1u << 5,    // uint32: the character's (or static mesh's) triangle; kNoHit on a miss
 };
-using OutputMask = std::uint32_t;
-constexpr OutputMask operator|(Output a, Output b) { return static_cast<OutputMask>(a) | static_cast<OutputMask>(b); }
-constexpr OutputMask operator|(OutputMask a, Output b) { return a | static_cast<OutputMask>(b); }
-constexpr bool has(OutputMask mask, Output o) { return (mask & static_cast<OutputMask>(o)) != 0; }
+// A set of outputs: `Output::kColorRgba8 | Output::kDepth`, or one Output.
+class OutputMask {
+ public:
+  constexpr OutputMask() = default;
+  constexpr OutputMask(Output o) : bits_(static_cast<std::uint32_t>(o)) {}  // NOLINT: implicit by design
+  constexpr explicit OutputMask(std::uint32_t bits) : bits_(bits) {}
+
+  constexpr std::uint32_t bits() const { return bits_; }
+  constexpr bool empty() const { return bits_ == 0; }
+  constexpr bool has(Output o) const { return (bits_ & static_cast<std::uint32_t>(o)) != 0; }
+  friend constexpr OutputMask operator|(OutputMask a, OutputMask b) { return OutputMask(a.bits_ | b.bits_); }
+  friend constexpr bool operator==(OutputMask a, OutputMask b) { return a.bits_ == b.bits_; }
+
+ private:
+  std::uint32_t bits_ = 0;
+};
+constexpr OutputMask operator|(Output a, Output b) { return OutputMask(a) | OutputMask(b); }
 
 enum class TriangleTest : std::uint8_t {
   kFast,        // projection test (Wald 2004): fastest
@@ -51,7 +64,7 @@ enum class TriangleTest : std::uint8_t {
 struct PassDesc {
   int width = 1024;
   int height = 1024;
-  OutputMask outputs = static_cast<OutputMask>(Output::kColorRgba8);
+  OutputMask outputs = Output::kColorRgba8;
   bool shadows = true;  // one shadow ray per hit and light (colour outputs only)
   TriangleTest triangle_test = TriangleTest::kFast;
   // Exact per-bone world boxes (a pass over the bone's triangles) or the
@@ -61,7 +74,10 @@ struct PassDesc {
   // pose space) through a per-frame tree, so the image stays exact. Off:
   // escapes are still counted (PassStats) and may show as holes.
   bool fallback = true;
-  int threads = 0;  // the default TBB executor's threads; 0: all cores
+  // Threads of the pass's own TBB arena, made the first time execute() runs
+  // without a TaskScheduler (never, for a host that always passes one);
+  // 0: all cores.
+  int threads = 0;
 };
 
 struct Camera {  // a pinhole camera; y = 0 is the image's top row

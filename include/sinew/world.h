@@ -65,14 +65,19 @@ class SINEW_API World {
   Result<InstanceId> add_static_mesh(const StaticMeshDesc& mesh) noexcept;
 
   // Host-driven instances: this frame's skinning matrices (bind pose ->
-  // world), one per bone in Character::bone_name order; copied. Errors:
+  // world), one per bone in Character::bone_name order; copied. Identity
+  // matrices show the mesh as stored in the pack (its bind pose), which can
+  // differ from the skeleton's rest pose a mixer-driven instance starts in
+  // (glTF files whose root node turns the skeleton, say). Errors:
   // kNotFound (no such instance), kInvalidArgument (a mixer-driven
   // instance, the wrong count, a non-finite matrix — nothing is changed).
   Status set_bone_matrices(InstanceId instance, std::span<const Matrix3x4> skinning) noexcept;
 
-  // Mixer-driven instances. Clips by name or "#<index>". Errors: kNotFound
-  // (instance or clip), kInvalidArgument (a host-driven instance, negative
-  // or non-finite weights and times).
+  // Mixer-driven instances. Clips by name or "#<index>". A cycle started on
+  // an idle mixer starts its clock at once: the next advance(dt) plays it dt
+  // seconds in (Cal3D's own mixer would spend that first update starting
+  // the clock). Errors: kNotFound (instance or clip), kInvalidArgument (a
+  // host-driven instance, negative or non-finite weights and times).
   Status set_transform(InstanceId instance, const Matrix3x4& model_to_world) noexcept;
   Status play_cycle(InstanceId instance, std::string_view clip, float weight, float fade_seconds) noexcept;
   Status stop_cycle(InstanceId instance, std::string_view clip, float fade_seconds) noexcept;

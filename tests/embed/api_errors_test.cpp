@@ -136,9 +136,9 @@ TEST(ApiPassErrors, DescriptionsAreChecked) {
   desc.width = 0;
   expect_error(api::RayTracePass::create(desc), api::ErrorCode::kInvalidArgument, "0x1024");
   desc.width = 64;
-  desc.outputs = 0;
+  desc.outputs = api::OutputMask();
   expect_error(api::RayTracePass::create(desc), api::ErrorCode::kInvalidArgument, "desc.outputs");
-  desc.outputs = 1u << 20;
+  desc.outputs = api::OutputMask(1u << 20);
   expect_error(api::RayTracePass::create(desc), api::ErrorCode::kInvalidArgument, "desc.outputs");
   desc.outputs = api::Output::kDepth | api::Output::kTriangleId;
   auto pass = api::RayTracePass::create(desc);

@@ -6,3 +6,27 @@ sinew_add_test_binary(sinew_api_tests
           ${CMAKE_CURRENT_LIST_DIR}/api_errors_test.cpp
   LIBS Sinew::raytrace sinew::editor sinew::content)
 target_include_directories(sinew_api_tests PRIVATE ${PROJECT_SOURCE_DIR})
+
+# A host animating with the Cal3D library hands Sinew its bone matrices.
+if(TARGET Cal3D::cal3d)
+  sinew_add_test_binary(sinew_host_bones_tests
+    SOURCES ${CMAKE_CURRENT_LIST_DIR}/host_bones_cal3d_test.cpp
+    LIBS Sinew::raytrace sinew::editor_cli sinew::editor Cal3D::cal3d)
+  target_include_directories(sinew_host_bones_tests PRIVATE ${PROJECT_SOURCE_DIR})
+  target_compile_options(sinew_host_bones_tests PRIVATE -fno-sanitize=vptr)  # as for the importer
+endif()
+
+# The installed package from a separate project (label "package"). Not in
+# sanitizer builds: an instrumented libsinew needs an instrumented host.
+add_executable(sinew-image-diff ${CMAKE_CURRENT_LIST_DIR}/image_diff.cpp)
+target_link_libraries(sinew-image-diff PRIVATE sinew::runtime)
+set(consumer_model ${PROJECT_SOURCE_DIR}/../shared/content/gltf/CesiumMan/CesiumMan.glb)
+if(NOT CMAKE_CXX_FLAGS MATCHES "-fsanitize" AND EXISTS ${consumer_model})
+  add_test(NAME package.consumer
+    COMMAND ${CMAKE_COMMAND}
+      -DBUILD_DIR=${PROJECT_BINARY_DIR} -DSOURCE_DIR=${PROJECT_SOURCE_DIR}
+      -DWORK_DIR=${PROJECT_BINARY_DIR}/package-test -DEDITOR=$<TARGET_FILE:sinew-editor>
+      -DIMAGE_DIFF=$<TARGET_FILE:sinew-image-diff> -DMODEL=${consumer_model} -DCXX=${CMAKE_CXX_COMPILER}
+      -P ${CMAKE_CURRENT_LIST_DIR}/consumer_test.cmake)
+  set_tests_properties(package.consumer PROPERTIES LABELS "package" TIMEOUT 600 RUN_SERIAL TRUE)
+endif()

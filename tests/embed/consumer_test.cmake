@@ -1,0 +1,74 @@
+# The installed package, used the way an engine would (cmake -P, run by the
+# ctest "package.consumer"): install Sinew to a fresh prefix, configure and
+# build the example host engine against it with find_package(Sinew), build
+# the minimal example through pkg-config, then render one frame headless and
+# compare it with sinew-editor render of the same frame.
+#
+# Variables: BUILD_DIR SOURCE_DIR WORK_DIR EDITOR IMAGE_DIFF MODEL CXX
+cmake_minimum_required(VERSION 3.25)
+
+function(run)
+  execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  message("$ ${ARGN}\n${out}${err}")
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "failed (${rc}): ${ARGN}")
+  endif()
+endfunction()
+
+file(REMOVE_RECURSE ${WORK_DIR})
+file(MAKE_DIRECTORY ${WORK_DIR})
+set(prefix ${WORK_DIR}/prefix)
+
+# 1. Install: headers, libsinew, the CMake package and sinew.pc.
+run(${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${prefix} --component sinew)
+
+# 2. A separate project finds it.
+run(${CMAKE_COMMAND} -S ${SOURCE_DIR}/examples/host_engine -B ${WORK_DIR}/host-build -G Ninja
+    -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH=${prefix} -DCMAKE_CXX_COMPILER=${CXX}
+    "-DCMAKE_CXX_FLAGS=-Wall -Wextra -Wpedantic -Werror")
+run(${CMAKE_COMMAND} --build ${WORK_DIR}/host-build)
+
+# 3. pkg-config alone is enough too (the source before the libraries:
+#    Debian's GCC links with --as-needed).
+execute_process(COMMAND ${CMAKE_COMMAND} -E env PKG_CONFIG_PATH=${prefix}/lib/pkgconfig
+                        pkg-config --cflags --libs sinew
+                OUTPUT_VARIABLE pc_flags RESULT_VARIABLE rc OUTPUT_STRIP_TRAILING_WHITESPACE)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "pkg-config does not find sinew.pc under ${prefix}")
+endif()
+separate_arguments(pc_flags UNIX_COMMAND "${pc_flags}")
+run(${CXX} ${SOURCE_DIR}/examples/minimal/minimal.cpp ${pc_flags} -Wl,-rpath,${prefix}/lib
+    -o ${WORK_DIR}/minimal)
+
+# 4. One frame: the editor's and the host's, same pack, pose, camera, light.
+set(camera 0.0108692,1.37059,3.10876,0.0108692,0.754971,0.0306663,0,1,0,40)
+run(${EDITOR} bake ${MODEL} -o ${WORK_DIR}/cesium.pack --threads 2)
+run(${EDITOR} render ${WORK_DIR}/cesium.pack --clip "#0" --time 0.7 --camera ${camera} --light 2,4,3
+    --size 200x150 --instances 1 --ground off --threads 2 --out ${WORK_DIR}/editor)
+run(${WORK_DIR}/host-build/host_engine --headless --pack ${WORK_DIR}/cesium.pack --clip "#0" --time 0.7
+    --camera ${camera} --light 2,4,3 --size 200x150 --threads 2 --out ${WORK_DIR}/host)
+run(${IMAGE_DIFF} ${WORK_DIR}/host/sinew_color.ppm ${WORK_DIR}/editor/color.png
+    --max-channel-diff 0 --max-differing-pixels 0)
+# The host's own pass shows around the character in its composite.
+execute_process(COMMAND ${IMAGE_DIFF} ${WORK_DIR}/host/frame.ppm ${WORK_DIR}/host/sinew_color.ppm
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out)
+message("${out}")
+if(rc EQUAL 0)
+  message(FATAL_ERROR "the composite equals Sinew's output: the host's pass is missing")
+endif()
+
+# 5. Through the host's own thread pool: the same image.
+run(${WORK_DIR}/host-build/host_engine --headless --pack ${WORK_DIR}/cesium.pack --clip "#0" --time 0.7
+    --camera ${camera} --light 2,4,3 --size 200x150 --scheduler host --threads 3 --out ${WORK_DIR}/host-pool)
+run(${IMAGE_DIFF} ${WORK_DIR}/host-pool/frame.ppm ${WORK_DIR}/host/frame.ppm --max-channel-diff 0)
+
+# 6. The windowed engine frame, where a display can be made (Xvfb).
+find_program(xvfb_run xvfb-run)
+if(xvfb_run)
+  run(${xvfb_run} -a -s "-screen 0 640x480x24" ${WORK_DIR}/host-build/host_engine --pack ${WORK_DIR}/cesium.pack
+      --size 320x240 --frames 3 --threads 2)
+endif()
+
+# 7. The 30-line example runs.
+run(${WORK_DIR}/minimal ${WORK_DIR}/cesium.pack ${WORK_DIR}/minimal.ppm)
+message("package.consumer: passed")
