@@ -5,6 +5,16 @@
 // Time is seconds on the file's own timeline (DESIGN.md section 8): before a
 // track's first key it holds the first value, after its last key the last.
 // A looping clip of duration D (its last key time) plays t mod D.
+//
+// Key times (the one rule for every source): a track's times must be finite,
+// >= 0 and strictly increasing. Duplicate or out-of-order times are
+// REJECTED by Clip::build (kInvalidData naming "...times[k]"), never sorted:
+// sorting would silently pick an order between equal-time keys and hide a
+// broken exporter. glTF requires strictly increasing times, so its files
+// pass unchanged; the Cal3D importer keeps the last of equal-time keys
+// itself before building (Cal3D's own upper-bound sampling does the same),
+// and hands anything else to this rule. A single key holds its value at
+// every time; a clip whose keys are all at 0 has duration 0 and loops to 0.
 #pragma once
 
 #include <cstdint>

@@ -1,6 +1,9 @@
 #include "editor/bake/in_memory_bake.h"
 
+#include <algorithm>
 #include <chrono>
+#include <cstdint>
+#include <string>
 
 #include "animation/pose.h"
 #include "runtime/jobs/job_system.h"
@@ -10,8 +13,16 @@ namespace {
 
 Status append_skinning(const anim::Skeleton& skeleton, std::span<const anim::JointTransform> local,
                        const Affine3& instance, std::vector<Affine3>& model_scratch,
-                       std::vector<Affine3>& out) {
+                       std::vector<Affine3>& out, std::size_t max_bytes = SIZE_MAX) {
   const std::size_t joints = skeleton.joint_count();
+  const std::size_t max_matrices = max_bytes / sizeof(Affine3);
+  if (joints > max_matrices || out.size() > max_matrices - joints) {
+    const std::size_t samples = out.size() / std::max<std::size_t>(joints, 1);
+    return make_error(ErrorCode::kLimitExceeded, "", "pose_space", "more than " + std::to_string(samples) + " samples",
+                      "the pose samples of " + std::to_string(joints) + " joints would take more than " +
+                          std::to_string(max_bytes >> 20) +
+                          " MiB (the bake's memory bound); sample fewer poses or raise the bound");
+  }
   model_scratch.resize(joints);
   SINEW_RETURN_IF_ERROR(anim::local_to_model(skeleton, local, model_scratch));
   const std::size_t first = out.size();
@@ -31,19 +42,20 @@ anim::PoseSpaceDesc default_pose_space() {
 
 Expected<std::vector<Affine3>> pose_space_skinning(const ImportedModel& model,
                                                    const anim::PoseSpaceDesc& space,
-                                                   std::span<const anim::JointLimit> limits) {
+                                                   std::span<const anim::JointLimit> limits,
+                                                   std::size_t max_bytes) {
   std::vector<Affine3> out;
   std::vector<Affine3> model_scratch;
   const bool clip_space = space.mode == anim::PoseSpaceMode::kClips || space.mode == anim::PoseSpaceMode::kClip;
   if (clip_space && model.clips.empty()) {
     std::vector<anim::JointTransform> rest(model.skeleton.joint_count());
     SINEW_RETURN_IF_ERROR(anim::rest_pose(model.skeleton, rest));
-    SINEW_RETURN_IF_ERROR(append_skinning(model.skeleton, rest, Affine3::identity(), model_scratch, out));
+    SINEW_RETURN_IF_ERROR(append_skinning(model.skeleton, rest, Affine3::identity(), model_scratch, out, max_bytes));
     return out;
   }
   SINEW_RETURN_IF_ERROR(anim::for_each_pose(
       space, model.skeleton, model.clips, limits, [&](std::span<const anim::JointTransform> local) {
-        return append_skinning(model.skeleton, local, Affine3::identity(), model_scratch, out);
+        return append_skinning(model.skeleton, local, Affine3::identity(), model_scratch, out, max_bytes);
       }));
   return out;
 }
@@ -62,9 +74,17 @@ Expected<std::vector<Affine3>> clip_skinning(const ImportedModel& model, const a
 
 Expected<InMemoryBake> bake_in_memory(const ImportedModel& model, const BakeRequest& request, JobSystem& jobs) {
   InMemoryBake bake;
+  // The fuzzy bake holds an inverse per sample matrix beside its boxes.
+  if (request.max_memory_bytes <= request.fuzzy.memory_budget_bytes) {
+    return invalid_argument("max_memory_bytes", std::to_string(request.max_memory_bytes),
+                            "must exceed the fuzzy bake's box budget (" +
+                                std::to_string(request.fuzzy.memory_budget_bytes) + " bytes)");
+  }
+  const std::size_t sample_bound = (request.max_memory_bytes - request.fuzzy.memory_budget_bytes) / 2;
   const auto start = std::chrono::steady_clock::now();
   SINEW_ASSIGN_OR_RETURN(std::vector<Affine3> samples,
-                         pose_space_skinning(model, request.pose_space, request.limits));
+                         pose_space_skinning(model, request.pose_space, request.limits, sample_bound));
+  bake.memory.pose_samples = samples.capacity() * sizeof(Affine3);
   bake.pose_sampling_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   rt::FuzzyBakeInput input;
@@ -73,6 +93,7 @@ Expected<InMemoryBake> bake_in_memory(const ImportedModel& model, const BakeRequ
   input.bone_parents = model.skeleton.parents();
   input.samples = samples;
   SINEW_ASSIGN_OR_RETURN(bake.fuzzy, rt::bake_fuzzy_character(input, request.fuzzy, jobs));
+  bake.memory.fuzzy_peak = bake.fuzzy.stats.peak_bytes;
   return bake;
 }
 

@@ -6,6 +6,8 @@
 // matrices, produced here.
 #pragma once
 
+#include <cstddef>
+#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -29,9 +31,13 @@ anim::PoseSpaceDesc default_pose_space();
 // Skinning matrices (bind pose -> model space) of every pose of the space,
 // sample-major (poses x joints). A clip space over a model without clips
 // gives the rest pose alone, so a static skinned model still bakes.
+// `max_bytes` bounds the matrices produced: a space that would need more is
+// refused (kLimitExceeded, field "pose_space") as soon as it passes the
+// bound, so the refusal costs at most `max_bytes`.
 Expected<std::vector<Affine3>> pose_space_skinning(const ImportedModel& model,
                                                    const anim::PoseSpaceDesc& space,
-                                                   std::span<const anim::JointLimit> limits);
+                                                   std::span<const anim::JointLimit> limits,
+                                                   std::size_t max_bytes = SIZE_MAX);
 
 // Skinning matrices of the model posed by one clip alone at weight 1 at
 // playback time `seconds` (looping), placed in the world by `instance`.
@@ -42,12 +48,32 @@ struct BakeRequest {
   anim::PoseSpaceDesc pose_space = default_pose_space();
   std::vector<anim::JointLimit> limits;  // kLimits only
   rt::FuzzyBakeOptions fuzzy;
+  // The bake's working set may not exceed this. The fuzzy boxes already fit
+  // fuzzy.memory_budget_bytes (bones are processed in chunks); what is left
+  // bounds the pose samples, which the bake holds twice (the matrices and
+  // their inverses): samples x joints x 48 bytes x 2.
+  std::size_t max_memory_bytes = std::size_t{8} << 30;
+};
+
+// What a bake holds at its peak, estimated from its large buffers (the
+// same ledger the fuzzy bake keeps; allocator overhead and the kd builders'
+// scratch are not counted).
+struct BakeMemory {
+  std::size_t pose_samples = 0;  // the samples' skinning matrices
+  std::size_t fuzzy_peak = 0;    // the fuzzy bake's own peak (inverses, boxes, trees)
+  std::size_t peak() const { return pose_samples + fuzzy_peak; }
 };
 
 struct InMemoryBake {
   rt::FuzzyCharacterData fuzzy;
   double pose_sampling_ms = 0.0;  // producing the samples' matrices (before the fuzzy bake)
+  BakeMemory memory;
 };
+
+// Errors besides the fuzzy bake's: kInvalidArgument when max_memory_bytes
+// leaves no room beside fuzzy.memory_budget_bytes; kLimitExceeded when the
+// pose space needs more than that room (refused while sampling, before the
+// matrices outgrow the bound).
 
 Expected<InMemoryBake> bake_in_memory(const ImportedModel& model, const BakeRequest& request, JobSystem& jobs);
 

@@ -1,5 +1,6 @@
 #include "editor/cli/pack_commands.h"
 
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -43,6 +44,7 @@ struct BakeOptions {
   float padding = 0.0f;
   rt::CandidateBones candidates = rt::CandidateBones::kAll;
   int threads = 0;
+  std::size_t max_memory_bytes = BakeRequest{}.max_memory_bytes;
   bool help = false;
 };
 
@@ -64,6 +66,9 @@ std::string bake_usage() {
          "  --pad FRACTION        grow every fuzzy box by this fraction of the model's size (default 0)\n"
          "  --candidates MODE     all (the paper's) | influencing (faster; default all)\n"
          "  --threads N           worker threads (default all cores)\n"
+         "  --max-memory-mib M    refuse a bake whose working set would exceed M MiB\n"
+         "                        (default 8192, at least 4; a quarter of it at most goes\n"
+         "                        to the fuzzy boxes, processed in bone chunks)\n"
          "Set SOURCE_DATE_EPOCH for a reproducible pack (fixed date, no timings).\n";
 }
 
@@ -71,7 +76,7 @@ const std::vector<cli::FlagSpec>& bake_flags() {
   static const std::vector<cli::FlagSpec> flags = {
       {"--help", false}, {"-h", false},      {"--out"},     {"--pose-space"}, {"--clips"},
       {"--samples"},     {"--seed"},         {"--limits"}, {"--pad"},  {"--candidates"}, {"--threads"},
-      {"--scene"},
+      {"--scene"},       {"--max-memory-mib"},
   };
   return flags;
 }
@@ -160,6 +165,10 @@ Expected<BakeOptions> parse_bake_options(std::vector<std::string> args) {
   if (auto v = parsed.value("--threads")) {
     SINEW_ASSIGN_OR_RETURN(const std::int64_t n, cli::parse_int("--threads", *v, 1, 1024));
     o.threads = static_cast<int>(n);
+  }
+  if (auto v = parsed.value("--max-memory-mib")) {
+    SINEW_ASSIGN_OR_RETURN(const std::int64_t mib, cli::parse_int("--max-memory-mib", *v, 4, std::int64_t{1} << 30));
+    o.max_memory_bytes = static_cast<std::size_t>(mib) << 20;
   }
   return o;
 }
@@ -397,6 +406,26 @@ void print_inspect(const Json& j, std::ostream& out) {
       << f["max_depth"] << " max / " << f["mean_leaf_depth"] << " mean leaf\n";
 }
 
+// The process's peak resident set so far (getrusage), in KiB; 0 if unknown.
+long max_rss_kib() {
+  rusage usage{};
+  if (::getrusage(RUSAGE_SELF, &usage) != 0) return 0;
+  return usage.ru_maxrss;  // Linux reports KiB
+}
+
+// The estimate counts the bake's large buffers; the RSS peak is what the
+// process really touched (it includes the loaded model and the allocator's
+// slack, and only grows, so a bake below an earlier peak adds nothing).
+void print_bake_memory(const BakeMemory& m, long rss_before_kib, long rss_after_kib, std::ostream& out) {
+  const auto mib = [](double bytes) { return bytes / (1024.0 * 1024.0); };
+  out << std::fixed << std::setprecision(1) << "bake memory: peak " << mib(static_cast<double>(m.peak()))
+      << " MiB estimated (pose samples " << mib(static_cast<double>(m.pose_samples)) << " MiB + fuzzy bake "
+      << mib(static_cast<double>(m.fuzzy_peak)) << " MiB); process peak RSS "
+      << static_cast<double>(rss_after_kib) / 1024.0 << " MiB (" << static_cast<double>(rss_before_kib) / 1024.0
+      << " MiB before the bake)\n"
+      << std::defaultfloat << std::flush;
+}
+
 }  // namespace
 
 int run_bake(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
@@ -410,6 +439,7 @@ int run_bake(const std::vector<std::string>& args, std::ostream& out, std::ostre
   const auto start = Clock::now();
   auto model = load_model(o.model_path);
   if (!model.ok()) return fail(err, "bake", model.status());
+  for (const std::string& warning : model->warnings) err << "sinew-editor bake: warning: " << warning << "\n";
   if (o.scene) {  // model only what the scene plays
     auto kept = keep_recipe_clips(*model, *o.scene);
     if (!kept.ok()) return fail(err, "bake", kept.status());
@@ -419,6 +449,8 @@ int run_bake(const std::vector<std::string>& args, std::ostream& out, std::ostre
   request.pose_space = o.pose_space;
   request.fuzzy.padding = o.padding;
   request.fuzzy.candidates = o.candidates;
+  request.max_memory_bytes = o.max_memory_bytes;
+  request.fuzzy.memory_budget_bytes = std::min(request.fuzzy.memory_budget_bytes, o.max_memory_bytes / 4);
   if (!o.limits_path.empty()) {
     auto limits = anim::load_joint_limits(o.limits_path, model->skeleton);
     if (!limits.ok()) return fail(err, "bake", limits.status());
@@ -431,11 +463,13 @@ int run_bake(const std::vector<std::string>& args, std::ostream& out, std::ostre
       << model->skeleton.joint_count() << " joints) over the " << anim::pose_space_mode_name(o.pose_space.mode)
       << " pose space on " << jobs.thread_count() << " threads\n"
       << std::flush;
+  const long rss_before_kib = max_rss_kib();
   Expected<InMemoryBake> bake = [&] {
     ScopedInterruptHandler interrupts;
     return bake_in_memory(*model, request, jobs);
   }();
   progress.done();
+  if (bake.ok()) print_bake_memory(bake->memory, rss_before_kib, max_rss_kib(), out);
   if (!bake.ok()) {
     if (bake.status().code() == ErrorCode::kCancelled) {
       err << "sinew-editor bake: interrupted; " << o.out_path << " was not written (an existing file is unchanged)\n";
@@ -500,6 +534,7 @@ int run_subdivide(const std::vector<std::string>& args, std::ostream& out, std::
   const std::string& model_path = parsed->positionals.front();
   auto model = load_model(model_path);
   if (!model.ok()) return fail(err, "subdivide", model.status());
+  for (const std::string& warning : model->warnings) err << "sinew-editor subdivide: warning: " << warning << "\n";
   auto finer = subdivide(*model, static_cast<int>(*levels));
   if (!finer.ok()) return fail(err, "subdivide", finer.status());
   CharacterPackContents contents;

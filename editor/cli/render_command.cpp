@@ -422,6 +422,7 @@ Expected<RenderOutputs> render_model(const RenderOptions& options) {
   if (!pack) {
     report(options, "importing " + options.model_path);
     SINEW_ASSIGN_OR_RETURN(imported, load_model(options.model_path));
+    for (const std::string& warning : imported.warnings) report(options, "warning: " + warning);
   }
   const ImportedModel& model = pack ? pack->model() : imported;
   if (model.mesh.triangle_count() == 0) {

@@ -36,7 +36,9 @@
 // * Robustness: Cal3D 0.11 trusts its input (unchecked counts, reads past
 //   the end, an unchecked face index in its own loader), so binary
 //   .csf/.cmf/.caf files are walked and checked before Cal3D sees them;
-//   XML files and materials are left to Cal3D's own checks. Exceptions from
+//   XML materials (.xrf) must have exactly the form Cal3D writes (its XML
+//   loader dereferences missing attributes and texts); other XML files and
+//   binary .crf materials are left to Cal3D's own checks. Exceptions from
 //   Cal3D (std::bad_alloc) become errors naming the file being loaded.
 // * Influences: the 8 largest weights, renormalised to sum 1 (Cal3D does not
 //   renormalise; the test content's weights already sum to 1). A vertex

@@ -162,6 +162,17 @@ Expected<const unsigned char*> view_bytes(const Ctx& c, int view, std::size_t of
   return data.data() + bv.byteOffset + offset;
 }
 
+// The most elements an accessor without a bufferView (zeros, then sparse
+// substitution) may declare: the byte size of the file's buffers, so what
+// the importer allocates stays proportional to its input. Real files use
+// such accessors for sparse morph targets or edits of a mesh whose dense
+// data is in the same buffers, far below this.
+std::size_t unbacked_element_limit(const Ctx& c) {
+  std::size_t bytes = 0;
+  for (const tinygltf::Buffer& b : c.model.buffers) bytes += b.data.size();
+  return bytes;
+}
+
 // Decodes accessor `index` (dense data, then sparse substitution). `use`
 // names where the accessor is referenced, for messages. Float components
 // must be finite.
@@ -203,6 +214,13 @@ Expected<AccessorData> read_accessor(const Ctx& c, int index, const std::string&
   }
 
   const std::size_t elem = ucomps * ucsize;
+  if (a.bufferView < 0 && a.count > unbacked_element_limit(c)) {
+    // All zeros plus sparse values: nothing in the file bounds the count, so
+    // a tiny file could make us allocate gigabytes of zeros per accessor.
+    return c.error(ErrorCode::kLimitExceeded, field + ".count", std::to_string(a.count),
+                   "an accessor without a bufferView may not have more elements than the "
+                   "file's buffers have bytes (" + std::to_string(unbacked_element_limit(c)) + ")");
+  }
   const unsigned char* base = nullptr;
   std::size_t stride = elem;
   if (a.bufferView >= 0 && a.count > 0) {
@@ -966,7 +984,6 @@ Status add_primitive(const Ctx& c, const NodeGraph& g, const SkeletonPlan& plan,
         return c.error(ErrorCode::kInvalidData, idx(afield + ".WEIGHTS_0", v), "0",
                        "the vertex's weights are all zero");
       }
-      for (float& w : weights[v]) w = static_cast<float>(static_cast<double>(w) / sum);
     }
   } else {
     const std::uint16_t j = static_cast<std::uint16_t>(raw_to_sorted[static_cast<std::size_t>(rigid_raw)]);
@@ -1114,6 +1131,9 @@ Expected<ImportedModel> convert(const Ctx& c) {
   }
 
   SINEW_ASSIGN_OR_RETURN(out.clips, build_clips(c, plan, out.skeleton, raw_to_sorted));
+  // Weights that do not sum to 1 are renormalised here, with a warning when
+  // they were off by more than rounding (the rule all importers share).
+  SINEW_RETURN_IF_ERROR(normalize_skin_weights(out));
   return out;
 }
 

@@ -37,6 +37,10 @@
 //   Translation, rotation and scale channels on joints become tracks with
 //   STEP / LINEAR / CUBICSPLINE interpolation; `weights` channels (morph
 //   targets) and channels on non-joint nodes are ignored.
+// * Limits (kLimitExceeded, naming the accessor's count): at most 2^25
+//   values per accessor, and an accessor without a bufferView (zeros plus
+//   sparse values) at most as many elements as the file's buffers have
+//   bytes, so that memory stays proportional to the file's size.
 #pragma once
 
 #include <string>

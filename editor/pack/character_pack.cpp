@@ -491,6 +491,16 @@ Expected<CharacterPack> CharacterPack::load(PackReader reader) {
     return make_error(ErrorCode::kInvalidData, r.name(), "FZHD.bone_count", std::to_string(h.bone_count),
                       "differs from the skeleton's " + std::to_string(pack.model_.skeleton.joint_count()) + " joints");
   }
+  // The counts are only reported (stats), never used to size anything, but
+  // a header that disagrees with the mesh is a corrupt pack, not a statistic.
+  if (h.vertex_count != pack.model_.mesh.vertex_count()) {
+    return make_error(ErrorCode::kInvalidData, r.name(), "FZHD.vertex_count", std::to_string(h.vertex_count),
+                      "differs from the mesh's " + std::to_string(pack.model_.mesh.vertex_count()) + " vertices");
+  }
+  if (h.triangle_count != pack.model_.mesh.triangle_count()) {
+    return make_error(ErrorCode::kInvalidData, r.name(), "FZHD.triangle_count", std::to_string(h.triangle_count),
+                      "differs from the mesh's " + std::to_string(pack.model_.mesh.triangle_count()) + " triangles");
+  }
   if (h.candidates > static_cast<std::uint8_t>(rt::CandidateBones::kInfluencing)) {
     return make_error(ErrorCode::kInvalidData, r.name(), "FZHD.candidates", std::to_string(h.candidates),
                       "unknown candidate-bone mode");

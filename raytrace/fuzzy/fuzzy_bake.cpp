@@ -157,6 +157,16 @@ Status validate_input(const FuzzyBakeInput& input, const FuzzyBakeOptions& optio
     return make_error(ErrorCode::kLimitExceeded, "", "bone_count", std::to_string(bones),
                       "more bones than triangle_bone (uint16) can name (65535)");
   }
+  // Vertex and triangle ids are 32-bit everywhere past this point.
+  constexpr std::size_t kMaxIds = std::numeric_limits<std::uint32_t>::max();
+  if (input.mesh->vertex_count() > kMaxIds) {
+    return make_error(ErrorCode::kLimitExceeded, "", "vertex_count", std::to_string(input.mesh->vertex_count()),
+                      "more vertices than 32-bit ids can name");
+  }
+  if (input.mesh->triangle_count() > kMaxIds) {
+    return make_error(ErrorCode::kLimitExceeded, "", "triangle_count", std::to_string(input.mesh->triangle_count()),
+                      "more triangles than 32-bit ids can name");
+  }
   if (input.bone_parents.size() != bones) {
     return invalid_argument("bone_parents", std::to_string(input.bone_parents.size()) + " entries",
                             "expected one parent per bone (" + std::to_string(bones) + ")");

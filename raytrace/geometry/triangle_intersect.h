@@ -62,6 +62,14 @@ inline bool intersect_triangle_watertight(const WatertightRay& wr, const Ray& ra
 
 namespace detail {
 inline constexpr float kFloatMax = std::numeric_limits<float>::max();
+// The fast test's determinant is a sum of products whose rounding error is
+// below a few float epsilons times the same sum taken over absolute values
+// (fast_det_bound). A |det| under this fraction of that bound has no
+// reliable sign or size: the ray lies in the triangle's plane up to
+// rounding, e.g. a ray along one of its edges, where u, v and t come out as
+// ratios of rounding noise (a "hit" at t = 0 metres away from the triangle).
+// Such rays are reported as misses; the watertight test handles them exactly.
+inline constexpr float kFastDetTolerance = 8.0f * std::numeric_limits<float>::epsilon();
 
 // True for finite non-zero x; false for zero, infinities and NaN.
 inline bool finite_nonzero(float x) { return (x > 0.0f && x <= kFloatMax) || (x < 0.0f && x >= -kFloatMax); }
@@ -118,6 +126,13 @@ inline bool intersect_triangle_fast(const Ray& ray, float t_max, const Vec3& p0,
   // infinite or NaN coordinate always makes det inf or NaN, so this one test
   // keeps such triangles from producing garbage hits.
   if (!detail::finite_nonzero(det)) return false;
+  // Within rounding of zero: the ray lies in the triangle's plane
+  // (kFastDetTolerance). Same expression, same order as the 8-wide twin.
+  const float det_bound =
+      (std::fabs(e1.x) * (std::fabs(d.y * e2.z) + std::fabs(d.z * e2.y)) +
+       std::fabs(e1.y) * (std::fabs(d.z * e2.x) + std::fabs(d.x * e2.z))) +
+      std::fabs(e1.z) * (std::fabs(d.x * e2.y) + std::fabs(d.y * e2.x));
+  if (!(std::fabs(det) > detail::kFastDetTolerance * det_bound)) return false;
   const float inv_det = 1.0f / det;
 
   const Vec3 tv = ray.origin - p0;

@@ -47,6 +47,15 @@ inline std::uint32_t intersect_triangle_fast8(const RayLanes8& r, std::uint32_t 
   const __m256 abs_det = _mm256_andnot_ps(_mm256_set1_ps(-0.0f), det);
   __m256 ok = _mm256_and_ps(_mm256_cmp_ps(abs_det, _mm256_setzero_ps(), _CMP_GT_OQ),
                             _mm256_cmp_ps(abs_det, _mm256_set1_ps(detail::kFloatMax), _CMP_LE_OQ));
+  // |det| > kFastDetTolerance * det_bound, as the scalar test computes it.
+  const __m256 sign = _mm256_set1_ps(-0.0f);
+  const auto abs = [&sign](__m256 a) { return _mm256_andnot_ps(sign, a); };
+  const __m256 det_bound =
+      add(add(mul(abs(e1x), add(abs(mul(dy, e2z)), abs(mul(dz, e2y)))),
+              mul(abs(e1y), add(abs(mul(dz, e2x)), abs(mul(dx, e2z))))),
+          mul(abs(e1z), add(abs(mul(dx, e2y)), abs(mul(dy, e2x)))));
+  ok = _mm256_and_ps(ok, _mm256_cmp_ps(abs_det, mul(_mm256_set1_ps(detail::kFastDetTolerance), det_bound),
+                                       _CMP_GT_OQ));
   if (_mm256_testz_ps(ok, ok) != 0) return 0;
   const __m256 inv_det = _mm256_div_ps(_mm256_set1_ps(1.0f), det);
 

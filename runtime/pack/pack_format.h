@@ -83,6 +83,11 @@ inline constexpr std::uint32_t kSectionAlignment = 64;
 // A sanity cap, far above what a character needs (a dozen sections), that
 // bounds the work and memory the reader spends on the table before it trusts it.
 inline constexpr std::uint32_t kMaxSections = 4096;
+// The largest pack a reader accepts (64 GiB): thousands of times a
+// subdivided character, and small enough that validating it (every byte is
+// checksummed or checked to be zero padding) ends in bounded time. A larger
+// file is refused from its header, before the table or any payload is read.
+inline constexpr std::uint64_t kMaxPackBytes = std::uint64_t{1} << 36;
 
 struct PackVersion {
   std::uint16_t major = 0;

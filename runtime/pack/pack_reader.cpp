@@ -139,6 +139,12 @@ Expected<PackReader> PackReader::parse(std::span<const std::byte> bytes, std::st
                     " trailing bytes after the declared end (" + dec(actual_size) +
                     " bytes in all)");
   }
+  // After the two checks above, so that a small file claiming a huge size
+  // still reads as truncated; here the file really is that large.
+  if (actual_size > kMaxPackBytes) {
+    return fail(ErrorCode::kLimitExceeded, "header.file_size", dec(actual_size),
+                "larger than the " + dec(kMaxPackBytes >> 30) + " GiB a pack may be");
+  }
   const std::uint64_t file_size = actual_size;
 
   // --- section table ----------------------------------------------------------

@@ -404,6 +404,11 @@ TEST_F(Cal3dBadInput, CorruptFields) {
   };
   const std::string cmf = read(model_file("cally", "cally_chest.cmf"));
   const std::string caf = read(model_file("cally", "cally_wave.caf"));
+  auto i32_at = [](const std::string& bytes, std::size_t at) {
+    std::uint32_t v = 0;
+    for (int i = 3; i >= 0; --i) v = (v << 8) | static_cast<unsigned char>(bytes[at + static_cast<std::size_t>(i)]);
+    return static_cast<std::size_t>(v);
+  };
   const std::vector<Case> cases = {
       // .cmf: magic, version, submeshCount, then material, vertexCount (16), ...
       {"c.cmf", patch_i32(cmf, 16, 0x7fffffffu), ErrorCode::kTruncated},
@@ -415,6 +420,10 @@ TEST_F(Cal3dBadInput, CorruptFields) {
       {"c.caf", patch_i32(caf, 12, 0x10000000u), ErrorCode::kTruncated},
       {"c.caf", patch_i32(caf, 16, 999u), ErrorCode::kOutOfBounds},
       {"c.caf", patch_i32(caf, 24, 0x7fc00000u), ErrorCode::kInvalidData},
+      // A negative bone id in a later track: Cal3D leaked the tracks before
+      // it (found by fuzzing). track[0] has 4-byte bone, keyframeCount and
+      // 32-byte keys, so track[1].bone follows them.
+      {"c.caf", patch_i32(caf, 24 + 32 * i32_at(caf, 20), 0xffffffefu), ErrorCode::kOutOfBounds},
   };
   for (const Case& c : cases) {
     const std::string file = write(c.name, c.bytes);
@@ -425,6 +434,106 @@ TEST_F(Cal3dBadInput, CorruptFields) {
     EXPECT_EQ(m.status().code(), c.code) << m.status().message();
     EXPECT_EQ(m.status().file(), file) << m.status().message();
   }
+}
+
+// Skeleton files that crashed inside Cal3D when fuzzed (a bone name without
+// its NUL: strlen past the buffer; a parent id past the bone count: a null
+// bone in CalCoreBone::calculateState), plus a child list that contradicts
+// the parents and an absurd bone count: refused by the pre-check, naming
+// the field.
+TEST_F(Cal3dBadInput, CorruptSkeletonLinksAndNames) {
+  const std::string csf = read(model_file("cally", "cally.csf"));
+  auto i32_at = [&csf](std::size_t at) {
+    std::uint32_t v = 0;
+    for (int i = 3; i >= 0; --i) v = (v << 8) | static_cast<unsigned char>(csf[at + static_cast<std::size_t>(i)]);
+    return v;
+  };
+  auto patch_i32 = [](std::string bytes, std::size_t at, std::uint32_t v) {
+    for (int i = 0; i < 4; ++i) bytes[at + static_cast<std::size_t>(i)] = static_cast<char>((v >> (8 * i)) & 0xff);
+    return bytes;
+  };
+  // magic, version, boneCount, then bone[0]: name length (12), name, 14 floats, parent.
+  const std::size_t name_length = i32_at(12);
+  const std::size_t parent_at = 16 + name_length + 14 * 4;
+  const std::size_t child_count_at = parent_at + 4;
+  ASSERT_EQ(i32_at(parent_at), 0xffffffffu) << "bone[0] of cally.csf is a root";
+  ASSERT_GT(i32_at(child_count_at), 0u);
+
+  std::string no_nul = csf;
+  no_nul[16 + name_length - 1] = 'X';
+  std::string huge("CSF\0", 4);
+  huge += std::string("\xbc\x02\x00\x00", 4) + std::string("\x88\x13\x00\x00", 4);  // version 700, 5000 bones
+  huge += std::string(5000 * 72, '\0');
+  struct Case {
+    std::string bytes;
+    ErrorCode code;
+    std::string field;
+  };
+  const std::vector<Case> cases = {
+      {no_nul, ErrorCode::kInvalidData, "bone[0].name"},
+      {patch_i32(csf, parent_at, 999u), ErrorCode::kOutOfBounds, "bone[0].parentId"},
+      {patch_i32(csf, child_count_at + 4, 0u), ErrorCode::kInvalidData, "bone[0].children[0]"},
+      {huge, ErrorCode::kLimitExceeded, "boneCount"},
+  };
+  for (const Case& c : cases) {
+    const std::string file = write("s.csf", c.bytes);
+    auto m = import_cal3d(write("s.cfg", "skeleton=" + file + "\n"));
+    ASSERT_FALSE(m.ok()) << c.field;
+    EXPECT_EQ(m.status().code(), c.code) << m.status().message();
+    EXPECT_EQ(m.status().file(), file) << m.status().message();
+    EXPECT_EQ(m.status().field(), c.field) << m.status().message();
+  }
+  // The unpatched file still loads.
+  auto m = import_cal3d(write("s.cfg", "skeleton=" + write("s.csf", csf) + "\n"));
+  ASSERT_TRUE(m.ok()) << m.status().message();
+}
+
+// XML materials go to Cal3D's XML loader, which dereferences missing
+// attributes and element texts (found by fuzzing: a HEADER without MAGIC
+// crashed in strcasecmp(nullptr)); the importer refuses them first. The
+// same file with the canonical header still loads, so the check is not
+// simply refusing every material.
+TEST_F(Cal3dBadInput, MalformedXmlMaterialsAreRefusedBeforeCal3d) {
+  const std::string csf = model_file("cally", "cally.csf");
+  const std::string cmf = model_file("cally", "cally_neck.cmf");
+  const std::string good = read(model_file("cally", "cally_skin.xrf"));
+  auto with = [&good](const std::string& from, const std::string& to) {
+    std::string text = good;
+    const std::size_t at = text.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    if (at != std::string::npos) text.replace(at, from.size(), to);
+    return text;
+  };
+  struct Case {
+    std::string bytes;
+    std::string element;  // the field the error must name
+  };
+  const std::vector<Case> cases = {
+      {with("MAGIC=", "M2AGIC="), "HEADER"},  // the fuzzer's input, in essence
+      {with(" VERSION=\"900\"", ""), "HEADER"},
+      {with("<MATERIAL NUMMAPS=\"0\">", "<MATERIAL>"), "MATERIAL"},
+      {with("<AMBIENT>128 98 98 0</AMBIENT>", "<AMBIENT></AMBIENT>"), "AMBIENT"},
+      {with("<AMBIENT>128 98 98 0</AMBIENT>", "<AMBIENT/>"), "AMBIENT"},
+      {with("<DIFFUSE>240 184 184 0</DIFFUSE>", "<DIFFUSE>240 x 184 0</DIFFUSE>"), "DIFFUSE"},
+      {with("<SHININESS>0.05</SHININESS>", ""), "SHININESS"},
+      {with("</MATERIAL>", "<MAP/></MATERIAL>"), "MATERIAL"},
+      {with("</MATERIAL>", "<MAP>  </MAP></MATERIAL>"), "MAP"},
+      {good.substr(0, good.find("<MATERIAL")), "MATERIAL"},
+      {"", "magic"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.bytes);
+    const std::string xrf = write("m.xrf", c.bytes);
+    auto m = import_cal3d(write("m.cfg", "skeleton=" + csf + "\nmesh=" + cmf + "\nmaterial=" + xrf + "\n"));
+    ASSERT_FALSE(m.ok());
+    EXPECT_EQ(m.status().file(), xrf) << m.status().message();
+    EXPECT_EQ(m.status().field(), c.element) << m.status().message();
+  }
+  const std::string xrf = write("m.xrf", with("</MATERIAL>", "<MAP>skin.tga</MAP>\n</MATERIAL>"));
+  auto m = import_cal3d(write("m.cfg", "skeleton=" + csf + "\nmesh=" + cmf + "\nmaterial=" + xrf + "\n"));
+  ASSERT_TRUE(m.ok()) << m.status().message();
+  ASSERT_FALSE(m->mesh.material_colors.empty());
+  EXPECT_FLOAT_EQ(m->mesh.material_colors[0].x, 240.0f / 255.0f);
 }
 
 TEST_F(Cal3dBadInput, TwoListedAnimationsWithOneClipName) {

@@ -862,6 +862,25 @@ TEST_F(GltfSynthetic, TruncatedGlb) {
   EXPECT_EQ(m.status().file(), path);
 }
 
+// Found by fuzzing (a time-out): accessors without a bufferView are zeros,
+// so a 400-byte file could declare 11 million vertices and make the importer
+// allocate and process gigabytes. Their count is now limited by the bytes
+// of the file's buffers (here: none), before anything is allocated.
+TEST_F(GltfSynthetic, UnbackedAccessorCountIsLimitedByTheBuffers) {
+  const std::string path = (dir_ / "huge.gltf").string();
+  std::ofstream(path, std::ios::binary)
+      << R"({"asset": {"version": "2.0"}, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+  "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+  "accessors": [{"componentType": 5126, "count": 11000000, "type": "VEC3",
+                 "min": [0, 0, 0], "max": [0, 0, 0]}]})";
+  const auto m = import_gltf(path);
+  ASSERT_FALSE(m.ok());
+  EXPECT_EQ(m.status().code(), ErrorCode::kLimitExceeded) << m.status().message();
+  EXPECT_EQ(m.status().file(), path);
+  EXPECT_NE(m.status().field().find("accessors[0].count"), std::string::npos) << m.status().message();
+  EXPECT_EQ(m.status().value(), "11000000");
+}
+
 TEST_F(GltfSynthetic, WeightsChannelIgnoredAndCubicSplineAccepted) {
   Synthetic s = synthetic();
   // A cubic spline sampler needs 3 values per key: reuse the 2 rotation
