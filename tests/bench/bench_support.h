@@ -12,9 +12,15 @@
 #include <string_view>
 #include <vector>
 
+#include <chrono>
+
 #include "content/mannequin/mannequin.h"
+#include "editor/bake/in_memory_bake.h"
 #include "editor/cli/cli_args.h"
+#include "editor/cli/render_command.h"
 #include "editor/import/cal3d_importer.h"
+#include "editor/import/model_loader.h"
+#include "raytrace/scene/scene.h"
 #include "runtime/core/expected.h"
 #include "runtime/cpu/cpu_features.h"
 #include "runtime/jobs/job_system.h"
@@ -44,6 +50,30 @@ inline std::string utc_date() {
   return text;
 }
 
+// The short commit of the working directory's git checkout, "unknown"
+// outside one (or without git).
+inline std::string git_commit() {
+  std::FILE* pipe = popen("git rev-parse --short HEAD 2>/dev/null", "r");
+  if (!pipe) return "unknown";
+  char text[64] = {};
+  const bool read = std::fgets(text, sizeof text, pipe) != nullptr;
+  pclose(pipe);
+  std::string commit = read ? text : "";
+  while (!commit.empty() && (commit.back() == '\n' || commit.back() == '\r')) commit.pop_back();
+  return commit.empty() ? "unknown" : commit;
+}
+
+// The 1, 5 and 15 minute load averages (/proc/loadavg): a busy machine's
+// timings are noisy, and the table should say so.
+inline std::string load_average() {
+  std::ifstream in("/proc/loadavg");
+  double one = 0.0, five = 0.0, fifteen = 0.0;
+  if (!(in >> one >> five >> fifteen)) return "unknown";
+  char text[64];
+  std::snprintf(text, sizeof text, "%.2f, %.2f, %.2f", one, five, fifteen);
+  return text;
+}
+
 // The lines every benchmark table starts with: what ran, where, when.
 inline void print_bench_header(const char* name, const std::string& command_line, const std::string& threads,
                                const std::string& cpu, const std::string& date) {
@@ -53,6 +83,14 @@ inline void print_bench_header(const char* name, const std::string& command_line
   std::printf("  threads: %s\n", threads.c_str());
   std::printf("  isa:     %s\n", std::string(build_isa()).c_str());
   std::printf("  date:    %s\n", date.c_str());
+  std::printf("  commit:  %s\n", git_commit().c_str());
+  std::printf("  load:    %s (1, 5, 15 min, at start)\n", load_average().c_str());
+}
+
+// The error of an Expected whose value the caller does not need.
+template <typename T>
+Status status_of(const Expected<T>& result) {
+  return result.ok() ? Status{} : result.status();
 }
 
 // A comma-separated list of integers in [lo, hi] ("1,6,12").
@@ -85,12 +123,93 @@ inline Expected<std::optional<editor::ImportedModel>> load_model(const std::stri
   return std::optional<editor::ImportedModel>(std::move(model));
 }
 
+// "mannequin", "cally", or the path of any model the tools read (glTF,
+// Cal3D .cfg, or a .pack, whose model is used and baked in memory).
+inline Expected<std::optional<editor::ImportedModel>> load_model_or_path(const std::string& name,
+                                                                 const std::string& shared, std::string& note) {
+  if (name == "mannequin" || name == "cally") return load_model(name, shared, note);
+  SINEW_ASSIGN_OR_RETURN(editor::ImportedModel model, editor::load_model(name));
+  return std::optional<editor::ImportedModel>(std::move(model));
+}
+
+// The index of the clip called `clip`.
+inline Expected<std::size_t> find_clip(const editor::ImportedModel& model, const std::string& name,
+                                       const std::string& clip) {
+  for (std::size_t i = 0; i < model.clips.size(); ++i) {
+    if (model.clips[i].name() == clip) return i;
+  }
+  std::string known;
+  for (const anim::Clip& c : model.clips) known += (known.empty() ? "" : ", ") + c.name();
+  return make_error(ErrorCode::kNotFound, name, "clip", clip,
+                    "the model has no clip of that name (its clips: " + (known.empty() ? "none" : known) + ")");
+}
+
 // The index of the clip named "walk".
 inline Expected<std::size_t> find_walk_clip(const editor::ImportedModel& model, const std::string& name) {
-  for (std::size_t i = 0; i < model.clips.size(); ++i) {
-    if (model.clips[i].name() == "walk") return i;
+  return find_clip(model, name, "walk");
+}
+
+// The staged benchmark scene: `instances` copies of one character placed in
+// a row on a ground quad, as the render command places them.
+struct BenchStage {
+  rt::Scene scene;
+  std::vector<std::uint32_t> ids;
+  std::vector<Affine3> placements;
+  rt::StaticMeshDesc ground;
+  Aabb rest;
+  int up = 1;
+};
+
+inline Status stage_instances(const editor::ImportedModel& model, const rt::FuzzyCharacterView& fuzzy,
+                              int instances, BenchStage& stage) {
+  stage.rest = editor::rest_bounds(model);
+  stage.up = editor::up_axis_of(stage.rest);
+  SINEW_ASSIGN_OR_RETURN(const std::uint32_t character, stage.scene.add_character(model.mesh, fuzzy));
+  for (int i = 0; i < instances; ++i) {
+    SINEW_ASSIGN_OR_RETURN(const std::uint32_t id, stage.scene.add_instance(character));
+    stage.ids.push_back(id);
+    stage.placements.push_back(editor::instance_placement(stage.rest, i));
   }
-  return make_error(ErrorCode::kNotFound, name, "clip", "walk", "the model has no walk clip");
+  stage.ground = editor::ground_plane_for(stage.rest, instances);
+  const auto ground = stage.scene.add_static_mesh(stage.ground);
+  return ground.ok() ? Status{} : ground.status();
+}
+
+// Poses every instance of `stage` at `seconds` through `clip` (instance i
+// offset by instance_time_offset(i)); prepare_frame comes next.
+inline Status pose_instances(const editor::ImportedModel& model, const anim::Clip& clip, double seconds,
+                             BenchStage& stage) {
+  for (std::size_t i = 0; i < stage.ids.size(); ++i) {
+    const double t = seconds + editor::instance_time_offset(static_cast<int>(i));
+    SINEW_ASSIGN_OR_RETURN(const std::vector<Affine3> bones,
+                           editor::clip_skinning(model, clip, t, stage.placements[i]));
+    SINEW_RETURN_IF_ERROR(stage.scene.set_bones(stage.ids[i], bones));
+  }
+  return {};
+}
+
+// The exact SAH kd-tree contender: `exact` (an empty scene) gets one static
+// mesh of `fuzzy_scene`'s skinned world triangles (instance after instance,
+// so triangle i*T + t is instance i's triangle t) and the ground, and is
+// prepared. Returns the build time of the skinned mesh's tree in ms.
+inline Expected<double> build_exact_scene(const rt::Scene& fuzzy_scene, const SkinnedMesh& mesh,
+                                          const rt::StaticMeshDesc& ground, JobSystem& jobs, rt::Scene& exact) {
+  rt::StaticMeshDesc skinned;
+  for (const rt::InstanceFrame& instance : fuzzy_scene.instances()) {
+    const auto base = static_cast<std::uint32_t>(skinned.positions.size());
+    skinned.positions.insert(skinned.positions.end(), instance.positions.begin(), instance.positions.end());
+    for (const auto& t : mesh.triangles) skinned.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
+  }
+  const auto build_start = std::chrono::steady_clock::now();
+  const auto added = exact.add_static_mesh(std::move(skinned));
+  if (!added.ok()) return added.status();
+  const double build_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - build_start).count();
+  const auto ground_added = exact.add_static_mesh(ground);
+  if (!ground_added.ok()) return ground_added.status();
+  const auto prepared = exact.prepare_frame(rt::FrameOptions{}, jobs);
+  if (!prepared.ok()) return prepared.status();
+  return build_ms;
 }
 
 }  // namespace sinew::bench

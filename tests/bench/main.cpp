@@ -8,6 +8,7 @@
 #include "tests/bench/animation_bench.h"
 #include "tests/bench/bake_bench.h"
 #include "tests/bench/demo_bench.h"
+#include "tests/bench/embree_bench.h"
 #include "tests/bench/raytrace_bench.h"
 
 namespace {
@@ -20,6 +21,8 @@ void usage() {
       "           fuzzy bake cost per candidate-bone mode, its trace effect, and its memory bound\n"
       "  demo [--characters LIST] [--size WxH] [--threads N] [--frames N] [--warmup N]\n"
       "           [--shadows on|off] [--model PATH] [--json FILE]   the game demo's fps and phases\n"
+      "  embree [--quick] [--model NAME|PATH] [--instances N] [--frames N] [--clips LIST] [--size WxH]\n"
+      "           [--threads LIST] [--json FILE]   Sinew vs Embree 3 (rebuild LOW/MEDIUM, refit) vs exact kd\n"
       "  raytrace [--size WxH] [--frames N] [--threads LIST] [--models LIST] [--instances LIST]\n"
       "           [--shared DIR] [--triangle-test fast|watertight] [--bone-boxes exact|cheap]\n"
       "           [--json FILE]   ray tracer frame phases, and fuzzy vs exact kd-tree trace time\n");
@@ -53,6 +56,7 @@ int main(int argc, char** argv) {
   if (what == "animation") return sinew::bench::run_animation_bench(args);
   if (what == "bake") return sinew::bench::run_bake_bench(args, command_line(argc, argv));
   if (what == "demo") return sinew::bench::run_demo_bench(args, command_line(argc, argv));
+  if (what == "embree") return sinew::bench::run_embree_bench(args, command_line(argc, argv));
   if (what == "raytrace") return sinew::bench::run_raytrace_bench(args, command_line(argc, argv));
   if (what == "--help" || what == "-h" || what == "help") {
     usage();

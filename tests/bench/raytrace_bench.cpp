@@ -29,20 +29,10 @@
 namespace sinew::bench {
 namespace {
 
-using Clock = std::chrono::steady_clock;
 using Json = nlohmann::ordered_json;
 
 constexpr double kFramesPerSecond = 30.0;
 constexpr int kMaxImageSide = 16384;
-// The error of an Expected whose value the caller does not need.
-template <typename T>
-Status status_of(const Expected<T>& result) {
-  return result.ok() ? Status{} : result.status();
-}
-
-double ms_since(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 // --- options -----------------------------------------------------------------
 
@@ -195,18 +185,8 @@ Status compare_with_exact(const rt::Scene& fuzzy_scene, const SkinnedMesh& mesh,
                           const rt::PinholeCamera& camera, const rt::RenderSettings& settings,
                           const rt::FrameBuffers& buffers, const rt::RenderStats& fuzzy, JobSystem& jobs,
                           rt::Renderer& renderer, ExactComparison& out) {
-  rt::StaticMeshDesc skinned;
-  for (const rt::InstanceFrame& instance : fuzzy_scene.instances()) {
-    const auto base = static_cast<std::uint32_t>(skinned.positions.size());
-    skinned.positions.insert(skinned.positions.end(), instance.positions.begin(), instance.positions.end());
-    for (const auto& t : mesh.triangles) skinned.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
-  }
   rt::Scene exact;
-  const Clock::time_point build_start = Clock::now();
-  SINEW_RETURN_IF_ERROR(status_of(exact.add_static_mesh(std::move(skinned))));
-  const double build_ms = ms_since(build_start);
-  SINEW_RETURN_IF_ERROR(status_of(exact.add_static_mesh(ground)));
-  SINEW_RETURN_IF_ERROR(status_of(exact.prepare_frame(rt::FrameOptions{}, jobs)));
+  SINEW_ASSIGN_OR_RETURN(const double build_ms, build_exact_scene(fuzzy_scene, mesh, ground, jobs, exact));
   SINEW_ASSIGN_OR_RETURN(const rt::RenderStats traced, renderer.render(exact, camera, settings, buffers, jobs));
 
   const double fuzzy_trace = fuzzy.trace_primary_ms + fuzzy.trace_shadow_ms;

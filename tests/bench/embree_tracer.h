@@ -1,0 +1,85 @@
+// The Embree 3 contender of `sinew-bench embree` (and of its test): an
+// Embree scene over the skinned triangles a prepared rt::Scene already holds
+// (Sinew's own skinning, so skinning is identical for every contender), and
+// a tile-parallel renderer over Sinew's JobSystem that casts the same camera
+// rays, the same shadow rays and shades with the same surface math as
+// rt::Renderer. Only the acceleration structure and the traversal differ.
+//
+// What differs from rt::Renderer, on purpose or for simplicity:
+// - rays are cast one at a time (rtcIntersect1 / rtcOccluded1); Sinew's
+//   renderer traces 4x2 packets and packets of eight shadow rays;
+// - Embree's own triangle test (not Sinew's fast/watertight choice);
+// - the vertex positions are copied into Embree's padded buffers each frame
+//   (Embree may read 4 bytes past the last vertex); the copy is timed as
+//   part of the build / refit;
+// - sRGB encoding uses a local 4096-entry table in place of the renderer's
+//   private one (the same cost class: one lookup per channel).
+// Surfaces and shadow-ray origins come from rt::surface_at / rt::offset_origin
+// on the same Scene, so the shading arithmetic is exactly the renderer's.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+
+#include "raytrace/camera/camera.h"
+#include "raytrace/render/renderer.h"
+#include "raytrace/scene/scene.h"
+#include "runtime/core/expected.h"
+#include "runtime/math/ray.h"
+
+namespace sinew {
+class JobSystem;
+}
+
+namespace sinew::bench {
+
+enum class EmbreeMode : std::uint8_t {
+  kRebuildLow,     // RTC_BUILD_QUALITY_LOW, dynamic scene, full rebuild every frame
+  kRebuildMedium,  // RTC_BUILD_QUALITY_MEDIUM, full rebuild every frame
+  kRefit,          // built once, then RTC_BUILD_QUALITY_REFIT: the BVH is refitted each frame
+};
+
+const char* embree_mode_name(EmbreeMode mode);
+
+struct EmbreeRenderStats {
+  std::uint64_t primary_hits = 0;
+  std::uint64_t shadow_rays = 0;
+  std::uint64_t shadowed = 0;
+  double trace_primary_ms = 0.0;
+  double trace_shadow_ms = 0.0;
+  double shade_ms = 0.0;
+};
+
+class EmbreeTracer {
+ public:
+  // `threads`: the Embree device's build threads (the JobSystem's count, so
+  // builds and traces use the same number of cores). Errors: the device or
+  // scene could not be created (the message carries Embree's error code).
+  static Expected<std::unique_ptr<EmbreeTracer>> create(EmbreeMode mode, int threads);
+  ~EmbreeTracer();
+  EmbreeTracer(const EmbreeTracer&) = delete;
+  EmbreeTracer& operator=(const EmbreeTracer&) = delete;
+
+  // Brings the BVH up to date with `scene`'s current skinned positions (after
+  // its prepare_frame): the first call creates one Embree geometry per
+  // instance and per static mesh and builds; later calls upload the new
+  // positions and rebuild or refit by the mode. The scene's set of instances
+  // and static meshes must not change between calls. Returns milliseconds.
+  Expected<double> update(const rt::Scene& scene);
+
+  // Renders like rt::Renderer::render with `settings` (one light, its
+  // shadows, diffuse shading) into `color_rgba8` (width x height x 4, may be
+  // empty) and, when not empty, the primary hits into `hits` (width x height,
+  // Sinew's ids: triangle index within its mesh and the scene's instance id).
+  Expected<EmbreeRenderStats> render(const rt::Scene& scene, const rt::PinholeCamera& camera,
+                                     const rt::RenderSettings& settings, std::span<std::uint8_t> color_rgba8,
+                                     std::span<Hit> hits, JobSystem& jobs);
+
+ private:
+  struct State;
+  explicit EmbreeTracer(std::unique_ptr<State> state);
+  std::unique_ptr<State> state_;
+};
+
+}  // namespace sinew::bench
