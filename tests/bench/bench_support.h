@@ -93,6 +93,13 @@ Status status_of(const Expected<T>& result) {
   return result.ok() ? Status{} : result.status();
 }
 
+// "1,2,4": the inverse of parse_int_list, for headers and tables.
+inline std::string join_ints(const std::vector<int>& values) {
+  std::string out;
+  for (int v : values) out += (out.empty() ? "" : ",") + std::to_string(v);
+  return out;
+}
+
 // A comma-separated list of integers in [lo, hi] ("1,6,12").
 inline Expected<std::vector<int>> parse_int_list(std::string_view flag, const std::string& text, int lo, int hi) {
   SINEW_ASSIGN_OR_RETURN(const std::vector<std::string> items, editor::cli::parse_list(flag, text));

@@ -450,12 +450,6 @@ Json config_json(const ConfigResult& r) {
   return doc;
 }
 
-std::string join(const std::vector<int>& values) {
-  std::string out;
-  for (int v : values) out += (out.empty() ? "" : ",") + std::to_string(v);
-  return out;
-}
-
 }  // namespace
 
 int run_embree_bench(const std::vector<std::string>& args, const std::string& command_line) {
@@ -472,7 +466,7 @@ int run_embree_bench(const std::vector<std::string>& args, const std::string& co
   }
   const std::string cpu = cpu_model();
   const std::string date = utc_date();
-  print_bench_header("embree", command_line, join(o.threads), cpu, date);
+  print_bench_header("embree", command_line, join_ints(o.threads), cpu, date);
 #ifdef SINEW_HAVE_EMBREE
   const bool have_embree = true;
 #else

@@ -123,12 +123,6 @@ void print_usage(std::FILE* to) {
 
 // --- machine -------------------------------------------------------------------
 
-std::string join_ints(const std::vector<int>& values) {
-  std::string out;
-  for (int v : values) out += (out.empty() ? "" : ",") + std::to_string(v);
-  return out;
-}
-
 // --- models --------------------------------------------------------------------
 
 struct BenchModel {

@@ -14,6 +14,7 @@
 #include "raytrace/scene/scene.h"
 #include "runtime/jobs/job_system.h"
 #include "sinew/sinew.h"
+#include "tests/support/aov_frame.h"
 #include "tests/support/idle_mannequin.h"
 
 namespace sinew::testing_support {
@@ -38,40 +39,9 @@ inline const std::string& mannequin_pack_path() {
   return path;
 }
 
-// Every output of one frame, packed rows.
-struct Frame {
-  int width = 0;
-  int height = 0;
-  std::vector<std::uint8_t> rgba8;
-  std::vector<float> rgba32f;
-  std::vector<float> depth;
-  std::vector<Vec3> normal;
-  std::vector<std::uint32_t> instance_id;
-  std::vector<std::uint32_t> triangle_id;
-
-  Frame(int w, int h)
-      : width(w),
-        height(h),
-        rgba8(4 * pixels()),
-        rgba32f(4 * pixels()),
-        depth(pixels()),
-        normal(pixels()),
-        instance_id(pixels()),
-        triangle_id(pixels()) {}
-  std::size_t pixels() const { return static_cast<std::size_t>(width) * static_cast<std::size_t>(height); }
-
-  rt::FrameBuffers buffers() {
-    rt::FrameBuffers b;
-    b.width = width;
-    b.height = height;
-    b.color_rgba8 = rgba8;
-    b.color_rgba32f = rgba32f;
-    b.depth = depth;
-    b.normal = normal;
-    b.instance_id = instance_id;
-    b.triangle_id = triangle_id;
-    return b;
-  }
+// Every output of one frame, packed rows, also as the API's PassOutputs.
+struct Frame : AovFrame {
+  using AovFrame::AovFrame;
   api::PassOutputs outputs() {
     api::PassOutputs o;
     o.color_rgba8 = {rgba8.data(), 0};

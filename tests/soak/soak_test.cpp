@@ -41,6 +41,7 @@
 #include <string>
 #include <vector>
 
+#include "tests/support/aov_frame.h"
 #include "animation/blend.h"
 #include "animation/mixer.h"
 #include "animation/pose.h"
@@ -247,46 +248,7 @@ void advance_probe(Probe& probe, const std::vector<std::vector<float>>& sample_t
   }
 }
 
-struct Aovs {
-  std::vector<std::uint8_t> rgba8;
-  std::vector<float> rgba32f;
-  std::vector<float> depth;
-  std::vector<Vec3> normal;
-  std::vector<std::uint32_t> triangle_id;
-  std::vector<std::uint32_t> instance_id;
-
-  explicit Aovs(int pixels)
-      : rgba8(4 * static_cast<std::size_t>(pixels)),
-        rgba32f(4 * static_cast<std::size_t>(pixels)),
-        depth(static_cast<std::size_t>(pixels)),
-        normal(static_cast<std::size_t>(pixels)),
-        triangle_id(static_cast<std::size_t>(pixels)),
-        instance_id(static_cast<std::size_t>(pixels)) {}
-
-  // Poison so a pixel the renderer forgot to write shows up as a failure.
-  void poison() {
-    constexpr float nan = std::numeric_limits<float>::quiet_NaN();
-    std::fill(rgba8.begin(), rgba8.end(), std::uint8_t{7});
-    std::fill(rgba32f.begin(), rgba32f.end(), nan);
-    std::fill(depth.begin(), depth.end(), nan);
-    std::fill(normal.begin(), normal.end(), Vec3(nan));
-    std::fill(triangle_id.begin(), triangle_id.end(), 0xDEADBEEFu);
-    std::fill(instance_id.begin(), instance_id.end(), 0xDEADBEEFu);
-  }
-
-  rt::FrameBuffers buffers(int width, int height) {
-    rt::FrameBuffers b;
-    b.width = width;
-    b.height = height;
-    b.color_rgba8 = rgba8;
-    b.color_rgba32f = rgba32f;
-    b.depth = depth;
-    b.normal = normal;
-    b.triangle_id = triangle_id;
-    b.instance_id = instance_id;
-    return b;
-  }
-};
+using Aovs = testing_support::AovFrame;
 
 bool finite(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
@@ -411,7 +373,7 @@ TEST(Soak, LongRandomRunKeepsMemoryFlatPoseSpaceInsideAndAovsClean) {
   settings.light.position = arena.light_position;
   settings.background = Vec3(0.30f, 0.38f, 0.50f);
   rt::Renderer renderer;
-  Aovs aovs(kImageSize * kImageSize);
+  Aovs aovs(kImageSize, kImageSize);
   RandomPlayer player;
   RandomCamera camera;
 
@@ -491,7 +453,7 @@ TEST(Soak, LongRandomRunKeepsMemoryFlatPoseSpaceInsideAndAovsClean) {
     auto cam = rt::PinholeCamera::create(camera.next(rng, lead.position), kImageSize, kImageSize);
     ASSERT_TRUE(cam.ok()) << "frame " << frame << ": " << cam.status().message();
     aovs.poison();
-    auto rendered = renderer.render(scene, *cam, settings, aovs.buffers(kImageSize, kImageSize), jobs);
+    auto rendered = renderer.render(scene, *cam, settings, aovs.buffers(), jobs);
     ASSERT_TRUE(rendered.ok()) << rendered.status().message();
     primary_hits += rendered->primary_hits;
     aov_failure = check_aovs(aovs, scene, kImageSize, settings);
