@@ -426,6 +426,45 @@ DQuat nearest_swing_twist(const SwingTwistLimit& st, const SwingTwistParts& part
   return swing_at(best_rho, best_alpha) * twist_quat(parts.axis, best_theta);
 }
 
+// Near a half-turn swing the twist is ill-conditioned: it is
+// 2 atan2(proj, w) with both arguments (cos of half the swing angle) near
+// zero, so the 6e-8 rounding of a float quaternion moves it by about
+// 6e-8 / hypot(w, proj) and the swing turns with it. Inside this band
+// (swing within ~1.1 degrees of a half turn) the separate swing and twist
+// violations can call an allowed rotation far outside, so the true distance
+// to the allowed set decides instead. Outside the band the rounding error
+// stays below ~1e-5 rad, the unchanged-tolerance.
+constexpr double kHalfTurnBand = 1e-2;
+
+bool near_half_turn(const SwingTwistParts& parts, const DQuat& q) {
+  const double proj = q.x * parts.axis.x + q.y * parts.axis.y + q.z * parts.axis.z;
+  return q.w * q.w + proj * proj < kHalfTurnBand * kHalfTurnBand;
+}
+
+// How far q lies outside a swing-twist limit, with the allowed rotation
+// nearest to it when that had to be found (left untouched otherwise).
+// Away from the half-turn band: the larger of the twist's violation and the
+// swing vector's distance from the ellipse. In the band: the smaller of that
+// and the rotation angle to the nearest allowed rotation.
+struct SwingTwistViolation {
+  double amount = 0.0;
+  bool has_nearest = false;
+  DQuat nearest{1.0, 0.0, 0.0, 0.0};
+};
+
+SwingTwistViolation swing_twist_violation(const SwingTwistLimit& st, const DQuat& q) {
+  const SwingTwistParts parts = split_swing_twist(st, q);
+  const DVec2 s =
+      project_ellipse(parts.swing, static_cast<double>(st.swing_max_1), static_cast<double>(st.swing_max_2));
+  SwingTwistViolation v;
+  v.amount = std::max(parts.twist_clamped.violation, glm::length(s - parts.swing));
+  if (v.amount == 0.0 || !near_half_turn(parts, q)) return v;
+  v.nearest = nearest_swing_twist(st, parts, q, s);
+  v.has_nearest = true;
+  v.amount = std::min(v.amount, rotation_angle(glm::conjugate(v.nearest) * q));
+  return v;
+}
+
 bool valid_quat(const Quat& q) {
   return std::isfinite(q.w) && std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z);
 }
@@ -497,14 +536,12 @@ Quat clamp_rotation(const JointLimit& limit, const Quat& delta) {
     return to_float_quat(compose_euler(r.fit.angle, r.info), q);
   }
   const SwingTwistLimit& st = limit.swing_twist;
+  const SwingTwistViolation v = swing_twist_violation(st, q);
+  if (v.amount <= static_cast<double>(kUnchangedTolerance) && valid_quat(delta)) return delta;
+  if (v.has_nearest) return to_float_quat(v.nearest, q);
   const SwingTwistParts parts = split_swing_twist(st, q);
   const DVec2 s =
       project_ellipse(parts.swing, static_cast<double>(st.swing_max_1), static_cast<double>(st.swing_max_2));
-  const double swing_violation = glm::length(s - parts.swing);
-  if (parts.twist_clamped.violation <= static_cast<double>(kUnchangedTolerance) &&
-      swing_violation <= static_cast<double>(kUnchangedTolerance) && valid_quat(delta)) {
-    return delta;
-  }
   return to_float_quat(nearest_swing_twist(st, parts, q, s), q);
 }
 
@@ -526,12 +563,7 @@ bool is_within(const JointLimit& limit, const Quat& delta, float tolerance_radia
                                        wrap_angle(d.angle[2] + kPi)};
     return fit_free(d.angle, lo, hi).worst <= tol || fit_free(alt, lo, hi).worst <= tol;
   }
-  const SwingTwistLimit& st = limit.swing_twist;
-  const SwingTwistParts parts = split_swing_twist(st, q);
-  if (parts.twist_clamped.violation > tol) return false;
-  const DVec2 s =
-      project_ellipse(parts.swing, static_cast<double>(st.swing_max_1), static_cast<double>(st.swing_max_2));
-  return glm::length(s - parts.swing) <= tol;
+  return swing_twist_violation(limit.swing_twist, q).amount <= tol;
 }
 
 Status apply_joint_limits(const Skeleton& skeleton, std::span<const JointLimit> limits,

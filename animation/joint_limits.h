@@ -67,7 +67,9 @@ using JointLimits = std::vector<JointLimit>;
 // degrees). Allowed rotations (within 1e-5 rad) are returned unchanged, bit
 // for bit. Non-finite input is treated as the identity.
 // is_within's tolerance is per Euler angle, or on the twist angle and the
-// swing vector's distance from the ellipse.
+// swing vector's distance from the ellipse; for a swing within about a
+// degree of a half turn, where the twist of a float quaternion is
+// ill-conditioned, on the rotation angle to the nearest allowed rotation.
 Quat clamp_rotation(const JointLimit& limit, const Quat& delta);
 bool is_within(const JointLimit& limit, const Quat& delta, float tolerance_radians = 1e-4f);
 

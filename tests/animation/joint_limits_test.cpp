@@ -226,6 +226,56 @@ TEST(JointLimits, TwistExtremesAt180) {
   EXPECT_NEAR(decompose_swing_twist(Vec3(0, 0, 1), w).twist, -170 * kDeg, 1e-4f);
 }
 
+// Swings within a degree of a half turn, where the twist of a float
+// quaternion is ill-conditioned. The fuzzer found clamp_rotation's result
+// rejected by is_within for a 180 x 0 degree ellipse
+// (tests/fuzz/corpus/joint_limits/swing-180-clamp.json).
+TEST(JointLimits, HalfTurnSwingsClampInsideAndStayPut) {
+  RandomRotations rng(19);
+  const std::vector<JointLimit> cases = {
+      swing_twist({4.6f, 0.8f, 0}, 180, 0, -180, 108),  // the fuzzer's limit
+      swing_twist({0, 1, 0}, 180, 90, -30, 30),
+      swing_twist({0, 0, 1}, 180, 180, -90, 90),
+      swing_twist({1, 1, 1}, 0, 180, 0, 0),
+  };
+  for (std::size_t li = 0; li < cases.size(); ++li) {
+    const JointLimit& l = cases[li];
+    const auto& st = l.swing_twist;
+    for (int i = 0; i < 4000; ++i) {
+      // Any swing direction, angle in [179, 180] degrees, any twist.
+      const double psi = 6.283185307179586 * rng.u();
+      const double angle = static_cast<double>(kPi) * (1.0 - 0.0056 * rng.u());
+      const Vec2 swing(static_cast<float>(angle * std::cos(psi)), static_cast<float>(angle * std::sin(psi)));
+      const float twist = kPi * static_cast<float>(2.0 * rng.u() - 1.0);
+      const Quat q = compose_swing_twist(st.twist_axis, swing, twist);
+      const Quat c = clamp_rotation(l, q);
+      ASSERT_NEAR(glm::length(c), 1.0f, 1e-5f) << "limit " << li;
+      ASSERT_TRUE(is_within(l, c, 1e-4f)) << "limit " << li << " rotation " << i;
+      ASSERT_EQ(clamp_rotation(l, c), c) << "limit " << li << " rotation " << i;
+      // The clamp is no farther than the separate projection of swing and
+      // twist, an allowed rotation built independently here.
+      const Vec2 e(st.swing_max_1 > 0 ? swing.x / st.swing_max_1 : 0.0f,
+                   st.swing_max_2 > 0 ? swing.y / st.swing_max_2 : 0.0f);
+      const float k = std::max(1.0f, glm::length(e));
+      const Vec2 inside(st.swing_max_1 > 0 ? swing.x / k : 0.0f, st.swing_max_2 > 0 ? swing.y / k : 0.0f);
+      const float t_inside = std::clamp(twist, st.twist_min, st.twist_max);
+      const Quat simple = compose_swing_twist(st.twist_axis, inside, t_inside);
+      ASSERT_TRUE(is_within(l, simple, 1e-4f)) << "limit " << li;
+      EXPECT_LE(rotation_distance(c, q), rotation_distance(simple, q) + 1e-4f) << "limit " << li;
+    }
+    // Allowed rotations at the half turn itself come back bit for bit.
+    for (int i = 0; i < 1000; ++i) {
+      const double a = static_cast<double>(kPi) * (1.0 - 0.0056 * rng.u());
+      const Vec2 swing = st.swing_max_1 >= st.swing_max_2 ? Vec2(static_cast<float>(a) * st.swing_max_1 / kPi, 0)
+                                                          : Vec2(0, static_cast<float>(a) * st.swing_max_2 / kPi);
+      const float t = st.twist_min + (st.twist_max - st.twist_min) * static_cast<float>(rng.u());
+      const Quat q = compose_swing_twist(st.twist_axis, rng.u() < 0.5 ? swing : -swing, t);
+      ASSERT_TRUE(is_within(l, q, 1e-5f)) << "limit " << li << " allowed " << i;
+      ASSERT_EQ(clamp_rotation(l, q), q) << "limit " << li << " allowed " << i;
+    }
+  }
+}
+
 TEST(JointLimits, ZeroWidthRangesPin) {
   RandomRotations rng(11);
   const JointLimit pinned_e = euler(RotationOrder::kYZX, {0, 0, 0}, {0, 0, 0});
