@@ -9,7 +9,10 @@
 #include "tests/bench/bake_bench.h"
 #include "tests/bench/demo_bench.h"
 #include "tests/bench/embree_bench.h"
+#include "tests/bench/paper_bench.h"
 #include "tests/bench/raytrace_bench.h"
+#include "tests/bench/report_bench.h"
+#include "tests/bench/tradeoff_bench.h"
 
 namespace {
 
@@ -57,7 +60,10 @@ int main(int argc, char** argv) {
   if (what == "bake") return sinew::bench::run_bake_bench(args, command_line(argc, argv));
   if (what == "demo") return sinew::bench::run_demo_bench(args, command_line(argc, argv));
   if (what == "embree") return sinew::bench::run_embree_bench(args, command_line(argc, argv));
+  if (what == "paper") return sinew::bench::run_paper_bench(args, command_line(argc, argv));
   if (what == "raytrace") return sinew::bench::run_raytrace_bench(args, command_line(argc, argv));
+  if (what == "report") return sinew::bench::run_report_bench(args, command_line(argc, argv));
+  if (what == "tradeoff") return sinew::bench::run_tradeoff_bench(args, command_line(argc, argv));
   if (what == "--help" || what == "-h" || what == "help") {
     usage();
     return 0;

@@ -1,0 +1,11 @@
+// sinew-bench report: placeholder, being written.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace sinew::bench {
+
+int run_report_bench(const std::vector<std::string>& args, const std::string& command_line);
+
+}  // namespace sinew::bench
