@@ -19,7 +19,10 @@
 #include <vector>
 
 #include "raytrace/camera/camera.h"
+#include "raytrace/render/renderer.h"
 #include "raytrace/scene/scene.h"
+#include "runtime/core/expected.h"
+#include "runtime/jobs/job_system.h"
 #include "tests/support/brute_force.h"
 
 namespace sinew::bench {
@@ -133,5 +136,28 @@ class BruteForceGate {
   std::unordered_map<std::uint64_t, std::uint32_t> index_;
   std::vector<Hit> reference_;
 };
+
+// The renderer's primary hits on `scene`, for the gate: an untimed render of
+// the id and depth outputs (depth = t: camera rays are unit length).
+inline Expected<std::vector<Hit>> render_primary_hits(const rt::Scene& scene, const rt::PinholeCamera& camera,
+                                                      const rt::RenderSettings& settings, JobSystem& jobs) {
+  const std::size_t pixels = static_cast<std::size_t>(camera.width()) * static_cast<std::size_t>(camera.height());
+  std::vector<std::uint32_t> triangle(pixels), instance(pixels);
+  std::vector<float> depth(pixels);
+  rt::FrameBuffers ids;
+  ids.width = camera.width();
+  ids.height = camera.height();
+  ids.triangle_id = triangle;
+  ids.instance_id = instance;
+  ids.depth = depth;
+  rt::Renderer renderer;
+  const auto rendered = renderer.render(scene, camera, settings, ids, jobs);
+  if (!rendered.ok()) return rendered.status();
+  std::vector<Hit> hits(pixels);
+  for (std::size_t i = 0; i < pixels; ++i) {
+    if (triangle[i] != kInvalidId) hits[i] = Hit{depth[i], 0.0f, 0.0f, triangle[i], instance[i]};
+  }
+  return hits;
+}
 
 }  // namespace sinew::bench

@@ -14,6 +14,7 @@
 
 #include "editor/bake/in_memory_bake.h"
 #include "editor/cli/cli_args.h"
+#include "editor/mesh/subdivide.h"
 #include "raytrace/camera/camera.h"
 #include "raytrace/render/renderer.h"
 #include "raytrace/scene/scene.h"
@@ -47,6 +48,7 @@ struct Options {
   std::vector<std::string> clips{"walk"};
   std::string model = "cally";
   int instances = 1;
+  int subdivide = 0;  // subdivision levels applied to the model (Table 2's larger meshes)
   int check_stride = 7;
   std::string shared = SINEW_SHARED_DIR;
   std::string json_path;
@@ -57,7 +59,7 @@ const std::vector<editor::cli::FlagSpec>& flags() {
   static const std::vector<editor::cli::FlagSpec> specs = {
       {"--help", false}, {"-h", false},        {"--quick", false}, {"--size"},   {"--frames"}, {"--threads"},
       {"--clips"},       {"--clip"},           {"--model"},        {"--instances"}, {"--shared"}, {"--json"},
-      {"--check-stride"},
+      {"--check-stride"}, {"--subdivide"},
   };
   return specs;
 }
@@ -102,6 +104,11 @@ Expected<Options> parse_options(const std::vector<std::string>& args) {
     SINEW_ASSIGN_OR_RETURN(const std::int64_t n, cli::parse_int("--instances", *text, 1, 256));
     o.instances = static_cast<int>(n);
   }
+  if (const auto text = parsed.value("--subdivide")) {
+    SINEW_ASSIGN_OR_RETURN(const std::int64_t n,
+                           cli::parse_int("--subdivide", *text, 0, editor::kMaxSubdivisionLevels));
+    o.subdivide = static_cast<int>(n);
+  }
   if (const auto text = parsed.value("--check-stride")) {
     SINEW_ASSIGN_OR_RETURN(const std::int64_t n, cli::parse_int("--check-stride", *text, 1, 1 << 20));
     o.check_stride = static_cast<int>(n);
@@ -115,7 +122,7 @@ void print_usage(std::FILE* to) {
   std::fprintf(to,
                "usage: sinew-bench embree [--quick] [--model NAME|PATH] [--instances N] [--frames N]\n"
                "                          [--clips LIST | --clip NAME] [--size WxH] [--threads LIST]\n"
-               "                          [--check-stride N] [--shared DIR] [--json FILE]\n"
+               "                          [--subdivide LEVELS] [--check-stride N] [--shared DIR] [--json FILE]\n"
                "  --quick             256x256, 30 frames, 1 thread (later flags override)\n"
                "  --model M           cally (default), mannequin, or a .gltf/.glb/.cfg/.pack path\n"
                "  --instances N       character instances (default 1)\n"
@@ -123,6 +130,7 @@ void print_usage(std::FILE* to) {
                "  --clips LIST        clips to animate, e.g. walk,tornado_kick (default walk)\n"
                "  --size WxH          image size (default 1024x1024)\n"
                "  --threads LIST      thread counts (default 1,2)\n"
+               "  --subdivide L       subdivide the model L times first (each level: 4x the triangles)\n"
                "  --check-stride N    brute-force check every Nth pixel of the first frame (default 7)\n"
                "  --shared DIR        the shared folder holding content/cal3d/cally\n"
                "  --json FILE         also write the numbers as JSON\n");
@@ -186,17 +194,6 @@ double phase(const PhaseTimers& timers, std::string_view name) {
   return 0.0;
 }
 
-// Hits from the renderer's id and depth outputs (depth = t: unit rays).
-std::vector<Hit> hits_from_buffers(std::span<const std::uint32_t> triangle, std::span<const std::uint32_t> instance,
-                                   std::span<const float> depth) {
-  std::vector<Hit> hits(triangle.size());
-  for (std::size_t i = 0; i < hits.size(); ++i) {
-    if (triangle[i] == kInvalidId) continue;
-    hits[i] = Hit{depth[i], 0.0f, 0.0f, triangle[i], instance[i]};
-  }
-  return hits;
-}
-
 // The frame's fixed inputs shared by every contender.
 struct FrameContext {
   const editor::ImportedModel* model = nullptr;
@@ -216,22 +213,6 @@ FrameSample sinew_sample(const PhaseTimers& prepare, const rt::RenderStats& stat
   s.primary_hits = stats.primary_hits;
   s.shadow_rays = stats.shadow_rays;
   return s;
-}
-
-// The renderer's primary hits on `scene` for the gate (an untimed render).
-Expected<std::vector<Hit>> renderer_hits(const rt::Scene& scene, const FrameContext& c) {
-  const std::size_t pixels = static_cast<std::size_t>(c.camera.width()) * static_cast<std::size_t>(c.camera.height());
-  std::vector<std::uint32_t> triangle(pixels), instance(pixels);
-  std::vector<float> depth(pixels);
-  rt::FrameBuffers ids;
-  ids.width = c.camera.width();
-  ids.height = c.camera.height();
-  ids.triangle_id = triangle;
-  ids.instance_id = instance;
-  ids.depth = depth;
-  rt::Renderer renderer;
-  SINEW_RETURN_IF_ERROR(status_of(renderer.render(scene, c.camera, c.settings, ids, *c.jobs)));
-  return hits_from_buffers(triangle, instance, depth);
 }
 
 // The exact scene's merged-mesh ids back to the fuzzy scene's: triangle
@@ -263,7 +244,7 @@ Expected<FrameSample> run_exact(const FrameContext& c, rt::Renderer& renderer, c
   s.primary_hits = stats.primary_hits;
   s.shadow_rays = stats.shadow_rays;
   if (gate) {
-    SINEW_ASSIGN_OR_RETURN(std::vector<Hit> hits, renderer_hits(exact, c));
+    SINEW_ASSIGN_OR_RETURN(std::vector<Hit> hits, render_primary_hits(exact, c.camera, c.settings, *c.jobs));
     map_exact_ids(c.stage->scene, c.model->mesh.triangles.size(), hits);
     *gate_out = gate->check(hits);
   }
@@ -371,7 +352,7 @@ Expected<ConfigResult> run_configuration(const editor::ImportedModel& model, con
                                  sinew_renderer.render(stage.scene, ctx.camera, ctx.settings, ctx.color, jobs));
           sample = sinew_sample(prepare, stats);
           if (check) {
-            SINEW_ASSIGN_OR_RETURN(const std::vector<Hit> hits, renderer_hits(stage.scene, ctx));
+            SINEW_ASSIGN_OR_RETURN(const std::vector<Hit> hits, render_primary_hits(stage.scene, ctx.camera, ctx.settings, *ctx.jobs));
             r.gate = check->check(hits);
           }
           break;
@@ -480,7 +461,7 @@ int run_embree_bench(const std::vector<std::string>& args, const std::string& co
   std::fflush(stdout);
 
   Json doc = {{"command", command_line}, {"cpu", cpu}, {"commit", git_commit()}, {"load_average_start", load_average()},           {"hardware_threads", JobSystem::hardware_threads()},
-              {"date", date},            {"model", o.model},     {"instances", o.instances},
+              {"date", date},            {"model", o.model},     {"subdivide", o.subdivide}, {"instances", o.instances},
               {"size", {o.width, o.height}}, {"frames", o.frames}, {"embree", have_embree},
               {"configurations", Json::array()}};
   std::string note;
@@ -493,7 +474,16 @@ int run_embree_bench(const std::vector<std::string>& args, const std::string& co
     std::printf("\n%s\n", note.c_str());
     return 0;
   }
-  const editor::ImportedModel model = std::move(**loaded);
+  editor::ImportedModel loaded_model = std::move(**loaded);
+  if (o.subdivide > 0) {
+    auto finer = editor::subdivide(loaded_model, o.subdivide);
+    if (!finer.ok()) {
+      std::fprintf(stderr, "sinew-bench embree: %s\n", finer.status().message().c_str());
+      return 1;
+    }
+    loaded_model = std::move(*finer);
+  }
+  const editor::ImportedModel model = std::move(loaded_model);
   editor::InMemoryBake bake;
   {
     JobSystem jobs(*std::max_element(o.threads.begin(), o.threads.end()));
@@ -504,7 +494,9 @@ int run_embree_bench(const std::vector<std::string>& args, const std::string& co
     }
     bake = std::move(*baked);
   }
-  std::printf("  %zu triangles, %zu bones\n", model.mesh.triangle_count(), model.skeleton.joint_count());
+  std::printf("  %zu triangles (%d subdivision levels), %zu bones\n", model.mesh.triangle_count(), o.subdivide,
+              model.skeleton.joint_count());
+  doc["triangles"] = model.mesh.triangle_count();
 
   int exit_code = 0;
   for (const std::string& clip_name : o.clips) {

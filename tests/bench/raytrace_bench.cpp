@@ -1,5 +1,6 @@
 #include "tests/bench/raytrace_bench.h"
 #include "tests/bench/bench_support.h"
+#include "tests/bench/brute_force_gate.h"
 
 #include <algorithm>
 #include <chrono>
@@ -33,6 +34,7 @@ using Json = nlohmann::ordered_json;
 
 constexpr double kFramesPerSecond = 30.0;
 constexpr int kMaxImageSide = 16384;
+constexpr int kGateStride = 7;
 
 // --- options -----------------------------------------------------------------
 
@@ -157,6 +159,7 @@ struct RunResult {
   std::uint64_t shadow_rays = 0;
   std::size_t max_escaped_triangles = 0;
   ExactComparison exact;
+  GateResult gate;  // the first frame's primary hits against brute force
 };
 
 double phase_median(const PhaseTimers& timers, std::string_view phase) {
@@ -275,6 +278,14 @@ Expected<RunResult> run_configuration(const BenchModel& m, const BenchOptions& o
     run.shadow_rays = rendered.shadow_rays;
     run.max_escaped_triangles = std::max(run.max_escaped_triangles, prepared.escaped_triangles);
 
+    if (f == 0) {
+      // Issue 7's rule: a configuration whose first frame disagrees with
+      // brute force is not reported (every 7th pixel, untimed).
+      const BruteForceGate gate(scene, *camera, kGateStride);
+      SINEW_ASSIGN_OR_RETURN(const std::vector<Hit> hits, render_primary_hits(scene, *camera, settings, jobs));
+      run.gate = gate.check(hits);
+      if (!run.gate.passed()) return run;
+    }
     if (std::find(run.exact.frames.begin(), run.exact.frames.end(), f) != run.exact.frames.end()) {
       SINEW_RETURN_IF_ERROR(compare_with_exact(scene, model.mesh, ground, *camera, settings, buffers, rendered, jobs,
                                                exact_renderer, run.exact));
@@ -347,6 +358,7 @@ Json run_json(const RunResult& r) {
           {"primary_rays", r.primary_rays},
           {"shadow_rays", r.shadow_rays},
           {"max_escaped_triangles", r.max_escaped_triangles},
+          {"brute_force", {{"checked", r.gate.checked}, {"edge_grazes", r.gate.grazes}}},
           {"exact",
            {{"frames", e.frames},
             {"phases", exact_phases},
@@ -376,7 +388,8 @@ int run_raytrace_bench(const std::vector<std::string>& args, const std::string& 
   const std::string date = utc_date();
   print_bench_header("raytrace", command_line, join_ints(o.threads), cpu, date);
   std::printf("  %dx%d, %d frames at 30 fps through the walk clip (instance i %.2f s later), point light,\n"
-              "  shadows on, diffuse shading, triangle test %s, bone boxes %s, fallback on\n",
+              "  shadows on, diffuse shading, triangle test %s, bone boxes %s, fallback on; each\n"
+              "  configuration's first frame is checked against brute force (every 7th pixel)\n",
               o.width, o.height, o.frames, editor::instance_time_offset(1), triangle_test_name(o.triangle_test),
               bone_boxes_name(o.bone_boxes));
   std::fflush(stdout);
@@ -442,6 +455,14 @@ int run_raytrace_bench(const std::vector<std::string>& args, const std::string& 
         auto run = run_configuration(m, o, instances, threads);
         if (!run.ok()) {
           fail(run.status());
+          continue;
+        }
+        if (!run->gate.passed()) {
+          std::printf("  %d instances, %d threads: FAILED brute-force check (%llu of %llu sampled pixels differ): "
+                      "not reported\n",
+                      instances, threads, static_cast<unsigned long long>(run->gate.mismatched),
+                      static_cast<unsigned long long>(run->gate.checked));
+          exit_code = 1;
           continue;
         }
         runs.push_back(std::move(*run));

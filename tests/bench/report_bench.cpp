@@ -1,12 +1,563 @@
 #include "tests/bench/report_bench.h"
 
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdarg>
 #include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "editor/cli/cli_args.h"
+#include "runtime/cpu/cpu_features.h"
+#include "runtime/jobs/job_system.h"
+#include "tests/bench/bench_support.h"
+#include "tests/bench/embree_bench.h"
+#include "tests/bench/paper_bench.h"
+#include "tests/bench/raytrace_bench.h"
+#include "tests/bench/report_plots.h"
+#include "tests/bench/tradeoff_bench.h"
 
 namespace sinew::bench {
+namespace {
 
-int run_report_bench(const std::vector<std::string>& /*args*/, const std::string& /*command_line*/) {
-  std::fprintf(stderr, "sinew-bench report: not written yet\n");
-  return 2;
+using Json = nlohmann::ordered_json;
+namespace fs = std::filesystem;
+
+// --- options -------------------------------------------------------------------
+
+const std::vector<std::string> kAllSections = {"paper", "embree", "tradeoff", "scaling"};
+
+struct Options {
+  bool quick = false;
+  bool help = false;
+  std::string out_dir;  // empty: docs/ (full) or build/report-quick/ (quick)
+  std::vector<std::string> sections = kAllSections;
+  std::string shared = SINEW_SHARED_DIR;
+};
+
+Expected<Options> parse_options(const std::vector<std::string>& args) {
+  namespace cli = editor::cli;
+  static const std::vector<cli::FlagSpec> flags = {
+      {"--help", false}, {"-h", false}, {"--quick", false}, {"--out"}, {"--sections"}, {"--shared"},
+  };
+  SINEW_ASSIGN_OR_RETURN(const cli::ParsedArgs parsed, cli::parse_args(args, flags));
+  Options o;
+  o.help = parsed.has("--help") || parsed.has("-h");
+  if (!parsed.positionals.empty()) {
+    return invalid_argument("argument", parsed.positionals.front(), "unexpected argument");
+  }
+  o.quick = parsed.has("--quick");
+  if (const auto text = parsed.value("--out")) o.out_dir = *text;
+  if (const auto text = parsed.value("--shared")) o.shared = *text;
+  if (const auto text = parsed.value("--sections")) {
+    SINEW_ASSIGN_OR_RETURN(o.sections, cli::parse_list("--sections", *text));
+    for (const std::string& s : o.sections) {
+      if (std::find(kAllSections.begin(), kAllSections.end(), s) == kAllSections.end()) {
+        return invalid_argument("--sections", s, "unknown section (expected paper, embree, tradeoff or scaling)");
+      }
+    }
+  }
+  if (o.out_dir.empty()) {
+    o.out_dir = o.quick ? std::string(SINEW_SOURCE_DIR) + "/build/report-quick" : std::string(SINEW_SOURCE_DIR) + "/docs";
+  }
+  return o;
+}
+
+void print_usage(std::FILE* to) {
+  std::fprintf(to,
+               "usage: sinew-bench report [--quick] [--out DIR] [--sections LIST] [--shared DIR]\n"
+               "  --quick           a smoke run under 5 minutes on 2 cores (default --out build/report-quick)\n"
+               "  --out DIR         where BENCHMARKS.md, img/ and bench-data/ go (default: the source tree's docs/)\n"
+               "  --sections LIST   paper,embree,tradeoff,scaling (default all)\n"
+               "  --shared DIR      the shared folder holding content/cal3d/cally\n");
+}
+
+bool wanted(const Options& o, const std::string& section) {
+  return std::find(o.sections.begin(), o.sections.end(), section) != o.sections.end();
+}
+
+// --- running the benchmarks ------------------------------------------------------
+
+using BenchFunction = std::function<int(const std::vector<std::string>&, const std::string&)>;
+
+// One benchmark invocation: what ran, how it ended, where its JSON is.
+struct Run {
+  std::string key;      // names the JSON (and Markdown) files
+  std::string command;  // as a user would type it from the source tree
+  std::string json_path;
+  std::string markdown_path;  // empty when the benchmark writes none
+  int exit_code = 0;
+  double seconds = 0.0;
+  Json json;  // null when the file is missing or unreadable
+};
+
+std::string join_args(const std::vector<std::string>& args) {
+  std::string out;
+  for (const std::string& a : args) out += (out.empty() ? "" : " ") + a;
+  return out;
+}
+
+Json read_json(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) return Json();
+  Json doc = Json::parse(in, nullptr, false);
+  return doc.is_discarded() ? Json() : doc;
+}
+
+std::string read_text(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+Run run_bench(const std::string& bench, const std::string& key, std::vector<std::string> args, bool markdown,
+              const std::string& data_dir, const BenchFunction& fn) {
+  Run r;
+  r.key = key;
+  r.json_path = data_dir + "/" + key + ".json";
+  // The command as printed leaves out where the report keeps its files.
+  r.command = "build/release/tests/bench/sinew-bench " + bench + (args.empty() ? "" : " " + join_args(args));
+  args.push_back("--json");
+  args.push_back(r.json_path);
+  if (markdown) {
+    r.markdown_path = data_dir + "/" + key + ".md";
+    args.push_back("--markdown");
+    args.push_back(r.markdown_path);
+  }
+  std::fprintf(stderr, "sinew-bench report: running %s\n", r.command.c_str());
+  std::fflush(stdout);
+  const auto start = std::chrono::steady_clock::now();
+  r.exit_code = fn(args, "sinew-bench " + bench + " " + join_args(args));
+  std::fflush(stdout);
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  r.json = read_json(r.json_path);
+  std::fprintf(stderr, "sinew-bench report: %s finished in %.0f s (exit code %d)\n", key.c_str(), r.seconds,
+               r.exit_code);
+  return r;
+}
+
+// --- Markdown helpers ------------------------------------------------------------
+
+std::string format(const char* pattern, ...) __attribute__((format(printf, 1, 2)));
+std::string format(const char* pattern, ...) {
+  char text[512];
+  va_list list;
+  va_start(list, pattern);
+  std::vsnprintf(text, sizeof text, pattern, list);
+  va_end(list);
+  return text;
+}
+
+double number(const Json& j, const char* key, double fallback = std::nan("")) {
+  if (!j.is_object() || !j.contains(key) || !j[key].is_number()) return fallback;
+  return j[key].get<double>();
+}
+
+// The median of a phase in a PhaseTimers JSON object, NaN when absent.
+double phase_ms(const Json& phases, const char* name) {
+  if (!phases.is_object() || !phases.contains(name)) return std::nan("");
+  return number(phases[name], "median_ms");
+}
+
+// A number with `decimals` digits after the point, "–" when missing.
+std::string cell(double v, int decimals = 2) {
+  return std::isfinite(v) ? format("%.*f", decimals, v) : std::string("–");
+}
+
+// Two significant digits, for fractions that span decades.
+std::string cell_g(double v) {
+  return std::isfinite(v) ? format("%.2g", v) : std::string("–");
+}
+
+std::string ratio_cell(double a, double b) {
+  return std::isfinite(a) && std::isfinite(b) && b > 0.0 ? format("%.2f", a / b) : std::string("–");
+}
+
+std::string thousands(double v) {
+  if (!std::isfinite(v)) return "–";
+  std::string digits = std::to_string(static_cast<long long>(std::llround(v)));
+  for (int i = static_cast<int>(digits.size()) - 3; i > 0; i -= 3) digits.insert(static_cast<std::size_t>(i), ",");
+  return digits;
+}
+
+std::string failure_line(const Run& r) {
+  return r.exit_code == 0 ? std::string()
+                          : format("\n**This benchmark ended with exit code %d**: a model failed to load, a "
+                                   "configuration failed its brute-force check (and is left out), or a file could "
+                                   "not be written; its log is the report's standard output.\n",
+                                   r.exit_code);
+}
+
+// --- the peer comparison (Embree) ------------------------------------------------
+
+const Json* contender(const Json& config, const std::string& name) {
+  if (!config.contains("contenders")) return nullptr;
+  for (const Json& c : config["contenders"]) {
+    if (c.value("name", "") == name) return &c;
+  }
+  return nullptr;
+}
+
+std::string embree_markdown(const Run& r) {
+  std::string md;
+  const Json& doc = r.json;
+  md += format("\nModel %s (%s triangles, %d subdivision levels), %s instance, %d×%d, %d frames per clip at "
+               "30 fps.\n\n",
+               doc.value("model", "?").c_str(), thousands(number(doc, "triangles")).c_str(),
+               doc.value("subdivide", 0), thousands(number(doc, "instances")).c_str(),
+               doc.contains("size") ? doc["size"][0].get<int>() : 0, doc.contains("size") ? doc["size"][1].get<int>() : 0,
+               doc.value("frames", 0));
+  md += "```sh\n" + r.command + "\n```\n";
+  if (!doc.value("embree", false)) md += "\nEmbree was not found when this was built: only Sinew and the exact kd-tree ran.\n";
+  for (const Json& config : doc.value("configurations", Json::array())) {
+    const Json& shared = config["shared"];
+    md += format("\n%s, %d thread%s (shared per frame: animation %s ms, skinning %s ms):\n\n",
+                 config.value("clip", "?").c_str(), config.value("threads", 0), config.value("threads", 0) == 1 ? "" : "s",
+                 cell(phase_ms(shared, "animation"), 3).c_str(), cell(phase_ms(shared, "skinning"), 3).c_str());
+    md += "| contender | build ms | primary ms | shadow ms | shade ms | total ms | Sinew ÷ this: build | trace | total "
+          "| brute force (first frame) |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---|\n";
+    const Json* sinew = contender(config, "sinew fuzzy kd");
+    const Json sinew_phases = sinew && sinew->contains("phases") ? (*sinew)["phases"] : Json();
+    for (const Json& c : config["contenders"]) {
+      const Json& gate = c["brute_force"];
+      if (!gate.value("passed", false)) {
+        md += format("| %s | FAILED brute-force check: %s of %s sampled pixels differ; not reported | | | | | | | | "
+                     "FAILED |\n",
+                     c.value("name", "?").c_str(), thousands(number(gate, "mismatched")).c_str(),
+                     thousands(number(gate, "checked")).c_str());
+        continue;
+      }
+      const Json& p = c["phases"];
+      md += format("| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s px, %s grazes |\n", c.value("name", "?").c_str(),
+                   cell(phase_ms(p, "build"), 3).c_str(), cell(phase_ms(p, "trace primary"), 1).c_str(),
+                   cell(phase_ms(p, "trace shadow"), 1).c_str(), cell(phase_ms(p, "shade"), 1).c_str(),
+                   cell(phase_ms(p, "total"), 1).c_str(),
+                   ratio_cell(phase_ms(sinew_phases, "build"), phase_ms(p, "build")).c_str(),
+                   ratio_cell(phase_ms(sinew_phases, "trace"), phase_ms(p, "trace")).c_str(),
+                   ratio_cell(phase_ms(sinew_phases, "total"), phase_ms(p, "total")).c_str(),
+                   thousands(number(gate, "checked")).c_str(), thousands(number(gate, "edge_grazes")).c_str());
+    }
+  }
+  md += "\n*build*: Sinew = bone boxes + fallback + top level; Embree = vertex upload + `rtcCommitScene`; exact = "
+        "merge + SAH kd build + top level. *trace* = primary + shadow rays; *total* = skinning (shared) + build + "
+        "trace + shade; medians over the frames. Ratios below 1: Sinew is faster. Sinew traces 4×2 packets, Embree "
+        "single rays (`rtcIntersect1`/`rtcOccluded1`); camera, shading and threads are shared code.\n";
+  return md + failure_line(r);
+}
+
+// --- scaling -----------------------------------------------------------------------
+
+const Json* first_model(const Run& r) {
+  if (!r.json.contains("models") || r.json["models"].empty()) return nullptr;
+  return &r.json["models"][0];
+}
+
+std::string scaling_instances_markdown(const Run& r) {
+  std::string md = "\n```sh\n" + r.command + "\n```\n\n";
+  const Json* model = first_model(r);
+  if (!model) return md + "No results (see the log).\n" + failure_line(r);
+  md += format("%s: %s triangles per instance, %s bones; %d×%d, walk clip, shadows on.\n\n",
+               model->value("name", "?").c_str(), thousands(number(*model, "triangles")).c_str(),
+               thousands(number(*model, "bones")).c_str(), r.json["size"][0].get<int>(), r.json["size"][1].get<int>());
+  md += "| instances | triangles | threads | per-frame work ms (skin + boxes + top level) | trace ms | shade ms | total "
+        "ms | fps | M rays/s | fuzzy ÷ exact trace |\n|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+  for (const Json& run : model->value("runs", Json::array())) {
+    const Json& p = run["phases"];
+    const double per_frame = phase_ms(p, "skinning") + phase_ms(p, "boxes") + phase_ms(p, "top level + fallback");
+    md += format("| %d | %s | %d | %s | %s | %s | %s | %s | %s | %s |\n", run.value("instances", 0),
+                 thousands(number(*model, "triangles") * run.value("instances", 0)).c_str(), run.value("threads", 0),
+                 cell(per_frame).c_str(),
+                 cell(phase_ms(p, "trace primary") + phase_ms(p, "trace shadow"), 1).c_str(),
+                 cell(phase_ms(p, "shade"), 1).c_str(), cell(phase_ms(p, "total"), 1).c_str(),
+                 cell(number(run, "fps")).c_str(), cell(number(run, "mrays_per_s"), 1).c_str(),
+                 cell(number(run["exact"], "fuzzy_over_exact")).c_str());
+  }
+  return md + failure_line(r);
+}
+
+std::string scaling_sizes_markdown(const std::vector<Run>& runs) {
+  std::string md = "\n```sh\n";
+  for (const Run& r : runs) md += r.command + "\n";
+  md += "```\n\n| image | pixels | threads | trace ms | shade ms | total ms | fps | ns per pixel and thread |\n"
+        "|---|---:|---:|---:|---:|---:|---:|---:|\n";
+  for (const Run& r : runs) {
+    const Json* model = first_model(r);
+    if (!model) {
+      md += "| " + r.key + " | no results | | | | | | |\n";
+      continue;
+    }
+    const int w = r.json["size"][0].get<int>(), h = r.json["size"][1].get<int>();
+    const double pixels = static_cast<double>(w) * h;
+    for (const Json& run : model->value("runs", Json::array())) {
+      const Json& p = run["phases"];
+      const double total = phase_ms(p, "total");
+      md += format("| %d×%d | %s | %d | %s | %s | %s | %s | %s |\n", w, h, thousands(pixels).c_str(),
+                   run.value("threads", 0), cell(phase_ms(p, "trace primary") + phase_ms(p, "trace shadow"), 1).c_str(),
+                   cell(phase_ms(p, "shade"), 1).c_str(), cell(total, 1).c_str(), cell(number(run, "fps")).c_str(),
+                   cell(total * 1e6 * run.value("threads", 1) / pixels, 0).c_str());
+    }
+  }
+  for (const Run& r : runs) md += failure_line(r);
+  return md;
+}
+
+// --- headlines -----------------------------------------------------------------------
+
+const Json* table2_row(const Run* paper, int level) {
+  if (!paper || !paper->json.contains("table2")) return nullptr;
+  for (const Json& row : paper->json["table2"].value("rows", Json::array())) {
+    if (row.value("level", -1) == level && !row.value("interpolated", false)) return &row;
+  }
+  return nullptr;
+}
+
+double table2_fps(const Json& row, const char* threads, const char* kind) {
+  if (!row.contains("fps") || !row["fps"].contains(threads)) return std::nan("");
+  return number(row["fps"][threads], kind);
+}
+
+// Sinew's total over the named contender's, for one configuration.
+double total_ratio(const Json& config, const std::string& other) {
+  const Json* s = contender(config, "sinew fuzzy kd");
+  const Json* o = contender(config, other);
+  if (!s || !o || !s->contains("phases") || !o->contains("phases")) return std::nan("");
+  return phase_ms((*s)["phases"], "total") / phase_ms((*o)["phases"], "total");
+}
+
+double trace_ratio(const Json& config, const std::string& other) {
+  const Json* s = contender(config, "sinew fuzzy kd");
+  const Json* o = contender(config, other);
+  if (!s || !o || !s->contains("phases") || !o->contains("phases")) return std::nan("");
+  return phase_ms((*s)["phases"], "trace") / phase_ms((*o)["phases"], "trace");
+}
+
+std::string embree_headline(const Run& r, const char* label) {
+  std::string md;
+  for (const Json& config : r.json.value("configurations", Json::array())) {
+    md += format("- Sinew ÷ Embree, total frame time, %s, %s, %d thread%s: LOW rebuild %s, refit %s, MEDIUM rebuild "
+                 "%s; fuzzy ÷ exact kd-tree trace time %s.\n",
+                 label, config.value("clip", "?").c_str(), config.value("threads", 0),
+                 config.value("threads", 0) == 1 ? "" : "s",
+                 cell(total_ratio(config, "embree LOW rebuild")).c_str(),
+                 cell(total_ratio(config, "embree refit")).c_str(),
+                 cell(total_ratio(config, "embree MEDIUM rebuild")).c_str(),
+                 cell(trace_ratio(config, "exact SAH kd rebuild")).c_str());
+  }
+  return md;
+}
+
+std::string headlines(const Run* paper, const Run* embree_small, const Run* embree_large, const Run* tradeoff) {
+  std::string md = "## Headlines\n\n";
+  if (const Json* row = table2_row(paper, 0)) {
+    md += format("- Cally, %s triangles, 1024×1024, primary rays only: **%s fps on 1 thread** (%s on 2); the paper: "
+                 "9.5 fps on one 2.4 GHz Opteron core (2006). With shadows: %s fps on 1 thread, %s on 2.\n",
+                 thousands(number(*row, "triangles")).c_str(), cell(table2_fps(*row, "1", "primary")).c_str(),
+                 cell(table2_fps(*row, "2", "primary")).c_str(), cell(table2_fps(*row, "1", "primary_shadows")).c_str(),
+                 cell(table2_fps(*row, "2", "primary_shadows")).c_str());
+  }
+  if (embree_small) md += embree_headline(*embree_small, "Cally");
+  if (embree_large) {
+    md += embree_headline(*embree_large,
+                          format("Cally subdivided (%s triangles)", thousands(number(embree_large->json, "triangles")).c_str())
+                              .c_str());
+  }
+  if (tradeoff && tradeoff->json.contains("knee")) {
+    for (const Json& k : tradeoff->json["knee"]) {
+      md += format("- Knee of the speed/accuracy curve, %s pose space: %s samples (%s fps, hole fraction %s).\n",
+                   k.value("mode", "?").c_str(), thousands(number(k, "samples")).c_str(), cell(number(k, "fps")).c_str(),
+                   cell_g(number(k, "hole_fraction")).c_str());
+    }
+  }
+  return md + "\n";
+}
+
+// --- the document ------------------------------------------------------------------------
+
+struct Report {
+  std::vector<Run> runs;
+  const Run* find(const std::string& key) const {
+    for (const Run& r : runs) {
+      if (r.key == key) return &r;
+    }
+    return nullptr;
+  }
+};
+
+std::string document(const Options& o, const Report& report, const std::string& date, const std::string& cpu,
+                     const std::string& load_start, const std::string& load_end, double minutes,
+                     const PlotResult& plots) {
+  std::string md = "# Benchmarks\n\n";
+  md += "<!-- Written by `sinew-bench report` (tests/bench/report_bench.cpp). Do not edit by hand: rerun it. -->\n\n";
+  md += format("Measured %s on %s (%d hardware threads), build baseline %s, commit `%s`; %s mode, %.0f minutes in "
+               "all; load average %s at the start, %s at the end (1, 5, 15 min). Each benchmark checks the first "
+               "frame of every configuration against brute-force ray casting and leaves out any that disagrees.\n\n",
+               date.c_str(), cpu.c_str(), JobSystem::hardware_threads(), std::string(build_isa()).c_str(),
+               git_commit().c_str(), o.quick ? "quick" : "full", minutes, load_start.c_str(), load_end.c_str());
+  md += "Reproduce (the release preset; Embree 3 optional):\n\n```sh\n./sinew build release\n" +
+        std::string("build/release/tests/bench/sinew-bench report") + (o.quick ? " --quick" : "") +
+        "\n```\n\nThe raw numbers are in `bench-data/*.json` beside this file; each section names the command that "
+        "measured it. Earlier, per-issue measurements (animation against Cal3D, the bake's memory bound, the game "
+        "demo) are in [MEASUREMENTS.md](MEASUREMENTS.md).\n\n";
+  md += headlines(report.find("paper"), report.find("embree"), report.find("embree-large"), report.find("tradeoff"));
+
+  if (const Run* paper = report.find("paper")) {
+    md += read_text(paper->markdown_path);
+    md += failure_line(*paper);
+    if (!plots.fps_vs_triangles.empty()) md += "\n![fps vs triangles, Sinew and the paper](" + plots.fps_vs_triangles + ")\n";
+    md += "\n";
+  }
+  const Run* embree_small = report.find("embree");
+  const Run* embree_large = report.find("embree-large");
+  if (embree_small || embree_large) {
+    md += "## The peer: Embree 3, and an exact kd-tree rebuilt per frame\n\n"
+          "The same skinned triangles every frame (Sinew's skinning), the same camera rays, shadow rays and shading, "
+          "traced by Sinew's fuzzy kd-trees, by Embree 3 rebuilt per frame at LOW and MEDIUM quality and refitted "
+          "per frame, and by an exact SAH kd-tree of Sinew's rebuilt per frame; the contenders take turns frame by "
+          "frame so machine noise hits them alike.\n";
+    if (embree_small) md += embree_markdown(*embree_small);
+    if (embree_large) md += embree_markdown(*embree_large);
+    if (!plots.embree.empty()) md += "\n![frame time per contender](" + plots.embree + ")\n";
+    md += "\n";
+  }
+  if (const Run* trade = report.find("tradeoff")) {
+    md += read_text(trade->markdown_path);
+    md += failure_line(*trade);
+    if (!plots.tradeoff.empty()) md += "\n![fps against holes per sample count](" + plots.tradeoff + ")\n";
+    md += "\n";
+  }
+  const Run* instances = report.find("scaling-instances");
+  std::vector<Run> sizes;
+  for (const Run& r : report.runs) {
+    if (r.key.rfind("scaling-size-", 0) == 0) sizes.push_back(r);
+  }
+  if (instances || !sizes.empty()) {
+    md += "## Scaling\n\nFrames per second against the number of character instances, the image size and the "
+          "threads (this machine has " +
+          std::to_string(JobSystem::hardware_threads()) +
+          "; a 16-core run is reported separately when one was at hand). Instances stand in a row on the ground, "
+          "each a little later in the walk cycle.\n";
+    if (instances) md += "\n### Instances\n" + scaling_instances_markdown(*instances);
+    if (!sizes.empty()) md += "\n### Image size (one Cally)\n" + scaling_sizes_markdown(sizes);
+    if (!plots.scaling.empty()) md += "\n![scaling](" + plots.scaling + ")\n";
+    md += "\n";
+  }
+  md += "## How long each benchmark took\n\n| benchmark | command | minutes | exit code |\n|---|---|---:|---:|\n";
+  for (const Run& r : report.runs) {
+    md += format("| %s | `%s` | %.1f | %d |\n", r.key.c_str(), r.command.c_str(), r.seconds / 60.0, r.exit_code);
+  }
+  if (!plots.note.empty()) md += "\n" + plots.note + "\n";
+  return md;
+}
+
+// The benchmarks the report runs, with their full and quick arguments.
+void run_all(const Options& o, const std::string& data_dir, Report& report) {
+  std::vector<std::string> common;
+  if (o.shared != SINEW_SHARED_DIR) common = {"--shared", o.shared};
+  const auto with_common = [&](std::vector<std::string> args) {
+    args.insert(args.end(), common.begin(), common.end());
+    return args;
+  };
+  if (wanted(o, "paper")) {
+    report.runs.push_back(run_bench("paper", "paper", with_common(o.quick ? std::vector<std::string>{"--quick"}
+                                                                           : std::vector<std::string>{}),
+                                    true, data_dir, run_paper_bench));
+  }
+  if (wanted(o, "embree")) {
+    const std::vector<std::string> small =
+        o.quick ? std::vector<std::string>{"--clips", "walk,tornado_kick", "--frames", "20", "--size", "256x256",
+                                           "--threads", "1"}
+                : std::vector<std::string>{"--clips", "walk,tornado_kick", "--frames", "120", "--threads", "1,2"};
+    report.runs.push_back(run_bench("embree", "embree", with_common(small), false, data_dir, run_embree_bench));
+    // The largest mesh of Table 2: few frames, as its exact kd-tree alone
+    // takes seconds to build.
+    const std::vector<std::string> large =
+        o.quick ? std::vector<std::string>{"--subdivide", "2", "--clips", "walk", "--frames", "3", "--size", "256x256",
+                                           "--threads", "1"}
+                : std::vector<std::string>{"--subdivide", "4", "--clips", "walk", "--frames", "8", "--threads", "1,2"};
+    report.runs.push_back(run_bench("embree", "embree-large", with_common(large), false, data_dir, run_embree_bench));
+  }
+  if (wanted(o, "tradeoff")) {
+    report.runs.push_back(run_bench("tradeoff", "tradeoff",
+                                    with_common(o.quick ? std::vector<std::string>{"--quick"} : std::vector<std::string>{}),
+                                    true, data_dir, run_tradeoff_bench));
+  }
+  if (wanted(o, "scaling")) {
+    const std::vector<std::string> instances =
+        o.quick ? std::vector<std::string>{"--models", "cally", "--instances", "1,4,16", "--threads", "1,2", "--frames",
+                                           "2", "--size", "256x256"}
+                : std::vector<std::string>{"--models", "cally", "--instances", "1,2,4,8,16,32", "--threads", "1,2",
+                                           "--frames", "5"};
+    report.runs.push_back(
+        run_bench("raytrace", "scaling-instances", with_common(instances), false, data_dir, run_raytrace_bench));
+    const std::vector<int> sides = o.quick ? std::vector<int>{256, 512} : std::vector<int>{256, 512, 1024, 2048};
+    for (int side : sides) {
+      const std::string size = std::to_string(side) + "x" + std::to_string(side);
+      report.runs.push_back(run_bench("raytrace", "scaling-size-" + std::to_string(side),
+                                      with_common({"--models", "cally", "--instances", "1", "--threads", "1,2",
+                                                   "--frames", o.quick ? "2" : "5", "--size", size}),
+                                      false, data_dir, run_raytrace_bench));
+    }
+  }
+}
+
+}  // namespace
+
+int run_report_bench(const std::vector<std::string>& args, const std::string& command_line) {
+  const auto parsed = parse_options(args);
+  if (!parsed.ok()) {
+    std::fprintf(stderr, "sinew-bench report: %s\n", parsed.status().message().c_str());
+    print_usage(stderr);
+    return 2;
+  }
+  const Options& o = *parsed;
+  if (o.help) {
+    print_usage(stdout);
+    return 0;
+  }
+  const std::string data_dir = o.out_dir + "/bench-data";
+  const std::string image_dir = o.out_dir + "/img";
+  std::error_code ec;
+  fs::create_directories(data_dir, ec);
+  if (!ec) fs::create_directories(image_dir, ec);
+  if (ec) {
+    std::fprintf(stderr, "sinew-bench report: cannot create %s: %s\n", data_dir.c_str(), ec.message().c_str());
+    return 1;
+  }
+  const std::string cpu = cpu_model();
+  const std::string date = utc_date();
+  const std::string load_start = load_average();
+  print_bench_header("report", command_line, "per benchmark", cpu, date);
+  const auto start = std::chrono::steady_clock::now();
+
+  Report report;
+  run_all(o, data_dir, report);
+
+  const double minutes = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() / 60.0;
+  PlotInputs inputs;
+  for (const Run& r : report.runs) inputs.json[r.key] = &r.json;
+  const PlotResult plots = make_plots(inputs, image_dir, data_dir, "img");
+  const std::string path = o.out_dir + "/BENCHMARKS.md";
+  std::ofstream out(path);
+  out << document(o, report, date, cpu, load_start, load_average(), minutes, plots);
+  out.close();
+  if (!out) {
+    std::fprintf(stderr, "sinew-bench report: cannot write %s\n", path.c_str());
+    return 1;
+  }
+  std::printf("\nsinew-bench report: wrote %s (%.1f minutes)\n", path.c_str(), minutes);
+  int exit_code = plots.failed ? 1 : 0;
+  for (const Run& r : report.runs) {
+    if (r.exit_code != 0) exit_code = 1;
+  }
+  return exit_code;
 }
 
 }  // namespace sinew::bench

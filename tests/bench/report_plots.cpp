@@ -1,0 +1,339 @@
+#include "tests/bench/report_plots.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace sinew::bench {
+namespace {
+
+using Json = nlohmann::ordered_json;
+
+// Hole fractions of exactly zero cannot sit on a log axis; they are drawn
+// here, and the axis label says so.
+constexpr double kZeroHoles = 1e-6;
+
+const char* kTerminal = "set terminal pngcairo size 960,600 font 'sans,11'\n";
+
+double number(const Json& j, const char* key) {
+  if (!j.is_object() || !j.contains(key) || !j[key].is_number()) return std::nan("");
+  return j[key].get<double>();
+}
+
+// gnuplot reads "NaN" as a missing point.
+std::string value(double v) {
+  if (!std::isfinite(v)) return "NaN";
+  char text[32];
+  std::snprintf(text, sizeof text, "%.6g", v);
+  return text;
+}
+
+double phase_ms(const Json& phases, const char* name) {
+  if (!phases.is_object() || !phases.contains(name)) return std::nan("");
+  return number(phases[name], "median_ms");
+}
+
+const Json* input(const PlotInputs& in, const std::string& key) {
+  const auto it = in.json.find(key);
+  return it == in.json.end() || !it->second || it->second->is_null() ? nullptr : it->second;
+}
+
+// Runs one script; a missing or empty PNG counts as a failure.
+bool draw(const std::string& script_path, const std::string& png_path, std::string& note) {
+  const std::string log = script_path + ".log";
+  const std::string command = "gnuplot '" + script_path + "' > '" + log + "' 2>&1";
+  const int rc = std::system(command.c_str());
+  std::error_code ec;
+  if (rc != 0 || !std::filesystem::is_regular_file(png_path, ec) || std::filesystem::file_size(png_path, ec) == 0) {
+    note += "gnuplot failed on " + script_path + " (see " + log + "). ";
+    return false;
+  }
+  return true;
+}
+
+bool write_file(const std::string& path, const std::string& text, std::string& note) {
+  std::ofstream out(path);
+  out << text;
+  out.close();
+  if (!out) note += "cannot write " + path + ". ";
+  return static_cast<bool>(out);
+}
+
+// --- fps against triangles, beside the paper (Table 2) ---------------------------
+
+bool fps_vs_triangles_data(const Json& paper, std::string& data) {
+  if (!paper.contains("table2")) return false;
+  const Json& t2 = paper["table2"];
+  bool any = false;
+  for (const Json& row : t2.value("rows", Json::array())) {
+    if (row.value("interpolated", false) || !row.contains("fps")) continue;
+    const Json& fps = row["fps"];
+    const auto at = [&](const char* threads, const char* kind) {
+      return fps.contains(threads) ? number(fps[threads], kind) : std::nan("");
+    };
+    data += value(number(row, "triangles")) + " " + value(at("1", "primary")) + " " +
+            value(at("1", "primary_shadows")) + " " + value(at("2", "primary")) + " " +
+            value(at("2", "primary_shadows")) + "\n";
+    any = true;
+  }
+  data += "\n\n";
+  for (const Json& row : t2.value("paper", Json::array())) {
+    data += value(number(row, "triangles")) + " " + value(number(row, "fps")) + "\n";
+  }
+  return any;
+}
+
+std::string fps_vs_triangles_script(const std::string& dat, const std::string& png) {
+  return std::string(kTerminal) + "set output '" + png + "'\n" +
+         "set title 'Cally at 1024x1024: Sinew and the paper (Table 2)'\n"
+         "set logscale xy\nset grid\nset key outside below\n"
+         "set xlabel 'triangles (iterative subdivision of Cally)'\nset ylabel 'frames per second'\n"
+         "plot '" + dat + "' index 0 using 1:2 with linespoints lw 2 pt 7 title 'Sinew, 1 thread, primary rays', \\\n"
+         "     '' index 0 using 1:3 with linespoints lw 2 pt 5 title 'Sinew, 1 thread, primary + shadow rays', \\\n"
+         "     '' index 0 using 1:4 with linespoints lw 2 pt 9 title 'Sinew, 2 threads, primary rays', \\\n"
+         "     '' index 0 using 1:5 with linespoints lw 2 pt 11 title 'Sinew, 2 threads, primary + shadow rays', \\\n"
+         "     '' index 1 using 1:2 with linespoints lw 2 dt 2 pt 6 lc rgb 'black' "
+         "title 'paper: one 2.4 GHz Opteron core, primary rays'\n";
+}
+
+// --- Sinew against Embree: frame time per contender --------------------------------
+
+std::string short_name(const std::string& name) {
+  if (name == "sinew fuzzy kd") return "Sinew";
+  if (name == "embree LOW rebuild") return "Embree LOW";
+  if (name == "embree refit") return "Embree refit";
+  if (name == "embree MEDIUM rebuild") return "Embree MEDIUM";
+  if (name == "exact SAH kd rebuild") return "exact kd";
+  return name;
+}
+
+// One data block per configuration; returns the blocks' titles.
+std::vector<std::string> embree_data(const Json& doc, std::string& data) {
+  std::vector<std::string> titles;
+  for (const Json& config : doc.value("configurations", Json::array())) {
+    const double skinning = phase_ms(config["shared"], "skinning");
+    std::string block;
+    for (const Json& c : config.value("contenders", Json::array())) {
+      if (!c.contains("phases")) continue;  // failed its brute-force check
+      const Json& p = c["phases"];
+      block += "\"" + short_name(c.value("name", "?")) + "\" " + value(skinning) + " " + value(phase_ms(p, "build")) +
+               " " + value(phase_ms(p, "trace primary")) + " " + value(phase_ms(p, "trace shadow")) + " " +
+               value(phase_ms(p, "shade")) + "\n";
+    }
+    if (block.empty()) continue;
+    data += block + "\n\n";
+    const int threads = config.value("threads", 0);
+    titles.push_back(config.value("clip", "?") + ", " + std::to_string(threads) + (threads == 1 ? " thread" : " threads"));
+  }
+  return titles;
+}
+
+std::string embree_panel(const std::string& dat, const std::vector<std::string>& titles, const std::string& title) {
+  std::string s = "set title '" + title + "'\nplot ";
+  for (std::size_t i = 0; i < titles.size(); ++i) {
+    const std::string index = " index " + std::to_string(i);
+    const bool first = i == 0;
+    s += std::string(first ? "" : ", \\\n     ") + "newhistogram '" + titles[i] + "' lt 1, '" + dat + "'" + index +
+         " using 2:xtic(1) " + (first ? "title 'skinning'" : "notitle") + ", '' " + index + " using 3 " +
+         (first ? "title 'build / refit'" : "notitle") + ", '' " + index + " using 4 " +
+         (first ? "title 'primary rays'" : "notitle") + ", '' " + index + " using 5 " +
+         (first ? "title 'shadow rays'" : "notitle") + ", '' " + index + " using 6 " +
+         (first ? "title 'shading'" : "notitle");
+  }
+  return s + "\n";
+}
+
+// --- the speed/accuracy trade -------------------------------------------------------
+
+std::vector<std::string> tradeoff_data(const Json& doc, std::string& data) {
+  std::vector<std::string> modes;
+  for (const Json& row : doc.value("sweep", Json::array())) {
+    const std::string mode = row.value("mode", "?");
+    if (std::find(modes.begin(), modes.end(), mode) == modes.end()) modes.push_back(mode);
+  }
+  std::vector<std::string> drawn;
+  for (const std::string& mode : modes) {
+    std::string block;
+    for (const Json& row : doc["sweep"]) {
+      if (row.value("mode", "") != mode || number(row, "padding") != 0.0) continue;
+      const double holes = number(row, "hole_fraction"), fps = number(row, "fps");
+      if (!std::isfinite(holes) || !std::isfinite(fps)) continue;
+      block += value(std::max(holes, kZeroHoles)) + " " + value(fps) + " " + value(number(row, "samples")) + "\n";
+    }
+    if (block.empty()) continue;
+    data += block + "\n\n";
+    drawn.push_back(mode);
+  }
+  return drawn;
+}
+
+std::string tradeoff_script(const std::string& dat, const std::string& png, const std::vector<std::string>& modes) {
+  std::string s = std::string(kTerminal) + "set output '" + png + "'\n" +
+                  "set title 'Speed against accuracy: each point a sample count (padding 0)'\n"
+                  "set logscale x\nset grid\nset key outside below\n"
+                  "set xlabel 'fraction of pixels whose hit differs from brute force, fallback off (0 drawn at 1e-6)'\n"
+                  "set ylabel 'frames per second, fallback on'\nplot ";
+  for (std::size_t i = 0; i < modes.size(); ++i) {
+    const std::string index = " index " + std::to_string(i);
+    s += std::string(i == 0 ? "" : ", \\\n     ") + "'" + dat + "'" + index +
+         " using 1:2 with linespoints lw 2 pt 7 title '" + modes[i] + "', ''" + index +
+         " using 1:2:(sprintf('%d', $3)) with labels offset char 0.8,0.6 font ',8' notitle";
+  }
+  return s + "\n";
+}
+
+// --- scaling ------------------------------------------------------------------------
+
+struct Point {
+  double x;
+  double fps;
+};
+
+// Points by thread count, from the raytrace benchmark's runs.
+void scaling_points(const Json& doc, bool by_instances, std::map<int, std::vector<Point>>& out) {
+  if (!doc.contains("models") || doc["models"].empty()) return;
+  const double pixels = doc.contains("size") ? doc["size"][0].get<double>() * doc["size"][1].get<double>() : 0.0;
+  for (const Json& run : doc["models"][0].value("runs", Json::array())) {
+    const double x = by_instances ? number(run, "instances") : pixels / 1e6;
+    out[run.value("threads", 0)].push_back({x, number(run, "fps")});
+  }
+}
+
+std::vector<int> scaling_data(const std::map<int, std::vector<Point>>& points, std::string& data) {
+  std::vector<int> threads;
+  for (const auto& [t, list] : points) {
+    std::vector<Point> sorted = list;
+    std::sort(sorted.begin(), sorted.end(), [](const Point& a, const Point& b) { return a.x < b.x; });
+    for (const Point& p : sorted) data += value(p.x) + " " + value(p.fps) + "\n";
+    data += "\n\n";
+    threads.push_back(t);
+  }
+  return threads;
+}
+
+std::string scaling_panel(const std::string& dat, const std::vector<int>& threads, const std::string& xlabel,
+                          const std::string& title) {
+  std::string s = "set title '" + title + "'\nset xlabel '" + xlabel + "'\nplot ";
+  for (std::size_t i = 0; i < threads.size(); ++i) {
+    s += std::string(i == 0 ? "" : ", ") + "'" + dat + "' index " + std::to_string(i) +
+         " using 1:2 with linespoints lw 2 pt 7 title '" + std::to_string(threads[i]) +
+         (threads[i] == 1 ? " thread'" : " threads'");
+  }
+  return s + "\n";
+}
+
+}  // namespace
+
+PlotResult make_plots(const PlotInputs& inputs, const std::string& image_dir, const std::string& data_dir,
+                      const std::string& link_dir) {
+  PlotResult result;
+  if (std::system("command -v gnuplot > /dev/null 2>&1") != 0) {
+    result.note = "Plots skipped: gnuplot was not found (Debian: gnuplot-nox; `./sinew deps` installs it).";
+    return result;
+  }
+  const auto paths = [&](const std::string& name) {
+    return std::array<std::string, 4>{data_dir + "/plot_" + name + ".dat", data_dir + "/plot_" + name + ".gp",
+                                      image_dir + "/bench_" + name + ".png", link_dir + "/bench_" + name + ".png"};
+  };
+  const auto render = [&](const std::string& name, const std::string& data, const std::string& script,
+                          std::string& link) {
+    const auto [dat, gp, png, href] = paths(name);
+    if (!write_file(dat, data, result.note) || !write_file(gp, script, result.note)) {
+      result.failed = true;
+      return;
+    }
+    if (draw(gp, png, result.note)) {
+      link = href;
+    } else {
+      result.failed = true;
+    }
+  };
+
+  if (const Json* paper = input(inputs, "paper")) {
+    std::string data;
+    if (fps_vs_triangles_data(*paper, data)) {
+      const auto [dat, gp, png, href] = paths("fps_vs_triangles");
+      render("fps_vs_triangles", data, fps_vs_triangles_script(dat, png), result.fps_vs_triangles);
+    }
+  }
+
+  {
+    const Json* small = input(inputs, "embree");
+    const Json* large = input(inputs, "embree-large");
+    std::string small_data, large_data;
+    const std::vector<std::string> small_titles = small ? embree_data(*small, small_data) : std::vector<std::string>{};
+    const std::vector<std::string> large_titles = large ? embree_data(*large, large_data) : std::vector<std::string>{};
+    if (!small_titles.empty() || !large_titles.empty()) {
+      const auto [dat, gp, png, href] = paths("embree");
+      const std::string large_dat = data_dir + "/plot_embree_large.dat";
+      std::string script = std::string("set terminal pngcairo size 1280,600 font 'sans,11'\nset output '") + png +
+                           "'\nset style data histograms\nset style histogram rowstacked\n"
+                           "set style fill solid 0.85 border -1\nset boxwidth 0.8\nset grid ytics\n"
+                           "set ylabel 'ms per frame (median)'\nset xtics rotate by -40 scale 0 font ',9'\n"
+                           "set key top left\n";
+      const int panels = (small_titles.empty() ? 0 : 1) + (large_titles.empty() ? 0 : 1);
+      script += "set multiplot layout 1," + std::to_string(panels) + "\n";
+      const auto triangles = [](const Json* doc) {
+        char text[64];
+        std::snprintf(text, sizeof text, "%.0f", doc ? number(*doc, "triangles") : 0.0);
+        return std::string(text);
+      };
+      if (!small_titles.empty()) script += embree_panel(dat, small_titles, "Cally, " + triangles(small) + " triangles");
+      if (!large_titles.empty()) {
+        script += embree_panel(large_dat, large_titles, "Cally subdivided, " + triangles(large) + " triangles");
+      }
+      script += "unset multiplot\n";
+      if (!large_titles.empty() && !write_file(large_dat, large_data, result.note)) result.failed = true;
+      render("embree", small_data, script, result.embree);
+    }
+  }
+
+  if (const Json* trade = input(inputs, "tradeoff")) {
+    std::string data;
+    const std::vector<std::string> modes = tradeoff_data(*trade, data);
+    if (!modes.empty()) {
+      const auto [dat, gp, png, href] = paths("tradeoff");
+      render("tradeoff", data, tradeoff_script(dat, png, modes), result.tradeoff);
+    }
+  }
+
+  {
+    std::map<int, std::vector<Point>> by_instances, by_pixels;
+    for (const auto& [key, doc] : inputs.json) {
+      if (!doc || doc->is_null()) continue;
+      if (key == "scaling-instances") scaling_points(*doc, true, by_instances);
+      if (key.rfind("scaling-size-", 0) == 0) scaling_points(*doc, false, by_pixels);
+    }
+    std::string instance_data, pixel_data;
+    const std::vector<int> instance_threads = scaling_data(by_instances, instance_data);
+    const std::vector<int> pixel_threads = scaling_data(by_pixels, pixel_data);
+    if (!instance_threads.empty() || !pixel_threads.empty()) {
+      const auto [dat, gp, png, href] = paths("scaling");
+      const std::string pixel_dat = data_dir + "/plot_scaling_pixels.dat";
+      const int panels = (instance_threads.empty() ? 0 : 1) + (pixel_threads.empty() ? 0 : 1);
+      std::string script = std::string("set terminal pngcairo size 1200,520 font 'sans,11'\nset output '") + png +
+                           "'\nset logscale xy\nset grid\nset key top right\nset ylabel 'frames per second'\n"
+                           "set multiplot layout 1," +
+                           std::to_string(panels) + "\n";
+      if (!instance_threads.empty()) {
+        script += scaling_panel(dat, instance_threads, "Cally instances", "fps against instances");
+      }
+      if (!pixel_threads.empty()) {
+        script += scaling_panel(pixel_dat, pixel_threads, "megapixels", "fps against image size (one Cally)");
+        if (!write_file(pixel_dat, pixel_data, result.note)) result.failed = true;
+      }
+      script += "unset multiplot\n";
+      render("scaling", instance_data, script, result.scaling);
+    }
+  }
+  return result;
+}
+
+}  // namespace sinew::bench
