@@ -40,7 +40,8 @@ struct FrameOptions {
   BoneBoxMode bone_boxes = BoneBoxMode::kExact;
   // Route triangles that left their fuzzy boxes through a per-frame
   // world-space kd-tree so the image stays exact (DESIGN.md section 4). Off:
-  // escapes are still counted, and may show as holes.
+  // escapes are still counted in FrameStats::escaped_checks (escaped_triangles
+  // stays 0: nothing is routed), and may show as holes.
   bool fallback = true;
   bool normals = true;  // skin normals (shading needs them; depth-only passes do not)
   SkinningPath skinning = SkinningPath::kAuto;
@@ -51,7 +52,7 @@ struct FrameOptions {
 
 struct FrameStats {
   std::size_t escaped_checks = 0;     // (vertex, bone) pairs outside their fuzzy boxes
-  std::size_t escaped_triangles = 0;  // triangles routed through the fallback
+  std::size_t escaped_triangles = 0;  // triangles routed through the fallback (0 with it off)
   std::size_t singular_bones = 0;     // bones without a finite inverse (zero scale)
   std::uint32_t top_level_objects = 0;
   std::uint32_t top_level_nodes = 0;

@@ -137,27 +137,51 @@ class BruteForceGate {
   std::vector<Hit> reference_;
 };
 
-// The renderer's primary hits on `scene`, for the gate: an untimed render of
-// the id and depth outputs (depth = t: camera rays are unit length).
+// The renderer's primary hits, for the gate: untimed renders of the id and
+// depth outputs (depth = t: camera rays are unit length), into buffers kept
+// from one render to the next (the trade benchmark renders thousands).
+class PrimaryHitRenderer {
+ public:
+  PrimaryHitRenderer(int width, int height)
+      : width_(width),
+        height_(height),
+        triangle_(static_cast<std::size_t>(width) * static_cast<std::size_t>(height)),
+        instance_(triangle_.size()),
+        depth_(triangle_.size()),
+        hits_(triangle_.size()) {}
+
+  // `camera` must be width x height. The span lives until the next render.
+  Expected<std::span<const Hit>> render(const rt::Scene& scene, const rt::PinholeCamera& camera,
+                                        const rt::RenderSettings& settings, JobSystem& jobs) {
+    rt::FrameBuffers ids;
+    ids.width = width_;
+    ids.height = height_;
+    ids.triangle_id = triangle_;
+    ids.instance_id = instance_;
+    ids.depth = depth_;
+    const auto rendered = renderer_.render(scene, camera, settings, ids, jobs);
+    if (!rendered.ok()) return rendered.status();
+    for (std::size_t i = 0; i < hits_.size(); ++i) {
+      hits_[i] = triangle_[i] != kInvalidId ? Hit{depth_[i], 0.0f, 0.0f, triangle_[i], instance_[i]} : Hit{};
+    }
+    return std::span<const Hit>(hits_);
+  }
+
+ private:
+  int width_, height_;
+  std::vector<std::uint32_t> triangle_, instance_;
+  std::vector<float> depth_;
+  std::vector<Hit> hits_;
+  rt::Renderer renderer_;
+};
+
+// One render's primary hits, as a vector.
 inline Expected<std::vector<Hit>> render_primary_hits(const rt::Scene& scene, const rt::PinholeCamera& camera,
                                                       const rt::RenderSettings& settings, JobSystem& jobs) {
-  const std::size_t pixels = static_cast<std::size_t>(camera.width()) * static_cast<std::size_t>(camera.height());
-  std::vector<std::uint32_t> triangle(pixels), instance(pixels);
-  std::vector<float> depth(pixels);
-  rt::FrameBuffers ids;
-  ids.width = camera.width();
-  ids.height = camera.height();
-  ids.triangle_id = triangle;
-  ids.instance_id = instance;
-  ids.depth = depth;
-  rt::Renderer renderer;
-  const auto rendered = renderer.render(scene, camera, settings, ids, jobs);
-  if (!rendered.ok()) return rendered.status();
-  std::vector<Hit> hits(pixels);
-  for (std::size_t i = 0; i < pixels; ++i) {
-    if (triangle[i] != kInvalidId) hits[i] = Hit{depth[i], 0.0f, 0.0f, triangle[i], instance[i]};
-  }
-  return hits;
+  PrimaryHitRenderer renderer(camera.width(), camera.height());
+  const auto hits = renderer.render(scene, camera, settings, jobs);
+  if (!hits.ok()) return hits.status();
+  return std::vector<Hit>(hits->begin(), hits->end());
 }
 
 }  // namespace sinew::bench

@@ -24,11 +24,18 @@ void usage() {
       "           fuzzy bake cost per candidate-bone mode, its trace effect, and its memory bound\n"
       "  demo [--characters LIST] [--size WxH] [--threads N] [--frames N] [--warmup N]\n"
       "           [--shadows on|off] [--model PATH] [--json FILE]   the game demo's fps and phases\n"
-      "  embree [--quick] [--model NAME|PATH] [--instances N] [--frames N] [--clips LIST] [--size WxH]\n"
-      "           [--threads LIST] [--json FILE]   Sinew vs Embree 3 (rebuild LOW/MEDIUM, refit) vs exact kd\n"
+      "  embree [--quick] [--model NAME|PATH] [--subdivide L] [--instances N] [--frames N] [--clips LIST]\n"
+      "           [--size WxH] [--threads LIST] [--json FILE]   Sinew vs Embree 3 (rebuild LOW/MEDIUM, refit) vs exact kd\n"
+      "  paper [--quick] [--tables 1,2] [--levels LIST] [--threads LIST] [--frames N] [--size WxH]\n"
+      "           [--samples N] [--json FILE] [--markdown FILE]   the paper's Tables 1 and 2 on Cally\n"
+      "  report [--quick] [--out DIR] [--sections LIST]   every issue-7 benchmark; writes docs/BENCHMARKS.md\n"
+      "  tradeoff [--quick] [--model NAME] [--samples LIST] [--modes LIST] [--padding LIST] [--held-out N]\n"
+      "           [--json FILE] [--markdown FILE]   speed against accuracy: samples, pose spaces, padding,\n"
+      "           held-out escapes and holes, fallback cost, fast vs watertight, exact vs cheap boxes\n"
       "  raytrace [--size WxH] [--frames N] [--threads LIST] [--models LIST] [--instances LIST]\n"
       "           [--shared DIR] [--triangle-test fast|watertight] [--bone-boxes exact|cheap]\n"
-      "           [--json FILE]   ray tracer frame phases, and fuzzy vs exact kd-tree trace time\n");
+      "           [--json FILE]   ray tracer frame phases, and fuzzy vs exact kd-tree trace time\n"
+      "Run `sinew-bench <benchmark> --help` for a benchmark's options.\n");
 }
 
 // The command as typed (arguments with spaces quoted), so a printed table

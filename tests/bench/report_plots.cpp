@@ -20,7 +20,7 @@ using Json = nlohmann::ordered_json;
 // here, and the axis label says so.
 constexpr double kZeroHoles = 1e-6;
 
-const char* kTerminal = "set terminal pngcairo size 960,600 font 'sans,11'\n";
+const char* kTerminal = "set terminal pngcairo noenhanced size 960,600 font 'sans,11'\n";
 
 double number(const Json& j, const char* key) {
   if (!j.is_object() || !j.contains(key) || !j[key].is_number()) return std::nan("");
@@ -273,7 +273,7 @@ PlotResult make_plots(const PlotInputs& inputs, const std::string& image_dir, co
     if (!small_titles.empty() || !large_titles.empty()) {
       const auto [dat, gp, png, href] = paths("embree");
       const std::string large_dat = data_dir + "/plot_embree_large.dat";
-      std::string script = std::string("set terminal pngcairo size 1280,600 font 'sans,11'\nset output '") + png +
+      std::string script = std::string("set terminal pngcairo noenhanced size 1280,600 font 'sans,11'\nset output '") + png +
                            "'\nset style data histograms\nset style histogram rowstacked\n"
                            "set style fill solid 0.85 border -1\nset boxwidth 0.8\nset grid ytics\n"
                            "set ylabel 'ms per frame (median)'\nset xtics rotate by -40 scale 0 font ',9'\n"
@@ -318,7 +318,7 @@ PlotResult make_plots(const PlotInputs& inputs, const std::string& image_dir, co
       const auto [dat, gp, png, href] = paths("scaling");
       const std::string pixel_dat = data_dir + "/plot_scaling_pixels.dat";
       const int panels = (instance_threads.empty() ? 0 : 1) + (pixel_threads.empty() ? 0 : 1);
-      std::string script = std::string("set terminal pngcairo size 1200,520 font 'sans,11'\nset output '") + png +
+      std::string script = std::string("set terminal pngcairo noenhanced size 1200,520 font 'sans,11'\nset output '") + png +
                            "'\nset logscale xy\nset grid\nset key top right\nset ylabel 'frames per second'\n"
                            "set multiplot layout 1," +
                            std::to_string(panels) + "\n";

@@ -4,6 +4,7 @@ if(TARGET Cal3D::cal3d)
   sinew_add_test_binary(sinew_cal3d_tests
     SOURCES ${CMAKE_CURRENT_LIST_DIR}/cal3d_import_test.cpp
             ${CMAKE_CURRENT_LIST_DIR}/cal3d_mixer_oracle_test.cpp
+            ${CMAKE_CURRENT_LIST_DIR}/cally_limits_test.cpp
     LIBS sinew::editor Cal3D::cal3d)
   # As for the importer (editor/import/cal3d.cmake): libcal3d exports no
   # typeinfo for UBSan's vptr check to reference.
