@@ -146,6 +146,15 @@ Run run_bench(const std::string& bench, const std::string& key, std::vector<std:
 
 // --- Markdown helpers ------------------------------------------------------------
 
+// A benchmark's own Markdown section, its commands' paths made relative to
+// the source tree (the report's readers do not share this machine's paths).
+std::string pasted_markdown(const Run& r) {
+  std::string text = read_text(r.markdown_path);
+  const std::string root = std::string(SINEW_SOURCE_DIR) + "/";
+  for (std::size_t at = text.find(root); at != std::string::npos; at = text.find(root, at)) text.erase(at, root.size());
+  return text;
+}
+
 std::string format(const char* pattern, ...) __attribute__((format(printf, 1, 2)));
 std::string format(const char* pattern, ...) {
   char text[512];
@@ -311,10 +320,14 @@ std::string scaling_sizes_markdown(const std::vector<Run>& runs) {
 
 // --- headlines -----------------------------------------------------------------------
 
+// Points into the run's JSON (not into a copy: value() returns one).
 const Json* table2_row(const Run* paper, int level) {
-  if (!paper || !paper->json.contains("table2")) return nullptr;
-  for (const Json& row : paper->json["table2"].value("rows", Json::array())) {
-    if (row.value("level", -1) == level && !row.value("interpolated", false)) return &row;
+  if (!paper || !paper->json.contains("table2") || !paper->json["table2"].contains("rows")) return nullptr;
+  for (const Json& row : paper->json["table2"]["rows"]) {
+    if (row.contains("level") && row["level"].is_number_integer() && row["level"].get<int>() == level &&
+        !row.value("interpolated", false)) {
+      return &row;
+    }
   }
   return nullptr;
 }
@@ -409,7 +422,7 @@ std::string document(const Options& o, const Report& report, const std::string& 
   md += headlines(report.find("paper"), report.find("embree"), report.find("embree-large"), report.find("tradeoff"));
 
   if (const Run* paper = report.find("paper")) {
-    md += read_text(paper->markdown_path);
+    md += pasted_markdown(*paper);
     md += failure_line(*paper);
     if (!plots.fps_vs_triangles.empty()) md += "\n![fps vs triangles, Sinew and the paper](" + plots.fps_vs_triangles + ")\n";
     md += "\n";
@@ -428,7 +441,7 @@ std::string document(const Options& o, const Report& report, const std::string& 
     md += "\n";
   }
   if (const Run* trade = report.find("tradeoff")) {
-    md += read_text(trade->markdown_path);
+    md += pasted_markdown(*trade);
     md += failure_line(*trade);
     if (!plots.tradeoff.empty()) md += "\n![fps against holes per sample count](" + plots.tradeoff + ")\n";
     md += "\n";
