@@ -80,14 +80,11 @@ const std::vector<editor::cli::FlagSpec>& bake_flags() {
 
 Expected<BakeBenchOptions> parse_options(const std::vector<std::string>& args) {
   namespace cli = editor::cli;
-  SINEW_ASSIGN_OR_RETURN(const cli::ParsedArgs parsed, cli::parse_args(args, bake_flags()));
+  SINEW_ASSIGN_OR_RETURN(const cli::ParsedArgs parsed, parse_bench_args(args, bake_flags()));
   BakeBenchOptions o;
-  if (parsed.has("--help") || parsed.has("-h")) {
+  if (wants_help(parsed)) {
     o.help = true;
     return o;
-  }
-  if (!parsed.positionals.empty()) {
-    return invalid_argument("argument", parsed.positionals.front(), "unexpected argument");
   }
   if (const auto text = parsed.value("--models")) {
     SINEW_ASSIGN_OR_RETURN(o.models, cli::parse_list("--models", *text));
@@ -605,16 +602,8 @@ Json large_json(const LargeResult& r) {
 
 int run_bake_bench(const std::vector<std::string>& args, const std::string& command_line) {
   const auto parsed = parse_options(args);
-  if (!parsed.ok()) {
-    std::fprintf(stderr, "sinew-bench bake: %s\n", parsed.status().message().c_str());
-    print_usage(stderr);
-    return 2;
-  }
+  if (const std::optional<int> done = usage_exit("bake", parsed, print_usage)) return *done;
   const BakeBenchOptions& o = *parsed;
-  if (o.help) {
-    print_usage(stdout);
-    return 0;
-  }
 
   const std::string cpu = cpu_model();
   const std::string date = utc_date();

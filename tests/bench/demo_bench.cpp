@@ -40,14 +40,11 @@ const std::vector<editor::cli::FlagSpec>& demo_flags() {
 
 Expected<DemoBenchOptions> parse_options(const std::vector<std::string>& args) {
   namespace cli = editor::cli;
-  SINEW_ASSIGN_OR_RETURN(const cli::ParsedArgs parsed, cli::parse_args(args, demo_flags()));
+  SINEW_ASSIGN_OR_RETURN(const cli::ParsedArgs parsed, parse_bench_args(args, demo_flags()));
   DemoBenchOptions o;
-  if (parsed.has("--help") || parsed.has("-h")) {
+  if (wants_help(parsed)) {
     o.help = true;
     return o;
-  }
-  if (!parsed.positionals.empty()) {
-    return invalid_argument("argument", parsed.positionals.front(), "unexpected argument");
   }
   if (const auto text = parsed.value("--characters")) {
     SINEW_ASSIGN_OR_RETURN(o.characters, parse_int_list("--characters", *text, 1, 256));
@@ -150,17 +147,9 @@ void print_table(const DemoBenchOptions& o, const std::vector<CountResult>& resu
 }  // namespace
 
 int run_demo_bench(const std::vector<std::string>& args, const std::string& command_line) {
-  auto parsed = parse_options(args);
-  if (!parsed.ok()) {
-    std::fprintf(stderr, "sinew-bench demo: %s\n", parsed.status().message().c_str());
-    print_usage(stderr);
-    return 2;
-  }
+  const auto parsed = parse_options(args);
+  if (const std::optional<int> done = usage_exit("demo", parsed, print_usage)) return *done;
   const DemoBenchOptions& o = *parsed;
-  if (o.help) {
-    print_usage(stdout);
-    return 0;
-  }
   JobSystem jobs(o.threads);
   std::printf("# sinew-bench demo\n\n`%s`\n\n%s, %d threads, %s, %dx%d, shadows %s\n", command_line.c_str(),
               cpu_model().c_str(), jobs.thread_count(), utc_date().c_str(), o.width, o.height,

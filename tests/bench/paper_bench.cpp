@@ -117,14 +117,11 @@ const std::vector<editor::cli::FlagSpec>& flags() {
 
 Expected<Options> parse_options(const std::vector<std::string>& args) {
   namespace cli = editor::cli;
-  SINEW_ASSIGN_OR_RETURN(const cli::ParsedArgs parsed, cli::parse_args(args, flags()));
+  SINEW_ASSIGN_OR_RETURN(const cli::ParsedArgs parsed, parse_bench_args(args, flags()));
   Options o;
-  if (parsed.has("--help") || parsed.has("-h")) {
+  if (wants_help(parsed)) {
     o.help = true;
     return o;
-  }
-  if (!parsed.positionals.empty()) {
-    return invalid_argument("argument", parsed.positionals.front(), "unexpected argument");
   }
   if (parsed.has("--quick")) {  // explicit flags below still override
     o.quick = true;
@@ -429,18 +426,25 @@ std::string gate_text(const GateReport& g) {
   return text;
 }
 
+// A table's two header lines: `left` columns (with their `rule`), two fps
+// columns per thread count, then the brute-force column and four paper
+// columns (`right`).
+std::string table_head(const std::string& left, const std::string& rule_left, const std::vector<int>& threads,
+                       const std::string& right) {
+  std::string head = left, rule = rule_left;
+  for (int t : threads) {
+    head += " fps " + std::to_string(t) + "T primary | fps " + std::to_string(t) + "T +shadows |";
+    rule += "---:|---:|";
+  }
+  return head + right + "\n" + rule + "---|---:|---:|---:|---:|\n";
+}
+
 // The Markdown table (printed and written): Sinew's rows by triangle count,
 // the paper's row beside those at its counts.
 std::string table2_markdown(const std::vector<Table2Row>& rows, const std::vector<int>& threads) {
-  std::string md = "| level | triangles | sampling s | build s | tris/leaf |";
-  std::string rule = "|---|---:|---:|---:|---:|";
-  for (int t : threads) {
-    md += " fps " + std::to_string(t) + "T primary | fps " + std::to_string(t) + "T +shadows |";
-    rule += "---:|---:|";
-  }
-  md += " brute force | paper tris | paper sampling s | paper build s | paper fps (1 core) |\n";
-  rule += "---|---:|---:|---:|---:|\n";
-  md += rule;
+  std::string md = table_head("| level | triangles | sampling s | build s | tris/leaf |", "|---|---:|---:|---:|---:|",
+                              threads,
+                              " brute force | paper tris | paper sampling s | paper build s | paper fps (1 core) |");
   for (const Table2Row& r : rows) {
     md += "| " + (r.interpolated ? std::string("interpolated") : std::to_string(r.level)) + " | " +
           std::to_string(r.triangles) + " | ";
@@ -685,15 +689,10 @@ struct Table1Model {
 };
 
 std::string table1_markdown(const Table1Model& m, const std::vector<int>& threads) {
-  std::string md = "| pose space | samples | fuzzy area | / rest area | tris/leaf | escaped tris | tri tests/ray |";
-  std::string rule = "|---|---:|---:|---:|---:|---:|---:|";
-  for (int t : threads) {
-    md += " fps " + std::to_string(t) + "T primary | fps " + std::to_string(t) + "T +shadows |";
-    rule += "---:|---:|";
-  }
-  md += " brute force | paper samples | paper fuzzy area | paper tris/leaf | paper fps |\n";
-  rule += "---|---:|---:|---:|---:|\n";
-  md += rule;
+  std::string md = table_head(
+      "| pose space | samples | fuzzy area | / rest area | tris/leaf | escaped tris | tri tests/ray |",
+      "|---|---:|---:|---:|---:|---:|---:|", threads,
+      " brute force | paper samples | paper fuzzy area | paper tris/leaf | paper fps |");
   for (const Table1Row& r : m.rows) {
     const PaperTable1Row* paper = nullptr;
     for (const PaperTable1Row& p : kPaperTable1) {
@@ -946,16 +945,8 @@ bool wants(const Options& o, int table) {
 
 int run_paper_bench(const std::vector<std::string>& args, const std::string& command_line) {
   const auto parsed = parse_options(args);
-  if (!parsed.ok()) {
-    std::fprintf(stderr, "sinew-bench paper: %s\n", parsed.status().message().c_str());
-    print_usage(stderr);
-    return 2;
-  }
+  if (const std::optional<int> done = usage_exit("paper", parsed, print_usage)) return *done;
   const Options& o = *parsed;
-  if (o.help) {
-    print_usage(stdout);
-    return 0;
-  }
 
   std::string note;
   auto loaded = load_model("cally", o.shared, note);

@@ -62,14 +62,11 @@ const std::vector<editor::cli::FlagSpec>& bench_flags() {
 
 Expected<BenchOptions> parse_options(const std::vector<std::string>& args) {
   namespace cli = editor::cli;
-  SINEW_ASSIGN_OR_RETURN(const cli::ParsedArgs parsed, cli::parse_args(args, bench_flags()));
+  SINEW_ASSIGN_OR_RETURN(const cli::ParsedArgs parsed, parse_bench_args(args, bench_flags()));
   BenchOptions o;
-  if (parsed.has("--help") || parsed.has("-h")) {
+  if (wants_help(parsed)) {
     o.help = true;
     return o;
-  }
-  if (!parsed.positionals.empty()) {
-    return invalid_argument("argument", parsed.positionals.front(), "unexpected argument");
   }
   if (const auto text = parsed.value("--size")) {
     SINEW_ASSIGN_OR_RETURN(const cli::Size2 size, cli::parse_size("--size", *text, kMaxImageSide));
@@ -373,16 +370,8 @@ const char* bone_boxes_name(rt::BoneBoxMode b) { return b == rt::BoneBoxMode::kE
 
 int run_raytrace_bench(const std::vector<std::string>& args, const std::string& command_line) {
   const auto parsed = parse_options(args);
-  if (!parsed.ok()) {
-    std::fprintf(stderr, "sinew-bench raytrace: %s\n", parsed.status().message().c_str());
-    print_usage(stderr);
-    return 2;
-  }
+  if (const std::optional<int> done = usage_exit("raytrace", parsed, print_usage)) return *done;
   const BenchOptions& o = *parsed;
-  if (o.help) {
-    print_usage(stdout);
-    return 0;
-  }
 
   const std::string cpu = cpu_model();
   const std::string date = utc_date();

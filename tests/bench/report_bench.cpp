@@ -47,11 +47,11 @@ Expected<Options> parse_options(const std::vector<std::string>& args) {
   static const std::vector<cli::FlagSpec> flags = {
       {"--help", false}, {"-h", false}, {"--quick", false}, {"--out"}, {"--sections"}, {"--shared"},
   };
-  SINEW_ASSIGN_OR_RETURN(const cli::ParsedArgs parsed, cli::parse_args(args, flags));
+  SINEW_ASSIGN_OR_RETURN(const cli::ParsedArgs parsed, parse_bench_args(args, flags));
   Options o;
-  o.help = parsed.has("--help") || parsed.has("-h");
-  if (!parsed.positionals.empty()) {
-    return invalid_argument("argument", parsed.positionals.front(), "unexpected argument");
+  if (wants_help(parsed)) {
+    o.help = true;
+    return o;
   }
   o.quick = parsed.has("--quick");
   if (const auto text = parsed.value("--out")) o.out_dir = *text;
@@ -525,16 +525,8 @@ void run_all(const Options& o, const std::string& data_dir, Report& report) {
 
 int run_report_bench(const std::vector<std::string>& args, const std::string& command_line) {
   const auto parsed = parse_options(args);
-  if (!parsed.ok()) {
-    std::fprintf(stderr, "sinew-bench report: %s\n", parsed.status().message().c_str());
-    print_usage(stderr);
-    return 2;
-  }
+  if (const std::optional<int> done = usage_exit("report", parsed, print_usage)) return *done;
   const Options& o = *parsed;
-  if (o.help) {
-    print_usage(stdout);
-    return 0;
-  }
   const std::string data_dir = o.out_dir + "/bench-data";
   const std::string image_dir = o.out_dir + "/img";
   std::error_code ec;

@@ -45,16 +45,20 @@ const Json* input(const PlotInputs& in, const std::string& key) {
   return it == in.json.end() || !it->second || it->second->is_null() ? nullptr : it->second;
 }
 
-// Runs one script; a missing or empty PNG counts as a failure.
-bool draw(const std::string& script_path, const std::string& png_path, std::string& note) {
-  const std::string log = script_path + ".log";
-  const std::string command = "gnuplot '" + script_path + "' > '" + log + "' 2>&1";
+// Runs one script from the data folder (its paths are relative to it, so
+// the scripts can be rerun anywhere); a missing or empty PNG counts as a
+// failure. An empty log is removed.
+bool draw(const std::string& data_dir, const std::string& script, const std::string& png_path, std::string& note) {
+  const std::string log = script + ".log";
+  const std::string command = "cd '" + data_dir + "' && gnuplot '" + script + "' > '" + log + "' 2>&1";
   const int rc = std::system(command.c_str());
   std::error_code ec;
+  const std::string log_path = data_dir + "/" + log;
   if (rc != 0 || !std::filesystem::is_regular_file(png_path, ec) || std::filesystem::file_size(png_path, ec) == 0) {
-    note += "gnuplot failed on " + script_path + " (see " + log + "). ";
+    note += "gnuplot failed on " + data_dir + "/" + script + " (see " + log_path + "). ";
     return false;
   }
+  if (std::filesystem::file_size(log_path, ec) == 0) std::filesystem::remove(log_path, ec);
   return true;
 }
 
@@ -238,18 +242,23 @@ PlotResult make_plots(const PlotInputs& inputs, const std::string& image_dir, co
     result.note = "Plots skipped: gnuplot was not found (Debian: gnuplot-nox; `./sinew deps` installs it).";
     return result;
   }
+  // The scripts name their data and images relative to the data folder.
+  std::error_code ec;
+  const std::string images_from_data = std::filesystem::relative(image_dir, data_dir, ec).string();
   const auto paths = [&](const std::string& name) {
-    return std::array<std::string, 4>{data_dir + "/plot_" + name + ".dat", data_dir + "/plot_" + name + ".gp",
-                                      image_dir + "/bench_" + name + ".png", link_dir + "/bench_" + name + ".png"};
+    return std::array<std::string, 4>{"plot_" + name + ".dat", "plot_" + name + ".gp",
+                                      (ec ? image_dir : images_from_data) + "/bench_" + name + ".png",
+                                      link_dir + "/bench_" + name + ".png"};
   };
+  const auto in_data = [&](const std::string& file) { return data_dir + "/" + file; };
   const auto render = [&](const std::string& name, const std::string& data, const std::string& script,
                           std::string& link) {
     const auto [dat, gp, png, href] = paths(name);
-    if (!write_file(dat, data, result.note) || !write_file(gp, script, result.note)) {
+    if (!write_file(in_data(dat), data, result.note) || !write_file(in_data(gp), script, result.note)) {
       result.failed = true;
       return;
     }
-    if (draw(gp, png, result.note)) {
+    if (draw(data_dir, gp, image_dir + "/bench_" + name + ".png", result.note)) {
       link = href;
     } else {
       result.failed = true;
@@ -272,7 +281,7 @@ PlotResult make_plots(const PlotInputs& inputs, const std::string& image_dir, co
     const std::vector<std::string> large_titles = large ? embree_data(*large, large_data) : std::vector<std::string>{};
     if (!small_titles.empty() || !large_titles.empty()) {
       const auto [dat, gp, png, href] = paths("embree");
-      const std::string large_dat = data_dir + "/plot_embree_large.dat";
+      const std::string large_dat = "plot_embree_large.dat";
       std::string script = std::string("set terminal pngcairo noenhanced size 1280,600 font 'sans,11'\nset output '") + png +
                            "'\nset style data histograms\nset style histogram rowstacked\n"
                            "set style fill solid 0.85 border -1\nset boxwidth 0.8\nset grid ytics\n"
@@ -290,7 +299,7 @@ PlotResult make_plots(const PlotInputs& inputs, const std::string& image_dir, co
         script += embree_panel(large_dat, large_titles, "Cally subdivided, " + triangles(large) + " triangles");
       }
       script += "unset multiplot\n";
-      if (!large_titles.empty() && !write_file(large_dat, large_data, result.note)) result.failed = true;
+      if (!large_titles.empty() && !write_file(in_data(large_dat), large_data, result.note)) result.failed = true;
       render("embree", small_data, script, result.embree);
     }
   }
@@ -316,7 +325,7 @@ PlotResult make_plots(const PlotInputs& inputs, const std::string& image_dir, co
     const std::vector<int> pixel_threads = scaling_data(by_pixels, pixel_data);
     if (!instance_threads.empty() || !pixel_threads.empty()) {
       const auto [dat, gp, png, href] = paths("scaling");
-      const std::string pixel_dat = data_dir + "/plot_scaling_pixels.dat";
+      const std::string pixel_dat = "plot_scaling_pixels.dat";
       const int panels = (instance_threads.empty() ? 0 : 1) + (pixel_threads.empty() ? 0 : 1);
       std::string script = std::string("set terminal pngcairo noenhanced size 1200,520 font 'sans,11'\nset output '") + png +
                            "'\nset logscale xy\nset grid\nset key top right\nset ylabel 'frames per second'\n"
@@ -327,7 +336,7 @@ PlotResult make_plots(const PlotInputs& inputs, const std::string& image_dir, co
       }
       if (!pixel_threads.empty()) {
         script += scaling_panel(pixel_dat, pixel_threads, "megapixels", "fps against image size (one Cally)");
-        if (!write_file(pixel_dat, pixel_data, result.note)) result.failed = true;
+        if (!write_file(in_data(pixel_dat), pixel_data, result.note)) result.failed = true;
       }
       script += "unset multiplot\n";
       render("scaling", instance_data, script, result.scaling);

@@ -86,14 +86,11 @@ const std::vector<editor::cli::FlagSpec>& flags() {
 
 Expected<Options> parse_options(const std::vector<std::string>& args) {
   namespace cli = editor::cli;
-  SINEW_ASSIGN_OR_RETURN(const cli::ParsedArgs parsed, cli::parse_args(args, flags()));
+  SINEW_ASSIGN_OR_RETURN(const cli::ParsedArgs parsed, parse_bench_args(args, flags()));
   Options o;
-  if (parsed.has("--help") || parsed.has("-h")) {
+  if (wants_help(parsed)) {
     o.help = true;
     return o;
-  }
-  if (!parsed.positionals.empty()) {
-    return invalid_argument("argument", parsed.positionals.front(), "unexpected argument");
   }
   if (parsed.has("--quick")) {  // explicit flags below still override
     o.quick = true;
@@ -835,16 +832,8 @@ CrackResult crack_test(bool watertight, int subdivisions, std::uint64_t seed) {
 int run_tradeoff_bench(const std::vector<std::string>& args, const std::string& command_line) {
   const Clock::time_point run_start = Clock::now();
   const auto parsed = parse_options(args);
-  if (!parsed.ok()) {
-    std::fprintf(stderr, "sinew-bench tradeoff: %s\n", parsed.status().message().c_str());
-    print_usage(stderr);
-    return 2;
-  }
+  if (const std::optional<int> done = usage_exit("tradeoff", parsed, print_usage)) return *done;
   const Options& o = *parsed;
-  if (o.help) {
-    print_usage(stdout);
-    return 0;
-  }
 
   Report rep;
   rep.o = &o;
