@@ -75,7 +75,8 @@ void print_usage(std::FILE* to) {
                "usage: sinew-bench report [--quick] [--out DIR] [--sections LIST] [--shared DIR]\n"
                "  --quick           a smoke run under 5 minutes on 2 cores (default --out build/report-quick)\n"
                "  --out DIR         where BENCHMARKS.md, img/ and bench-data/ go (default: the source tree's docs/)\n"
-               "  --sections LIST   paper,embree,tradeoff,scaling (default all)\n"
+               "  --sections LIST   paper,embree,tradeoff,scaling (default all); the other sections are kept\n"
+               "                    from the last report written to the same --out\n"
                "  --shared DIR      the shared folder holding content/cal3d/cally\n");
 }
 
@@ -95,8 +96,18 @@ struct Run {
   std::string markdown_path;  // empty when the benchmark writes none
   int exit_code = 0;
   double seconds = 0.0;
-  Json json;  // null when the file is missing or unreadable
+  std::string date;    // when it started
+  std::string commit;  // what it measured
+  bool kept = false;   // taken from an earlier report (its section was not rerun)
+  Json json;           // null when the file is missing or unreadable
 };
+
+// The report section a run belongs to (what --sections names).
+std::string section_of(const std::string& key) {
+  if (key.rfind("embree", 0) == 0) return "embree";
+  if (key.rfind("scaling", 0) == 0) return "scaling";
+  return key;
+}
 
 std::string join_args(const std::vector<std::string>& args) {
   std::string out;
@@ -132,6 +143,8 @@ Run run_bench(const std::string& bench, const std::string& key, std::vector<std:
     args.push_back("--markdown");
     args.push_back(r.markdown_path);
   }
+  r.date = utc_date();
+  r.commit = git_commit();
   std::fprintf(stderr, "sinew-bench report: running %s\n", r.command.c_str());
   std::fflush(stdout);
   const auto start = std::chrono::steady_clock::now();
@@ -414,6 +427,17 @@ std::string document(const Options& o, const Report& report, const std::string& 
                "frame of every configuration against brute-force ray casting and leaves out any that disagrees.\n\n",
                date.c_str(), cpu.c_str(), JobSystem::hardware_threads(), std::string(build_isa()).c_str(),
                git_commit().c_str(), o.quick ? "quick" : "full", minutes, load_start.c_str(), load_end.c_str());
+  std::string kept;
+  for (const Run& r : report.runs) {
+    if (r.kept && kept.find(section_of(r.key)) == std::string::npos) {
+      kept += (kept.empty() ? "" : ", ") + section_of(r.key);
+    }
+  }
+  if (!kept.empty()) {
+    md += "Only some sections were measured by this run. Kept from an earlier run of the report: **" + kept +
+          "** (`--sections` reruns the named sections and keeps the others; the last table gives each "
+          "benchmark's date and commit).\n\n";
+  }
   md += "Reproduce (the release preset; Embree 3 optional):\n\n```sh\n./sinew build release\n" +
         std::string("build/release/tests/bench/sinew-bench report") + (o.quick ? " --quick" : "") +
         "\n```\n\nThe raw numbers are in `bench-data/*.json` beside this file; each section names the command that "
@@ -462,12 +486,75 @@ std::string document(const Options& o, const Report& report, const std::string& 
     if (!plots.scaling.empty()) md += "\n![scaling](" + plots.scaling + ")\n";
     md += "\n";
   }
-  md += "## How long each benchmark took\n\n| benchmark | command | minutes | exit code |\n|---|---|---:|---:|\n";
+  md += "## When and how long each benchmark ran\n\n| benchmark | command | measured | commit | minutes | exit code |\n"
+        "|---|---|---|---|---:|---:|\n";
   for (const Run& r : report.runs) {
-    md += format("| %s | `%s` | %.1f | %d |\n", r.key.c_str(), r.command.c_str(), r.seconds / 60.0, r.exit_code);
+    md += format("| %s | `%s` | %s%s | `%s` | %.1f | %d |\n", r.key.c_str(), r.command.c_str(), r.date.c_str(),
+                 r.kept ? " (kept)" : "", r.commit.c_str(), r.seconds / 60.0, r.exit_code);
   }
   if (!plots.note.empty()) md += "\n" + plots.note + "\n";
   return md;
+}
+
+// --- the runs' manifest: rerunning some sections keeps the others -----------------
+
+constexpr const char* kManifest = "report-runs.json";
+
+std::string file_name(const std::string& path) { return path.empty() ? "" : fs::path(path).filename().string(); }
+
+Status write_manifest(const Report& report, const std::string& data_dir) {
+  Json runs = Json::array();
+  for (const Run& r : report.runs) {
+    runs.push_back({{"key", r.key},
+                    {"command", r.command},
+                    {"json", file_name(r.json_path)},
+                    {"markdown", file_name(r.markdown_path)},
+                    {"exit_code", r.exit_code},
+                    {"seconds", r.seconds},
+                    {"date", r.date},
+                    {"commit", r.commit}});
+  }
+  const std::string path = data_dir + "/" + kManifest;
+  std::ofstream out(path);
+  out << runs.dump(2) << "\n";
+  out.close();
+  if (!out) return make_error(ErrorCode::kIoError, path, "file", path, "cannot write the report's manifest");
+  return {};
+}
+
+// The earlier report's runs of the sections not rerun now, read back from
+// its manifest and JSON (a run whose files are gone is left out).
+std::vector<Run> kept_runs(const Options& o, const std::string& data_dir) {
+  std::vector<Run> kept;
+  const Json manifest = read_json(data_dir + "/" + kManifest);
+  if (!manifest.is_array()) return kept;
+  for (const Json& entry : manifest) {
+    const std::string key = entry.value("key", "");
+    if (key.empty() || wanted(o, section_of(key))) continue;
+    Run r;
+    r.key = key;
+    r.command = entry.value("command", "");
+    r.json_path = data_dir + "/" + entry.value("json", "");
+    const std::string markdown = entry.value("markdown", "");
+    if (!markdown.empty()) r.markdown_path = data_dir + "/" + markdown;
+    r.exit_code = entry.value("exit_code", 0);
+    r.seconds = entry.value("seconds", 0.0);
+    r.date = entry.value("date", "");
+    r.commit = entry.value("commit", "");
+    r.kept = true;
+    r.json = read_json(r.json_path);
+    if (!r.json.is_null()) kept.push_back(std::move(r));
+  }
+  return kept;
+}
+
+// Report order: the sections as kAllSections lists them, runs within a
+// section in the order they ran.
+void sort_runs(std::vector<Run>& runs) {
+  const auto rank = [](const Run& r) {
+    return std::find(kAllSections.begin(), kAllSections.end(), section_of(r.key)) - kAllSections.begin();
+  };
+  std::stable_sort(runs.begin(), runs.end(), [&](const Run& a, const Run& b) { return rank(a) < rank(b); });
 }
 
 // The benchmarks the report runs, with their full and quick arguments.
@@ -543,7 +630,13 @@ int run_report_bench(const std::vector<std::string>& args, const std::string& co
   const auto start = std::chrono::steady_clock::now();
 
   Report report;
+  report.runs = kept_runs(o, data_dir);
   run_all(o, data_dir, report);
+  sort_runs(report.runs);
+  if (const Status written = write_manifest(report, data_dir); !written.ok()) {
+    std::fprintf(stderr, "sinew-bench report: %s\n", written.message().c_str());
+    return 1;
+  }
 
   const double minutes = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() / 60.0;
   PlotInputs inputs;
