@@ -1,4 +1,5 @@
 #include "raytrace/render/renderer.h"
+#include "raytrace/render/tile_scratch.h"
 
 #include <algorithm>
 #include <array>
@@ -199,29 +200,6 @@ Vec3 offset_origin(const SurfacePoint& surface, const Vec3& toward) {
 }
 
 namespace {
-
-// One tile's working set, reused by each thread across tiles and frames:
-// the tile's hits, primary directions and surfaces stay in cache from the
-// primary rays through the shadow rays to the shading.
-struct TileScratch {
-  std::vector<Hit> hits;
-  std::vector<Vec3> directions;  // unit primary directions
-  std::vector<SurfacePoint> surfaces;
-  std::vector<std::uint8_t> lit;  // bit l: light l reaches the hit
-  void resize(std::size_t n) {
-    if (hits.size() < n) {
-      hits.resize(n);
-      directions.resize(n);
-      surfaces.resize(n);
-      lit.resize(n);
-    }
-  }
-};
-
-TileScratch& tile_scratch() {
-  thread_local TileScratch scratch;
-  return scratch;
-}
 
 using Clock = std::chrono::steady_clock;
 

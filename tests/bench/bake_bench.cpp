@@ -668,14 +668,7 @@ int run_bake_bench(const std::vector<std::string>& args, const std::string& comm
     }
   }
 
-  if (!o.json_path.empty()) {
-    std::ofstream json(o.json_path);
-    json << doc.dump(2) << "\n";
-    if (!json) {
-      std::fprintf(stderr, "sinew-bench bake: cannot write --json %s\n", o.json_path.c_str());
-      return 1;
-    }
-  }
+  if (!write_output("bake", "--json", o.json_path, doc.dump(2) + "\n")) return 1;
   return exit_code;
 }
 

@@ -118,6 +118,21 @@ std::optional<int> usage_exit(const char* bench, const Expected<Options>& parsed
   return std::nullopt;
 }
 
+// Writes a benchmark's --json or --markdown output (nothing for an empty
+// path). False, with a message naming the flag and the file, when the file
+// cannot be written.
+inline bool write_output(const char* bench, const char* flag, const std::string& path, const std::string& text) {
+  if (path.empty()) return true;
+  std::ofstream out(path);
+  out << text;
+  out.close();
+  if (!out) {
+    std::fprintf(stderr, "sinew-bench %s: cannot write %s %s\n", bench, flag, path.c_str());
+    return false;
+  }
+  return true;
+}
+
 // The error of an Expected whose value the caller does not need.
 template <typename T>
 Status status_of(const Expected<T>& result) {

@@ -517,14 +517,7 @@ int run_embree_bench(const std::vector<std::string>& args, const std::string& co
   const std::string load_end = load_average();
   std::printf("  load at the end: %s (1, 5, 15 min)\n", load_end.c_str());
   doc["load_average_end"] = load_end;
-  if (!o.json_path.empty()) {
-    std::ofstream json(o.json_path);
-    json << doc.dump(2) << "\n";
-    if (!json) {
-      std::fprintf(stderr, "sinew-bench embree: cannot write --json %s\n", o.json_path.c_str());
-      return 1;
-    }
-  }
+  if (!write_output("embree", "--json", o.json_path, doc.dump(2) + "\n")) return 1;
   return exit_code;
 }
 

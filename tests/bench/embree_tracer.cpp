@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "raytrace/render/tile_scratch.h"
 #include "runtime/jobs/job_system.h"
 
 namespace sinew::bench {
@@ -56,26 +57,6 @@ const SrgbBytes kSrgb;
 
 Vec3 light_vector(const rt::Light& light, const Vec3& from) {
   return light.kind == rt::Light::Kind::kPoint ? light.position - from : light.direction;
-}
-
-struct TileScratch {
-  std::vector<Hit> hits;
-  std::vector<Vec3> directions;
-  std::vector<rt::SurfacePoint> surfaces;
-  std::vector<std::uint8_t> lit;
-  void resize(std::size_t n) {
-    if (hits.size() < n) {
-      hits.resize(n);
-      directions.resize(n);
-      surfaces.resize(n);
-      lit.resize(n);
-    }
-  }
-};
-
-TileScratch& tile_scratch() {
-  thread_local TileScratch scratch;
-  return scratch;
 }
 
 struct TileRecord {
@@ -260,7 +241,7 @@ Expected<EmbreeRenderStats> EmbreeTracer::render(const rt::Scene& scene, const r
     TileRecord& record = records[static_cast<std::size_t>(t.index)];
     const int tw = t.x1 - t.x0;
     const auto local = [&](int x, int y) { return static_cast<std::size_t>((y - t.y0) * tw + (x - t.x0)); };
-    TileScratch& s = tile_scratch();
+    rt::TileScratch& s = rt::tile_scratch();
     s.resize(static_cast<std::size_t>(tw * (t.y1 - t.y0)));
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);

@@ -999,22 +999,8 @@ int run_paper_bench(const std::vector<std::string>& args, const std::string& com
   std::printf("\n  wall time %.1f s; load at the end: %s (1, 5, 15 min)\n", wall_s, load_end.c_str());
   run.doc["wall_s"] = wall_s;
   run.doc["load_average_end"] = load_end;
-  if (!o.json_path.empty()) {
-    std::ofstream json(o.json_path);
-    json << run.doc.dump(2) << "\n";
-    if (!json) {
-      std::fprintf(stderr, "sinew-bench paper: cannot write --json %s\n", o.json_path.c_str());
-      return 1;
-    }
-  }
-  if (!o.markdown_path.empty()) {
-    std::ofstream md(o.markdown_path);
-    md << run.markdown;
-    if (!md) {
-      std::fprintf(stderr, "sinew-bench paper: cannot write --markdown %s\n", o.markdown_path.c_str());
-      return 1;
-    }
-  }
+  if (!write_output("paper", "--json", o.json_path, run.doc.dump(2) + "\n")) return 1;
+  if (!write_output("paper", "--markdown", o.markdown_path, run.markdown)) return 1;
   return run.exit_code;
 }
 

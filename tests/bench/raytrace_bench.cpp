@@ -474,14 +474,7 @@ int run_raytrace_bench(const std::vector<std::string>& args, const std::string& 
               "  The exact tree is rebuilt on the listed frames over the posed triangles (Wald-Havran SAH\n"
               "  sweep over triangle boxes, the static-mesh builder); fuzzy/exact is the median ratio of trace\n"
               "  times on those frames; hits = both found the same number of primary hits.\n");
-  if (!o.json_path.empty()) {
-    std::ofstream json(o.json_path);
-    json << doc.dump(2) << "\n";
-    if (!json) {
-      std::fprintf(stderr, "sinew-bench raytrace: cannot write --json %s\n", o.json_path.c_str());
-      return 1;
-    }
-  }
+  if (!write_output("raytrace", "--json", o.json_path, doc.dump(2) + "\n")) return 1;
   return exit_code;
 }
 

@@ -1036,22 +1036,8 @@ int run_tradeoff_bench(const std::vector<std::string>& args, const std::string& 
               rep.wall_s);
   std::fflush(stdout);
 
-  if (!o.json_path.empty()) {
-    std::ofstream json(o.json_path);
-    json << report_json(rep).dump(2) << "\n";
-    if (!json) {
-      std::fprintf(stderr, "sinew-bench tradeoff: cannot write --json %s\n", o.json_path.c_str());
-      return 1;
-    }
-  }
-  if (!o.markdown_path.empty()) {
-    std::ofstream md(o.markdown_path);
-    md << markdown(rep);
-    if (!md) {
-      std::fprintf(stderr, "sinew-bench tradeoff: cannot write --markdown %s\n", o.markdown_path.c_str());
-      return 1;
-    }
-  }
+  if (!write_output("tradeoff", "--json", o.json_path, report_json(rep).dump(2) + "\n")) return 1;
+  if (!write_output("tradeoff", "--markdown", o.markdown_path, markdown(rep))) return 1;
   return exit_code;
 }
 
