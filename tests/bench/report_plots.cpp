@@ -134,7 +134,9 @@ std::vector<std::string> embree_data(const Json& doc, std::string& data) {
     if (block.empty()) continue;
     data += block + "\n\n";
     const int threads = config.value("threads", 0);
-    titles.push_back(config.value("clip", "?") + ", " + std::to_string(threads) + (threads == 1 ? " thread" : " threads"));
+    // Two lines (gnuplot's "\n" in a double-quoted string): one line per
+    // group overlapped its neighbours under four groups of five bars.
+    titles.push_back(config.value("clip", "?") + "\\n" + std::to_string(threads) + (threads == 1 ? " thread" : " threads"));
   }
   return titles;
 }
@@ -144,7 +146,7 @@ std::string embree_panel(const std::string& dat, const std::vector<std::string>&
   for (std::size_t i = 0; i < titles.size(); ++i) {
     const std::string index = " index " + std::to_string(i);
     const bool first = i == 0;
-    s += std::string(first ? "" : ", \\\n     ") + "newhistogram '" + titles[i] + "' lt 1, '" + dat + "'" + index +
+    s += std::string(first ? "" : ", \\\n     ") + "newhistogram \"" + titles[i] + "\" lt 1, '" + dat + "'" + index +
          " using 2:xtic(1) " + (first ? "title 'skinning'" : "notitle") + ", '' " + index + " using 3 " +
          (first ? "title 'build / refit'" : "notitle") + ", '' " + index + " using 4 " +
          (first ? "title 'primary rays'" : "notitle") + ", '' " + index + " using 5 " +
@@ -286,7 +288,7 @@ PlotResult make_plots(const PlotInputs& inputs, const std::string& image_dir, co
                            "'\nset style data histograms\nset style histogram rowstacked\n"
                            "set style fill solid 0.85 border -1\nset boxwidth 0.8\nset grid ytics\n"
                            "set ylabel 'ms per frame (median)'\nset xtics rotate by -40 scale 0 font ',9'\n"
-                           "set key top left\n";
+                           "set key top left\nset bmargin 7\n";  // room for the two-line group titles
       const int panels = (small_titles.empty() ? 0 : 1) + (large_titles.empty() ? 0 : 1);
       script += "set multiplot layout 1," + std::to_string(panels) + "\n";
       const auto triangles = [](const Json* doc) {
