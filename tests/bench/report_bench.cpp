@@ -422,7 +422,7 @@ std::string document(const Options& o, const Report& report, const std::string& 
                      const PlotResult& plots) {
   std::string md = "# Benchmarks\n\n";
   md += "<!-- Written by `sinew-bench report` (tests/bench/report_bench.cpp). Do not edit by hand: rerun it. -->\n\n";
-  md += format("Measured %s on %s (%d hardware threads), build baseline %s, commit `%s`; %s mode, %.0f minutes in "
+  md += format("Measured %s on %s (%d hardware threads), build baseline %s, commit `%s`; %s mode, %.1f minutes in "
                "all; load average %s at the start, %s at the end (1, 5, 15 min). Each benchmark checks the first "
                "frame of every configuration against brute-force ray casting and leaves out any that disagrees.\n\n",
                date.c_str(), cpu.c_str(), JobSystem::hardware_threads(), std::string(build_isa()).c_str(),
