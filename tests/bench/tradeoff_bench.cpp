@@ -600,8 +600,8 @@ std::string markdown(const Report& rep) {
        "box area; `fps` is 1000 / the median of prepare_frame + render over " + std::to_string(o.frames) +
        " frames of the walk at 30 Hz, " + std::to_string(o.width) + "x" + std::to_string(o.height) +
        ", fallback on, shadows on, point light, fast triangle test; `tests/ray` is the triangle tests per traced "
-       "ray (primary and shadow) over those frames, the speed side of the trade without the timing noise; the first frame is checked against brute force "
-       "(every " + std::to_string(kWalkGateStride) + "th pixel) and a configuration that fails is FAILED and not "
+       "ray (primary and shadow) over those frames, the speed side of the trade without the timing noise; the "
+       "first frame is checked against brute force (every " + std::to_string(kWalkGateStride) + "th pixel) and a configuration that fails is FAILED and not "
        "reported. Accuracy is measured on " + std::to_string(o.held_out) + " held-out poses per mode that the bake "
        "never sampled: arbitrary/limits draw the same mode with another seed, clips/clip take uniform random times "
        "in [0, duration) of a random clip (the walk for `clip`). `escaped` is the mean fraction of triangles routed "
