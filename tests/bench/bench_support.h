@@ -87,19 +87,18 @@ inline void print_bench_header(const char* name, const std::string& command_line
   std::printf("  load:    %s (1, 5, 15 min, at start)\n", load_average().c_str());
 }
 
+inline bool wants_help(const editor::cli::ParsedArgs& parsed) { return parsed.has("--help") || parsed.has("-h"); }
+
 // The start every benchmark's option parser shares: the flags parsed and
 // no positional arguments (unless help was asked for, which ends parsing).
 inline Expected<editor::cli::ParsedArgs> parse_bench_args(const std::vector<std::string>& args,
                                                           const std::vector<editor::cli::FlagSpec>& flags) {
   SINEW_ASSIGN_OR_RETURN(editor::cli::ParsedArgs parsed, editor::cli::parse_args(args, flags));
-  const bool help = parsed.has("--help") || parsed.has("-h");
-  if (!help && !parsed.positionals.empty()) {
+  if (!wants_help(parsed) && !parsed.positionals.empty()) {
     return invalid_argument("argument", parsed.positionals.front(), "unexpected argument");
   }
   return parsed;
 }
-
-inline bool wants_help(const editor::cli::ParsedArgs& parsed) { return parsed.has("--help") || parsed.has("-h"); }
 
 // What every benchmark's entry point does with its parsed options: a usage
 // error is printed with the usage (exit code 2), --help prints the usage

@@ -502,7 +502,7 @@ constexpr const char* kManifest = "report-runs.json";
 
 std::string file_name(const std::string& path) { return path.empty() ? "" : fs::path(path).filename().string(); }
 
-Status write_manifest(const Report& report, const std::string& data_dir) {
+Json manifest(const Report& report) {
   Json runs = Json::array();
   for (const Run& r : report.runs) {
     runs.push_back({{"key", r.key},
@@ -514,12 +514,7 @@ Status write_manifest(const Report& report, const std::string& data_dir) {
                     {"date", r.date},
                     {"commit", r.commit}});
   }
-  const std::string path = data_dir + "/" + kManifest;
-  std::ofstream out(path);
-  out << runs.dump(2) << "\n";
-  out.close();
-  if (!out) return make_error(ErrorCode::kIoError, path, "file", path, "cannot write the report's manifest");
-  return {};
+  return runs;
 }
 
 // The earlier report's runs of the sections not rerun now, read back from
@@ -633,10 +628,7 @@ int run_report_bench(const std::vector<std::string>& args, const std::string& co
   report.runs = kept_runs(o, data_dir);
   run_all(o, data_dir, report);
   sort_runs(report.runs);
-  if (const Status written = write_manifest(report, data_dir); !written.ok()) {
-    std::fprintf(stderr, "sinew-bench report: %s\n", written.message().c_str());
-    return 1;
-  }
+  if (!write_output("report", "manifest", data_dir + "/" + kManifest, manifest(report).dump(2) + "\n")) return 1;
 
   const double minutes = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() / 60.0;
   PlotInputs inputs;
