@@ -369,9 +369,10 @@ class PacketQuery {
     }
   }
 
-  void run() {
+  void run(const ObjectFilter* filter) {
+    filter_ = filter;
     const KdTreeView top = scene_.top_level().view();
-    if (top.empty() || live_ == 0) return;
+    if (top.empty() || live_ == 0 || (filter_ != nullptr && filter_->objects.empty())) return;
     // The whole scene's box: slack for the box alone, then for the ray's
     // reach to its far side (the single-ray query's two steps).
     const float box_magnitude = max_abs(top.bounds);
@@ -383,6 +384,16 @@ class PacketQuery {
     const std::uint32_t mask = clip_lanes(top.bounds, eps, world_, live_, span);
     if (mask == 0) return;
     _mm256_store_ps(world_.eps, world_eps8(box_magnitude, _mm256_load_ps(span.t1)));
+    if (filter_ != nullptr) {
+      // The culled objects front to back: each visit covers each lane's
+      // whole ray up to its best hit, as the walk's first leaf holding the
+      // object would, and skips lanes whose best hit lies before the box.
+      for (const std::uint32_t object : filter_->objects) {
+        if ((mask & live_) == 0) return;
+        if (visit(scene_.top_level().objects()[object], mask & live_)) return;
+      }
+      return;
+    }
     auto leaf = [this](std::span<const std::uint32_t> objects, std::uint32_t lanes) {
       for (const std::uint32_t object : objects) {
         const std::uint32_t entering = lanes_entering(object, lanes & live_);
@@ -521,6 +532,16 @@ class PacketQuery {
   }
 
   bool visit_static(const Scene::StaticMesh& mesh, std::uint32_t lanes, const Intervals& span) {
+    if (mesh.desc.triangles.size() <= detail::kBruteForceStaticTriangles) {
+      for (std::uint32_t t = 0; t < mesh.desc.triangles.size(); ++t) {
+        const auto& v = mesh.desc.triangles[t];
+        if (test(lanes, mesh.desc.positions[v[0]], mesh.desc.positions[v[1]], mesh.desc.positions[v[2]], t,
+                 mesh.instance_id, t)) {
+          return true;
+        }
+      }
+      return false;
+    }
     const KdTreeView tree = mesh.tree.view();
     auto leaf = [&](std::span<const std::uint32_t> triangles, std::uint32_t active) {
       for (const std::uint32_t t : triangles) {
@@ -600,6 +621,7 @@ class PacketQuery {
   }
 
   const Scene& scene_;
+  const ObjectFilter* filter_ = nullptr;
   FrameRays world_;
   alignas(32) float t_limit_[kLanes];
   alignas(32) float t_min_[kLanes];
@@ -626,17 +648,19 @@ void accumulate(TraversalCounters* into, const TraversalCounters& from, std::uin
 }
 
 template <TriangleTest kTest>
-void closest_hits(const Scene& scene, const RayPacket& packet, Hit hits[kPacketSize], TraversalCounters* counters) {
+void closest_hits(const Scene& scene, const RayPacket& packet, Hit hits[kPacketSize], TraversalCounters* counters,
+                  const ObjectFilter* filter) {
   PacketQuery<kTest, false> query(scene, packet);
-  query.run();
+  query.run(filter);
   for (int lane = 0; lane < kLanes; ++lane) hits[lane] = query.hit(lane);
   accumulate(counters, query.counters(), query.valid_lanes());
 }
 
 template <TriangleTest kTest>
-std::uint8_t any_hits(const Scene& scene, const RayPacket& packet, TraversalCounters* counters) {
+std::uint8_t any_hits(const Scene& scene, const RayPacket& packet, TraversalCounters* counters,
+                      const ObjectFilter* filter) {
   PacketQuery<kTest, true> query(scene, packet);
-  query.run();
+  query.run(filter);
   std::uint8_t bits = 0;
   for (int lane = 0; lane < kLanes; ++lane) {
     if (query.hit(lane).valid()) bits = static_cast<std::uint8_t>(bits | (1u << lane));
@@ -648,18 +672,18 @@ std::uint8_t any_hits(const Scene& scene, const RayPacket& packet, TraversalCoun
 }  // namespace
 
 void intersect_packet(const Scene& scene, const RayPacket& packet, TriangleTest test, Hit hits[kPacketSize],
-                      TraversalCounters* counters) {
+                      TraversalCounters* counters, const ObjectFilter* filter) {
   if (test == TriangleTest::kWatertight) {
-    closest_hits<TriangleTest::kWatertight>(scene, packet, hits, counters);
+    closest_hits<TriangleTest::kWatertight>(scene, packet, hits, counters, filter);
   } else {
-    closest_hits<TriangleTest::kFast>(scene, packet, hits, counters);
+    closest_hits<TriangleTest::kFast>(scene, packet, hits, counters, filter);
   }
 }
 
 std::uint8_t occluded_packet(const Scene& scene, const RayPacket& packet, TriangleTest test,
-                             TraversalCounters* counters) {
-  return test == TriangleTest::kWatertight ? any_hits<TriangleTest::kWatertight>(scene, packet, counters)
-                                           : any_hits<TriangleTest::kFast>(scene, packet, counters);
+                             TraversalCounters* counters, const ObjectFilter* filter) {
+  return test == TriangleTest::kWatertight ? any_hits<TriangleTest::kWatertight>(scene, packet, counters, filter)
+                                           : any_hits<TriangleTest::kFast>(scene, packet, counters, filter);
 }
 
 #else
@@ -667,14 +691,14 @@ std::uint8_t occluded_packet(const Scene& scene, const RayPacket& packet, Triang
 // Without AVX2 the lanes gain nothing from walking together: each is the
 // single-ray query itself.
 void intersect_packet(const Scene& scene, const RayPacket& packet, TriangleTest test, Hit hits[kPacketSize],
-                      TraversalCounters* counters) {
+                      TraversalCounters* counters, const ObjectFilter* /*filter: culling only saves time*/) {
   for (int lane = 0; lane < kPacketSize; ++lane) {
     hits[lane] = (packet.active >> lane & 1u) ? intersect(scene, packet.ray(lane), test, counters) : Hit{};
   }
 }
 
 std::uint8_t occluded_packet(const Scene& scene, const RayPacket& packet, TriangleTest test,
-                             TraversalCounters* counters) {
+                             TraversalCounters* counters, const ObjectFilter* /*filter*/) {
   std::uint8_t bits = 0;
   for (int lane = 0; lane < kPacketSize; ++lane) {
     if ((packet.active >> lane & 1u) && occluded(scene, packet.ray(lane), test, counters)) {

@@ -13,6 +13,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 
 #include "raytrace/geometry/triangle_intersect.h"
 #include "raytrace/render/traversal.h"
@@ -34,16 +35,27 @@ struct RayPacket {
   void set(int lane, const Ray& ray);
 };
 
+// The top-level objects a packet may enter (indices into
+// scene.top_level().objects()), front to back, found by culling the
+// packet's rays (render/ray_bound.h). With a filter the top-level walk is
+// skipped: the listed objects are entered in order, each lane over its
+// whole ray up to its best hit so far. Culling is conservative, so results
+// equal the walk's except where two objects are hit at exactly the same t
+// (the earlier in the list wins).
+struct ObjectFilter {
+  std::span<const std::uint32_t> objects;
+};
+
 // Nearest hits for each active lane, identical to intersect() per lane;
 // hits[i] of an inactive lane (or an invalid ray, as intersect() rejects)
 // is a miss. Counters: rays, object visits and triangle tests per lane as
 // intersect() counts them; node visits once per node the packet fetches.
 void intersect_packet(const Scene& scene, const RayPacket& packet, TriangleTest test, Hit hits[kPacketSize],
-                      TraversalCounters* counters = nullptr);
+                      TraversalCounters* counters = nullptr, const ObjectFilter* filter = nullptr);
 
 // Occlusion per active lane as a bit mask (bit i = lane i occluded),
 // identical to occluded() per lane.
 std::uint8_t occluded_packet(const Scene& scene, const RayPacket& packet, TriangleTest test,
-                             TraversalCounters* counters = nullptr);
+                             TraversalCounters* counters = nullptr, const ObjectFilter* filter = nullptr);
 
 }  // namespace sinew::rt

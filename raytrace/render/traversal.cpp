@@ -204,6 +204,16 @@ class Query {
   }
 
   bool visit_static(const Scene::StaticMesh& mesh, float t0, float t1) {
+    if (mesh.desc.triangles.size() <= detail::kBruteForceStaticTriangles) {
+      for (std::uint32_t t = 0; t < mesh.desc.triangles.size(); ++t) {
+        const auto& v = mesh.desc.triangles[t];
+        if (test(mesh.desc.positions[v[0]], mesh.desc.positions[v[1]], mesh.desc.positions[v[2]], t,
+                 mesh.instance_id)) {
+          return true;
+        }
+      }
+      return false;
+    }
     const KdTreeView tree = mesh.tree.view();
     const float eps = world_eps(tree.bounds, t1);
     return traverse_tree(tree, ray_.origin, ray_.direction, inv_dir_, eps, t0, t1, t_limit_, counters_.node_visits,

@@ -26,6 +26,12 @@ inline bool valid_ray(const Ray& ray) {
          !std::isnan(ray.t_min) && !std::isnan(ray.t_max) && ray.t_min < ray.t_max;
 }
 
+// Static meshes with at most this many triangles (a ground quad, a wall)
+// are tested triangle by triangle, without walking their kd-tree: the walk
+// costs more than the tests, and testing every triangle gives the same
+// nearest hit. Single rays and packets both do it, so they stay alike.
+inline constexpr std::size_t kBruteForceStaticTriangles = 8;
+
 // Clips [t0, t1] to the ray's passage through `box` grown by `eps` on every
 // side. The growth absorbs the rounding of the slab arithmetic, which is
 // relative to the magnitudes folded into `eps` by the callers.

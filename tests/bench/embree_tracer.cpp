@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -12,6 +13,7 @@
 #include <vector>
 
 #include "raytrace/render/tile_scratch.h"
+#include "raytrace/render/tile_stages.h"
 #include "runtime/jobs/job_system.h"
 
 namespace sinew::bench {
@@ -31,32 +33,6 @@ Status embree_error(RTCDevice device, const char* what) {
   const RTCError code = rtcGetDeviceError(device);  // nullptr: this thread's last error
   return make_error(ErrorCode::kInternal, "embree", what, std::to_string(static_cast<int>(code)),
                     "Embree reported an error");
-}
-
-// Linear [0, 1] -> sRGB byte; the renderer's table is private to it.
-class SrgbBytes {
- public:
-  SrgbBytes() {
-    for (std::size_t i = 0; i < bytes_.size(); ++i) {
-      const double linear = static_cast<double>(i) / static_cast<double>(bytes_.size() - 1);
-      const double encoded = linear <= 0.0031308 ? 12.92 * linear : 1.055 * std::pow(linear, 1.0 / 2.4) - 0.055;
-      bytes_[i] = static_cast<std::uint8_t>(std::lround(std::clamp(encoded, 0.0, 1.0) * 255.0));
-    }
-  }
-  std::uint8_t operator()(float linear) const {
-    if (!(linear > 0.0f)) return 0;  // also NaN
-    const float scaled = std::min(linear, 1.0f) * static_cast<float>(bytes_.size() - 1) + 0.5f;
-    return bytes_[static_cast<std::size_t>(scaled)];
-  }
-
- private:
-  std::array<std::uint8_t, 4096> bytes_{};
-};
-
-const SrgbBytes kSrgb;
-
-Vec3 light_vector(const rt::Light& light, const Vec3& from) {
-  return light.kind == rt::Light::Kind::kPoint ? light.position - from : light.direction;
 }
 
 struct TileRecord {
@@ -211,10 +187,121 @@ Expected<double> EmbreeTracer::update(const rt::Scene& scene) {
   return ms;
 }
 
+namespace {
+
+// Embree's ray packet types and calls by width.
+template <int W>
+struct Packet;
+template <>
+struct Packet<4> {
+  using RayHit = RTCRayHit4;
+  using Ray = RTCRay4;
+  static void intersect(const int* valid, RTCScene s, RTCIntersectContext* c, RayHit* r) { rtcIntersect4(valid, s, c, r); }
+  static void occluded(const int* valid, RTCScene s, RTCIntersectContext* c, Ray* r) { rtcOccluded4(valid, s, c, r); }
+};
+template <>
+struct Packet<8> {
+  using RayHit = RTCRayHit8;
+  using Ray = RTCRay8;
+  static void intersect(const int* valid, RTCScene s, RTCIntersectContext* c, RayHit* r) { rtcIntersect8(valid, s, c, r); }
+  static void occluded(const int* valid, RTCScene s, RTCIntersectContext* c, Ray* r) { rtcOccluded8(valid, s, c, r); }
+};
+template <>
+struct Packet<16> {
+  using RayHit = RTCRayHit16;
+  using Ray = RTCRay16;
+  static void intersect(const int* valid, RTCScene s, RTCIntersectContext* c, RayHit* r) {
+    rtcIntersect16(valid, s, c, r);
+  }
+  static void occluded(const int* valid, RTCScene s, RTCIntersectContext* c, Ray* r) { rtcOccluded16(valid, s, c, r); }
+};
+
+// Primary rays of the tile's lanes [k, k + W) (camera origin, SoA
+// directions) as one Embree packet; hits go back into the scratch.
+template <int W>
+void trace_primary_packet(RTCScene scene, RTCIntersectContext* context, const Vec3& eye,
+                          const std::vector<std::uint32_t>& sinew_id, rt::TileScratch& s, std::size_t k) {
+  alignas(64) typename Packet<W>::RayHit rh;
+  alignas(64) int valid[W];
+  for (int i = 0; i < W; ++i) {
+    const std::size_t lane = k + static_cast<std::size_t>(i);
+    valid[i] = (s.block_pixels[lane / rt::kBlockLanes] >> (lane % rt::kBlockLanes) & 1u) ? -1 : 0;
+    rh.ray.org_x[i] = eye.x;
+    rh.ray.org_y[i] = eye.y;
+    rh.ray.org_z[i] = eye.z;
+    rh.ray.dir_x[i] = s.dir_x[lane];
+    rh.ray.dir_y[i] = s.dir_y[lane];
+    rh.ray.dir_z[i] = s.dir_z[lane];
+    rh.ray.tnear[i] = 0.0f;
+    rh.ray.tfar[i] = std::numeric_limits<float>::infinity();
+    rh.ray.time[i] = 0.0f;
+    rh.ray.mask[i] = 0xFFFFFFFFu;
+    rh.ray.id[i] = static_cast<unsigned>(i);
+    rh.ray.flags[i] = 0;
+    rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+  }
+  Packet<W>::intersect(valid, scene, context, &rh);
+  for (int i = 0; i < W; ++i) {
+    const std::size_t lane = k + static_cast<std::size_t>(i);
+    const bool hit = valid[i] != 0 && rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
+    s.t[lane] = hit ? rh.ray.tfar[i] : std::numeric_limits<float>::infinity();
+    s.u[lane] = hit ? rh.hit.u[i] : 0.0f;
+    s.v[lane] = hit ? rh.hit.v[i] : 0.0f;
+    s.triangle[lane] = hit ? rh.hit.primID[i] : kInvalidId;
+    s.instance[lane] = hit ? sinew_id[rh.hit.geomID[i]] : kInvalidId;
+    if (hit) s.block_hits[lane / rt::kBlockLanes] |= static_cast<std::uint8_t>(1u << (lane % rt::kBlockLanes));
+  }
+}
+
+// Shadow rays [i, i + W) of the scratch's compacted list as one packet;
+// returns the blocked lanes as bits.
+template <int W>
+std::uint32_t trace_shadow_packet(RTCScene scene, RTCIntersectContext* context, const rt::TileScratch& s,
+                                  std::size_t first) {
+  alignas(64) typename Packet<W>::Ray r;
+  alignas(64) int valid[W];
+  for (int i = 0; i < W; ++i) {
+    const std::size_t k = first + static_cast<std::size_t>(i);
+    const bool live = k < s.shadow_count;
+    valid[i] = live ? -1 : 0;
+    r.org_x[i] = live ? s.so_x[k] : 0.0f;
+    r.org_y[i] = live ? s.so_y[k] : 0.0f;
+    r.org_z[i] = live ? s.so_z[k] : 0.0f;
+    r.dir_x[i] = live ? s.sd_x[k] : 0.0f;
+    r.dir_y[i] = live ? s.sd_y[k] : 0.0f;
+    r.dir_z[i] = live ? s.sd_z[k] : 1.0f;
+    r.tnear[i] = 0.0f;
+    r.tfar[i] = live ? s.s_tmax[k] : 1.0f;
+    r.time[i] = 0.0f;
+    r.mask[i] = 0xFFFFFFFFu;
+    r.id[i] = static_cast<unsigned>(i);
+    r.flags[i] = 0;
+  }
+  Packet<W>::occluded(valid, scene, context, &r);
+  std::uint32_t blocked = 0;
+  for (int i = 0; i < W; ++i) {
+    if (valid[i] != 0 && r.tfar[i] < 0.0f) blocked |= 1u << i;  // Embree sets tfar to -inf when blocked
+  }
+  return blocked;
+}
+
+}  // namespace
+
+const char* embree_width_name(EmbreeWidth width) {
+  switch (width) {
+    case EmbreeWidth::k1: return "rtcIntersect1";
+    case EmbreeWidth::k4: return "rtcIntersect4";
+    case EmbreeWidth::k8: return "rtcIntersect8";
+    case EmbreeWidth::k16: return "rtcIntersect16";
+  }
+  return "rtcIntersect";
+}
+
 Expected<EmbreeRenderStats> EmbreeTracer::render(const rt::Scene& scene, const rt::PinholeCamera& camera,
                                                  const rt::RenderSettings& settings,
                                                  std::span<std::uint8_t> color_rgba8, std::span<Hit> hits,
-                                                 JobSystem& jobs) {
+                                                 JobSystem& jobs, EmbreeWidth width) {
   const int w = camera.width();
   const int h = camera.height();
   const std::size_t pixels = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
@@ -228,128 +315,127 @@ Expected<EmbreeRenderStats> EmbreeTracer::render(const rt::Scene& scene, const r
   const RTCScene rtc_scene = state_->scene;
   const std::vector<std::uint32_t>& sinew_id = state_->sinew_id_of_geometry;
   const rt::Light& light = settings.light;
-  const bool shadows = settings.shadows;
+  const std::span<const rt::Light> lights(&light, 1);
   const int tile = std::max(1, settings.tile_size);
   const int tiles_x = (w + tile - 1) / tile;
   const int tiles_y = (h + tile - 1) / tile;
   std::vector<TileRecord> records(static_cast<std::size_t>(tiles_x) * static_cast<std::size_t>(tiles_y));
-  const std::array<std::uint8_t, 4> background = {kSrgb(settings.background.x), kSrgb(settings.background.y),
-                                                   kSrgb(settings.background.z), 255};
+  rt::OutputPlanes out;
+  if (!color_rgba8.empty()) out.rgba8 = {reinterpret_cast<std::byte*>(color_rgba8.data()), 4 * static_cast<std::size_t>(w), 4};
+  const Vec3 eye = camera.eye();
 
   const Clock::time_point start = Clock::now();
   jobs.parallel_for_tiles(w, h, tile, [&](const Tile& t) {
     TileRecord& record = records[static_cast<std::size_t>(t.index)];
-    const int tw = t.x1 - t.x0;
-    const auto local = [&](int x, int y) { return static_cast<std::size_t>((y - t.y0) * tw + (x - t.x0)); };
     rt::TileScratch& s = rt::tile_scratch();
-    s.resize(static_cast<std::size_t>(tw * (t.y1 - t.y0)));
+    s.prepare(t);
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
+    // Primary rays of one tile are coherent; shadow rays towards one point
+    // light from neighbouring hits nearly so.
+    if (width != EmbreeWidth::k1) context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
 
     const Clock::time_point t0 = Clock::now();
-    for (int y = t.y0; y < t.y1; ++y) {
-      for (int x = t.x0; x < t.x1; ++x) {
-        const Ray ray = camera.ray(x, y);
-        RTCRayHit rh;
-        rh.ray.org_x = ray.origin.x;
-        rh.ray.org_y = ray.origin.y;
-        rh.ray.org_z = ray.origin.z;
-        rh.ray.dir_x = ray.direction.x;
-        rh.ray.dir_y = ray.direction.y;
-        rh.ray.dir_z = ray.direction.z;
-        rh.ray.tnear = ray.t_min;
-        rh.ray.tfar = ray.t_max;
-        rh.ray.time = 0.0f;
-        rh.ray.mask = 0xFFFFFFFFu;
-        rh.ray.id = 0;
-        rh.ray.flags = 0;
-        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-        rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-        rtcIntersect1(rtc_scene, &context, &rh);
-        const std::size_t k = local(x, y);
-        s.directions[k] = ray.direction;
-        s.hits[k] = rh.hit.geomID == RTC_INVALID_GEOMETRY_ID
-                        ? Hit{}
-                        : Hit{rh.ray.tfar, rh.hit.u, rh.hit.v, rh.hit.primID, sinew_id[rh.hit.geomID]};
-      }
+    rt::generate_camera_rays(camera, s);
+    switch (width) {
+      case EmbreeWidth::k1:
+        for (std::size_t k = 0; k < s.lanes; ++k) {
+          s.t[k] = std::numeric_limits<float>::infinity();
+          s.triangle[k] = s.instance[k] = kInvalidId;
+          s.u[k] = s.v[k] = 0.0f;
+          if (!(s.block_pixels[k / rt::kBlockLanes] >> (k % rt::kBlockLanes) & 1u)) continue;
+          RTCRayHit rh;
+          rh.ray.org_x = eye.x;
+          rh.ray.org_y = eye.y;
+          rh.ray.org_z = eye.z;
+          rh.ray.dir_x = s.dir_x[k];
+          rh.ray.dir_y = s.dir_y[k];
+          rh.ray.dir_z = s.dir_z[k];
+          rh.ray.tnear = 0.0f;
+          rh.ray.tfar = std::numeric_limits<float>::infinity();
+          rh.ray.time = 0.0f;
+          rh.ray.mask = 0xFFFFFFFFu;
+          rh.ray.id = 0;
+          rh.ray.flags = 0;
+          rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+          rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+          rtcIntersect1(rtc_scene, &context, &rh);
+          if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) continue;
+          s.t[k] = rh.ray.tfar;
+          s.u[k] = rh.hit.u;
+          s.v[k] = rh.hit.v;
+          s.triangle[k] = rh.hit.primID;
+          s.instance[k] = sinew_id[rh.hit.geomID];
+          s.block_hits[k / rt::kBlockLanes] |= static_cast<std::uint8_t>(1u << (k % rt::kBlockLanes));
+        }
+        break;
+      case EmbreeWidth::k4:
+        for (std::size_t k = 0; k < s.lanes; k += 4) trace_primary_packet<4>(rtc_scene, &context, eye, sinew_id, s, k);
+        break;
+      case EmbreeWidth::k8:
+        for (std::size_t k = 0; k < s.lanes; k += 8) trace_primary_packet<8>(rtc_scene, &context, eye, sinew_id, s, k);
+        break;
+      case EmbreeWidth::k16:
+        for (std::size_t k = 0; k < s.lanes; k += 16) {
+          if (k + 16 <= s.lanes) {
+            trace_primary_packet<16>(rtc_scene, &context, eye, sinew_id, s, k);
+          } else {
+            trace_primary_packet<8>(rtc_scene, &context, eye, sinew_id, s, k);
+          }
+        }
+        break;
     }
     const Clock::time_point t1 = Clock::now();
-
-    for (int y = t.y0; y < t.y1; ++y) {
-      for (int x = t.x0; x < t.x1; ++x) {
-        const std::size_t k = local(x, y);
-        s.lit[k] = 1;
-        if (!s.hits[k].valid()) continue;
-        ++record.hits;
-        s.surfaces[k] = rt::surface_at(scene, s.hits[k], settings.default_albedo);
-      }
+    for (std::size_t b = 0; b < s.lanes / rt::kBlockLanes; ++b) {
+      record.hits += static_cast<std::uint64_t>(std::popcount(static_cast<unsigned>(s.block_hits[b])));
     }
+    std::fill(s.lit.begin(), s.lit.begin() + static_cast<std::ptrdiff_t>(s.lanes), std::uint8_t{1});
+    if (out.want_color()) rt::reconstruct_surfaces(scene, settings.default_albedo, s);
     double shadow_ns = 0.0;
-    if (shadows) {
+    if (settings.shadows && out.want_color()) {
       const Clock::time_point shadow_start = Clock::now();
-      for (int y = t.y0; y < t.y1; ++y) {
-        for (int x = t.x0; x < t.x1; ++x) {
-          const std::size_t k = local(x, y);
-          if (!s.hits[k].valid()) continue;
-          const rt::SurfacePoint& surface = s.surfaces[k];
-          Vec3 facing = surface.geometric_normal;
-          if (glm::dot(facing, s.directions[k]) > 0.0f) facing = -facing;
-          if (glm::dot(facing, light_vector(light, surface.position)) <= 0.0f) {
-            s.lit[k] = 0;  // the light is behind the surface: no ray needed
-            continue;
-          }
-          const Vec3 origin = rt::offset_origin(surface, facing);
-          const Vec3 direction = light_vector(light, origin);
-          RTCRay shadow;
-          shadow.org_x = origin.x;
-          shadow.org_y = origin.y;
-          shadow.org_z = origin.z;
-          shadow.dir_x = direction.x;
-          shadow.dir_y = direction.y;
-          shadow.dir_z = direction.z;
-          shadow.tnear = 0.0f;
-          shadow.tfar = light.kind == rt::Light::Kind::kPoint ? 1.0f : std::numeric_limits<float>::infinity();
-          shadow.time = 0.0f;
-          shadow.mask = 0xFFFFFFFFu;
-          shadow.id = 0;
-          shadow.flags = 0;
-          rtcOccluded1(rtc_scene, &context, &shadow);
-          ++record.shadow_rays;
-          if (shadow.tfar < 0.0f) {  // Embree sets tfar to -inf when blocked
-            s.lit[k] = 0;
-            ++record.shadowed;
-          }
+      rt::make_shadow_rays(light, 0, s);
+      record.shadow_rays += s.shadow_count;
+      const int step = width == EmbreeWidth::k1 ? 1 : width == EmbreeWidth::k4 ? 4 : width == EmbreeWidth::k8 ? 8 : 16;
+      for (std::size_t i = 0; i < s.shadow_count; i += static_cast<std::size_t>(step)) {
+        std::uint32_t blocked = 0;
+        if (width == EmbreeWidth::k1) {
+          RTCRay r;
+          r.org_x = s.so_x[i];
+          r.org_y = s.so_y[i];
+          r.org_z = s.so_z[i];
+          r.dir_x = s.sd_x[i];
+          r.dir_y = s.sd_y[i];
+          r.dir_z = s.sd_z[i];
+          r.tnear = 0.0f;
+          r.tfar = s.s_tmax[i];
+          r.time = 0.0f;
+          r.mask = 0xFFFFFFFFu;
+          r.id = 0;
+          r.flags = 0;
+          rtcOccluded1(rtc_scene, &context, &r);
+          blocked = r.tfar < 0.0f ? 1u : 0u;
+        } else if (width == EmbreeWidth::k4) {
+          blocked = trace_shadow_packet<4>(rtc_scene, &context, s, i);
+        } else if (width == EmbreeWidth::k8) {
+          blocked = trace_shadow_packet<8>(rtc_scene, &context, s, i);
+        } else {
+          blocked = trace_shadow_packet<16>(rtc_scene, &context, s, i);
+        }
+        for (std::uint32_t m = blocked; m != 0; m &= m - 1) {
+          s.lit[s.shadow_pixel[i + static_cast<std::size_t>(std::countr_zero(m))]] = 0;
+          ++record.shadowed;
         }
       }
       shadow_ns = ns_between(shadow_start, Clock::now());
     }
-
-    for (int y = t.y0; y < t.y1; ++y) {
-      for (int x = t.x0; x < t.x1; ++x) {
-        const std::size_t k = local(x, y);
-        const Hit& hit = s.hits[k];
-        const std::size_t pixel = static_cast<std::size_t>(y) * static_cast<std::size_t>(w) +
-                                  static_cast<std::size_t>(x);
-        if (!hits.empty()) hits[pixel] = hit;
-        if (color_rgba8.empty()) continue;
-        std::uint8_t* rgba = color_rgba8.data() + 4 * pixel;
-        if (!hit.valid()) {
-          std::memcpy(rgba, background.data(), 4);
-          continue;
-        }
-        const rt::SurfacePoint& surface = s.surfaces[k];
-        Vec3 facing = surface.geometric_normal;
-        if (glm::dot(facing, s.directions[k]) > 0.0f) facing = -facing;
-        Vec3 n = surface.shading_normal;
-        if (glm::dot(n, facing) < 0.0f) n = -n;
-        Vec3 radiance = settings.ambient;
-        if (s.lit[k]) {
-          const Vec3 to_light = glm::normalize(light_vector(light, surface.position));
-          radiance += light.color * std::max(0.0f, glm::dot(n, to_light));
-        }
-        const Vec3 linear = surface.albedo * radiance;
-        for (int c = 0; c < 3; ++c) rgba[c] = kSrgb(linear[c]);
-        rgba[3] = 255;
+    if (out.want_color()) rt::shade_and_write(settings, lights, out, s);
+    if (!hits.empty()) {
+      for (std::size_t k = 0; k < s.lanes; ++k) {
+        if (!(s.block_pixels[k / rt::kBlockLanes] >> (k % rt::kBlockLanes) & 1u)) continue;
+        const std::size_t pixel = static_cast<std::size_t>(s.pixel_y(k)) * static_cast<std::size_t>(w) +
+                                  static_cast<std::size_t>(s.pixel_x(k));
+        hits[pixel] = s.triangle[k] == kInvalidId ? Hit{} : Hit{s.t[k], s.u[k], s.v[k], s.triangle[k], s.instance[k]};
       }
     }
     const Clock::time_point t3 = Clock::now();

@@ -1,21 +1,18 @@
 // The Embree 3 contender of `sinew-bench embree` (and of its test): an
 // Embree scene over the skinned triangles a prepared rt::Scene already holds
 // (Sinew's own skinning, so skinning is identical for every contender), and
-// a tile-parallel renderer over Sinew's JobSystem that casts the same camera
-// rays, the same shadow rays and shades with the same surface math as
-// rt::Renderer. Only the acceleration structure and the traversal differ.
+// a tile-parallel renderer over Sinew's JobSystem that runs the renderer's
+// own tile stages (render/tile_stages.h: camera rays, surfaces, shadow-ray
+// origins, shading) with Embree doing the two trace stages. Only the
+// acceleration structure and the traversal differ.
 //
 // What differs from rt::Renderer, on purpose or for simplicity:
-// - rays are cast one at a time (rtcIntersect1 / rtcOccluded1); Sinew's
-//   renderer traces 4x2 packets and packets of eight shadow rays;
-// - Embree's own triangle test (not Sinew's fast/watertight choice);
+// - Embree's own ray packets (EmbreeWidth: single rays or 4/8/16-wide
+//   packets with the coherent flag) and its own triangle test (not Sinew's
+//   fast/watertight choice);
 // - the vertex positions are copied into Embree's padded buffers each frame
 //   (Embree may read 4 bytes past the last vertex); the copy is timed as
-//   part of the build / refit;
-// - sRGB encoding uses a local 4096-entry table in place of the renderer's
-//   private one (the same cost class: one lookup per channel).
-// Surfaces and shadow-ray origins come from rt::surface_at / rt::offset_origin
-// on the same Scene, so the shading arithmetic is exactly the renderer's.
+//   part of the build / refit.
 #pragma once
 
 #include <cstdint>
@@ -41,6 +38,16 @@ enum class EmbreeMode : std::uint8_t {
 };
 
 const char* embree_mode_name(EmbreeMode mode);
+
+// How rays are handed to Embree: one at a time (rtcIntersect1/rtcOccluded1)
+// or as packets of 4, 8 or 16 (rtcIntersectN/rtcOccludedN with
+// RTC_INTERSECT_CONTEXT_FLAG_COHERENT). Primary packets are 4x1, 4x2 and
+// 8x2 pixels of the tile; shadow packets take the tile's shadow rays in
+// order.
+enum class EmbreeWidth : std::uint8_t { k1, k4, k8, k16 };
+inline constexpr EmbreeWidth kEmbreeWidths[] = {EmbreeWidth::k1, EmbreeWidth::k4, EmbreeWidth::k8,
+                                                EmbreeWidth::k16};
+const char* embree_width_name(EmbreeWidth width);
 
 struct EmbreeRenderStats {
   std::uint64_t primary_hits = 0;
@@ -74,7 +81,7 @@ class EmbreeTracer {
   // Sinew's ids: triangle index within its mesh and the scene's instance id).
   Expected<EmbreeRenderStats> render(const rt::Scene& scene, const rt::PinholeCamera& camera,
                                      const rt::RenderSettings& settings, std::span<std::uint8_t> color_rgba8,
-                                     std::span<Hit> hits, JobSystem& jobs);
+                                     std::span<Hit> hits, JobSystem& jobs, EmbreeWidth width = EmbreeWidth::k16);
 
  private:
   struct State;

@@ -1,0 +1,299 @@
+#include "raytrace/render/ray_bound.h"
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cmath>
+#include <limits>
+
+#include "raytrace/render/traversal_shared.h"
+#include "runtime/math/float8.h"
+
+#include <immintrin.h>
+
+namespace sinew::rt {
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+// Directions smaller than this on an axis give no reciprocal bound there
+// (1/d may overflow); such an axis simply does not cull.
+constexpr float kTinyDirection = 1e-30f;
+// Widening of every interval product and box coordinate: far above the
+// 2^-24 relative rounding of each operation.
+constexpr float kRelativeMargin = 0x1.0p-20f;
+
+}  // namespace
+
+void RayBound::add_lanes(const float* const o[3], const float* const d[3], const float* t_min, const float* t_max,
+                         std::uint32_t lanes) {
+  lanes &= 0xFFu;
+  if (lanes == 0) return;
+  const Mask8 use = Mask8::from_bits(lanes);
+  const Float8 t0 = Float8::load(t_min), t1 = Float8::load(t_max);
+  Mask8 finite = is_finite(t0) & (t0 < t1);
+  // Lanes not in `lanes` repeat an active lane's values, so they widen nothing.
+  const int first = std::countr_zero(lanes);
+  const auto pick = [&](const float* p) { return select(use, Float8::load(p), Float8(p[first])); };
+  const auto fold_in = [&](float* lo, float* hi, Float8 x) {
+    if (empty_) {
+      x.store(lo);
+      x.store(hi);
+    } else {
+      min(Float8::load(lo), x).store(lo);
+      max(Float8::load(hi), x).store(hi);
+    }
+  };
+  for (int a = 0; a < 3; ++a) {
+    const Float8 oa = pick(o[a]);
+    const Float8 da = pick(d[a]);
+    finite = finite & is_finite(oa) & is_finite(da);
+    fold_in(lanes_.o_min[a], lanes_.o_max[a], oa);
+    fold_in(lanes_.d_min[a], lanes_.d_max[a], da);
+  }
+  if ((finite.bits() & lanes) != lanes) unbounded_ = true;
+  const Float8 t0p = pick(t_min), t1p = pick(t_max);
+  if (empty_) {
+    t0p.store(lanes_.t_min);
+    t1p.store(lanes_.t_max);
+  } else {
+    min(Float8::load(lanes_.t_min), t0p).store(lanes_.t_min);
+    max(Float8::load(lanes_.t_max), t1p).store(lanes_.t_max);
+  }
+  empty_ = false;
+  folded_ = false;
+}
+
+void RayBound::add_lanes(const Vec3& origin, const float* const d[3], float t_min, float t_max,
+                         std::uint32_t lanes) {
+  if ((lanes & 0xFFu) == 0) return;
+  alignas(32) float ox[8], oy[8], oz[8], t0[8], t1[8];
+  Float8(origin.x).store(ox);
+  Float8(origin.y).store(oy);
+  Float8(origin.z).store(oz);
+  Float8(t_min).store(t0);
+  Float8(t_max).store(t1);
+  const float* const o[3] = {ox, oy, oz};
+  add_lanes(o, d, t0, t1, lanes);
+}
+
+void RayBound::fold() const {
+  if (folded_ || empty_) return;
+  o_mag_ = d_mag_ = 0.0f;
+  for (int a = 0; a < 3; ++a) {
+    o_lo_[a] = reduce_min(Float8::load(lanes_.o_min[a]));
+    o_hi_[a] = reduce_max(Float8::load(lanes_.o_max[a]));
+    d_lo_[a] = reduce_min(Float8::load(lanes_.d_min[a]));
+    d_hi_[a] = reduce_max(Float8::load(lanes_.d_max[a]));
+    o_mag_ = std::max({o_mag_, std::fabs(o_lo_[a]), std::fabs(o_hi_[a])});
+    d_mag_ = std::max({d_mag_, std::fabs(d_lo_[a]), std::fabs(d_hi_[a])});
+  }
+  t_lo_ = reduce_min(Float8::load(lanes_.t_min));
+  t_hi_ = reduce_max(Float8::load(lanes_.t_max));
+  folded_ = true;
+}
+
+float RayBound::world_slack_bound(float scene_magnitude) const {
+  fold();
+  // The traversal's slack is kFrameRelativeSlack * (|o| + t_end |d| +
+  // |box|), t_end being the ray's t_max or its best hit so far. A finite hit
+  // lies inside the scene, so t_end |d| <= |o| + |scene| there; boxes are
+  // inside the scene, so |box| <= |scene|.
+  float reach = 1.01f * (o_mag_ + scene_magnitude);
+  if (std::isfinite(t_hi_)) reach = std::max(reach, t_hi_ * d_mag_ * 1.01f);
+  return kFrameRelativeSlack * 1.01f * (o_mag_ + reach + scene_magnitude);
+}
+
+RayBound::Test RayBound::test() const {
+  fold();
+  Test t;
+  t.unbounded = unbounded_;
+  t.t_lo = t_lo_;
+  t.t_hi = t_hi_;
+  t.o_mag = o_mag_;
+  const float ones = std::bit_cast<float>(0xFFFFFFFFu);
+  for (int a = 0; a < 4; ++a) {
+    const bool axis = a < 3;
+    t.o_lo[a] = axis ? o_lo_[a] : 0.0f;
+    t.o_hi[a] = axis ? o_hi_[a] : 0.0f;
+    const bool positive = axis && d_lo_[a] >= kTinyDirection;
+    const bool negative = axis && d_hi_[a] <= -kTinyDirection;
+    t.positive[a] = positive ? ones : 0.0f;
+    t.negative[a] = negative ? ones : 0.0f;
+    t.not_rising[a] = axis && d_hi_[a] <= 0.0f ? ones : 0.0f;
+    t.not_falling[a] = axis && d_lo_[a] >= 0.0f ? ones : 0.0f;
+    // 1/d decreases on each sign, so [1/d_hi, 1/d_lo], widened.
+    float r_lo = positive || negative ? 1.0f / d_hi_[a] : 0.0f;
+    float r_hi = positive || negative ? 1.0f / d_lo_[a] : 0.0f;
+    r_lo -= std::fabs(r_lo) * kRelativeMargin;
+    r_hi += std::fabs(r_hi) * kRelativeMargin;
+    t.r_lo[a] = r_lo;
+    t.r_hi[a] = r_hi;
+  }
+  return t;
+}
+
+bool RayBound::Test::may_enter(const Aabb& box, float grow) const {
+  if (unbounded) return true;
+  const __m128 sign = _mm_set1_ps(-0.0f);
+  const __m128 lower = _mm_setr_ps(box.lower.x, box.lower.y, box.lower.z, 0.0f);
+  const __m128 upper = _mm_setr_ps(box.upper.x, box.upper.y, box.upper.z, 0.0f);
+  __m128 mag = _mm_max_ps(_mm_andnot_ps(sign, lower), _mm_andnot_ps(sign, upper));
+  mag = _mm_max_ps(mag, _mm_movehl_ps(mag, mag));
+  mag = _mm_max_ss(mag, _mm_movehdup_ps(mag));
+  const float margin = grow + kRelativeMargin * std::max(_mm_cvtss_f32(mag), o_mag);
+  const __m128 lo = _mm_sub_ps(lower, _mm_set1_ps(margin));
+  const __m128 hi = _mm_add_ps(upper, _mm_set1_ps(margin));
+  const __m128 olo = _mm_loadu_ps(o_lo), ohi = _mm_loadu_ps(o_hi);
+  // Every origin on one side of a slab, no direction turning towards it.
+  const __m128 below = _mm_and_ps(_mm_cmplt_ps(ohi, lo), _mm_loadu_ps(not_rising));
+  const __m128 above = _mm_and_ps(_mm_cmpgt_ps(olo, hi), _mm_loadu_ps(not_falling));
+  if (_mm_movemask_ps(_mm_or_ps(below, above)) != 0) return false;
+  const __m128 rlo = _mm_loadu_ps(r_lo), rhi = _mm_loadu_ps(r_hi);
+  // Each plane's parameter range over the set: the extremes of the four
+  // products of (plane - origin range) x (reciprocal range), widened.
+  const auto products = [&](__m128 plane, __m128& min_out, __m128& max_out) {
+    const __m128 a0 = _mm_sub_ps(plane, ohi), a1 = _mm_sub_ps(plane, olo);
+    const __m128 p0 = _mm_mul_ps(a0, rlo), p1 = _mm_mul_ps(a0, rhi);
+    const __m128 p2 = _mm_mul_ps(a1, rlo), p3 = _mm_mul_ps(a1, rhi);
+    const __m128 mn = _mm_min_ps(_mm_min_ps(p0, p1), _mm_min_ps(p2, p3));
+    const __m128 mx = _mm_max_ps(_mm_max_ps(p0, p1), _mm_max_ps(p2, p3));
+    const __m128 rel = _mm_set1_ps(kRelativeMargin);
+    min_out = _mm_sub_ps(mn, _mm_mul_ps(_mm_andnot_ps(sign, mn), rel));
+    max_out = _mm_add_ps(mx, _mm_mul_ps(_mm_andnot_ps(sign, mx), rel));
+  };
+  __m128 lo_min, lo_max, hi_min, hi_max;
+  products(lo, lo_min, lo_max);
+  products(hi, hi_min, hi_max);
+  // Rising rays enter through the lower plane and leave through the upper;
+  // falling ones the other way; other axes bound nothing.
+  const __m128 pos = _mm_loadu_ps(positive), neg = _mm_loadu_ps(negative);
+  const __m128 minus_inf = _mm_set1_ps(-kInf), plus_inf = _mm_set1_ps(kInf);
+  const __m128 enter = _mm_blendv_ps(_mm_blendv_ps(minus_inf, hi_min, neg), lo_min, pos);
+  const __m128 leave = _mm_blendv_ps(_mm_blendv_ps(plus_inf, lo_max, neg), hi_max, pos);
+  __m128 e = _mm_max_ps(enter, _mm_movehl_ps(enter, enter));
+  e = _mm_max_ss(e, _mm_movehdup_ps(e));
+  __m128 l = _mm_min_ps(leave, _mm_movehl_ps(leave, leave));
+  l = _mm_min_ss(l, _mm_movehdup_ps(l));
+  const float t_enter = std::max(t_lo, _mm_cvtss_f32(e));
+  const float t_leave = std::min(t_hi, _mm_cvtss_f32(l));
+  return !(t_enter > t_leave);
+}
+
+void cull_objects(const Scene& scene, const RayBound& bound, std::vector<std::uint32_t>& out) {
+  const TopLevel& top = scene.top_level();
+  const KdTreeView tree = top.view();
+  if (tree.empty() || bound.empty()) return;
+  const std::span<const TopLevelObject> objects = top.objects();
+  const RayBound::Test test = bound.test();
+  // One grow for every box and cell: the largest slack of any box in the
+  // scene. A point within an object's slack of the object lies within that
+  // much of a cell that lists the object.
+  const float grow = bound.world_slack_bound(detail::max_abs(tree.bounds));
+  if (!test.may_enter(tree.bounds, grow)) return;
+  // Walk the top-level tree over the cells the set may enter; each object
+  // is tested once (objects straddle splits and sit in several leaves).
+  thread_local std::vector<std::uint32_t> stamp;
+  thread_local std::uint32_t stamp_value = 0;
+  if (stamp.size() < objects.size()) stamp.assign(objects.size(), 0);
+  if (++stamp_value == 0) {
+    std::fill(stamp.begin(), stamp.end(), 0);
+    stamp_value = 1;
+  }
+  struct Entry {
+    std::uint32_t node;
+    Aabb cell;
+  };
+  std::array<Entry, kMaxTraversalDepth + 2> stack;
+  std::size_t top_index = 0;
+  stack[top_index++] = {0, tree.bounds};
+  const std::size_t first_out = out.size();
+  while (top_index > 0) {
+    const Entry e = stack[--top_index];
+    const KdNode node = tree.nodes[e.node];
+    if (node.is_leaf()) {
+      for (std::uint32_t i = 0; i < node.item_count(); ++i) {
+        const std::uint32_t object = tree.items[node.first_item() + i];
+        if (stamp[object] == stamp_value) continue;
+        stamp[object] = stamp_value;
+        if (test.may_enter(objects[object].box, grow)) out.push_back(object);
+      }
+      continue;
+    }
+    const int a = node.axis();
+    Entry below{e.node + 1, e.cell};
+    Entry above{node.above_child(), e.cell};
+    below.cell.upper[a] = std::min(below.cell.upper[a], node.split());
+    above.cell.lower[a] = std::max(above.cell.lower[a], node.split());
+    if (test.may_enter(below.cell, grow)) stack[top_index++] = below;
+    if (test.may_enter(above.cell, grow)) stack[top_index++] = above;
+  }
+  std::sort(out.begin() + static_cast<std::ptrdiff_t>(first_out), out.end());
+}
+
+void cull_objects_for_packet(const Scene& scene, const float* const o[3], const float* const d[3],
+                             const float* t_min, const float* t_max, std::uint32_t lanes,
+                             const std::vector<std::uint32_t>& among, std::vector<std::uint32_t>& out) {
+  lanes &= 0xFFu;
+  if (lanes == 0 || among.empty()) return;
+  const std::span<const TopLevelObject> objects = scene.top_level().objects();
+  const float scene_magnitude = detail::max_abs(scene.top_level().bounds());
+  // The traversal's slack for these lanes, bounded as RayBound does (one
+  // value for all lanes and boxes).
+  Float8 o_mag(0.0f), d_mag(0.0f);
+  Vec3x8 origin, direction, inverse;
+  Float8* const oc[3] = {&origin.x, &origin.y, &origin.z};
+  Float8* const dc[3] = {&direction.x, &direction.y, &direction.z};
+  Float8* const ic[3] = {&inverse.x, &inverse.y, &inverse.z};
+  for (int a = 0; a < 3; ++a) {
+    *oc[a] = Float8::load(o[a]);
+    *dc[a] = Float8::load(d[a]);
+    *ic[a] = Float8(1.0f) / *dc[a];
+    o_mag = max(o_mag, abs(*oc[a]));
+    d_mag = max(d_mag, abs(*dc[a]));
+  }
+  const Float8 t0 = Float8::load(t_min), t1 = Float8::load(t_max);
+  const Mask8 use = Mask8::from_bits(lanes);
+  const float om = reduce_max(select(use, o_mag, Float8(0.0f)));
+  const float dm = reduce_max(select(use, d_mag, Float8(0.0f)));
+  const float tm = reduce_max(select(use, t1, Float8(0.0f)));
+  float reach = 1.01f * (om + scene_magnitude);
+  if (std::isfinite(tm)) reach = std::max(reach, tm * dm * 1.01f);
+  const float grow = kFrameRelativeSlack * 1.01f * (om + reach + scene_magnitude);
+  // Entered objects with the earliest entry of any lane, sorted by it.
+  struct Entered {
+    float entry;
+    std::uint32_t object;
+  };
+  thread_local std::vector<Entered> entered;
+  entered.clear();
+  for (const std::uint32_t object : among) {
+    const Aabb& box = objects[object].box;
+    // The lane clip of render/traversal_shared.h (clip_to_box), per lane,
+    // against the box grown by `grow` (>= every lane's own slack).
+    Float8 near_t = t0, far_t = t1;
+    Mask8 outside = Mask8::from_bits(0);
+    for (int a = 0; a < 3; ++a) {
+      const Float8 lo = Float8(box.lower[a] - grow);
+      const Float8 hi = Float8(box.upper[a] + grow);
+      const Mask8 parallel = *dc[a] == Float8(0.0f);
+      outside = outside | (parallel & !((*oc[a] >= lo) & (*oc[a] <= hi)));
+      const Float8 n = (lo - *oc[a]) * *ic[a];
+      const Float8 f = (hi - *oc[a]) * *ic[a];
+      near_t = select(parallel, near_t, max(min(n, f), near_t));
+      far_t = select(parallel, far_t, min(max(n, f), far_t));
+    }
+    // NaN in near/far (0 * inf cannot happen off parallel lanes) keeps the lane.
+    const std::uint32_t open = (!(near_t > far_t)).bits() & ~outside.bits() & lanes;
+    if (open != 0) {
+      // NaN entries (kept lanes) sort first.
+      const float entry = reduce_min(select(Mask8::from_bits(open), near_t, Float8(kInf)));
+      entered.push_back({entry == entry ? entry : -kInf, object});
+    }
+  }
+  std::sort(entered.begin(), entered.end(), [](const Entered& a, const Entered& b) {
+    return a.entry < b.entry || (a.entry == b.entry && a.object < b.object);
+  });
+  for (const Entered& e : entered) out.push_back(e.object);
+}
+
+}  // namespace sinew::rt

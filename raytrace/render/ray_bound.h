@@ -1,0 +1,101 @@
+// RayBound: a conservative bound on a whole set of rays (a tile's primary
+// rays, a packet's shadow rays), and the culling it pays for: which of the
+// scene's top-level objects any ray of the set may enter.
+//
+// The bound is interval arithmetic over the set: per axis the range of the
+// origins, the range of the directions (and so of their reciprocals, where
+// the sign is the same for every ray), and the range of [t_min, t_max]. A
+// ray of the set inside a box at parameter t satisfies, on every axis whose
+// direction sign is fixed, entry_a <= t <= exit_a for the box's slab; the
+// interval products below bound entry_a from below and exit_a from above
+// over every origin and reciprocal in the ranges. When
+// max(t_lo, max_a entry_a) > min(t_hi, min_a exit_a), no ray of the set
+// reaches the box. One test costs a dozen multiplies whatever the set's size,
+// which is what makes tiles that see only the ground or the sky cheap.
+//
+// Numerical safety: the traversal's own box clips (render/traversal.h) grow
+// each box by a slack eps that depends on the ray (its origin, its reach and
+// the box's magnitude). cull_objects() grows every box by an upper bound on
+// that slack over the whole set plus a relative margin for its own rounding,
+// and widens each interval product by a relative 2^-20, so it never rejects a
+// box that a single ray's clip would accept: culling changes no result.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "raytrace/scene/scene.h"
+#include "runtime/math/aabb.h"
+#include "runtime/math/types.h"
+
+namespace sinew::rt {
+
+class RayBound {
+ public:
+  // Adds the rays of `lanes` (bit i: lane i) of an eight-lane SoA packet.
+  // Accumulates lane by lane; the eight lanes are folded into one range
+  // only when the bound is used.
+  void add_lanes(const float* const o[3], const float* const d[3], const float* t_min, const float* t_max,
+                 std::uint32_t lanes);
+  // Adds eight rays from one shared origin.
+  void add_lanes(const Vec3& origin, const float* const d[3], float t_min, float t_max, std::uint32_t lanes);
+
+  bool empty() const { return empty_; }
+
+  // An upper bound, over every ray of the set, on the slack the traversal
+  // grows a world-space box by when it clips a ray against it, for boxes
+  // inside a scene of magnitude `scene_magnitude` (render/traversal.h).
+  float world_slack_bound(float scene_magnitude) const;
+
+  // The bound in the form the box test wants, computed once per set.
+  class Test {
+   public:
+    // Whether some ray of the set may pass through `box` grown by `grow`
+    // on every side within its [t_min, t_max]. False only when none can.
+    bool may_enter(const Aabb& box, float grow) const;
+
+   private:
+    friend class RayBound;
+    float o_lo[4], o_hi[4];  // origin range per axis (x, y, z, unused)
+    float r_lo[4], r_hi[4];  // reciprocal direction range where the sign is fixed
+    float positive[4], negative[4];         // all-ones where every direction is > 0 (< 0)
+    float not_rising[4], not_falling[4];    // all-ones where no direction is > 0 (< 0)
+    float t_lo = 0.0f, t_hi = 0.0f, o_mag = 0.0f;
+    bool unbounded = false;  // a non-finite ray: every box may be entered
+  };
+  Test test() const;
+
+ private:
+  void fold() const;
+
+  // Per lane, the running minimum and maximum of each quantity.
+  struct Lanes {
+    float o_min[3][8], o_max[3][8], d_min[3][8], d_max[3][8];
+    float t_min[8], t_max[8];
+  };
+  Lanes lanes_{};
+  bool empty_ = true;
+  bool unbounded_ = false;  // a non-finite ray was added
+  // Folded (by fold(), on first use).
+  mutable bool folded_ = false;
+  mutable float o_lo_[3] = {0, 0, 0}, o_hi_[3] = {0, 0, 0};
+  mutable float d_lo_[3] = {0, 0, 0}, d_hi_[3] = {0, 0, 0};
+  mutable float t_lo_ = 0.0f, t_hi_ = 0.0f;
+  mutable float o_mag_ = 0.0f, d_mag_ = 0.0f;
+};
+
+// The top-level objects (indices into scene.top_level().objects(), in
+// ascending order) that some ray of `bound` may enter. Appends to `out`.
+void cull_objects(const Scene& scene, const RayBound& bound, std::vector<std::uint32_t>& out);
+
+// Of `among` (object indices), those that some lane of `lanes` of an
+// eight-ray SoA packet may enter, by each lane's own slab test against the
+// box grown by a bound on the traversal's slack (exact per lane, so tighter
+// than a bound on the packet). Appends them to `out` front to back: by the
+// earliest entry of any lane, then by index.
+void cull_objects_for_packet(const Scene& scene, const float* const o[3], const float* const d[3],
+                             const float* t_min, const float* t_max, std::uint32_t lanes,
+                             const std::vector<std::uint32_t>& among, std::vector<std::uint32_t>& out);
+
+}  // namespace sinew::rt

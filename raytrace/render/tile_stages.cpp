@@ -1,0 +1,557 @@
+#include "raytrace/render/tile_stages.h"
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <vector>
+
+#include "raytrace/render/packet_traversal.h"
+#include "raytrace/render/ray_bound.h"
+#include "raytrace/render/traversal.h"
+#include "runtime/math/float8.h"
+
+namespace sinew::rt {
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+// pbrt's gamma(n): a bound on n successive float roundings.
+constexpr float gamma(int n) {
+  constexpr float u = std::numeric_limits<float>::epsilon() * 0.5f;
+  return (static_cast<float>(n) * u) / (1.0f - static_cast<float>(n) * u);
+}
+
+float encode_srgb(float linear) {
+  const float c = std::clamp(linear, 0.0f, 1.0f);
+  return c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
+}
+
+// Linear -> sRGB byte through a table: std::pow per channel per pixel cost
+// more than the shading itself. 16384 entries keep the darkest steps
+// (sRGB byte 1 is linear 3e-4) apart.
+class SrgbTable {
+ public:
+  static constexpr int kSize = 16384;
+  SrgbTable() {
+    for (std::size_t i = 0; i < bytes_.size(); ++i) {
+      const float linear = (static_cast<float>(i) + 0.5f) / static_cast<float>(kSize);
+      bytes_[i] = static_cast<std::uint8_t>(std::lround(encode_srgb(linear) * 255.0f));
+    }
+  }
+  std::uint8_t operator[](std::int32_t i) const { return bytes_[static_cast<std::size_t>(i)]; }
+
+ private:
+  std::array<std::uint8_t, kSize> bytes_{};
+};
+
+// Built once at start-up, not behind a function-local static's guard.
+const SrgbTable kSrgbTable;
+
+// Table indices of eight linear values; lanes that are not > 0 (NaN too)
+// give index -1 (byte 0).
+void srgb_indices(Float8 linear, std::int32_t* out) {
+  const Float8 scaled = min(linear, Float8(1.0f)) * Float8(static_cast<float>(SrgbTable::kSize - 1));
+  store_truncated(select(linear > Float8(0.0f), scaled, Float8(-1.0f)), out);
+}
+std::uint8_t srgb_byte(std::int32_t index) { return index < 0 ? 0 : kSrgbTable[index]; }
+std::uint8_t srgb_byte(float linear) {
+  alignas(32) std::int32_t index[8];
+  srgb_indices(Float8(linear), index);
+  return srgb_byte(index[0]);
+}
+
+// The next float from x away from zero offsets: towards +inf where
+// offset > 0, towards -inf where offset < 0, x itself where offset is 0 or
+// x is not finite (offset_origin's next_float step, eight lanes).
+Float8 step_away(Float8 x, Float8 offset) {
+#if SINEW_FLOAT8_AVX2
+  const __m256i bits = _mm256_castps_si256(x.v);
+  const Mask8 up = offset > Float8(0.0f);
+  const Mask8 down = offset < Float8(0.0f);
+  const Mask8 positive = x > Float8(0.0f);
+  // (x > 0) == up: one ulp up in magnitude, else down.
+  const __m256 grow = _mm256_xor_ps(_mm256_xor_ps(positive.m, up.m), _mm256_castsi256_ps(_mm256_set1_epi32(-1)));
+  const __m256i delta = _mm256_blendv_epi8(_mm256_set1_epi32(-1), _mm256_set1_epi32(1), _mm256_castps_si256(grow));
+  Float8 stepped{_mm256_castsi256_ps(_mm256_add_epi32(bits, delta))};
+  const Float8 denorm = std::numeric_limits<float>::denorm_min();
+  stepped = select(x == Float8(0.0f), select(up, denorm, -denorm), stepped);
+  return select((up | down) & is_finite(x), stepped, x);
+#else
+  return Float8::map([&](int i) {
+    const float v = x.v[i];
+    const float o = offset.v[i];
+    if (o == 0.0f || !std::isfinite(v)) return v;
+    const bool up = o > 0.0f;
+    if (v == 0.0f) return up ? std::numeric_limits<float>::denorm_min() : -std::numeric_limits<float>::denorm_min();
+    std::uint32_t b = std::bit_cast<std::uint32_t>(v);
+    b = (v > 0.0f) == up ? b + 1 : b - 1;
+    return std::bit_cast<float>(b);
+  });
+#endif
+}
+
+Vec3x8 load3(const std::vector<float>& x, const std::vector<float>& y, const std::vector<float>& z, std::size_t k) {
+  return {Float8::load(&x[k]), Float8::load(&y[k]), Float8::load(&z[k])};
+}
+void store3(const Vec3x8& v, std::vector<float>& x, std::vector<float>& y, std::vector<float>& z, std::size_t k) {
+  v.x.store(&x[k]);
+  v.y.store(&y[k]);
+  v.z.store(&z[k]);
+}
+
+// Per-thread lists of the objects a tile's and a packet's rays may enter.
+struct CullLists {
+  std::vector<std::uint32_t> tile;
+  std::vector<std::uint32_t> packet;
+};
+CullLists& cull_lists() {
+  thread_local CullLists lists;
+  return lists;
+}
+
+void set_miss(TileScratch& s, std::size_t k) {
+  s.t[k] = kInf;
+  s.u[k] = 0.0f;
+  s.v[k] = 0.0f;
+  s.triangle[k] = kInvalidId;
+  s.instance[k] = kInvalidId;
+}
+
+}  // namespace
+
+void TileScratch::prepare(const Tile& area) {
+  tile = area;
+  blocks_x = (area.x1 - area.x0 + kBlockWidth - 1) / kBlockWidth;
+  blocks_y = (area.y1 - area.y0 + kBlockHeight - 1) / kBlockHeight;
+  const std::size_t blocks = static_cast<std::size_t>(blocks_x) * static_cast<std::size_t>(blocks_y);
+  lanes = blocks * kBlockLanes;
+  if (block_pixels.size() < blocks) {
+    block_pixels.resize(blocks);
+    block_hits.resize(blocks);
+  }
+  if (capacity_ < lanes) {
+    for (std::vector<float>* a : {&dir_x, &dir_y, &dir_z, &t, &u, &v, &px, &py, &pz, &gx, &gy, &gz, &nx, &ny,
+                                  &nz, &ar, &ag, &ab, &error, &so_x, &so_y, &so_z, &sd_x, &sd_y, &sd_z, &s_tmax}) {
+      a->resize(lanes);
+    }
+    triangle.resize(lanes);
+    instance.resize(lanes);
+    lit.resize(lanes);
+    shadow_pixel.resize(lanes);
+    capacity_ = lanes;
+  }
+  for (std::size_t b = 0; b < blocks; ++b) {
+    const int bx = area.x0 + static_cast<int>(b % static_cast<std::size_t>(blocks_x)) * kBlockWidth;
+    const int by = area.y0 + static_cast<int>(b / static_cast<std::size_t>(blocks_x)) * kBlockHeight;
+    const int w = std::min(kBlockWidth, area.x1 - bx);
+    const int h = std::min(kBlockHeight, area.y1 - by);
+    const std::uint32_t row = (1u << w) - 1u;
+    block_pixels[b] = static_cast<std::uint8_t>(h == 2 ? row | (row << kBlockWidth) : row);
+    block_hits[b] = 0;
+  }
+  shadow_count = 0;
+}
+
+void generate_camera_rays(const PinholeCamera& camera, TileScratch& s) {
+  const Float8 lane = Float8::lane_index();
+  // Lane i sits at (i % 4, i / 4) in its block: (0,1,2,3,0,1,2,3), (0,0,0,0,1,1,1,1).
+  const Float8 lane_x = lane - Float8(4.0f) * select(lane >= Float8(4.0f), Float8(1.0f), Float8(0.0f));
+  const Float8 lane_y = select(lane >= Float8(4.0f), Float8(1.0f), Float8(0.0f));
+  for (std::size_t k = 0; k < s.lanes; k += kBlockLanes) {
+    // Pixel centres (integer + 0.5, exact in float), as PinholeCamera::ray.
+    const Float8 x = Float8(static_cast<float>(s.pixel_x(k))) + lane_x + Float8(0.5f);
+    const Float8 y = Float8(static_cast<float>(s.pixel_y(k))) + lane_y + Float8(0.5f);
+    store3(camera.directions_at(x, y), s.dir_x, s.dir_y, s.dir_z, k);
+  }
+}
+
+void trace_primary(const Scene& scene, const PinholeCamera& camera, TriangleTest test, bool packets,
+                   TileScratch& s, TraversalCounters& counters) {
+  const std::size_t blocks = s.lanes / kBlockLanes;
+  const Vec3 eye = camera.eye();
+  if (!packets) {
+    for (std::size_t b = 0; b < blocks; ++b) {
+      std::uint32_t hits = 0;
+      for (int lane = 0; lane < kBlockLanes; ++lane) {
+        const std::size_t k = b * kBlockLanes + static_cast<std::size_t>(lane);
+        if (!(s.block_pixels[b] >> lane & 1u)) {
+          set_miss(s, k);
+          continue;
+        }
+        Ray ray;
+        ray.origin = eye;
+        ray.direction = Vec3(s.dir_x[k], s.dir_y[k], s.dir_z[k]);
+        const Hit hit = intersect(scene, ray, test, &counters);
+        s.t[k] = hit.t;
+        s.u[k] = hit.u;
+        s.v[k] = hit.v;
+        s.triangle[k] = hit.triangle_id;
+        s.instance[k] = hit.instance_id;
+        hits |= hit.valid() ? (1u << lane) : 0u;
+      }
+      s.block_hits[b] = static_cast<std::uint8_t>(hits);
+    }
+    return;
+  }
+  // One bound over the whole tile picks the objects any of its rays may
+  // enter; each packet then keeps those of its own rays.
+  CullLists& lists = cull_lists();
+  lists.tile.clear();
+  RayBound tile_bound;
+  const auto lane_dirs = [&](std::size_t k) {
+    return std::array<const float*, 3>{&s.dir_x[k], &s.dir_y[k], &s.dir_z[k]};
+  };
+  for (std::size_t b = 0; b < blocks; ++b) {
+    tile_bound.add_lanes(eye, lane_dirs(b * kBlockLanes).data(), 0.0f, kInf, s.block_pixels[b]);
+  }
+  cull_objects(scene, tile_bound, lists.tile);
+  for (std::size_t b = 0; b < blocks; ++b) {
+    const std::size_t k0 = b * kBlockLanes;
+    for (int lane = 0; lane < kBlockLanes; ++lane) set_miss(s, k0 + static_cast<std::size_t>(lane));
+    s.block_hits[b] = 0;
+    const std::uint32_t pixels = s.block_pixels[b];
+    counters.rays += static_cast<std::uint64_t>(std::popcount(pixels));
+    if (lists.tile.empty()) continue;
+    const auto dirs = lane_dirs(k0);
+    alignas(32) float ex[8], ey[8], ez[8], t0[8], t1[8];
+    Float8(eye.x).store(ex);
+    Float8(eye.y).store(ey);
+    Float8(eye.z).store(ez);
+    Float8(0.0f).store(t0);
+    Float8(kInf).store(t1);
+    const float* const origins[3] = {ex, ey, ez};
+    lists.packet.clear();
+    cull_objects_for_packet(scene, origins, dirs.data(), t0, t1, pixels, lists.tile, lists.packet);
+    if (lists.packet.empty()) continue;
+    RayPacket packet;
+    for (int lane = 0; lane < kPacketSize; ++lane) {
+      packet.ox[lane] = eye.x;
+      packet.oy[lane] = eye.y;
+      packet.oz[lane] = eye.z;
+      packet.t_min[lane] = 0.0f;
+      packet.t_max[lane] = kInf;
+    }
+    std::memcpy(packet.dx, dirs[0], sizeof(packet.dx));
+    std::memcpy(packet.dy, dirs[1], sizeof(packet.dy));
+    std::memcpy(packet.dz, dirs[2], sizeof(packet.dz));
+    packet.active = static_cast<std::uint8_t>(pixels);
+    Hit hits[kPacketSize];
+    TraversalCounters packet_counters;
+    const ObjectFilter filter{lists.packet};
+    intersect_packet(scene, packet, test, hits, &packet_counters, &filter);
+    counters.node_visits += packet_counters.node_visits;
+    counters.object_visits += packet_counters.object_visits;
+    counters.triangle_tests += packet_counters.triangle_tests;
+    std::uint32_t hit_bits = 0;
+    for (int lane = 0; lane < kPacketSize; ++lane) {
+      const std::size_t k = k0 + static_cast<std::size_t>(lane);
+      const Hit& h = hits[lane];
+      if (!h.valid()) continue;
+      s.t[k] = h.t;
+      s.u[k] = h.u;
+      s.v[k] = h.v;
+      s.triangle[k] = h.triangle_id;
+      s.instance[k] = h.instance_id;
+      hit_bits |= 1u << lane;
+    }
+    s.block_hits[b] = static_cast<std::uint8_t>(hit_bits & pixels);
+  }
+}
+
+void reconstruct_surfaces(const Scene& scene, const Vec3& default_albedo, TileScratch& s) {
+  const std::size_t blocks = s.lanes / kBlockLanes;
+  const std::span<const Scene::ObjectSlot> slots = scene.object_slots();
+  for (std::size_t b = 0; b < blocks; ++b) {
+    const std::uint32_t hits = s.block_hits[b];
+    if (hits == 0) continue;
+    const std::size_t k0 = b * kBlockLanes;
+    // Gather each lane's corners, corner normals and albedo (lanes without
+    // a hit repeat a harmless unit triangle).
+    alignas(32) float p[3][3][8];  // [corner][axis][lane]
+    alignas(32) float n[3][3][8];
+    alignas(32) float albedo[3][8];
+    std::uint32_t with_normals = 0;
+    for (int lane = 0; lane < kBlockLanes; ++lane) {
+      const std::size_t k = k0 + static_cast<std::size_t>(lane);
+      Vec3 corner[3] = {Vec3(0.0f), Vec3(1.0f, 0.0f, 0.0f), Vec3(0.0f, 1.0f, 0.0f)};
+      Vec3 normal[3] = {Vec3(0.0f), Vec3(0.0f), Vec3(0.0f)};
+      Vec3 color = default_albedo;
+      if (hits >> lane & 1u) {
+        const Scene::ObjectSlot slot = slots[s.instance[k]];
+        const std::uint32_t tri = s.triangle[k];
+        if (slot.kind == Scene::ObjectKind::kCharacter) {
+          const InstanceFrame& frame = scene.instances()[slot.index];
+          const SkinnedMesh& mesh = *scene.characters()[frame.character].mesh;
+          const auto& v = mesh.triangles[tri];
+          for (int i = 0; i < 3; ++i) corner[i] = frame.positions[v[static_cast<std::size_t>(i)]];
+          if (!frame.normals.empty()) {
+            for (int i = 0; i < 3; ++i) normal[i] = frame.normals[v[static_cast<std::size_t>(i)]];
+            with_normals |= 1u << lane;
+          }
+          if (tri < mesh.triangle_material.size()) {
+            const std::uint32_t m = mesh.triangle_material[tri];
+            if (m < mesh.material_colors.size()) color = mesh.material_colors[m];
+          }
+        } else {
+          const StaticMeshDesc& mesh = scene.static_meshes()[slot.index].desc;
+          const auto& v = mesh.triangles[tri];
+          for (int i = 0; i < 3; ++i) corner[i] = mesh.positions[v[static_cast<std::size_t>(i)]];
+          const std::uint32_t m = mesh.triangle_material.empty() ? 0 : mesh.triangle_material[tri];
+          if (m < mesh.material_colors.size()) color = mesh.material_colors[m];
+        }
+      }
+      for (int i = 0; i < 3; ++i) {
+        for (int a = 0; a < 3; ++a) {
+          p[i][a][lane] = corner[i][a];
+          n[i][a][lane] = normal[i][a];
+        }
+      }
+      for (int a = 0; a < 3; ++a) albedo[a][lane] = color[a];
+    }
+    // surface_at's arithmetic, eight lanes at once.
+    const auto corner = [&](const float (&c)[3][3][8], int i) {
+      return Vec3x8{Float8::load(c[i][0]), Float8::load(c[i][1]), Float8::load(c[i][2])};
+    };
+    const Vec3x8 p0 = corner(p, 0), p1 = corner(p, 1), p2 = corner(p, 2);
+    const Float8 u = Float8::load(&s.u[k0]);
+    const Float8 v = Float8::load(&s.v[k0]);
+    const Float8 w = Float8(1.0f) - u - v;
+    const Vec3x8 position = (w * p0 + u * p1) + v * p2;
+    Float8 magnitude = abs(p0.x);
+    for (const Vec3x8* c : {&p0, &p1, &p2}) {
+      magnitude = max(magnitude, max(max(abs(c->x), abs(c->y)), abs(c->z)));
+    }
+    const Vec3x8 cross_n = cross(p1 - p0, p2 - p0);
+    const Float8 length = sqrt(dot(cross_n, cross_n));
+    const Mask8 usable = (length > Float8(0.0f)) & is_finite(length);
+    Vec3x8 geometric = select(usable, Vec3x8{cross_n.x / length, cross_n.y / length, cross_n.z / length},
+                              Vec3x8{Float8(0.0f), Float8(0.0f), Float8(1.0f)});
+    const Vec3x8 shading_sum = (w * corner(n, 0) + u * corner(n, 1)) + v * corner(n, 2);
+    const Float8 shading_length =
+        select(Mask8::from_bits(with_normals), sqrt(dot(shading_sum, shading_sum)), Float8(0.0f));
+    const Mask8 shading_usable = (shading_length > Float8(0.0f)) & is_finite(shading_length);
+    Vec3x8 shading = select(shading_usable,
+                            Vec3x8{shading_sum.x / shading_length, shading_sum.y / shading_length,
+                                   shading_sum.z / shading_length},
+                            geometric);
+    // Both normals onto the camera's side of the surface.
+    const Vec3x8 dir = load3(s.dir_x, s.dir_y, s.dir_z, k0);
+    const Mask8 back = dot(geometric, dir) > Float8(0.0f);
+    geometric = select(back, Vec3x8{-geometric.x, -geometric.y, -geometric.z}, geometric);
+    const Mask8 flip = dot(shading, geometric) < Float8(0.0f);
+    shading = select(flip, Vec3x8{-shading.x, -shading.y, -shading.z}, shading);
+    store3(position, s.px, s.py, s.pz, k0);
+    store3(geometric, s.gx, s.gy, s.gz, k0);
+    store3(shading, s.nx, s.ny, s.nz, k0);
+    Float8::load(albedo[0]).store(&s.ar[k0]);
+    Float8::load(albedo[1]).store(&s.ag[k0]);
+    Float8::load(albedo[2]).store(&s.ab[k0]);
+    (Float8(gamma(7)) * magnitude).store(&s.error[k0]);
+  }
+}
+
+void make_shadow_rays(const Light& light, int l, TileScratch& s) {
+  const std::size_t blocks = s.lanes / kBlockLanes;
+  const std::uint8_t dark = static_cast<std::uint8_t>(~(1u << l));
+  const bool point = light.kind == Light::Kind::kPoint;
+  const Vec3x8 light_at{Float8(light.position.x), Float8(light.position.y), Float8(light.position.z)};
+  const Vec3x8 light_dir{Float8(light.direction.x), Float8(light.direction.y), Float8(light.direction.z)};
+  s.shadow_count = 0;
+  for (std::size_t b = 0; b < blocks; ++b) {
+    const std::uint32_t hits = s.block_hits[b];
+    if (hits == 0) continue;
+    const std::size_t k0 = b * kBlockLanes;
+    const Vec3x8 position = load3(s.px, s.py, s.pz, k0);
+    const Vec3x8 facing = load3(s.gx, s.gy, s.gz, k0);
+    const Vec3x8 to_light = point ? light_at - position : light_dir;
+    const std::uint32_t toward = (dot(facing, to_light) > Float8(0.0f)).bits() & hits;
+    for (std::uint32_t away = hits & ~toward; away != 0; away &= away - 1) {
+      s.lit[k0 + static_cast<std::size_t>(std::countr_zero(away))] &= dark;  // no ray needed
+    }
+    if (toward == 0) continue;
+    // offset_origin: pushed off along the camera-facing normal by the
+    // rounding bound, then one float further on every axis it moved.
+    const Float8 e = Float8::load(&s.error[k0]);
+    const Float8 distance = abs(facing.x) * e + abs(facing.y) * e + abs(facing.z) * e;
+    const Vec3x8 offset = distance * facing;
+    const Vec3x8 moved = position + offset;
+    const Vec3x8 origin{step_away(moved.x, offset.x), step_away(moved.y, offset.y), step_away(moved.z, offset.z)};
+    const Vec3x8 direction = point ? light_at - origin : light_dir;
+    alignas(32) float o[3][8], d[3][8];
+    origin.x.store(o[0]);
+    origin.y.store(o[1]);
+    origin.z.store(o[2]);
+    direction.x.store(d[0]);
+    direction.y.store(d[1]);
+    direction.z.store(d[2]);
+    for (std::uint32_t m = toward; m != 0; m &= m - 1) {
+      const int lane = std::countr_zero(m);
+      const std::size_t i = s.shadow_count++;
+      s.shadow_pixel[i] = static_cast<std::uint32_t>(k0 + static_cast<std::size_t>(lane));
+      s.so_x[i] = o[0][lane];
+      s.so_y[i] = o[1][lane];
+      s.so_z[i] = o[2][lane];
+      s.sd_x[i] = d[0][lane];
+      s.sd_y[i] = d[1][lane];
+      s.sd_z[i] = d[2][lane];
+      s.s_tmax[i] = point ? 1.0f : kInf;
+    }
+  }
+}
+
+std::uint64_t trace_shadow_rays(const Scene& scene, TriangleTest test, bool packets, int l, TileScratch& s,
+                                TraversalCounters& counters) {
+  const std::uint8_t dark = static_cast<std::uint8_t>(~(1u << l));
+  std::uint64_t blocked_count = 0;
+  const auto block = [&](std::size_t i) {
+    s.lit[s.shadow_pixel[i]] &= dark;
+    ++blocked_count;
+  };
+  if (!packets) {
+    for (std::size_t i = 0; i < s.shadow_count; ++i) {
+      Ray ray;
+      ray.origin = Vec3(s.so_x[i], s.so_y[i], s.so_z[i]);
+      ray.direction = Vec3(s.sd_x[i], s.sd_y[i], s.sd_z[i]);
+      ray.t_min = 0.0f;
+      ray.t_max = s.s_tmax[i];
+      if (occluded(scene, ray, test, &counters)) block(i);
+    }
+    return blocked_count;
+  }
+  if (s.shadow_count == 0) return 0;
+  // Pad the last packet's lanes (inactive, but the arithmetic reads them).
+  const std::size_t padded = (s.shadow_count + kPacketSize - 1) / kPacketSize * kPacketSize;
+  for (std::size_t i = s.shadow_count; i < padded; ++i) {
+    s.so_x[i] = s.so_y[i] = s.so_z[i] = 0.0f;
+    s.sd_x[i] = s.sd_y[i] = 0.0f;
+    s.sd_z[i] = 1.0f;
+    s.s_tmax[i] = 1.0f;
+  }
+  static const float kZeros[kPacketSize] = {};
+  CullLists& lists = cull_lists();
+  lists.tile.clear();
+  RayBound tile_bound;
+  for (std::size_t i = 0; i < padded; i += kPacketSize) {
+    const float* const o[3] = {&s.so_x[i], &s.so_y[i], &s.so_z[i]};
+    const float* const d[3] = {&s.sd_x[i], &s.sd_y[i], &s.sd_z[i]};
+    const std::size_t n = std::min<std::size_t>(kPacketSize, s.shadow_count - i);
+    tile_bound.add_lanes(o, d, kZeros, &s.s_tmax[i], (1u << n) - 1u);
+  }
+  cull_objects(scene, tile_bound, lists.tile);
+  for (std::size_t i = 0; i < padded; i += kPacketSize) {
+    const std::size_t n = std::min<std::size_t>(kPacketSize, s.shadow_count - i);
+    const std::uint32_t active = (1u << n) - 1u;
+    counters.rays += n;
+    if (lists.tile.empty()) continue;
+    const float* const o[3] = {&s.so_x[i], &s.so_y[i], &s.so_z[i]};
+    const float* const d[3] = {&s.sd_x[i], &s.sd_y[i], &s.sd_z[i]};
+    lists.packet.clear();
+    cull_objects_for_packet(scene, o, d, kZeros, &s.s_tmax[i], active, lists.tile, lists.packet);
+    if (lists.packet.empty()) continue;
+    RayPacket packet;
+    std::memcpy(packet.ox, o[0], sizeof(packet.ox));
+    std::memcpy(packet.oy, o[1], sizeof(packet.oy));
+    std::memcpy(packet.oz, o[2], sizeof(packet.oz));
+    std::memcpy(packet.dx, d[0], sizeof(packet.dx));
+    std::memcpy(packet.dy, d[1], sizeof(packet.dy));
+    std::memcpy(packet.dz, d[2], sizeof(packet.dz));
+    std::memcpy(packet.t_min, kZeros, sizeof(packet.t_min));
+    std::memcpy(packet.t_max, &s.s_tmax[i], sizeof(packet.t_max));
+    packet.active = static_cast<std::uint8_t>(active);
+    TraversalCounters packet_counters;
+    const ObjectFilter filter{lists.packet};
+    const std::uint8_t blocked = occluded_packet(scene, packet, test, &packet_counters, &filter);
+    counters.node_visits += packet_counters.node_visits;
+    counters.object_visits += packet_counters.object_visits;
+    counters.triangle_tests += packet_counters.triangle_tests;
+    for (std::uint32_t m = blocked & active; m != 0; m &= m - 1) block(i + static_cast<std::size_t>(std::countr_zero(m)));
+  }
+  return blocked_count;
+}
+
+void shade_and_write(const RenderSettings& settings, std::span<const Light> lights, const OutputPlanes& out,
+                     TileScratch& s) {
+  const std::size_t blocks = s.lanes / kBlockLanes;
+  const bool want_color = out.want_color();
+  const std::array<std::uint8_t, 4> background_bytes = {srgb_byte(settings.background.x),
+                                                         srgb_byte(settings.background.y),
+                                                         srgb_byte(settings.background.z), 255};
+  for (std::size_t b = 0; b < blocks; ++b) {
+    const std::size_t k0 = b * kBlockLanes;
+    const std::uint32_t pixels = s.block_pixels[b];
+    const std::uint32_t hits = s.block_hits[b];
+    alignas(32) float depth[8], linear[3][8];
+    alignas(32) std::int32_t bytes[3][8];
+    if (hits != 0) {
+      const Vec3x8 dir = load3(s.dir_x, s.dir_y, s.dir_z, k0);
+      (Float8::load(&s.t[k0]) * sqrt(dot(dir, dir))).store(depth);
+      if (want_color) {
+        const Vec3x8 position = load3(s.px, s.py, s.pz, k0);
+        const Vec3x8 n = load3(s.nx, s.ny, s.nz, k0);
+        Vec3x8 radiance{Float8(settings.ambient.x), Float8(settings.ambient.y), Float8(settings.ambient.z)};
+        for (std::size_t l = 0; l < lights.size(); ++l) {
+          std::uint32_t lit_bits = 0;
+          for (int lane = 0; lane < kBlockLanes; ++lane) {
+            lit_bits |= ((s.lit[k0 + static_cast<std::size_t>(lane)] >> l) & 1u) << lane;
+          }
+          lit_bits &= hits;
+          if (lit_bits == 0) continue;
+          const Light& light = lights[l];
+          const Vec3x8 to_light =
+              light.kind == Light::Kind::kPoint
+                  ? Vec3x8{Float8(light.position.x), Float8(light.position.y), Float8(light.position.z)} - position
+                  : Vec3x8{Float8(light.direction.x), Float8(light.direction.y), Float8(light.direction.z)};
+          const Float8 inv_length = Float8(1.0f) / sqrt(dot(to_light, to_light));
+          const Float8 cosine = select(Mask8::from_bits(lit_bits), max(dot(n, inv_length * to_light), Float8(0.0f)),
+                                       Float8(0.0f));
+          radiance = radiance + Vec3x8{Float8(light.color.x) * cosine, Float8(light.color.y) * cosine,
+                                       Float8(light.color.z) * cosine};
+        }
+        const Vec3x8 color{Float8::load(&s.ar[k0]) * radiance.x, Float8::load(&s.ag[k0]) * radiance.y,
+                           Float8::load(&s.ab[k0]) * radiance.z};
+        color.x.store(linear[0]);
+        color.y.store(linear[1]);
+        color.z.store(linear[2]);
+        srgb_indices(color.x, bytes[0]);
+        srgb_indices(color.y, bytes[1]);
+        srgb_indices(color.z, bytes[2]);
+      }
+    }
+    for (std::uint32_t m = pixels; m != 0; m &= m - 1) {
+      const int lane = std::countr_zero(m);
+      const std::size_t k = k0 + static_cast<std::size_t>(lane);
+      const int x = s.tile.x0 + static_cast<int>(b % static_cast<std::size_t>(s.blocks_x)) * kBlockWidth + lane % 4;
+      const int y = s.tile.y0 + static_cast<int>(b / static_cast<std::size_t>(s.blocks_x)) * kBlockHeight + lane / 4;
+      if (out.triangle.wanted()) *out.triangle.at(x, y) = s.triangle[k];
+      if (out.instance.wanted()) *out.instance.at(x, y) = s.instance[k];
+      if (!(hits >> lane & 1u)) {
+        if (out.depth.wanted()) *out.depth.at(x, y) = kInf;
+        if (out.normal.wanted()) *out.normal.at(x, y) = Vec3(0.0f);
+        if (out.rgba32f.wanted()) {
+          float* rgba = out.rgba32f.at(x, y);
+          for (int c = 0; c < 3; ++c) rgba[c] = settings.background[c];
+          rgba[3] = 1.0f;
+        }
+        if (out.rgba8.wanted()) std::memcpy(out.rgba8.at(x, y), background_bytes.data(), 4);
+        continue;
+      }
+      if (out.depth.wanted()) *out.depth.at(x, y) = depth[lane];
+      if (out.normal.wanted()) *out.normal.at(x, y) = Vec3(s.nx[k], s.ny[k], s.nz[k]);
+      if (out.rgba32f.wanted()) {
+        float* rgba = out.rgba32f.at(x, y);
+        for (int c = 0; c < 3; ++c) rgba[c] = linear[c][lane];
+        rgba[3] = 1.0f;
+      }
+      if (out.rgba8.wanted()) {
+        std::uint8_t* rgba = out.rgba8.at(x, y);
+        for (int c = 0; c < 3; ++c) rgba[c] = srgb_byte(bytes[c][lane]);
+        rgba[3] = 255;
+      }
+    }
+  }
+}
+
+}  // namespace sinew::rt

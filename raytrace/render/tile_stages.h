@@ -1,0 +1,54 @@
+// The stages of one tile's frame, each over the tile's 4x2-pixel blocks in
+// structure-of-arrays form (render/tile_scratch.h), eight lanes at a time:
+//
+//   generate_camera_rays -> trace_primary -> reconstruct_surfaces
+//   -> per light: make_shadow_rays -> trace_shadow_rays -> shade_and_write
+//
+// Renderer::render runs them per tile; the Embree peer of the benchmarks
+// runs the same stages with its own two trace stages, so camera rays,
+// surfaces, shadow-ray origins and shading are the same code for both.
+#pragma once
+
+#include <cstdint>
+#include <span>
+
+#include "raytrace/camera/camera.h"
+#include "raytrace/render/output_planes.h"
+#include "raytrace/render/renderer.h"
+#include "raytrace/render/tile_scratch.h"
+#include "raytrace/scene/scene.h"
+
+namespace sinew::rt {
+
+// Unit primary directions of every lane (lanes outside the image too, so
+// the arithmetic stays finite); bit-identical to PinholeCamera::ray.
+void generate_camera_rays(const PinholeCamera& camera, TileScratch& s);
+
+// Nearest hits of the tile's pixels, with the tile's primary rays culled
+// against the top level as one bound and each packet's again (render/
+// ray_bound.h). `packets` off: one single-ray query per pixel, no culling.
+// Fills t, u, v, triangle, instance and block_hits.
+void trace_primary(const Scene& scene, const PinholeCamera& camera, TriangleTest test, bool packets,
+                   TileScratch& s, TraversalCounters& counters);
+
+// The surfaces at the hits (positions, camera-facing geometric and
+// shading normals, albedo, rounding bound), as surface_at computes them.
+void reconstruct_surfaces(const Scene& scene, const Vec3& default_albedo, TileScratch& s);
+
+// Light `l`'s shadow rays for the hits whose surface faces it, compacted in
+// block order into s.shadow_*; hits facing away lose bit l of s.lit here.
+// Origins are offset_origin's, directions run to the light (t_max 1) or
+// along a directional light (t_max inf).
+void make_shadow_rays(const Light& light, int l, TileScratch& s);
+
+// Traces s.shadow_* as packets of eight (culled like the primary rays) or
+// one by one; blocked rays clear bit l of s.lit. Returns how many were blocked.
+std::uint64_t trace_shadow_rays(const Scene& scene, TriangleTest test, bool packets, int l, TileScratch& s,
+                                TraversalCounters& counters);
+
+// Diffuse shading (ambient + each unblocked light's N.L) and the requested
+// outputs of the tile's pixels.
+void shade_and_write(const RenderSettings& settings, std::span<const Light> lights, const OutputPlanes& out,
+                     TileScratch& s);
+
+}  // namespace sinew::rt

@@ -1,0 +1,196 @@
+// Float8 / Mask8: eight float lanes as one value, so the renderer's SoA
+// stages (ray generation, surface reconstruction, shading) read as the
+// scalar formulas they evaluate. With AVX2 each operation is one
+// instruction; in builds without AVX2 (the x86-64-v2 preset) the same code
+// runs lane by lane. Every operation rounds exactly like the scalar one
+// (IEEE add, sub, mul, div and sqrt; no fused multiply-add, see
+// cmake/SinewCompilerOptions.cmake), so a lane reproduces scalar code bit
+// for bit.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+
+#if defined(__AVX2__)
+#include <immintrin.h>
+#define SINEW_FLOAT8_AVX2 1
+#else
+#include <algorithm>
+#define SINEW_FLOAT8_AVX2 0
+#endif
+
+namespace sinew {
+
+#if SINEW_FLOAT8_AVX2
+
+struct Mask8 {
+  __m256 m;
+  std::uint32_t bits() const { return static_cast<std::uint32_t>(_mm256_movemask_ps(m)); }
+  bool any() const { return _mm256_testz_ps(m, m) == 0; }
+  friend Mask8 operator&(Mask8 a, Mask8 b) { return {_mm256_and_ps(a.m, b.m)}; }
+  friend Mask8 operator|(Mask8 a, Mask8 b) { return {_mm256_or_ps(a.m, b.m)}; }
+  friend Mask8 operator!(Mask8 a) { return {_mm256_xor_ps(a.m, _mm256_castsi256_ps(_mm256_set1_epi32(-1)))}; }
+  // All-ones in the lanes of `bits` (bit i: lane i).
+  static Mask8 from_bits(std::uint32_t bits) {
+    const __m256i lane = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+    return {_mm256_castsi256_ps(
+        _mm256_cmpeq_epi32(_mm256_and_si256(_mm256_set1_epi32(static_cast<int>(bits)), lane), lane))};
+  }
+};
+
+struct Float8 {
+  __m256 v;
+  Float8() = default;
+  Float8(__m256 x) : v(x) {}  // NOLINT: implicit from the native type
+  Float8(float x) : v(_mm256_set1_ps(x)) {}  // NOLINT: implicit broadcast
+  static Float8 load(const float* p) { return {_mm256_loadu_ps(p)}; }
+  void store(float* p) const { _mm256_storeu_ps(p, v); }
+  // p[index[i]] per lane.
+  static Float8 gather(const float* p, const std::uint32_t* index) {
+    return {_mm256_i32gather_ps(p, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(index)), 4)};
+  }
+  static Float8 lane_index() { return {_mm256_setr_ps(0, 1, 2, 3, 4, 5, 6, 7)}; }
+
+  friend Float8 operator+(Float8 a, Float8 b) { return {_mm256_add_ps(a.v, b.v)}; }
+  friend Float8 operator-(Float8 a, Float8 b) { return {_mm256_sub_ps(a.v, b.v)}; }
+  friend Float8 operator*(Float8 a, Float8 b) { return {_mm256_mul_ps(a.v, b.v)}; }
+  friend Float8 operator/(Float8 a, Float8 b) { return {_mm256_div_ps(a.v, b.v)}; }
+  friend Float8 operator-(Float8 a) { return {_mm256_xor_ps(a.v, _mm256_set1_ps(-0.0f))}; }
+  friend Mask8 operator<(Float8 a, Float8 b) { return {_mm256_cmp_ps(a.v, b.v, _CMP_LT_OQ)}; }
+  friend Mask8 operator<=(Float8 a, Float8 b) { return {_mm256_cmp_ps(a.v, b.v, _CMP_LE_OQ)}; }
+  friend Mask8 operator>(Float8 a, Float8 b) { return {_mm256_cmp_ps(a.v, b.v, _CMP_GT_OQ)}; }
+  friend Mask8 operator>=(Float8 a, Float8 b) { return {_mm256_cmp_ps(a.v, b.v, _CMP_GE_OQ)}; }
+  friend Mask8 operator==(Float8 a, Float8 b) { return {_mm256_cmp_ps(a.v, b.v, _CMP_EQ_OQ)}; }
+};
+
+// a < b ? a : b and a > b ? a : b per lane (the second operand on NaN).
+inline Float8 min(Float8 a, Float8 b) { return {_mm256_min_ps(a.v, b.v)}; }
+inline Float8 max(Float8 a, Float8 b) { return {_mm256_max_ps(a.v, b.v)}; }
+inline Float8 abs(Float8 a) { return {_mm256_andnot_ps(_mm256_set1_ps(-0.0f), a.v)}; }
+inline Float8 sqrt(Float8 a) { return {_mm256_sqrt_ps(a.v)}; }
+// mask ? yes : no per lane.
+inline Float8 select(Mask8 mask, Float8 yes, Float8 no) { return {_mm256_blendv_ps(no.v, yes.v, mask.m)}; }
+// Lanes whose value is finite (not inf, not NaN).
+inline Mask8 is_finite(Float8 a) {
+  return {_mm256_cmp_ps(abs(a).v, _mm256_set1_ps(3.402823466e38f), _CMP_LE_OQ)};
+}
+// Truncation towards zero to int32, stored.
+inline void store_truncated(Float8 a, std::int32_t* out) {
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(out), _mm256_cvttps_epi32(a.v));
+}
+// The smallest and the largest lane (no NaN lanes expected).
+inline float reduce_min(Float8 a) {
+  __m128 m = _mm_min_ps(_mm256_castps256_ps128(a.v), _mm256_extractf128_ps(a.v, 1));
+  m = _mm_min_ps(m, _mm_movehl_ps(m, m));
+  m = _mm_min_ss(m, _mm_movehdup_ps(m));
+  return _mm_cvtss_f32(m);
+}
+inline float reduce_max(Float8 a) {
+  __m128 m = _mm_max_ps(_mm256_castps256_ps128(a.v), _mm256_extractf128_ps(a.v, 1));
+  m = _mm_max_ps(m, _mm_movehl_ps(m, m));
+  m = _mm_max_ss(m, _mm_movehdup_ps(m));
+  return _mm_cvtss_f32(m);
+}
+
+#else  // lane by lane
+
+struct Mask8 {
+  std::uint32_t b = 0;
+  std::uint32_t bits() const { return b; }
+  bool any() const { return b != 0; }
+  friend Mask8 operator&(Mask8 a, Mask8 c) { return {a.b & c.b}; }
+  friend Mask8 operator|(Mask8 a, Mask8 c) { return {a.b | c.b}; }
+  friend Mask8 operator!(Mask8 a) { return {~a.b & 0xFFu}; }
+  static Mask8 from_bits(std::uint32_t bits) { return {bits & 0xFFu}; }
+};
+
+struct Float8 {
+  float v[8];
+  Float8() = default;
+  Float8(float x) {  // NOLINT: implicit broadcast
+    for (float& e : v) e = x;
+  }
+  static Float8 load(const float* p) {
+    Float8 r;
+    for (int i = 0; i < 8; ++i) r.v[i] = p[i];
+    return r;
+  }
+  void store(float* p) const {
+    for (int i = 0; i < 8; ++i) p[i] = v[i];
+  }
+  static Float8 gather(const float* p, const std::uint32_t* index) {
+    Float8 r;
+    for (int i = 0; i < 8; ++i) r.v[i] = p[index[i]];
+    return r;
+  }
+  static Float8 lane_index() {
+    Float8 r;
+    for (int i = 0; i < 8; ++i) r.v[i] = static_cast<float>(i);
+    return r;
+  }
+  template <class Fn>
+  static Float8 map(Fn fn) {
+    Float8 r;
+    for (int i = 0; i < 8; ++i) r.v[i] = fn(i);
+    return r;
+  }
+  template <class Fn>
+  static Mask8 test(Fn fn) {
+    Mask8 m;
+    for (int i = 0; i < 8; ++i) m.b |= fn(i) ? (1u << i) : 0u;
+    return m;
+  }
+  friend Float8 operator+(Float8 a, Float8 b) { return map([&](int i) { return a.v[i] + b.v[i]; }); }
+  friend Float8 operator-(Float8 a, Float8 b) { return map([&](int i) { return a.v[i] - b.v[i]; }); }
+  friend Float8 operator*(Float8 a, Float8 b) { return map([&](int i) { return a.v[i] * b.v[i]; }); }
+  friend Float8 operator/(Float8 a, Float8 b) { return map([&](int i) { return a.v[i] / b.v[i]; }); }
+  friend Float8 operator-(Float8 a) { return map([&](int i) { return -a.v[i]; }); }
+  friend Mask8 operator<(Float8 a, Float8 b) { return test([&](int i) { return a.v[i] < b.v[i]; }); }
+  friend Mask8 operator<=(Float8 a, Float8 b) { return test([&](int i) { return a.v[i] <= b.v[i]; }); }
+  friend Mask8 operator>(Float8 a, Float8 b) { return test([&](int i) { return a.v[i] > b.v[i]; }); }
+  friend Mask8 operator>=(Float8 a, Float8 b) { return test([&](int i) { return a.v[i] >= b.v[i]; }); }
+  friend Mask8 operator==(Float8 a, Float8 b) { return test([&](int i) { return a.v[i] == b.v[i]; }); }
+};
+
+inline Float8 min(Float8 a, Float8 b) { return Float8::map([&](int i) { return a.v[i] < b.v[i] ? a.v[i] : b.v[i]; }); }
+inline Float8 max(Float8 a, Float8 b) { return Float8::map([&](int i) { return a.v[i] > b.v[i] ? a.v[i] : b.v[i]; }); }
+inline Float8 abs(Float8 a) { return Float8::map([&](int i) { return std::fabs(a.v[i]); }); }
+inline Float8 sqrt(Float8 a) { return Float8::map([&](int i) { return std::sqrt(a.v[i]); }); }
+inline Float8 select(Mask8 mask, Float8 yes, Float8 no) {
+  return Float8::map([&](int i) { return (mask.b >> i & 1u) ? yes.v[i] : no.v[i]; });
+}
+inline Mask8 is_finite(Float8 a) { return Float8::test([&](int i) { return std::isfinite(a.v[i]); }); }
+inline void store_truncated(Float8 a, std::int32_t* out) {
+  for (int i = 0; i < 8; ++i) out[i] = static_cast<std::int32_t>(a.v[i]);
+}
+inline float reduce_min(Float8 a) {
+  float m = a.v[0];
+  for (int i = 1; i < 8; ++i) m = a.v[i] < m ? a.v[i] : m;
+  return m;
+}
+inline float reduce_max(Float8 a) {
+  float m = a.v[0];
+  for (int i = 1; i < 8; ++i) m = a.v[i] > m ? a.v[i] : m;
+  return m;
+}
+
+#endif
+
+// Vectors of eight lanes, structure of arrays.
+struct Vec3x8 {
+  Float8 x, y, z;
+};
+inline Vec3x8 operator+(const Vec3x8& a, const Vec3x8& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+inline Vec3x8 operator-(const Vec3x8& a, const Vec3x8& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+inline Vec3x8 operator*(Float8 s, const Vec3x8& a) { return {s * a.x, s * a.y, s * a.z}; }
+// glm::dot's order: (x*x + y*y) + z*z.
+inline Float8 dot(const Vec3x8& a, const Vec3x8& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+// glm::cross's expressions.
+inline Vec3x8 cross(const Vec3x8& a, const Vec3x8& b) {
+  return {a.y * b.z - b.y * a.z, a.z * b.x - b.z * a.x, a.x * b.y - b.x * a.y};
+}
+inline Vec3x8 select(Mask8 m, const Vec3x8& yes, const Vec3x8& no) {
+  return {select(m, yes.x, no.x), select(m, yes.y, no.y), select(m, yes.z, no.z)};
+}
+
+}  // namespace sinew
