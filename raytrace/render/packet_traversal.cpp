@@ -7,6 +7,7 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <span>
 
@@ -669,7 +670,95 @@ std::uint8_t any_hits(const Scene& scene, const RayPacket& packet, TraversalCoun
   return bits;
 }
 
+// Whether every object of `filter` is a static mesh the short cut handles.
+bool small_statics_only(const Scene& scene, TriangleTest test, const ObjectFilter& filter) {
+  if (test != TriangleTest::kFast) return false;
+  const std::span<const TopLevelObject> objects = scene.top_level().objects();
+  for (const std::uint32_t object : filter.objects) {
+    const TopLevelObject& o = objects[object];
+    if (o.kind != TopLevelObject::Kind::kStatic ||
+        scene.static_meshes()[o.index].desc.triangles.size() > detail::kBruteForceStaticTriangles) {
+      return false;
+    }
+  }
+  return true;
+}
+
+// Every triangle of the filter's static meshes against the packet, in
+// order, as PacketQuery::test does for kFast: a lane records a hit that is
+// strictly nearer than its best so far; any-hit lanes retire on a hit.
+template <bool kAnyHit>
+std::uint32_t small_statics(const Scene& scene, const RayPacket& packet, const ObjectFilter& filter,
+                            float* best_t, float* best_u, float* best_v, std::uint32_t* best_triangle,
+                            std::uint32_t* best_instance, TraversalCounters* counters) {
+  alignas(32) float o[3][kLanes], d[3][kLanes], t_limit[kLanes];
+  std::memcpy(o[0], packet.ox, sizeof(o[0]));
+  std::memcpy(o[1], packet.oy, sizeof(o[1]));
+  std::memcpy(o[2], packet.oz, sizeof(o[2]));
+  std::memcpy(d[0], packet.dx, sizeof(d[0]));
+  std::memcpy(d[1], packet.dy, sizeof(d[1]));
+  std::memcpy(d[2], packet.dz, sizeof(d[2]));
+  std::memcpy(t_limit, packet.t_max, sizeof(t_limit));
+  const RayLanes8 lanes8{o, d, packet.t_min, t_limit};
+  std::uint32_t live = packet.active;
+  std::uint32_t blocked = 0;
+  std::uint64_t tests = 0;
+  const std::span<const TopLevelObject> objects = scene.top_level().objects();
+  for (const std::uint32_t object : filter.objects) {
+    const Scene::StaticMesh& mesh = scene.static_meshes()[objects[object].index];
+    for (std::uint32_t tri = 0; tri < mesh.desc.triangles.size() && live != 0; ++tri) {
+      const auto& v = mesh.desc.triangles[tri];
+      const Vec3& p0 = mesh.desc.positions[v[0]];
+      const Vec3& p1 = mesh.desc.positions[v[1]];
+      const Vec3& p2 = mesh.desc.positions[v[2]];
+      tests += static_cast<std::uint64_t>(std::popcount(live));
+      alignas(32) float t[kLanes], u[kLanes], w[kLanes];
+      const std::uint32_t hit = intersect_triangle_fast8(lanes8, live, p0, p1, p2, t, u, w);
+      if (hit == 0 || detail::zero_area(p1 - p0, p2 - p0)) continue;
+      if constexpr (kAnyHit) {
+        blocked |= hit;
+        live &= ~hit;
+      } else {
+        for_each_lane(hit, [&](int lane) {
+          t_limit[lane] = t[lane];
+          best_t[lane] = t[lane];
+          best_u[lane] = u[lane];
+          best_v[lane] = w[lane];
+          best_triangle[lane] = tri;
+          best_instance[lane] = mesh.instance_id;
+        });
+      }
+    }
+  }
+  if (counters) {
+    counters->rays += static_cast<std::uint64_t>(std::popcount(static_cast<std::uint32_t>(packet.active)));
+    counters->object_visits += filter.objects.size() * static_cast<std::uint64_t>(std::popcount(
+                                                            static_cast<std::uint32_t>(packet.active)));
+    counters->triangle_tests += tests;
+  }
+  return blocked;
+}
+
 }  // namespace
+
+bool intersect_packet_small_statics(const Scene& scene, const RayPacket& packet, TriangleTest test,
+                                    const ObjectFilter& filter, PacketHits out, TraversalCounters* counters) {
+  if (!small_statics_only(scene, test, filter)) return false;
+  for (int lane = 0; lane < kLanes; ++lane) {
+    out.t[lane] = kInf;
+    out.u[lane] = out.v[lane] = 0.0f;
+    out.triangle[lane] = out.instance[lane] = kInvalidId;
+  }
+  small_statics<false>(scene, packet, filter, out.t, out.u, out.v, out.triangle, out.instance, counters);
+  return true;
+}
+
+int occluded_packet_small_statics(const Scene& scene, const RayPacket& packet, TriangleTest test,
+                                  const ObjectFilter& filter, TraversalCounters* counters) {
+  if (!small_statics_only(scene, test, filter)) return -1;
+  return static_cast<int>(small_statics<true>(scene, packet, filter, nullptr, nullptr, nullptr, nullptr, nullptr,
+                                              counters));
+}
 
 void intersect_packet(const Scene& scene, const RayPacket& packet, TriangleTest test, Hit hits[kPacketSize],
                       TraversalCounters* counters, const ObjectFilter* filter) {
@@ -706,6 +795,16 @@ std::uint8_t occluded_packet(const Scene& scene, const RayPacket& packet, Triang
     }
   }
   return bits;
+}
+
+bool intersect_packet_small_statics(const Scene&, const RayPacket&, TriangleTest, const ObjectFilter&, PacketHits,
+                                    TraversalCounters*) {
+  return false;
+}
+
+int occluded_packet_small_statics(const Scene&, const RayPacket&, TriangleTest, const ObjectFilter&,
+                                  TraversalCounters*) {
+  return -1;
 }
 
 #endif  // SINEW_PACKET_AVX2

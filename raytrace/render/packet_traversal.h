@@ -25,7 +25,7 @@ namespace sinew::rt {
 inline constexpr int kPacketSize = 8;
 
 // Structure of arrays, one ray per lane; lanes whose active bit is 0 are ignored.
-struct RayPacket {
+struct alignas(32) RayPacket {
   float ox[kPacketSize], oy[kPacketSize], oz[kPacketSize];
   float dx[kPacketSize], dy[kPacketSize], dz[kPacketSize];
   float t_min[kPacketSize], t_max[kPacketSize];
@@ -52,6 +52,30 @@ struct ObjectFilter {
 // intersect() counts them; node visits once per node the packet fetches.
 void intersect_packet(const Scene& scene, const RayPacket& packet, TriangleTest test, Hit hits[kPacketSize],
                       TraversalCounters* counters = nullptr, const ObjectFilter* filter = nullptr);
+
+// A packet's nearest hits written straight into structure-of-arrays
+// storage (eight entries each).
+struct PacketHits {
+  float* t;
+  float* u;
+  float* v;
+  std::uint32_t* triangle;
+  std::uint32_t* instance;
+};
+
+// The short cut for packets that can only meet a few static triangles (a
+// ground quad): when every object of `filter` is a static mesh small
+// enough to test triangle by triangle (render/traversal_shared.h) and the
+// test is kFast, tests them all against the packet in filter order and
+// returns true with the nearest hits in `out` (misses: t = inf, ids
+// kInvalidId), equal to intersect_packet's. Returns false, touching
+// nothing, otherwise.
+bool intersect_packet_small_statics(const Scene& scene, const RayPacket& packet, TriangleTest test,
+                                    const ObjectFilter& filter, PacketHits out, TraversalCounters* counters);
+// The same for occlusion: the blocked lanes as bits, or -1 when the short
+// cut does not apply.
+int occluded_packet_small_statics(const Scene& scene, const RayPacket& packet, TriangleTest test,
+                                  const ObjectFilter& filter, TraversalCounters* counters);
 
 // Occlusion per active lane as a bit mask (bit i = lane i occluded),
 // identical to occluded() per lane.

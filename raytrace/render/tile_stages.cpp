@@ -112,6 +112,37 @@ CullLists& cull_lists() {
   return lists;
 }
 
+// What shading reads of the mesh behind one hit instance.
+struct MeshRefs {
+  std::span<const std::array<std::uint32_t, 3>> triangles;
+  std::span<const Vec3> positions;  // world space (skinned for characters)
+  std::span<const Vec3> normals;    // empty: none
+  std::span<const std::uint32_t> triangle_material;
+  std::span<const Vec3> material_colors;
+  bool is_static = false;
+};
+
+MeshRefs mesh_refs(const Scene& scene, const Scene::ObjectSlot& slot) {
+  MeshRefs r;
+  if (slot.kind == Scene::ObjectKind::kCharacter) {
+    const InstanceFrame& frame = scene.instances()[slot.index];
+    const SkinnedMesh& mesh = *scene.characters()[frame.character].mesh;
+    r.triangles = mesh.triangles;
+    r.positions = frame.positions;
+    r.normals = frame.normals;
+    r.triangle_material = mesh.triangle_material;
+    r.material_colors = mesh.material_colors;
+  } else {
+    const StaticMeshDesc& mesh = scene.static_meshes()[slot.index].desc;
+    r.triangles = mesh.triangles;
+    r.positions = mesh.positions;
+    r.triangle_material = mesh.triangle_material;
+    r.material_colors = mesh.material_colors;
+    r.is_static = true;
+  }
+  return r;
+}
+
 void set_miss(TileScratch& s, std::size_t k) {
   s.t[k] = kInf;
   s.u[k] = 0.0f;
@@ -223,28 +254,45 @@ void trace_primary(const Scene& scene, const PinholeCamera& camera, TriangleTest
     Float8(0.0f).store(t0);
     Float8(kInf).store(t1);
     const float* const origins[3] = {ex, ey, ez};
+    // With one object for the whole tile a packet's own cull could only
+    // drop it, which the object's box clip does as cheaply.
     lists.packet.clear();
-    cull_objects_for_packet(scene, origins, dirs.data(), t0, t1, pixels, lists.tile, lists.packet);
+    if (lists.tile.size() == 1) {
+      lists.packet.push_back(lists.tile[0]);
+    } else {
+      cull_objects_for_packet(scene, origins, dirs.data(), t0, t1, pixels, lists.tile, lists.packet);
+    }
     if (lists.packet.empty()) continue;
     RayPacket packet;
-    for (int lane = 0; lane < kPacketSize; ++lane) {
-      packet.ox[lane] = eye.x;
-      packet.oy[lane] = eye.y;
-      packet.oz[lane] = eye.z;
-      packet.t_min[lane] = 0.0f;
-      packet.t_max[lane] = kInf;
-    }
     std::memcpy(packet.dx, dirs[0], sizeof(packet.dx));
     std::memcpy(packet.dy, dirs[1], sizeof(packet.dy));
     std::memcpy(packet.dz, dirs[2], sizeof(packet.dz));
+    std::memcpy(packet.ox, ex, sizeof(packet.ox));
+    std::memcpy(packet.oy, ey, sizeof(packet.oy));
+    std::memcpy(packet.oz, ez, sizeof(packet.oz));
+    std::memcpy(packet.t_min, t0, sizeof(packet.t_min));
+    std::memcpy(packet.t_max, t1, sizeof(packet.t_max));
     packet.active = static_cast<std::uint8_t>(pixels);
-    Hit hits[kPacketSize];
-    TraversalCounters packet_counters;
     const ObjectFilter filter{lists.packet};
+    const PacketHits direct{&s.t[k0], &s.u[k0], &s.v[k0], &s.triangle[k0], &s.instance[k0]};
+    TraversalCounters packet_counters;
+    const auto add_counters = [&] {
+      counters.node_visits += packet_counters.node_visits;
+      counters.object_visits += packet_counters.object_visits;
+      counters.triangle_tests += packet_counters.triangle_tests;
+    };
+    if (intersect_packet_small_statics(scene, packet, test, filter, direct, &packet_counters)) {
+      add_counters();
+      std::uint32_t hit_bits = 0;
+      for (int lane = 0; lane < kPacketSize; ++lane) {
+        hit_bits |= s.triangle[k0 + static_cast<std::size_t>(lane)] != kInvalidId ? (1u << lane) : 0u;
+      }
+      s.block_hits[b] = static_cast<std::uint8_t>(hit_bits & pixels);
+      continue;
+    }
+    Hit hits[kPacketSize];
     intersect_packet(scene, packet, test, hits, &packet_counters, &filter);
-    counters.node_visits += packet_counters.node_visits;
-    counters.object_visits += packet_counters.object_visits;
-    counters.triangle_tests += packet_counters.triangle_tests;
+    add_counters();
     std::uint32_t hit_bits = 0;
     for (int lane = 0; lane < kPacketSize; ++lane) {
       const std::size_t k = k0 + static_cast<std::size_t>(lane);
@@ -274,34 +322,33 @@ void reconstruct_surfaces(const Scene& scene, const Vec3& default_albedo, TileSc
     alignas(32) float n[3][3][8];
     alignas(32) float albedo[3][8];
     std::uint32_t with_normals = 0;
+    // The mesh behind the last instance seen: neighbouring lanes mostly hit
+    // the same one.
+    std::uint32_t resolved = kInvalidId;
+    MeshRefs mesh;
     for (int lane = 0; lane < kBlockLanes; ++lane) {
       const std::size_t k = k0 + static_cast<std::size_t>(lane);
       Vec3 corner[3] = {Vec3(0.0f), Vec3(1.0f, 0.0f, 0.0f), Vec3(0.0f, 1.0f, 0.0f)};
       Vec3 normal[3] = {Vec3(0.0f), Vec3(0.0f), Vec3(0.0f)};
       Vec3 color = default_albedo;
       if (hits >> lane & 1u) {
-        const Scene::ObjectSlot slot = slots[s.instance[k]];
-        const std::uint32_t tri = s.triangle[k];
-        if (slot.kind == Scene::ObjectKind::kCharacter) {
-          const InstanceFrame& frame = scene.instances()[slot.index];
-          const SkinnedMesh& mesh = *scene.characters()[frame.character].mesh;
-          const auto& v = mesh.triangles[tri];
-          for (int i = 0; i < 3; ++i) corner[i] = frame.positions[v[static_cast<std::size_t>(i)]];
-          if (!frame.normals.empty()) {
-            for (int i = 0; i < 3; ++i) normal[i] = frame.normals[v[static_cast<std::size_t>(i)]];
-            with_normals |= 1u << lane;
-          }
-          if (tri < mesh.triangle_material.size()) {
-            const std::uint32_t m = mesh.triangle_material[tri];
-            if (m < mesh.material_colors.size()) color = mesh.material_colors[m];
-          }
-        } else {
-          const StaticMeshDesc& mesh = scene.static_meshes()[slot.index].desc;
-          const auto& v = mesh.triangles[tri];
-          for (int i = 0; i < 3; ++i) corner[i] = mesh.positions[v[static_cast<std::size_t>(i)]];
-          const std::uint32_t m = mesh.triangle_material.empty() ? 0 : mesh.triangle_material[tri];
-          if (m < mesh.material_colors.size()) color = mesh.material_colors[m];
+        if (s.instance[k] != resolved) {
+          resolved = s.instance[k];
+          mesh = mesh_refs(scene, slots[resolved]);
         }
+        const std::uint32_t tri = s.triangle[k];
+        const auto& v = mesh.triangles[tri];
+        for (int i = 0; i < 3; ++i) corner[i] = mesh.positions[v[static_cast<std::size_t>(i)]];
+        if (!mesh.normals.empty()) {
+          for (int i = 0; i < 3; ++i) normal[i] = mesh.normals[v[static_cast<std::size_t>(i)]];
+          with_normals |= 1u << lane;
+        }
+        // Characters without per-triangle materials use the default albedo;
+        // static meshes without them use material 0.
+        const std::uint32_t m = tri < mesh.triangle_material.size() ? mesh.triangle_material[tri]
+                                : mesh.is_static                     ? 0u
+                                                                     : kInvalidId;
+        if (m < mesh.material_colors.size()) color = mesh.material_colors[m];
       }
       for (int i = 0; i < 3; ++i) {
         for (int a = 0; a < 3; ++a) {
@@ -449,7 +496,11 @@ std::uint64_t trace_shadow_rays(const Scene& scene, TriangleTest test, bool pack
     const float* const o[3] = {&s.so_x[i], &s.so_y[i], &s.so_z[i]};
     const float* const d[3] = {&s.sd_x[i], &s.sd_y[i], &s.sd_z[i]};
     lists.packet.clear();
-    cull_objects_for_packet(scene, o, d, kZeros, &s.s_tmax[i], active, lists.tile, lists.packet);
+    if (lists.tile.size() == 1) {
+      lists.packet.push_back(lists.tile[0]);
+    } else {
+      cull_objects_for_packet(scene, o, d, kZeros, &s.s_tmax[i], active, lists.tile, lists.packet);
+    }
     if (lists.packet.empty()) continue;
     RayPacket packet;
     std::memcpy(packet.ox, o[0], sizeof(packet.ox));
@@ -461,9 +512,11 @@ std::uint64_t trace_shadow_rays(const Scene& scene, TriangleTest test, bool pack
     std::memcpy(packet.t_min, kZeros, sizeof(packet.t_min));
     std::memcpy(packet.t_max, &s.s_tmax[i], sizeof(packet.t_max));
     packet.active = static_cast<std::uint8_t>(active);
-    TraversalCounters packet_counters;
     const ObjectFilter filter{lists.packet};
-    const std::uint8_t blocked = occluded_packet(scene, packet, test, &packet_counters, &filter);
+    TraversalCounters packet_counters;
+    const int small = occluded_packet_small_statics(scene, packet, test, filter, &packet_counters);
+    const std::uint32_t blocked =
+        small >= 0 ? static_cast<std::uint32_t>(small) : occluded_packet(scene, packet, test, &packet_counters, &filter);
     counters.node_visits += packet_counters.node_visits;
     counters.object_visits += packet_counters.object_visits;
     counters.triangle_tests += packet_counters.triangle_tests;
@@ -520,11 +573,56 @@ void shade_and_write(const RenderSettings& settings, std::span<const Light> ligh
         srgb_indices(color.z, bytes[2]);
       }
     }
+    const int bx = s.tile.x0 + static_cast<int>(b % static_cast<std::size_t>(s.blocks_x)) * kBlockWidth;
+    const int by = s.tile.y0 + static_cast<int>(b / static_cast<std::size_t>(s.blocks_x)) * kBlockHeight;
+    if (pixels == 0xFFu && (hits == 0xFFu || hits == 0u)) {
+      // A whole block of one kind: each output's two rows of four pixels
+      // are contiguous.
+      for (int row = 0; row < kBlockHeight; ++row) {
+        const std::size_t k = k0 + static_cast<std::size_t>(row * kBlockWidth);
+        const int y = by + row;
+        if (out.triangle.wanted()) std::memcpy(out.triangle.at(bx, y), &s.triangle[k], 4 * sizeof(std::uint32_t));
+        if (out.instance.wanted()) std::memcpy(out.instance.at(bx, y), &s.instance[k], 4 * sizeof(std::uint32_t));
+        if (hits == 0u) {
+          for (int i = 0; i < kBlockWidth; ++i) {
+            if (out.depth.wanted()) out.depth.at(bx, y)[i] = kInf;
+            if (out.normal.wanted()) out.normal.at(bx, y)[i] = Vec3(0.0f);
+            if (out.rgba8.wanted()) std::memcpy(out.rgba8.at(bx + i, y), background_bytes.data(), 4);
+            if (out.rgba32f.wanted()) {
+              float* rgba = out.rgba32f.at(bx + i, y);
+              for (int c = 0; c < 3; ++c) rgba[c] = settings.background[c];
+              rgba[3] = 1.0f;
+            }
+          }
+          continue;
+        }
+        const int l0 = row * kBlockWidth;
+        if (out.depth.wanted()) std::memcpy(out.depth.at(bx, y), &depth[l0], 4 * sizeof(float));
+        if (out.normal.wanted()) {
+          for (int i = 0; i < kBlockWidth; ++i) out.normal.at(bx, y)[i] = Vec3(s.nx[k + i], s.ny[k + i], s.nz[k + i]);
+        }
+        if (out.rgba8.wanted()) {
+          std::uint8_t* rgba = out.rgba8.at(bx, y);
+          for (int i = 0; i < kBlockWidth; ++i) {
+            for (int c = 0; c < 3; ++c) rgba[4 * i + c] = srgb_byte(bytes[c][l0 + i]);
+            rgba[4 * i + 3] = 255;
+          }
+        }
+        if (out.rgba32f.wanted()) {
+          float* rgba = out.rgba32f.at(bx, y);
+          for (int i = 0; i < kBlockWidth; ++i) {
+            for (int c = 0; c < 3; ++c) rgba[4 * i + c] = linear[c][l0 + i];
+            rgba[4 * i + 3] = 1.0f;
+          }
+        }
+      }
+      continue;
+    }
     for (std::uint32_t m = pixels; m != 0; m &= m - 1) {
       const int lane = std::countr_zero(m);
       const std::size_t k = k0 + static_cast<std::size_t>(lane);
-      const int x = s.tile.x0 + static_cast<int>(b % static_cast<std::size_t>(s.blocks_x)) * kBlockWidth + lane % 4;
-      const int y = s.tile.y0 + static_cast<int>(b / static_cast<std::size_t>(s.blocks_x)) * kBlockHeight + lane / 4;
+      const int x = bx + lane % kBlockWidth;
+      const int y = by + lane / kBlockWidth;
       if (out.triangle.wanted()) *out.triangle.at(x, y) = s.triangle[k];
       if (out.instance.wanted()) *out.instance.at(x, y) = s.instance[k];
       if (!(hits >> lane & 1u)) {
