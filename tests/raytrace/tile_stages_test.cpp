@@ -1,0 +1,358 @@
+// The coherent-ray machinery of render/: interval bounds on ray sets never
+// cull a box some ray enters (against a double-precision slab test), the
+// packet cull keeps every object a lane reaches, culled packets find the
+// single-ray hits, the SoA stages reproduce the scalar camera and surface
+// code, and the renderer matches single rays and brute force for packets
+// that straddle tile and image edges, cameras inside a character and rays
+// starting inside bone boxes.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "raytrace/camera/camera.h"
+#include "raytrace/render/packet_traversal.h"
+#include "raytrace/render/ray_bound.h"
+#include "raytrace/render/renderer.h"
+#include "raytrace/render/tile_stages.h"
+#include "raytrace/render/traversal.h"
+#include "raytrace/scene/scene.h"
+#include "runtime/jobs/job_system.h"
+#include "runtime/math/float8.h"
+#include "tests/support/brute_force.h"
+#include "tests/support/idle_mannequin.h"
+
+namespace sinew {
+namespace {
+
+using rt::TriangleTest;
+constexpr TriangleTest kTests[] = {TriangleTest::kFast, TriangleTest::kWatertight};
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+float unit(std::mt19937& g) { return static_cast<float>(g() >> 8) * 0x1.0p-24f; }
+
+// Two mannequins on a ground quad, one idling inside its pose space, one
+// kicking out of it (its escaped triangles go through the fallback).
+std::unique_ptr<rt::Scene> make_scene() {
+  const testing_support::BakedModel& m = testing_support::idle_mannequin();
+  auto scene = std::make_unique<rt::Scene>();
+  const std::uint32_t character = scene->add_character(m.model.mesh, m.bake.fuzzy.view()).value();
+  for (int i = 0; i < 2; ++i) {
+    const std::uint32_t instance = scene->add_instance(character).value();
+    const Affine3 place = Affine3::translation(Vec3(0.9f * static_cast<float>(i) - 0.45f, 0.0f, 0.0f));
+    EXPECT_TRUE(scene
+                    ->set_bones(instance, testing_support::clip_pose(m.model, i == 1 ? "kick" : "idle",
+                                                                     i == 1 ? 0.4 : 0.3, place))
+                    .ok());
+  }
+  rt::StaticMeshDesc ground;
+  ground.positions = {{-5, 0, -5}, {5, 0, -5}, {-5, 0, 5}, {5, 0, 5}};
+  ground.triangles = {{0, 2, 1}, {1, 2, 3}};
+  EXPECT_TRUE(scene->add_static_mesh(ground).ok());
+  JobSystem jobs(2);
+  EXPECT_TRUE(scene->prepare_frame(rt::FrameOptions{}, jobs).ok());
+  return scene;
+}
+
+const rt::Scene& scene() {
+  static const std::unique_ptr<rt::Scene> s = make_scene();
+  return *s;
+}
+
+// Whether the ray enters `box` within [t0, t1], in double precision.
+bool enters(const Aabb& box, const Vec3& o, const Vec3& d, double t0, double t1) {
+  for (int a = 0; a < 3; ++a) {
+    const double oa = o[a], da = d[a];
+    const double lo = box.lower[a], hi = box.upper[a];
+    if (da == 0.0) {
+      if (oa < lo || oa > hi) return false;
+      continue;
+    }
+    double n = (lo - oa) / da;
+    double f = (hi - oa) / da;
+    if (n > f) std::swap(n, f);
+    t0 = std::max(t0, n);
+    t1 = std::min(t1, f);
+  }
+  return t0 <= t1;
+}
+
+TEST(RayBound, NeverCullsABoxThatARayEnters) {
+  std::mt19937 g(7);
+  std::size_t entered = 0, culled = 0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    alignas(32) float o[3][8], d[3][8], t0[8], t1[8];
+    const bool shared = trial % 2 == 0;
+    const Vec3 base(unit(g) * 4 - 2, unit(g) * 4 - 2, unit(g) * 4 - 2);
+    const Vec3 aim(unit(g) - 0.5f, unit(g) - 0.5f, unit(g) - 0.5f);
+    for (int lane = 0; lane < 8; ++lane) {
+      for (int a = 0; a < 3; ++a) {
+        o[a][lane] = shared ? base[a] : base[a] + 0.3f * (unit(g) - 0.5f);
+        // Coherent around `aim`, sometimes spread over both signs, sometimes
+        // exactly zero on an axis.
+        const float spread = trial % 5 == 0 ? 2.0f : 0.1f;
+        d[a][lane] = (trial % 7 == 0 && a == 1) ? 0.0f : aim[a] + spread * (unit(g) - 0.5f);
+      }
+      t0[lane] = trial % 3 == 0 ? unit(g) : 0.0f;
+      t1[lane] = trial % 4 == 0 ? kInf : 1.0f + 4.0f * unit(g);
+    }
+    const std::uint32_t lanes = trial % 6 == 0 ? (g() & 0xFFu) | 1u : 0xFFu;
+    rt::RayBound bound;
+    const float* const op[3] = {o[0], o[1], o[2]};
+    const float* const dp[3] = {d[0], d[1], d[2]};
+    bound.add_lanes(op, dp, t0, t1, lanes);
+    const rt::RayBound::Test test = bound.test();
+    for (int b = 0; b < 8; ++b) {
+      const Vec3 c(unit(g) * 6 - 3, unit(g) * 6 - 3, unit(g) * 6 - 3);
+      const Vec3 e(unit(g) * 0.5f, unit(g) * 0.5f, unit(g) * 0.5f);
+      const Aabb box{c - e, c + e};
+      bool any = false;
+      for (int lane = 0; lane < 8; ++lane) {
+        if (!(lanes >> lane & 1u)) continue;
+        any = any || enters(box, Vec3(o[0][lane], o[1][lane], o[2][lane]), Vec3(d[0][lane], d[1][lane], d[2][lane]),
+                            t0[lane], t1[lane]);
+      }
+      const bool may = test.may_enter(box, 0.0f);
+      if (any) {
+        ++entered;
+        ASSERT_TRUE(may) << "trial " << trial << " box " << b << ": a ray enters a culled box";
+      } else if (!may) {
+        ++culled;
+      }
+    }
+  }
+  // The counts of this fixed seed: about 1,800 boxes entered, and most of
+  // the others culled.
+  EXPECT_GT(entered, 1000u);
+  EXPECT_GT(culled, 100000u) << "the bound should cull most boxes no ray enters";
+}
+
+TEST(RayBound, NonFiniteRaysCullNothing) {
+  alignas(32) float o[3][8] = {}, d[3][8] = {}, t0[8] = {}, t1[8];
+  for (int lane = 0; lane < 8; ++lane) {
+    d[2][lane] = 1.0f;
+    t1[lane] = 1.0f;
+  }
+  o[0][3] = std::numeric_limits<float>::quiet_NaN();
+  rt::RayBound bound;
+  const float* const op[3] = {o[0], o[1], o[2]};
+  const float* const dp[3] = {d[0], d[1], d[2]};
+  bound.add_lanes(op, dp, t0, t1, 0xFFu);
+  EXPECT_TRUE(bound.test().may_enter(Aabb{Vec3(100.0f), Vec3(101.0f)}, 0.0f));
+}
+
+// Random packets around the characters: culled (tile bound, then packet
+// cull, as the renderer does) and unculled traversal agree with single rays.
+TEST(PacketCulling, CulledPacketsFindTheSingleRayHits) {
+  const rt::Scene& s = scene();
+  std::mt19937 g(11);
+  const Vec3 c(0.0f, 0.9f, 0.0f);
+  std::size_t hits = 0, checked = 0;
+  for (int p = 0; p < 1500; ++p) {
+    rt::RayPacket packet;
+    // Origins: a shared far point, scattered points, or points inside the
+    // characters' bone boxes.
+    const Vec3 shared = c + Vec3(unit(g) - 0.5f, unit(g) - 0.5f, unit(g) - 0.5f) * 4.0f;
+    const std::span<const rt::TopLevelObject> objects = s.top_level().objects();
+    for (int lane = 0; lane < 8; ++lane) {
+      Ray ray;
+      if (p % 3 == 0) {
+        ray.origin = shared;
+      } else if (p % 3 == 1) {
+        ray.origin = c + Vec3(unit(g) - 0.5f, unit(g) - 0.5f, unit(g) - 0.5f) * 2.0f;
+      } else {
+        const Aabb& box = objects[g() % objects.size()].box;
+        ray.origin = box.lower + Vec3(unit(g), unit(g), unit(g)) * (box.upper - box.lower);
+      }
+      const Vec3 target = c + Vec3(unit(g) - 0.5f, unit(g) * 1.8f - 0.9f, unit(g) - 0.5f);
+      ray.direction = p % 4 == 0 ? Vec3(unit(g) - 0.5f, unit(g) - 0.5f, unit(g) - 0.5f) : target - ray.origin;
+      if (ray.direction == Vec3(0.0f)) ray.direction = Vec3(0.0f, -1.0f, 0.0f);
+      if (p % 5 == 0) ray.t_max = 0.5f + unit(g);
+      packet.set(lane, ray);
+    }
+    packet.active = static_cast<std::uint8_t>(p % 7 == 0 ? (g() & 0xFFu) : 0xFFu);
+    const float* const o[3] = {packet.ox, packet.oy, packet.oz};
+    const float* const d[3] = {packet.dx, packet.dy, packet.dz};
+    rt::RayBound bound;
+    bound.add_lanes(o, d, packet.t_min, packet.t_max, packet.active);
+    std::vector<std::uint32_t> tile, candidates;
+    rt::cull_objects(s, bound, tile);
+    rt::cull_objects_for_packet(s, o, d, packet.t_min, packet.t_max, packet.active, tile, candidates);
+    const rt::ObjectFilter filter{candidates};
+    for (const TriangleTest test : kTests) {
+      Hit culled[8];
+      rt::intersect_packet(s, packet, test, culled, nullptr, &filter);
+      const std::uint8_t blocked = rt::occluded_packet(s, packet, test, nullptr, &filter);
+      for (int lane = 0; lane < 8; ++lane) {
+        if (!(packet.active >> lane & 1u)) continue;
+        const Ray ray = packet.ray(lane);
+        const Hit single = rt::intersect(s, ray, test);
+        ++checked;
+        hits += single.valid() ? 1 : 0;
+        ASSERT_EQ(culled[lane].triangle_id, single.triangle_id) << "packet " << p << " lane " << lane;
+        ASSERT_EQ(culled[lane].instance_id, single.instance_id) << "packet " << p << " lane " << lane;
+        if (single.valid()) {
+          ASSERT_NEAR(culled[lane].t, single.t, 1e-5f * std::max(1.0f, single.t)) << "packet " << p;
+        }
+        ASSERT_EQ((blocked >> lane & 1u) != 0, rt::occluded(s, ray, test)) << "packet " << p << " lane " << lane;
+      }
+    }
+  }
+  EXPECT_GT(hits, checked / 5);
+}
+
+TEST(TileStages, CameraDirectionsAreTheCameraRays) {
+  const auto camera =
+      rt::PinholeCamera::create({Vec3(0.5f, 1.4f, 3.0f), Vec3(0.0f, 0.9f, 0.0f), Vec3(0, 1, 0), 47.0f}, 37, 23)
+          .value();
+  rt::TileScratch s;
+  s.prepare(Tile{5, 3, 18, 14, 0});  // 13x11: partial blocks at both edges
+  rt::generate_camera_rays(camera, s);
+  std::size_t pixels = 0;
+  for (std::size_t k = 0; k < s.lanes; ++k) {
+    if (!(s.block_pixels[k / rt::kBlockLanes] >> (k % rt::kBlockLanes) & 1u)) continue;
+    ++pixels;
+    const Ray ray = camera.ray(s.pixel_x(k), s.pixel_y(k));
+    ASSERT_EQ(std::bit_cast<std::uint32_t>(s.dir_x[k]), std::bit_cast<std::uint32_t>(ray.direction.x)) << k;
+    ASSERT_EQ(std::bit_cast<std::uint32_t>(s.dir_y[k]), std::bit_cast<std::uint32_t>(ray.direction.y)) << k;
+    ASSERT_EQ(std::bit_cast<std::uint32_t>(s.dir_z[k]), std::bit_cast<std::uint32_t>(ray.direction.z)) << k;
+  }
+  EXPECT_EQ(pixels, 13u * 11u);
+}
+
+TEST(TileStages, SurfacesAndShadowOriginsAreTheScalarOnes) {
+  const rt::Scene& sc = scene();
+  const auto camera =
+      rt::PinholeCamera::create({Vec3(0.5f, 1.4f, 3.0f), Vec3(0.0f, 0.9f, 0.0f), Vec3(0, 1, 0), 45.0f}, 64, 64)
+          .value();
+  rt::Light light;
+  light.position = Vec3(2.0f, 4.0f, 3.0f);
+  std::size_t hits = 0, rays = 0;
+  for (int ty = 0; ty < 64; ty += 16) {
+    for (int tx = 0; tx < 64; tx += 16) {
+      rt::TileScratch s;
+      s.prepare(Tile{tx, ty, tx + 16, ty + 16, 0});
+      rt::generate_camera_rays(camera, s);
+      rt::TraversalCounters counters;
+      rt::trace_primary(sc, camera, TriangleTest::kFast, true, s, counters);
+      std::fill(s.lit.begin(), s.lit.end(), std::uint8_t{1});
+      rt::reconstruct_surfaces(sc, Vec3(0.7f), s);
+      rt::make_shadow_rays(light, 0, s);
+      std::size_t next_ray = 0;
+      for (std::size_t k = 0; k < s.lanes; ++k) {
+        if (!s.hit(k)) continue;
+        ++hits;
+        const Hit hit{s.t[k], s.u[k], s.v[k], s.triangle[k], s.instance[k]};
+        const rt::SurfacePoint p = rt::surface_at(sc, hit, Vec3(0.7f));
+        const Vec3 dir(s.dir_x[k], s.dir_y[k], s.dir_z[k]);
+        Vec3 facing = p.geometric_normal;
+        if (glm::dot(facing, dir) > 0.0f) facing = -facing;
+        Vec3 n = p.shading_normal;
+        if (glm::dot(n, facing) < 0.0f) n = -n;
+        ASSERT_EQ(Vec3(s.px[k], s.py[k], s.pz[k]), p.position) << k;
+        ASSERT_EQ(Vec3(s.gx[k], s.gy[k], s.gz[k]), facing) << k;
+        ASSERT_EQ(Vec3(s.nx[k], s.ny[k], s.nz[k]), n) << k;
+        ASSERT_EQ(Vec3(s.ar[k], s.ag[k], s.ab[k]), p.albedo) << k;
+        ASSERT_EQ(s.error[k], p.error.x) << k;
+        if (glm::dot(facing, light.position - p.position) <= 0.0f) {
+          ASSERT_EQ(s.lit[k], 0u) << "facing away from the light: dark without a ray";
+          continue;
+        }
+        ASSERT_LT(next_ray, s.shadow_count);
+        ASSERT_EQ(s.shadow_pixel[next_ray], k);
+        const Vec3 origin = rt::offset_origin(p, facing);
+        ASSERT_EQ(Vec3(s.so_x[next_ray], s.so_y[next_ray], s.so_z[next_ray]), origin) << k;
+        ASSERT_EQ(Vec3(s.sd_x[next_ray], s.sd_y[next_ray], s.sd_z[next_ray]), light.position - origin) << k;
+        ++next_ray;
+        ++rays;
+      }
+      EXPECT_EQ(next_ray, s.shadow_count);
+    }
+  }
+  EXPECT_GT(hits, 1000u);
+  EXPECT_GT(rays, 500u);
+}
+
+struct Frame {
+  std::vector<std::uint8_t> color;
+  std::vector<float> depth;
+  std::vector<Vec3> normal;
+  std::vector<std::uint32_t> triangle, instance;
+};
+
+Frame render(const rt::Scene& sc, const rt::PinholeCamera& camera, int tile, bool packets, TriangleTest test,
+             JobSystem& jobs) {
+  const std::size_t n = static_cast<std::size_t>(camera.width() * camera.height());
+  Frame f;
+  f.color.resize(4 * n);
+  f.depth.resize(n);
+  f.normal.resize(n);
+  f.triangle.resize(n);
+  f.instance.resize(n);
+  rt::FrameBuffers buffers{camera.width(), camera.height(), f.color, {}, f.depth, f.normal, f.triangle, f.instance, {}};
+  rt::RenderSettings settings;
+  settings.tile_size = tile;
+  settings.packets = packets;
+  settings.triangle_test = test;
+  rt::Renderer renderer;
+  EXPECT_TRUE(renderer.render(sc, camera, settings, buffers, jobs).ok());
+  return f;
+}
+
+// Odd image sizes and tile sizes put partial 4x2 blocks on every tile and
+// image edge; cameras inside a character and inside a bone box start rays
+// inside objects. Every pixel is checked against the single-ray query and
+// against brute force, and packets against single rays for the whole image.
+TEST(Renderer, PacketsMatchSingleRaysAndBruteForceAtEdgesAndInsideCharacters) {
+  const rt::Scene& sc = scene();
+  const std::vector<testing_support::SoupTriangle> soup = testing_support::world_triangles(sc);
+  JobSystem jobs(2);
+  const Aabb chest = sc.top_level().objects()[sc.top_level().objects().size() / 3].box;
+  const rt::CameraDesc cameras[] = {
+      {Vec3(0.5f, 1.4f, 3.0f), Vec3(0.0f, 0.9f, 0.0f), Vec3(0, 1, 0), 45.0f},   // outside
+      {Vec3(-0.45f, 1.2f, 0.02f), Vec3(0.5f, 0.8f, -1.0f), Vec3(0, 1, 0), 100.0f},  // inside a mannequin
+      {chest.center(), chest.center() + Vec3(0.3f, -0.2f, 1.0f), Vec3(0, 1, 0), 120.0f},  // inside a bone box
+  };
+  const std::pair<int, int> sizes[] = {{37, 23}, {29, 31}};
+  std::size_t checked = 0, character = 0;
+  for (const rt::CameraDesc& desc : cameras) {
+    for (const auto& [w, h] : sizes) {
+      const auto camera = rt::PinholeCamera::create(desc, w, h).value();
+      for (const TriangleTest test : kTests) {
+        const Frame single = render(sc, camera, 16, false, test, jobs);
+        for (const int tile : {1, 3, 5, 16, 64}) {
+          const Frame packets = render(sc, camera, tile, true, test, jobs);
+          EXPECT_EQ(packets.triangle, single.triangle) << "tile " << tile;
+          EXPECT_EQ(packets.instance, single.instance) << "tile " << tile;
+          EXPECT_EQ(packets.depth, single.depth) << "tile " << tile;
+          EXPECT_EQ(packets.color, single.color) << "tile " << tile;
+        }
+        for (int y = 0; y < h; ++y) {
+          for (int x = 0; x < w; ++x) {
+            const std::size_t i = static_cast<std::size_t>(y * w + x);
+            const Ray ray = camera.ray(x, y);
+            const Hit ours{single.depth[i] / glm::length(ray.direction), 0.0f, 0.0f, single.triangle[i],
+                           single.instance[i]};
+            const Hit ref = testing_support::nearest(soup, ray, test);
+            ++checked;
+            character += ref.valid() && ref.instance_id < 2 ? 1 : 0;
+            ASSERT_EQ(single.triangle[i], rt::intersect(sc, ray, test).triangle_id) << x << "," << y;
+            ASSERT_TRUE(testing_support::same_nearest(rt::intersect(sc, ray, test), ref, soup, ray, test))
+                << x << "," << y << " tri " << ours.triangle_id << " ref " << ref.triangle_id;
+          }
+        }
+      }
+    }
+  }
+  EXPECT_GT(character, checked / 10);
+}
+
+}  // namespace
+}  // namespace sinew
