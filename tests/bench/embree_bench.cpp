@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <fstream>
+#include <iterator>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -22,9 +23,9 @@
 #include "runtime/timing/phase_timers.h"
 #include "tests/bench/bench_support.h"
 #include "tests/bench/brute_force_gate.h"
-#ifdef SINEW_HAVE_EMBREE
+// Always included for EmbreeMode and EmbreeWidth, which the options name;
+// the tracer itself is only linked (and called) when Embree was found.
 #include "tests/bench/embree_tracer.h"
-#endif
 
 namespace sinew::bench {
 namespace {
@@ -40,6 +41,34 @@ double ms_since(Clock::time_point start) {
 
 // --- options -------------------------------------------------------------------
 
+// The Embree modes as --embree-modes names them and as the table labels them.
+struct ModeSpec {
+  EmbreeMode mode;
+  const char* key;
+  const char* label;
+};
+constexpr ModeSpec kModes[] = {{EmbreeMode::kRebuildLow, "low", "LOW rebuild"},
+                               {EmbreeMode::kRefit, "refit", "refit"},
+                               {EmbreeMode::kRebuildMedium, "medium", "MEDIUM rebuild"}};
+
+const ModeSpec& mode_spec(EmbreeMode mode) {
+  for (const ModeSpec& m : kModes) {
+    if (m.mode == mode) return m;
+  }
+  return kModes[0];
+}
+
+// Rays per Embree call: what --embree-widths lists and the JSON records.
+int lanes_of(EmbreeWidth width) {
+  switch (width) {
+    case EmbreeWidth::k1: return 1;
+    case EmbreeWidth::k4: return 4;
+    case EmbreeWidth::k8: return 8;
+    case EmbreeWidth::k16: return 16;
+  }
+  return 1;
+}
+
 struct Options {
   int width = 1024;
   int height = 1024;
@@ -50,6 +79,11 @@ struct Options {
   int instances = 1;
   int subdivide = 0;  // subdivision levels applied to the model (Table 2's larger meshes)
   int check_stride = 7;
+  // Every (mode, width) pair is a row of its own: which width suits Embree
+  // best depends on the mode, the mesh and the machine, so all are measured
+  // and Sinew is compared with the best.
+  std::vector<EmbreeMode> embree_modes{EmbreeMode::kRebuildLow, EmbreeMode::kRefit, EmbreeMode::kRebuildMedium};
+  std::vector<EmbreeWidth> embree_widths{std::begin(kEmbreeWidths), std::end(kEmbreeWidths)};
   std::string shared = SINEW_SHARED_DIR;
   std::string json_path;
   bool help = false;
@@ -59,9 +93,43 @@ const std::vector<editor::cli::FlagSpec>& flags() {
   static const std::vector<editor::cli::FlagSpec> specs = {
       {"--help", false}, {"-h", false},        {"--quick", false}, {"--size"},   {"--frames"}, {"--threads"},
       {"--clips"},       {"--clip"},           {"--model"},        {"--instances"}, {"--shared"}, {"--json"},
-      {"--check-stride"}, {"--subdivide"},
+      {"--check-stride"}, {"--subdivide"},     {"--embree-modes"}, {"--embree-widths"},
   };
   return specs;
+}
+
+// "low,refit,medium": each mode once.
+Expected<std::vector<EmbreeMode>> parse_modes(const std::string& text) {
+  namespace cli = editor::cli;
+  SINEW_ASSIGN_OR_RETURN(const std::vector<std::string> items, cli::parse_list("--embree-modes", text));
+  std::vector<EmbreeMode> modes;
+  for (const std::string& item : items) {
+    SINEW_ASSIGN_OR_RETURN(const int index, cli::parse_choice("--embree-modes", item, {"low", "refit", "medium"}));
+    const EmbreeMode mode = kModes[index].mode;
+    if (std::find(modes.begin(), modes.end(), mode) != modes.end()) {
+      return invalid_argument("--embree-modes", item, "listed twice");
+    }
+    modes.push_back(mode);
+  }
+  return modes;
+}
+
+// "1,4,8,16": each width once, of the four Embree has calls for.
+Expected<std::vector<EmbreeWidth>> parse_widths(const std::string& text) {
+  SINEW_ASSIGN_OR_RETURN(const std::vector<int> lanes, parse_int_list("--embree-widths", text, 1, 16));
+  std::vector<EmbreeWidth> widths;
+  for (const int n : lanes) {
+    const auto* found = std::find_if(std::begin(kEmbreeWidths), std::end(kEmbreeWidths),
+                                     [n](EmbreeWidth w) { return lanes_of(w) == n; });
+    if (found == std::end(kEmbreeWidths)) {
+      return invalid_argument("--embree-widths", std::to_string(n), "expected 1, 4, 8 or 16");
+    }
+    if (std::find(widths.begin(), widths.end(), *found) != widths.end()) {
+      return invalid_argument("--embree-widths", std::to_string(n), "listed twice");
+    }
+    widths.push_back(*found);
+  }
+  return widths;
 }
 
 Expected<Options> parse_options(const std::vector<std::string>& args) {
@@ -76,6 +144,10 @@ Expected<Options> parse_options(const std::vector<std::string>& args) {
     o.width = o.height = 256;
     o.frames = 30;
     o.threads = {1};
+    // The cheapest Embree mode at its two ends, single rays and the widest
+    // packets: twelve Embree rows would triple the quick run.
+    o.embree_modes = {EmbreeMode::kRefit};
+    o.embree_widths = {EmbreeWidth::k1, EmbreeWidth::k16};
   }
   if (const auto text = parsed.value("--size")) {
     SINEW_ASSIGN_OR_RETURN(const cli::Size2 size, cli::parse_size("--size", *text, 16384));
@@ -110,6 +182,12 @@ Expected<Options> parse_options(const std::vector<std::string>& args) {
     SINEW_ASSIGN_OR_RETURN(const std::int64_t n, cli::parse_int("--check-stride", *text, 1, 1 << 20));
     o.check_stride = static_cast<int>(n);
   }
+  if (const auto text = parsed.value("--embree-modes")) {
+    SINEW_ASSIGN_OR_RETURN(o.embree_modes, parse_modes(*text));
+  }
+  if (const auto text = parsed.value("--embree-widths")) {
+    SINEW_ASSIGN_OR_RETURN(o.embree_widths, parse_widths(*text));
+  }
   if (const auto text = parsed.value("--shared")) o.shared = *text;
   if (const auto text = parsed.value("--json")) o.json_path = *text;
   return o;
@@ -119,14 +197,22 @@ void print_usage(std::FILE* to) {
   std::fprintf(to,
                "usage: sinew-bench embree [--quick] [--model NAME|PATH] [--instances N] [--frames N]\n"
                "                          [--clips LIST | --clip NAME] [--size WxH] [--threads LIST]\n"
+               "                          [--embree-modes LIST] [--embree-widths LIST]\n"
                "                          [--subdivide LEVELS] [--check-stride N] [--shared DIR] [--json FILE]\n"
-               "  --quick             256x256, 30 frames, 1 thread (later flags override)\n"
+               "  --quick             256x256, 30 frames, 1 thread, Embree refit at widths 1,16 only\n"
+               "                      (later flags override)\n"
                "  --model M           cally (default), mannequin, or a .gltf/.glb/.cfg/.pack path\n"
                "  --instances N       character instances (default 1)\n"
                "  --frames N          frames at 30 fps through each clip (default 120)\n"
                "  --clips LIST        clips to animate, e.g. walk,tornado_kick (default walk)\n"
                "  --size WxH          image size (default 1024x1024)\n"
                "  --threads LIST      thread counts (default 1,2)\n"
+               "  --embree-modes LIST\n"
+               "                      Embree modes: low (LOW rebuild), refit, medium (MEDIUM rebuild)\n"
+               "                      (default low,refit,medium)\n"
+               "  --embree-widths LIST\n"
+               "                      rays per Embree call: 1 (rtcIntersect1/rtcOccluded1) or 4, 8, 16\n"
+               "                      (coherent packets); every mode runs at every width (default 1,4,8,16)\n"
                "  --subdivide L       subdivide the model L times first (each level: 4x the triangles)\n"
                "  --check-stride N    brute-force check every Nth pixel of the first frame (default 7)\n"
                "  --shared DIR        the shared folder holding content/cal3d/cally\n"
@@ -135,21 +221,43 @@ void print_usage(std::FILE* to) {
 
 // --- contenders ----------------------------------------------------------------
 
-enum class Contender : std::uint8_t { kSinew, kEmbreeLow, kEmbreeRefit, kEmbreeMedium, kExact };
+enum class Kind : std::uint8_t { kSinew, kEmbree, kExact };
 
-const char* contender_name(Contender c) {
-  switch (c) {
-    case Contender::kSinew: return "sinew fuzzy kd";
-    case Contender::kEmbreeLow: return "embree LOW rebuild";
-    case Contender::kEmbreeRefit: return "embree refit";
-    case Contender::kEmbreeMedium: return "embree MEDIUM rebuild";
-    case Contender::kExact: return "exact SAH kd rebuild";
+// One row of the table: Sinew, Embree in one (mode, width) pair, or the
+// exact kd-tree.
+struct Contender {
+  Kind kind = Kind::kSinew;
+  EmbreeMode mode = EmbreeMode::kRefit;  // kEmbree only
+  EmbreeWidth width = EmbreeWidth::k1;   // kEmbree only
+};
+
+// "rtcIntersect8": the Embree call the width uses (its name lives in the
+// tracer, which is only linked when Embree was found).
+std::string width_label(EmbreeWidth width) {
+#ifdef SINEW_HAVE_EMBREE
+  return embree_width_name(width);
+#else
+  return "x" + std::to_string(lanes_of(width));
+#endif
+}
+
+// "LOW rebuild rtcIntersect8": the mode and the width, as the summary names
+// the best Embree row.
+std::string embree_label(const Contender& c) {
+  return std::string(mode_spec(c.mode).label) + " " + width_label(c.width);
+}
+
+std::string contender_name(const Contender& c) {
+  switch (c.kind) {
+    case Kind::kSinew: return "sinew fuzzy kd";
+    case Kind::kEmbree: return "embree " + embree_label(c);
+    case Kind::kExact: return "exact SAH kd rebuild";
   }
   return "?";
 }
 
 struct ContenderResult {
-  Contender which = Contender::kSinew;
+  Contender which;
   PhaseTimers timers;  // "build", "trace primary", "trace shadow", "trace", "shade", "total"
   GateResult gate;
   std::uint64_t primary_hits = 0;  // last frame
@@ -160,7 +268,7 @@ struct ConfigResult {
   std::string clip;
   int threads = 0;
   PhaseTimers shared;  // "animation", "skinning"
-  std::vector<ContenderResult> contenders;
+  std::vector<ContenderResult> contenders;  // Sinew first
 };
 
 // One frame's numbers of one contender.
@@ -189,6 +297,26 @@ double phase(const PhaseTimers& timers, std::string_view name) {
     if (s.name == name) return s.median_ms;
   }
   return 0.0;
+}
+
+// The passing Embree row of lowest median total among those `keep` accepts;
+// nullptr when there is none.
+template <class Keep>
+const ContenderResult* best_embree_where(const ConfigResult& r, Keep keep) {
+  const ContenderResult* best = nullptr;
+  for (const ContenderResult& c : r.contenders) {
+    if (c.which.kind != Kind::kEmbree || !c.gate.passed() || !keep(c.which)) continue;
+    if (!best || phase(c.timers, "total") < phase(best->timers, "total")) best = &c;
+  }
+  return best;
+}
+
+const ContenderResult* best_embree(const ConfigResult& r) {
+  return best_embree_where(r, [](const Contender&) { return true; });
+}
+
+const ContenderResult* best_embree_of_mode(const ConfigResult& r, EmbreeMode mode) {
+  return best_embree_where(r, [mode](const Contender& c) { return c.mode == mode; });
 }
 
 // The frame's fixed inputs shared by every contender.
@@ -249,12 +377,14 @@ Expected<FrameSample> run_exact(const FrameContext& c, rt::Renderer& renderer, c
 }
 
 #ifdef SINEW_HAVE_EMBREE
-Expected<FrameSample> run_embree(const FrameContext& c, EmbreeTracer& tracer, std::span<std::uint8_t> color,
-                                 const BruteForceGate* gate, GateResult* gate_out) {
+// One Embree row's frame: the BVH brought up to date and the frame rendered
+// at the row's width; on the gated frame, the hits of the same width.
+Expected<FrameSample> run_embree(const FrameContext& c, EmbreeTracer& tracer, EmbreeWidth width,
+                                 std::span<std::uint8_t> color, const BruteForceGate* gate, GateResult* gate_out) {
   FrameSample s;
   SINEW_ASSIGN_OR_RETURN(s.build_ms, tracer.update(c.stage->scene));
   SINEW_ASSIGN_OR_RETURN(const EmbreeRenderStats stats,
-                         tracer.render(c.stage->scene, c.camera, c.settings, color, {}, *c.jobs));
+                         tracer.render(c.stage->scene, c.camera, c.settings, color, {}, *c.jobs, width));
   s.primary_ms = stats.trace_primary_ms;
   s.shadow_ms = stats.trace_shadow_ms;
   s.shade_ms = stats.shade_ms;
@@ -262,26 +392,26 @@ Expected<FrameSample> run_embree(const FrameContext& c, EmbreeTracer& tracer, st
   s.shadow_rays = stats.shadow_rays;
   if (gate) {
     std::vector<Hit> hits(static_cast<std::size_t>(c.camera.width()) * static_cast<std::size_t>(c.camera.height()));
-    SINEW_RETURN_IF_ERROR(status_of(tracer.render(c.stage->scene, c.camera, c.settings, {}, hits, *c.jobs)));
+    SINEW_RETURN_IF_ERROR(status_of(tracer.render(c.stage->scene, c.camera, c.settings, {}, hits, *c.jobs, width)));
     *gate_out = gate->check(hits);
   }
   return s;
 }
-
-EmbreeMode mode_of(Contender c) {
-  return c == Contender::kEmbreeLow     ? EmbreeMode::kRebuildLow
-         : c == Contender::kEmbreeRefit ? EmbreeMode::kRefit
-                                        : EmbreeMode::kRebuildMedium;
-}
 #endif
 
-std::vector<Contender> contenders() {
+// Sinew, then every Embree (mode, width) pair asked for (mode by mode),
+// then the exact kd-tree.
+std::vector<Contender> contenders(const Options& o) {
+  std::vector<Contender> order{{Kind::kSinew}};
 #ifdef SINEW_HAVE_EMBREE
-  return {Contender::kSinew, Contender::kEmbreeLow, Contender::kEmbreeRefit, Contender::kEmbreeMedium,
-          Contender::kExact};
+  for (const EmbreeMode mode : o.embree_modes) {
+    for (const EmbreeWidth width : o.embree_widths) order.push_back({Kind::kEmbree, mode, width});
+  }
 #else
-  return {Contender::kSinew, Contender::kExact};
+  (void)o;
 #endif
+  order.push_back({Kind::kExact});
+  return order;
 }
 
 Expected<ConfigResult> run_configuration(const editor::ImportedModel& model, const rt::FuzzyCharacterView& fuzzy,
@@ -294,13 +424,17 @@ Expected<ConfigResult> run_configuration(const editor::ImportedModel& model, con
   ConfigResult result;
   result.clip = clip_name;
   result.threads = threads;
-  const std::vector<Contender> order = contenders();
-  for (Contender c : order) result.contenders.push_back(ContenderResult{c, {}, {}, 0, 0});
+  const std::vector<Contender> order = contenders(o);
+  for (const Contender& c : order) result.contenders.push_back(ContenderResult{c, {}, {}, 0, 0});
 
 #ifdef SINEW_HAVE_EMBREE
-  std::array<std::unique_ptr<EmbreeTracer>, 5> tracers;
-  for (Contender c : {Contender::kEmbreeLow, Contender::kEmbreeRefit, Contender::kEmbreeMedium}) {
-    SINEW_ASSIGN_OR_RETURN(tracers[static_cast<std::size_t>(c)], EmbreeTracer::create(mode_of(c), threads));
+  // One tracer (one Embree device and scene) per mode, shared by its widths:
+  // each row still uploads, rebuilds or refits and is timed for it before
+  // its own render, so a row never traces a BVH it did not pay for, and
+  // there are as many devices (thread pools) as before.
+  std::array<std::unique_ptr<EmbreeTracer>, std::size(kModes)> tracers;
+  for (const EmbreeMode mode : o.embree_modes) {
+    SINEW_ASSIGN_OR_RETURN(tracers[static_cast<std::size_t>(mode)], EmbreeTracer::create(mode, threads));
   }
 #endif
 
@@ -343,8 +477,8 @@ Expected<ConfigResult> run_configuration(const editor::ImportedModel& model, con
     for (std::size_t k = 0; k < order.size(); ++k) {
       ContenderResult& r = result.contenders[(k + static_cast<std::size_t>(f)) % order.size()];
       FrameSample sample;
-      switch (r.which) {
-        case Contender::kSinew: {
+      switch (r.which.kind) {
+        case Kind::kSinew: {
           SINEW_ASSIGN_OR_RETURN(const rt::RenderStats stats,
                                  sinew_renderer.render(stage.scene, ctx.camera, ctx.settings, ctx.color, jobs));
           sample = sinew_sample(prepare, stats);
@@ -354,14 +488,14 @@ Expected<ConfigResult> run_configuration(const editor::ImportedModel& model, con
           }
           break;
         }
-        case Contender::kExact: {
+        case Kind::kExact: {
           SINEW_ASSIGN_OR_RETURN(sample, run_exact(ctx, exact_renderer, check, &r.gate));
           break;
         }
-        default: {
+        case Kind::kEmbree: {
 #ifdef SINEW_HAVE_EMBREE
-          SINEW_ASSIGN_OR_RETURN(sample, run_embree(ctx, *tracers[static_cast<std::size_t>(r.which)], color, check,
-                                                    &r.gate));
+          SINEW_ASSIGN_OR_RETURN(sample, run_embree(ctx, *tracers[static_cast<std::size_t>(r.which.mode)],
+                                                    r.which.width, color, check, &r.gate));
 #endif
           break;
         }
@@ -381,6 +515,58 @@ std::string ratio_text(double sinew, double other) {
   return text;
 }
 
+double fps_of(double total_ms) { return total_ms > 0.0 ? 1000.0 / total_ms : 0.0; }
+
+// The table's name cell: the best Embree row is marked.
+std::string row_label(const ContenderResult& c, const ContenderResult* best) {
+  return contender_name(c.which) + (&c == best ? " (best Embree)" : "");
+}
+
+// Per mode, the width that ran it fastest (the modes asked for, in order).
+void print_best_widths(const ConfigResult& r) {
+  std::string line;
+  for (const ModeSpec& m : kModes) {
+    const bool ran = std::any_of(r.contenders.begin(), r.contenders.end(), [&](const ContenderResult& c) {
+      return c.which.kind == Kind::kEmbree && c.which.mode == m.mode;
+    });
+    if (!ran) continue;
+    const ContenderResult* best = best_embree_of_mode(r, m.mode);
+    char text[160];
+    if (best) {
+      std::snprintf(text, sizeof text, "%s %s (total %.3f ms)", m.label, width_label(best->which.width).c_str(),
+                    phase(best->timers, "total"));
+    } else {
+      std::snprintf(text, sizeof text, "%s none (every width failed its brute-force check)", m.label);
+    }
+    line += (line.empty() ? "" : "; ") + std::string(text);
+  }
+  if (!line.empty()) std::printf("best width per Embree mode: %s\n", line.c_str());
+}
+
+// The summary under the table: the best Embree row against Sinew.
+void print_best_summary(const ConfigResult& r) {
+  const bool any_embree = std::any_of(r.contenders.begin(), r.contenders.end(),
+                                      [](const ContenderResult& c) { return c.which.kind == Kind::kEmbree; });
+  if (!any_embree) return;
+  const ContenderResult* best = best_embree(r);
+  if (!best) {
+    std::printf("best Embree: none (every Embree row failed its brute-force check)\n");
+    return;
+  }
+  const ContenderResult& sinew = r.contenders.front();
+  const double total = phase(best->timers, "total"), trace = phase(best->timers, "trace");
+  std::printf("best Embree: %s: total %.3f ms (%.2f fps), trace %.3f ms; ", embree_label(best->which).c_str(), total,
+              fps_of(total), trace);
+  if (!sinew.gate.passed()) {
+    std::printf("Sinew FAILED its brute-force check\n");
+    return;
+  }
+  const double sinew_total = phase(sinew.timers, "total"), sinew_trace = phase(sinew.timers, "trace");
+  std::printf("Sinew total %.3f ms (%.2f fps), trace %.3f ms; Sinew/best total %s, trace %s\n", sinew_total,
+              fps_of(sinew_total), sinew_trace, ratio_text(sinew_total, total).c_str(),
+              ratio_text(sinew_trace, trace).c_str());
+}
+
 void print_config(const ConfigResult& r) {
   std::printf("\n### clip %s, %d thread%s\n\n", r.clip.c_str(), r.threads, r.threads == 1 ? "" : "s");
   std::printf("shared per frame (median ms): animation %.3f, skinning %.3f (Sinew's, identical for all)\n\n",
@@ -389,43 +575,131 @@ void print_config(const ConfigResult& r) {
               "sinew/this build | sinew/this trace | sinew/this total | brute force |\n");
   std::printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|\n");
   const ContenderResult& sinew = r.contenders.front();
+  const ContenderResult* best = best_embree(r);
   for (const ContenderResult& c : r.contenders) {
     const std::string check = std::to_string(c.gate.checked) + " px ok" +
                               (c.gate.grazes ? ", " + std::to_string(c.gate.grazes) + " edge grazes" : "");
     if (!c.gate.passed()) {
       std::printf("| %s | FAILED brute-force check (%llu of %llu sampled pixels differ) | | | | | | | | | FAILED |\n",
-                  contender_name(c.which), static_cast<unsigned long long>(c.gate.mismatched),
+                  contender_name(c.which).c_str(), static_cast<unsigned long long>(c.gate.mismatched),
                   static_cast<unsigned long long>(c.gate.checked));
       continue;
     }
     const double b = phase(c.timers, "build"), t = phase(c.timers, "trace"), tot = phase(c.timers, "total");
-    std::printf("| %s | %.3f | %.3f | %.3f | %.3f | %.3f | %.3f | %s | %s | %s | %s |\n", contender_name(c.which), b,
-                phase(c.timers, "trace primary"), phase(c.timers, "trace shadow"), t, phase(c.timers, "shade"), tot,
+    std::printf("| %s | %.3f | %.3f | %.3f | %.3f | %.3f | %.3f | %s | %s | %s | %s |\n", row_label(c, best).c_str(),
+                b, phase(c.timers, "trace primary"), phase(c.timers, "trace shadow"), t, phase(c.timers, "shade"), tot,
                 ratio_text(phase(sinew.timers, "build"), b).c_str(), ratio_text(phase(sinew.timers, "trace"), t).c_str(),
                 ratio_text(phase(sinew.timers, "total"), tot).c_str(), check.c_str());
   }
+  std::printf("\n");
+  print_best_widths(r);
+  print_best_summary(r);
+}
+
+// A ratio for the JSON: null when either side is missing.
+Json ratio_json(double sinew, double other) {
+  return sinew > 0.0 && other > 0.0 ? Json(sinew / other) : Json(nullptr);
+}
+
+// The Embree row's mode and width, as the report reads them.
+void add_embree_keys(const Contender& c, Json& entry) {
+  entry["mode"] = mode_spec(c.mode).key;
+  entry["mode_name"] = mode_spec(c.mode).label;
+  entry["width"] = lanes_of(c.width);
+  entry["width_name"] = width_label(c.width);
+  entry["label"] = embree_label(c);
+}
+
+// One row: its medians under plain names (the "phases" object keeps every
+// sample statistic) and Sinew's ratios against it.
+Json contender_json(const ContenderResult& c, const ContenderResult& sinew, const ContenderResult* best) {
+  const char* kinds[] = {"sinew", "embree", "exact"};
+  Json entry = {{"name", contender_name(c.which)}, {"kind", kinds[static_cast<int>(c.which.kind)]}};
+  if (c.which.kind == Kind::kEmbree) {
+    add_embree_keys(c.which, entry);
+    entry["best_embree"] = &c == best;
+  }
+  entry["brute_force"] = {{"passed", c.gate.passed()},
+                          {"checked", c.gate.checked},
+                          {"mismatched", c.gate.mismatched},
+                          {"edge_grazes", c.gate.grazes}};
+  if (!c.gate.passed()) return entry;
+  entry["phases"] = Json::parse(c.timers.json(), nullptr, false);
+  const double total = phase(c.timers, "total");
+  entry["median_ms"] = {{"build", phase(c.timers, "build")},
+                        {"primary", phase(c.timers, "trace primary")},
+                        {"shadow", phase(c.timers, "trace shadow")},
+                        {"trace", phase(c.timers, "trace")},
+                        {"shade", phase(c.timers, "shade")},
+                        {"total", total}};
+  entry["fps"] = fps_of(total);
+  const bool sinew_ok = sinew.gate.passed();
+  entry["sinew_over_this"] = {
+      {"build", sinew_ok ? ratio_json(phase(sinew.timers, "build"), phase(c.timers, "build")) : Json(nullptr)},
+      {"trace", sinew_ok ? ratio_json(phase(sinew.timers, "trace"), phase(c.timers, "trace")) : Json(nullptr)},
+      {"total", sinew_ok ? ratio_json(phase(sinew.timers, "total"), total) : Json(nullptr)}};
+  entry["primary_hits"] = c.primary_hits;
+  entry["shadow_rays"] = c.shadow_rays;
+  return entry;
+}
+
+// The best Embree row and Sinew against it, as the summary line prints
+// them; null when no Embree row ran or passed.
+Json best_json(const ConfigResult& r, const ContenderResult* best) {
+  if (!best) return nullptr;
+  const ContenderResult& sinew = r.contenders.front();
+  const double total = phase(best->timers, "total"), trace = phase(best->timers, "trace");
+  Json doc = {{"name", contender_name(best->which)}};
+  add_embree_keys(best->which, doc);
+  doc["total_ms"] = total;
+  doc["fps"] = fps_of(total);
+  doc["trace_ms"] = trace;
+  if (sinew.gate.passed()) {
+    const double sinew_total = phase(sinew.timers, "total"), sinew_trace = phase(sinew.timers, "trace");
+    doc["sinew_total_ms"] = sinew_total;
+    doc["sinew_fps"] = fps_of(sinew_total);
+    doc["sinew_trace_ms"] = sinew_trace;
+    doc["sinew_over_best_total"] = ratio_json(sinew_total, total);
+    doc["sinew_over_best_trace"] = ratio_json(sinew_trace, trace);
+  }
+  return doc;
 }
 
 Json config_json(const ConfigResult& r) {
+  const ContenderResult* best = best_embree(r);
   Json doc = {{"clip", r.clip},
               {"threads", r.threads},
               {"shared", Json::parse(r.shared.json(), nullptr, false)},
               {"contenders", Json::array()}};
   for (const ContenderResult& c : r.contenders) {
-    Json entry = {{"name", contender_name(c.which)},
-                  {"brute_force",
-                   {{"passed", c.gate.passed()},
-                    {"checked", c.gate.checked},
-                    {"mismatched", c.gate.mismatched},
-                    {"edge_grazes", c.gate.grazes}}}};
-    if (c.gate.passed()) {
-      entry["phases"] = Json::parse(c.timers.json(), nullptr, false);
-      entry["primary_hits"] = c.primary_hits;
-      entry["shadow_rays"] = c.shadow_rays;
-    }
-    doc["contenders"].push_back(std::move(entry));
+    doc["contenders"].push_back(contender_json(c, r.contenders.front(), best));
   }
+  // The fastest width of each mode that ran, by name: the rows above.
+  Json by_mode = Json::array();
+  for (const ModeSpec& m : kModes) {
+    if (const ContenderResult* b = best_embree_of_mode(r, m.mode)) by_mode.push_back(best_json(r, b));
+  }
+  doc["best_embree_by_mode"] = std::move(by_mode);
+  doc["best_embree"] = best_json(r, best);
   return doc;
+}
+
+std::vector<int> widths_of(const std::vector<EmbreeWidth>& widths) {
+  std::vector<int> lanes;
+  for (const EmbreeWidth w : widths) lanes.push_back(lanes_of(w));
+  return lanes;
+}
+
+std::vector<std::string> mode_keys(const std::vector<EmbreeMode>& modes) {
+  std::vector<std::string> keys;
+  for (const EmbreeMode m : modes) keys.emplace_back(mode_spec(m).key);
+  return keys;
+}
+
+std::string join_modes(const std::vector<EmbreeMode>& modes) {
+  std::string out;
+  for (const std::string& key : mode_keys(modes)) out += (out.empty() ? "" : ",") + key;
+  return out;
 }
 
 }  // namespace
@@ -447,11 +721,16 @@ int run_embree_bench(const std::vector<std::string>& args, const std::string& co
               "  diffuse shading; brute-force check of every %dth pixel of the first frame\n",
               o.model.c_str(), o.instances, o.instances == 1 ? "" : "s", o.width, o.height, o.frames,
               o.check_stride);
+  if (have_embree) {
+    std::printf("  Embree modes %s at widths %s: every pair is a row\n", join_modes(o.embree_modes).c_str(),
+                join_ints(widths_of(o.embree_widths)).c_str());
+  }
   std::fflush(stdout);
 
   Json doc = {{"command", command_line}, {"cpu", cpu}, {"commit", git_commit()}, {"load_average_start", load_average()},           {"hardware_threads", JobSystem::hardware_threads()},
               {"date", date},            {"model", o.model},     {"subdivide", o.subdivide}, {"instances", o.instances},
               {"size", {o.width, o.height}}, {"frames", o.frames}, {"embree", have_embree},
+              {"embree_modes", mode_keys(o.embree_modes)}, {"embree_widths", widths_of(o.embree_widths)},
               {"configurations", Json::array()}};
   std::string note;
   auto loaded = load_model_or_path(o.model, o.shared, note);
@@ -488,6 +767,7 @@ int run_embree_bench(const std::vector<std::string>& args, const std::string& co
   doc["triangles"] = model.mesh.triangle_count();
 
   int exit_code = 0;
+  std::vector<std::string> best_rows;  // the best Embree row of each configuration, for the note
   for (const std::string& clip_name : o.clips) {
     const auto clip = find_clip(model, o.model, clip_name);
     if (!clip.ok()) {
@@ -507,13 +787,21 @@ int run_embree_bench(const std::vector<std::string>& args, const std::string& co
       for (const ContenderResult& c : result->contenders) {
         if (!c.gate.passed()) exit_code = 1;
       }
+      if (const ContenderResult* best = best_embree(*result)) {
+        best_rows.push_back(clip_name + ", " + std::to_string(threads) + " thread" + (threads == 1 ? "" : "s") +
+                            ": " + embree_label(best->which));
+      }
       doc["configurations"].push_back(config_json(*result));
     }
   }
   std::printf("\n  build = Sinew: boxes + fallback + top level of prepare_frame; Embree: vertex upload +\n"
               "  rtcCommitScene (rebuild or refit); exact: merge + SAH kd build + top level. trace = primary +\n"
               "  shadow rays; total = skinning (shared) + build + trace + shade; medians over the frames.\n"
-              "  sinew/this < 1: Sinew is faster. Sinew traces 4x2 packets; Embree rtcIntersect1/rtcOccluded1.\n");
+              "  sinew/this < 1: Sinew is faster. Sinew traces 4x2 packets with tile/packet culling of the top\n"
+              "  level (render/tile_stages.h). Embree is shown at every width run: 1 = rtcIntersect1/rtcOccluded1,\n"
+              "  4/8/16 = rtcIntersectN/rtcOccludedN packets with RTC_INTERSECT_CONTEXT_FLAG_COHERENT; the best\n"
+              "  Embree row (lowest median total) is marked, and Sinew/best compares Sinew with it.\n");
+  for (const std::string& row : best_rows) std::printf("  best Embree, %s\n", row.c_str());
   const std::string load_end = load_average();
   std::printf("  load at the end: %s (1, 5, 15 min)\n", load_end.c_str());
   doc["load_average_end"] = load_end;

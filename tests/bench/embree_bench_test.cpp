@@ -1,12 +1,15 @@
 // The Embree contender of `sinew-bench embree` (tests/bench/embree_tracer.h),
-// run (not timed) on the mannequin: each Embree mode's primary hits must be
+// run (not timed) on the mannequin: in each Embree mode and at each ray
+// width (single rays and 4/8/16-wide packets), the primary hits must be
 // brute force's on every pixel of two animated frames, the second after a
-// rebuild or a refit, and its colour image must match Sinew's renderer on
+// rebuild or a refit, and the colour image must match Sinew's renderer on
 // the pixels where both hit the same triangle.
 #include <gtest/gtest.h>
 
 #include <cstdlib>
 #include <memory>
+#include <string>
+#include <tuple>
 #include <vector>
 
 #include "editor/cli/render_command.h"
@@ -19,9 +22,13 @@
 namespace sinew::bench {
 namespace {
 
-constexpr int kSize = 64;
+// Not a multiple of the 16-pixel tile: the last row and column of tiles are
+// 2 pixels wide, so partial 4x2 blocks (masked lanes) and a corner tile of a
+// single block (16-wide packets fall back to one 8-wide) are traced too.
+constexpr int kSize = 66;
 
-class EmbreeTracerTest : public ::testing::TestWithParam<EmbreeMode> {};
+// The bench measures every (mode, width) pair, so each is checked here.
+class EmbreeTracerTest : public ::testing::TestWithParam<std::tuple<EmbreeMode, EmbreeWidth>> {};
 
 TEST_P(EmbreeTracerTest, PrimaryHitsEqualBruteForceOverTwoFrames) {
   const testing_support::BakedModel& m = testing_support::idle_mannequin();
@@ -33,7 +40,8 @@ TEST_P(EmbreeTracerTest, PrimaryHitsEqualBruteForceOverTwoFrames) {
   const int up = editor::up_axis_of(rest);
   ASSERT_TRUE(scene.add_static_mesh(editor::ground_plane_for(rest, 1)).ok());
 
-  auto tracer = EmbreeTracer::create(GetParam(), 2);
+  const auto [mode, width] = GetParam();
+  auto tracer = EmbreeTracer::create(mode, 2);
   ASSERT_TRUE(tracer.ok()) << tracer.status().message();
   rt::Renderer renderer;
   rt::RenderSettings settings;
@@ -53,7 +61,7 @@ TEST_P(EmbreeTracerTest, PrimaryHitsEqualBruteForceOverTwoFrames) {
 
     std::vector<Hit> hits(kSize * kSize);
     std::vector<std::uint8_t> color(4 * kSize * kSize);
-    const auto rendered = (*tracer)->render(scene, *camera, settings, color, hits, jobs);
+    const auto rendered = (*tracer)->render(scene, *camera, settings, color, hits, jobs, width);
     ASSERT_TRUE(rendered.ok()) << rendered.status().message();
 
     // Sinew's renderer on the same scene, for the colours.
@@ -93,8 +101,18 @@ TEST_P(EmbreeTracerTest, PrimaryHitsEqualBruteForceOverTwoFrames) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Modes, EmbreeTracerTest,
-                         ::testing::Values(EmbreeMode::kRebuildLow, EmbreeMode::kRebuildMedium, EmbreeMode::kRefit));
+// "RebuildLow_rtcIntersect8": the mode and the Embree call of the width.
+std::string case_name(const ::testing::TestParamInfo<EmbreeTracerTest::ParamType>& info) {
+  const auto [mode, width] = info.param;
+  const char* modes[] = {"RebuildLow", "RebuildMedium", "Refit"};  // EmbreeMode's order
+  return std::string(modes[static_cast<int>(mode)]) + "_" + embree_width_name(width);
+}
+
+INSTANTIATE_TEST_SUITE_P(ModesAndWidths, EmbreeTracerTest,
+                         ::testing::Combine(::testing::Values(EmbreeMode::kRebuildLow, EmbreeMode::kRebuildMedium,
+                                                              EmbreeMode::kRefit),
+                                            ::testing::ValuesIn(kEmbreeWidths)),
+                         case_name);
 
 }  // namespace
 }  // namespace sinew::bench

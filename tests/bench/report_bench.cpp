@@ -228,6 +228,66 @@ const Json* contender(const Json& config, const std::string& name) {
   return nullptr;
 }
 
+// Whether the run measured every Embree (mode, width) pair and named each
+// mode's best width (sinew-bench embree since its --embree-widths); earlier
+// runs have one Embree row per mode, at a width they did not record.
+bool has_embree_widths(const Json& config) { return config.contains("best_embree_by_mode"); }
+
+// The rows the report's table shows: Sinew, each Embree mode at its best
+// width, the exact kd-tree, and every row that failed its brute-force
+// check. Earlier runs: all their rows.
+std::vector<const Json*> embree_table_rows(const Json& config) {
+  std::vector<const Json*> rows;
+  if (!config.contains("contenders")) return rows;
+  const bool widths = has_embree_widths(config);
+  for (const Json& c : config["contenders"]) {
+    const bool failed = !c["brute_force"].value("passed", false);
+    const bool embree = c.value("kind", "") == "embree";
+    if (!widths || !embree || failed) {
+      rows.push_back(&c);
+      continue;
+    }
+    for (const Json& best : config["best_embree_by_mode"]) {
+      if (best.value("name", "") == c.value("name", "")) rows.push_back(&c);
+    }
+  }
+  return rows;
+}
+
+// "LOW rebuild: rtcIntersect1 237.7, rtcIntersect4 201.3; refit: ...": every
+// width's median total, mode by mode as the run listed them.
+std::string embree_widths_line(const Json& config) {
+  std::string line, mode;
+  if (!config.contains("contenders")) return line;
+  for (const Json& c : config["contenders"]) {
+    if (c.value("kind", "") != "embree") continue;
+    const std::string total = c.contains("phases") ? cell(phase_ms(c["phases"], "total"), 1) : std::string("FAILED");
+    if (c.value("mode_name", "") != mode) {
+      mode = c.value("mode_name", "?");
+      line += (line.empty() ? "" : "; ") + mode + ":";
+    } else {
+      line += ",";
+    }
+    line += " " + c.value("width_name", "?") + " " + total;
+  }
+  return line;
+}
+
+// Sinew against the run's fastest Embree row, as sinew-bench embree prints it.
+std::string embree_best_line(const Json& config) {
+  const Json& best = config["best_embree"];
+  if (!best.is_object()) return "No Embree row passed its brute-force check.\n";
+  std::string md = format("Best Embree: **%s**, total %s ms (%s fps), trace %s ms", best.value("label", "?").c_str(),
+                          cell(number(best, "total_ms"), 1).c_str(), cell(number(best, "fps")).c_str(),
+                          cell(number(best, "trace_ms"), 1).c_str());
+  if (!best.contains("sinew_total_ms")) return md + "; Sinew failed its brute-force check.\n";
+  return md + format("; Sinew total %s ms (%s fps), trace %s ms; Sinew ÷ best: total %s, trace %s.\n",
+                     cell(number(best, "sinew_total_ms"), 1).c_str(), cell(number(best, "sinew_fps")).c_str(),
+                     cell(number(best, "sinew_trace_ms"), 1).c_str(),
+                     cell(number(best, "sinew_over_best_total")).c_str(),
+                     cell(number(best, "sinew_over_best_trace")).c_str());
+}
+
 std::string embree_markdown(const Run& r) {
   std::string md;
   const Json& doc = r.json;
@@ -239,39 +299,52 @@ std::string embree_markdown(const Run& r) {
                doc.value("frames", 0));
   md += "```sh\n" + r.command + "\n```\n";
   if (!doc.value("embree", false)) md += "\nEmbree was not found when this was built: only Sinew and the exact kd-tree ran.\n";
+  bool widths = false;
   for (const Json& config : doc.value("configurations", Json::array())) {
+    widths = widths || has_embree_widths(config);
     const Json& shared = config["shared"];
     md += format("\n%s, %d thread%s (shared per frame: animation %s ms, skinning %s ms):\n\n",
                  config.value("clip", "?").c_str(), config.value("threads", 0), config.value("threads", 0) == 1 ? "" : "s",
                  cell(phase_ms(shared, "animation"), 3).c_str(), cell(phase_ms(shared, "skinning"), 3).c_str());
-    md += "| contender | build ms | primary ms | shadow ms | shade ms | total ms | Sinew ÷ this: build | trace | total "
-          "| brute force (first frame) |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---|\n";
+    md += "| contender | build ms | primary ms | shadow ms | trace ms | shade ms | total ms | Sinew ÷ this: build | "
+          "trace | total | brute force (first frame) |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|\n";
     const Json* sinew = contender(config, "sinew fuzzy kd");
     const Json sinew_phases = sinew && sinew->contains("phases") ? (*sinew)["phases"] : Json();
-    for (const Json& c : config["contenders"]) {
+    for (const Json* row : embree_table_rows(config)) {
+      const Json& c = *row;
       const Json& gate = c["brute_force"];
       if (!gate.value("passed", false)) {
-        md += format("| %s | FAILED brute-force check: %s of %s sampled pixels differ; not reported | | | | | | | | "
+        md += format("| %s | FAILED brute-force check: %s of %s sampled pixels differ; not reported | | | | | | | | | "
                      "FAILED |\n",
                      c.value("name", "?").c_str(), thousands(number(gate, "mismatched")).c_str(),
                      thousands(number(gate, "checked")).c_str());
         continue;
       }
       const Json& p = c["phases"];
-      md += format("| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s px, %s grazes |\n", c.value("name", "?").c_str(),
+      const std::string name = c.value("name", "?") + (c.value("best_embree", false) ? " (best Embree)" : "");
+      md += format("| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s px, %s grazes |\n", name.c_str(),
                    cell(phase_ms(p, "build"), 3).c_str(), cell(phase_ms(p, "trace primary"), 1).c_str(),
-                   cell(phase_ms(p, "trace shadow"), 1).c_str(), cell(phase_ms(p, "shade"), 1).c_str(),
-                   cell(phase_ms(p, "total"), 1).c_str(),
+                   cell(phase_ms(p, "trace shadow"), 1).c_str(), cell(phase_ms(p, "trace"), 1).c_str(),
+                   cell(phase_ms(p, "shade"), 1).c_str(), cell(phase_ms(p, "total"), 1).c_str(),
                    ratio_cell(phase_ms(sinew_phases, "build"), phase_ms(p, "build")).c_str(),
                    ratio_cell(phase_ms(sinew_phases, "trace"), phase_ms(p, "trace")).c_str(),
                    ratio_cell(phase_ms(sinew_phases, "total"), phase_ms(p, "total")).c_str(),
                    thousands(number(gate, "checked")).c_str(), thousands(number(gate, "edge_grazes")).c_str());
     }
+    if (has_embree_widths(config) && doc.value("embree", false)) {
+      md += "\nEmbree total ms at each width: " + embree_widths_line(config) + ".\n\n" + embree_best_line(config);
+    }
   }
   md += "\n*build*: Sinew = bone boxes + fallback + top level; Embree = vertex upload + `rtcCommitScene`; exact = "
         "merge + SAH kd build + top level. *trace* = primary + shadow rays; *total* = skinning (shared) + build + "
-        "trace + shade; medians over the frames. Ratios below 1: Sinew is faster. Sinew traces 4×2 packets, Embree "
-        "single rays (`rtcIntersect1`/`rtcOccluded1`); camera, shading and threads are shared code.\n";
+        "trace + shade; medians over the frames. Ratios below 1: Sinew is faster. Sinew traces 4×2 packets with "
+        "tile and packet culling of the top level. ";
+  md += widths ? "Embree ran every mode at every width — single rays (`rtcIntersect1`/`rtcOccluded1`) and 4-, 8- "
+                 "and 16-wide packets (`rtcIntersectN`/`rtcOccludedN` with `RTC_INTERSECT_CONTEXT_FLAG_COHERENT`); "
+                 "each mode is shown at its fastest width, named in its row, and the fastest row of all is marked "
+                 "*best Embree*. "
+               : "Embree's ray width was not recorded by this run (one row per mode). ";
+  md += "Camera, shading and threads are shared code.\n";
   return md + failure_line(r);
 }
 
@@ -365,17 +438,46 @@ double trace_ratio(const Json& config, const std::string& other) {
   return phase_ms((*s)["phases"], "trace") / phase_ms((*o)["phases"], "trace");
 }
 
+// "LOW rebuild 0.95 (rtcIntersect8), refit ...": Sinew ÷ each mode at its
+// best width.
+std::string best_by_mode_ratios(const Json& config) {
+  std::string text;
+  for (const Json& best : config["best_embree_by_mode"]) {
+    text += (text.empty() ? "" : ", ") +
+            format("%s %s (%s)", best.value("mode_name", "?").c_str(),
+                   cell(number(best, "sinew_over_best_total")).c_str(), best.value("width_name", "?").c_str());
+  }
+  return text.empty() ? "no Embree row passed its brute-force check" : text;
+}
+
 std::string embree_headline(const Run& r, const char* label) {
   std::string md;
   for (const Json& config : r.json.value("configurations", Json::array())) {
-    md += format("- Sinew ÷ Embree, total frame time, %s, %s, %d thread%s: LOW rebuild %s, refit %s, MEDIUM rebuild "
-                 "%s; fuzzy ÷ exact kd-tree trace time %s.\n",
-                 label, config.value("clip", "?").c_str(), config.value("threads", 0),
-                 config.value("threads", 0) == 1 ? "" : "s",
-                 cell(total_ratio(config, "embree LOW rebuild")).c_str(),
-                 cell(total_ratio(config, "embree refit")).c_str(),
-                 cell(total_ratio(config, "embree MEDIUM rebuild")).c_str(),
-                 cell(trace_ratio(config, "exact SAH kd rebuild")).c_str());
+    const std::string where = format("%s, %s, %d thread%s", label, config.value("clip", "?").c_str(),
+                                     config.value("threads", 0), config.value("threads", 0) == 1 ? "" : "s");
+    const std::string exact = cell(trace_ratio(config, "exact SAH kd rebuild"));
+    if (!has_embree_widths(config)) {  // an earlier run: one row per mode
+      md += format("- Sinew ÷ Embree, total frame time, %s: LOW rebuild %s, refit %s, MEDIUM rebuild %s; fuzzy ÷ "
+                   "exact kd-tree trace time %s.\n",
+                   where.c_str(), cell(total_ratio(config, "embree LOW rebuild")).c_str(),
+                   cell(total_ratio(config, "embree refit")).c_str(),
+                   cell(total_ratio(config, "embree MEDIUM rebuild")).c_str(), exact.c_str());
+      continue;
+    }
+    if (!r.json.value("embree", false)) {
+      md += format("- Embree was not found (%s); fuzzy ÷ exact kd-tree trace time %s.\n", where.c_str(),
+                   exact.c_str());
+      continue;
+    }
+    const Json& best = config["best_embree"];
+    const std::string overall =
+        best.is_object() ? format("against the best Embree row (%s) total frame time %s, trace %s",
+                                  best.value("label", "?").c_str(), cell(number(best, "sinew_over_best_total")).c_str(),
+                                  cell(number(best, "sinew_over_best_trace")).c_str())
+                         : std::string("no Embree row passed its brute-force check");
+    md += format("- Sinew ÷ Embree, %s: %s; each mode at its best width, total: %s; fuzzy ÷ exact kd-tree trace "
+                 "time %s.\n",
+                 where.c_str(), overall.c_str(), best_by_mode_ratios(config).c_str(), exact.c_str());
   }
   return md;
 }
@@ -457,7 +559,8 @@ std::string document(const Options& o, const Report& report, const std::string& 
     md += "## The peer: Embree 3, and an exact kd-tree rebuilt per frame\n\n"
           "The same skinned triangles every frame (Sinew's skinning), the same camera rays, shadow rays and shading, "
           "traced by Sinew's fuzzy kd-trees, by Embree 3 rebuilt per frame at LOW and MEDIUM quality and refitted "
-          "per frame, and by an exact SAH kd-tree of Sinew's rebuilt per frame; the contenders take turns frame by "
+          "per frame (each at every ray width: single rays and 4-, 8- and 16-wide packets), and by an exact SAH "
+          "kd-tree of Sinew's rebuilt per frame; the contenders take turns frame by "
           "frame so machine noise hits them alike.\n";
     if (embree_small) md += embree_markdown(*embree_small);
     if (embree_large) md += embree_markdown(*embree_large);
