@@ -156,17 +156,38 @@ struct Mismatch {
   std::string first;
 };
 
+// Every pixel's single-ray hit and the renderer's (culled 4x2 packets in
+// 16x16 tiles, render/tile_stages.h) against brute force.
 void compare_primary(const rt::Scene& scene, std::span<const SoupTriangle> soup, const rt::CameraDesc& desc,
-                     int size, TriangleTest test, Mismatch& m) {
+                     int size, TriangleTest test, JobSystem& jobs, Mismatch& m) {
   auto camera = rt::PinholeCamera::create(desc, size, size);
   ASSERT_TRUE(camera.ok()) << camera.status().message();
   const testing_support::ScreenBinner binner(soup, *camera);
+  const std::size_t pixels = static_cast<std::size_t>(size) * static_cast<std::size_t>(size);
+  std::vector<float> depth(pixels);
+  std::vector<std::uint32_t> triangle(pixels), instance(pixels);
+  rt::FrameBuffers buffers;
+  buffers.width = buffers.height = size;
+  buffers.depth = depth;
+  buffers.triangle_id = triangle;
+  buffers.instance_id = instance;
+  rt::RenderSettings settings;
+  settings.triangle_test = test;
+  rt::Renderer renderer;
+  ASSERT_TRUE(renderer.render(scene, *camera, settings, buffers, jobs).ok());
   for (int y = 0; y < size; ++y) {
     for (int x = 0; x < size; ++x) {
       const Ray ray = camera->ray(x, y);
       const Hit ours = rt::intersect(scene, ray, test);
       const Hit ref = binner.nearest(soup, ray, x, y, test);
-      ++m.checked;
+      const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(size) + static_cast<std::size_t>(x);
+      const Hit packet{depth[i] / glm::length(ray.direction), 0.0f, 0.0f, triangle[i], instance[i]};
+      m.checked += 2;
+      if (!testing_support::same_nearest(packet, ref, soup, ray, test) && m.wrong++ == 0) {
+        m.first = "pixel (" + std::to_string(x) + "," + std::to_string(y) + ") " + test_name(test) +
+                  ", renderer packets: t=" + std::to_string(packet.t) + " tri=" + std::to_string(packet.triangle_id) +
+                  " ref t=" + std::to_string(ref.t) + " tri=" + std::to_string(ref.triangle_id);
+      }
       if (!testing_support::same_nearest(ours, ref, soup, ray, test)) {
         if (m.wrong++ == 0) {
           m.first = "pixel (" + std::to_string(x) + "," + std::to_string(y) + ") " + test_name(test) +
@@ -253,7 +274,7 @@ TEST_P(RenderOracle, PosesInsideThePoseSpaceMatchBruteForce) {
     for (std::size_t c = 0; c < cameras.size(); ++c) {
       if (!full && c != k % cameras.size()) continue;
       const int size = full ? 256 : (big ? 32 : 48);
-      for (const TriangleTest test : kTests) compare_primary(scene, soup, cameras[c], size, test, primary);
+      for (const TriangleTest test : kTests) compare_primary(scene, soup, cameras[c], size, test, jobs, primary);
     }
     // 2000 random rays per pose (10^5 over 50 poses), fewer for big meshes
     // so that brute force stays near 10^9 triangle tests per model.
@@ -313,7 +334,7 @@ TEST(SubdividedCallyOracle, LevelsOneToFourMatchBruteForce) {
       const std::vector<SoupTriangle> soup = testing_support::world_triangles(scene);
       const Aabb posed = bounds_of(scene.instances()[0].positions);
       const auto cameras = cameras_around(posed, 2);
-      for (const TriangleTest test : kTests) compare_primary(scene, soup, cameras[k % cameras.size()], 48, test, primary);
+      for (const TriangleTest test : kTests) compare_primary(scene, soup, cameras[k % cameras.size()], 48, test, jobs, primary);
       compare_random(scene, soup, posed, 100, random, rays);
     }
     EXPECT_EQ(escapes, 0u) << "a sampled pose left its fuzzy boxes";
