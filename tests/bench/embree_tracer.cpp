@@ -190,31 +190,21 @@ Expected<double> EmbreeTracer::update(const rt::Scene& scene) {
 namespace {
 
 // Embree's ray packet types and calls by width.
+template <class RayHitN, class RayN, auto kIntersect, auto kOccluded>
+struct PacketCalls {
+  using RayHit = RayHitN;
+  using Ray = RayN;
+  static void intersect(const int* valid, RTCScene s, RTCIntersectContext* c, RayHit* r) { kIntersect(valid, s, c, r); }
+  static void occluded(const int* valid, RTCScene s, RTCIntersectContext* c, Ray* r) { kOccluded(valid, s, c, r); }
+};
 template <int W>
 struct Packet;
 template <>
-struct Packet<4> {
-  using RayHit = RTCRayHit4;
-  using Ray = RTCRay4;
-  static void intersect(const int* valid, RTCScene s, RTCIntersectContext* c, RayHit* r) { rtcIntersect4(valid, s, c, r); }
-  static void occluded(const int* valid, RTCScene s, RTCIntersectContext* c, Ray* r) { rtcOccluded4(valid, s, c, r); }
-};
+struct Packet<4> : PacketCalls<RTCRayHit4, RTCRay4, rtcIntersect4, rtcOccluded4> {};
 template <>
-struct Packet<8> {
-  using RayHit = RTCRayHit8;
-  using Ray = RTCRay8;
-  static void intersect(const int* valid, RTCScene s, RTCIntersectContext* c, RayHit* r) { rtcIntersect8(valid, s, c, r); }
-  static void occluded(const int* valid, RTCScene s, RTCIntersectContext* c, Ray* r) { rtcOccluded8(valid, s, c, r); }
-};
+struct Packet<8> : PacketCalls<RTCRayHit8, RTCRay8, rtcIntersect8, rtcOccluded8> {};
 template <>
-struct Packet<16> {
-  using RayHit = RTCRayHit16;
-  using Ray = RTCRay16;
-  static void intersect(const int* valid, RTCScene s, RTCIntersectContext* c, RayHit* r) {
-    rtcIntersect16(valid, s, c, r);
-  }
-  static void occluded(const int* valid, RTCScene s, RTCIntersectContext* c, Ray* r) { rtcOccluded16(valid, s, c, r); }
-};
+struct Packet<16> : PacketCalls<RTCRayHit16, RTCRay16, rtcIntersect16, rtcOccluded16> {};
 
 // Primary rays of the tile's lanes [k, k + W) (camera origin, SoA
 // directions) as one Embree packet; hits go back into the scratch.

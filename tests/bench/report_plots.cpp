@@ -9,6 +9,7 @@
 #include <fstream>
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace sinew::bench {
@@ -111,11 +112,30 @@ std::string fps_vs_triangles_script(const std::string& dat, const std::string& p
 
 std::string short_name(const std::string& name) {
   if (name == "sinew fuzzy kd") return "Sinew";
-  if (name == "embree LOW rebuild") return "Embree LOW";
-  if (name == "embree refit") return "Embree refit";
-  if (name == "embree MEDIUM rebuild") return "Embree MEDIUM";
   if (name == "exact SAH kd rebuild") return "exact kd";
+  // "embree refit rtcIntersect16" -> "Embree refit x16" (the widths' rows).
+  static const std::pair<const char*, const char*> kModes[] = {
+      {"embree LOW rebuild", "Embree LOW"}, {"embree refit", "Embree refit"}, {"embree MEDIUM rebuild", "Embree MEDIUM"}};
+  for (const auto& [long_name, short_label] : kModes) {
+    const std::string prefix = long_name;
+    if (name.rfind(prefix, 0) != 0) continue;
+    const std::string rest = name.substr(prefix.size());
+    const std::size_t digits = rest.find_first_of("0123456789");
+    return std::string(short_label) + (digits == std::string::npos ? "" : " x" + rest.substr(digits));
+  }
   return name;
+}
+
+// Whether a contender is drawn: Sinew, the exact kd-tree, and each Embree
+// mode at its best width (every width of every mode would be 14 bars a
+// group); runs from before the widths draw every row.
+bool drawn(const Json& config, const Json& contender) {
+  const std::string name = contender.value("name", "");
+  if (!config.contains("best_embree_by_mode") || name.rfind("embree", 0) != 0) return true;
+  for (const Json& best : config["best_embree_by_mode"]) {
+    if (best.value("name", "") == name) return true;
+  }
+  return false;
 }
 
 // One data block per configuration; returns the blocks' titles.
@@ -125,7 +145,7 @@ std::vector<std::string> embree_data(const Json& doc, std::string& data) {
     const double skinning = phase_ms(config["shared"], "skinning");
     std::string block;
     for (const Json& c : config.value("contenders", Json::array())) {
-      if (!c.contains("phases")) continue;  // failed its brute-force check
+      if (!c.contains("phases") || !drawn(config, c)) continue;  // failed its brute-force check, or not a best width
       const Json& p = c["phases"];
       block += "\"" + short_name(c.value("name", "?")) + "\" " + value(skinning) + " " + value(phase_ms(p, "build")) +
                " " + value(phase_ms(p, "trace primary")) + " " + value(phase_ms(p, "trace shadow")) + " " +
