@@ -51,7 +51,7 @@ struct RenderSettings {
   Vec3 ambient{0.18f};
   Vec3 background{0.32f, 0.36f, 0.42f};
   Vec3 default_albedo{0.7f};  // meshes without material colors
-  int tile_size = 16;
+  int tile_size = 32;
   // Trace primary rays as 4x2-pixel packets and shadow rays as packets of
   // eight hits (render/packet_traversal.h). Same images either way.
   bool packets = true;
