@@ -402,7 +402,8 @@ TEST(ApiPass, AHostSchedulerRunsTheWorkAndGivesTheSameImage) {
   ASSERT_TRUE(stats.ok()) << stats.error().message;
   expect_same_frame(tbb, hosted);
   EXPECT_GE(pool.batches.load(), 2);  // at least the skinning and the tiles
-  EXPECT_GE(pool.tasks.load(), static_cast<long>((kW / 16) * (kH / 16)));
+  // The pass renders 32x32-pixel tiles (RenderSettings::tile_size), one task each.
+  EXPECT_GE(pool.tasks.load(), static_cast<long>((kW / 32) * (kH / 32)));
 }
 
 // --- lights -------------------------------------------------------------------
