@@ -8,7 +8,7 @@ set grid ytics
 set ylabel 'ms per frame (median)'
 set xtics rotate by -40 scale 0 font ',9'
 set key top left
-set bmargin 7
+set bmargin 9
 set multiplot layout 1,2
 set title 'Cally, 3342 triangles'
 plot newhistogram "walk\n1 thread" lt 1, 'plot_embree.dat' index 0 using 2:xtic(1) title 'skinning', ''  index 0 using 3 title 'build / refit', ''  index 0 using 4 title 'primary rays', ''  index 0 using 5 title 'shadow rays', ''  index 0 using 6 title 'shading', \

@@ -566,8 +566,9 @@ void shade_and_write(const RenderSettings& settings, std::span<const Light> ligh
     const std::size_t k0 = b * kBlockLanes;
     const std::uint32_t pixels = s.block_pixels[b];
     const std::uint32_t hits = s.block_hits[b];
-    alignas(32) float depth[8], linear[3][8];
-    alignas(32) std::uint32_t pixels_rgba8[8];
+    // Filled below for blocks with hits; zeroed so no path reads garbage.
+    alignas(32) float depth[8] = {}, linear[3][8] = {};
+    alignas(32) std::uint32_t pixels_rgba8[8] = {};
     if (hits != 0) {
       const Vec3x8 dir = load3(s.dir_x, s.dir_y, s.dir_z, k0);
       (Float8::load(&s.t[k0]) * sqrt(dot(dir, dir))).store(depth);

@@ -308,7 +308,7 @@ PlotResult make_plots(const PlotInputs& inputs, const std::string& image_dir, co
                            "'\nset style data histograms\nset style histogram rowstacked\n"
                            "set style fill solid 0.85 border -1\nset boxwidth 0.8\nset grid ytics\n"
                            "set ylabel 'ms per frame (median)'\nset xtics rotate by -40 scale 0 font ',9'\n"
-                           "set key top left\nset bmargin 7\n";  // room for the two-line group titles
+                           "set key top left\nset bmargin 9\n";  // room for the two-line group titles
       const int panels = (small_titles.empty() ? 0 : 1) + (large_titles.empty() ? 0 : 1);
       script += "set multiplot layout 1," + std::to_string(panels) + "\n";
       const auto triangles = [](const Json* doc) {
