@@ -58,6 +58,7 @@ struct TileScratch {
     return tile.y0 + static_cast<int>(block / static_cast<std::size_t>(blocks_x)) * kBlockHeight +
            static_cast<int>((k % kBlockLanes) / kBlockWidth);
   }
+  bool is_pixel(std::size_t k) const { return (block_pixels[k / kBlockLanes] >> (k % kBlockLanes) & 1u) != 0; }
   bool hit(std::size_t k) const { return (block_hits[k / kBlockLanes] >> (k % kBlockLanes) & 1u) != 0; }
 
  private:

@@ -208,6 +208,27 @@ void gather_lanes(const Scene& scene, const TileScratch& s, std::size_t k0, std:
     }
 }
 
+// Of the tile's objects, those `packet` may enter, into lists.packet. With
+// one object for the whole tile the packet's own cull could only drop it,
+// which the object's box clip does as cheaply.
+void cull_for_packet(const Scene& scene, const RayPacket& packet, CullLists& lists) {
+  lists.packet.clear();
+  if (lists.tile.size() == 1) {
+    lists.packet.push_back(lists.tile[0]);
+    return;
+  }
+  const float* const o[3] = {packet.ox, packet.oy, packet.oz};
+  const float* const d[3] = {packet.dx, packet.dy, packet.dz};
+  cull_objects_for_packet(scene, o, d, packet.t_min, packet.t_max, packet.active, lists.tile, lists.packet);
+}
+
+// A packet query's work added to the tile's (rays are counted by the caller).
+void add_work(TraversalCounters& into, const TraversalCounters& from) {
+  into.node_visits += from.node_visits;
+  into.object_visits += from.object_visits;
+  into.triangle_tests += from.triangle_tests;
+}
+
 void set_miss(TileScratch& s, std::size_t k) {
   s.t[k] = kInf;
   s.u[k] = 0.0f;
@@ -304,71 +325,47 @@ void trace_primary(const Scene& scene, const PinholeCamera& camera, TriangleTest
     tile_bound.add_lanes(eye, lane_dirs(b * kBlockLanes).data(), 0.0f, kInf, s.block_pixels[b]);
   }
   cull_objects(scene, tile_bound, lists.tile);
+  RayPacket packet;
+  for (int lane = 0; lane < kPacketSize; ++lane) {
+    packet.ox[lane] = eye.x;
+    packet.oy[lane] = eye.y;
+    packet.oz[lane] = eye.z;
+    packet.t_min[lane] = 0.0f;
+    packet.t_max[lane] = kInf;
+  }
   for (std::size_t b = 0; b < blocks; ++b) {
     const std::size_t k0 = b * kBlockLanes;
-    for (int lane = 0; lane < kBlockLanes; ++lane) set_miss(s, k0 + static_cast<std::size_t>(lane));
-    s.block_hits[b] = 0;
     const std::uint32_t pixels = s.block_pixels[b];
     counters.rays += static_cast<std::uint64_t>(std::popcount(pixels));
-    if (lists.tile.empty()) continue;
-    const auto dirs = lane_dirs(k0);
-    alignas(32) float ex[8], ey[8], ez[8], t0[8], t1[8];
-    Float8(eye.x).store(ex);
-    Float8(eye.y).store(ey);
-    Float8(eye.z).store(ez);
-    Float8(0.0f).store(t0);
-    Float8(kInf).store(t1);
-    const float* const origins[3] = {ex, ey, ez};
-    // With one object for the whole tile a packet's own cull could only
-    // drop it, which the object's box clip does as cheaply.
-    lists.packet.clear();
-    if (lists.tile.size() == 1) {
-      lists.packet.push_back(lists.tile[0]);
-    } else {
-      cull_objects_for_packet(scene, origins, dirs.data(), t0, t1, pixels, lists.tile, lists.packet);
-    }
-    if (lists.packet.empty()) continue;
-    RayPacket packet;
-    std::memcpy(packet.dx, dirs[0], sizeof(packet.dx));
-    std::memcpy(packet.dy, dirs[1], sizeof(packet.dy));
-    std::memcpy(packet.dz, dirs[2], sizeof(packet.dz));
-    std::memcpy(packet.ox, ex, sizeof(packet.ox));
-    std::memcpy(packet.oy, ey, sizeof(packet.oy));
-    std::memcpy(packet.oz, ez, sizeof(packet.oz));
-    std::memcpy(packet.t_min, t0, sizeof(packet.t_min));
-    std::memcpy(packet.t_max, t1, sizeof(packet.t_max));
+    s.block_hits[b] = 0;
+    std::memcpy(packet.dx, &s.dir_x[k0], sizeof(packet.dx));
+    std::memcpy(packet.dy, &s.dir_y[k0], sizeof(packet.dy));
+    std::memcpy(packet.dz, &s.dir_z[k0], sizeof(packet.dz));
     packet.active = static_cast<std::uint8_t>(pixels);
-    const ObjectFilter filter{lists.packet};
-    const PacketHits direct{&s.t[k0], &s.u[k0], &s.v[k0], &s.triangle[k0], &s.instance[k0]};
-    TraversalCounters packet_counters;
-    const auto add_counters = [&] {
-      counters.node_visits += packet_counters.node_visits;
-      counters.object_visits += packet_counters.object_visits;
-      counters.triangle_tests += packet_counters.triangle_tests;
-    };
-    if (intersect_packet_small_statics(scene, packet, test, filter, direct, &packet_counters)) {
-      add_counters();
-      std::uint32_t hit_bits = 0;
-      for (int lane = 0; lane < kPacketSize; ++lane) {
-        hit_bits |= s.triangle[k0 + static_cast<std::size_t>(lane)] != kInvalidId ? (1u << lane) : 0u;
-      }
-      s.block_hits[b] = static_cast<std::uint8_t>(hit_bits & pixels);
+    if (!lists.tile.empty()) cull_for_packet(scene, packet, lists);
+    if (lists.tile.empty() || lists.packet.empty()) {
+      for (int lane = 0; lane < kBlockLanes; ++lane) set_miss(s, k0 + static_cast<std::size_t>(lane));
       continue;
     }
-    Hit hits[kPacketSize];
-    intersect_packet(scene, packet, test, hits, &packet_counters, &filter);
-    add_counters();
+    const ObjectFilter filter{lists.packet};
+    TraversalCounters work;
+    const PacketHits direct{&s.t[k0], &s.u[k0], &s.v[k0], &s.triangle[k0], &s.instance[k0]};
+    if (!intersect_packet_small_statics(scene, packet, test, filter, direct, &work)) {
+      Hit hits[kPacketSize];
+      intersect_packet(scene, packet, test, hits, &work, &filter);
+      for (int lane = 0; lane < kPacketSize; ++lane) {
+        const std::size_t k = k0 + static_cast<std::size_t>(lane);
+        s.t[k] = hits[lane].t;
+        s.u[k] = hits[lane].u;
+        s.v[k] = hits[lane].v;
+        s.triangle[k] = hits[lane].triangle_id;
+        s.instance[k] = hits[lane].instance_id;
+      }
+    }
+    add_work(counters, work);
     std::uint32_t hit_bits = 0;
     for (int lane = 0; lane < kPacketSize; ++lane) {
-      const std::size_t k = k0 + static_cast<std::size_t>(lane);
-      const Hit& h = hits[lane];
-      if (!h.valid()) continue;
-      s.t[k] = h.t;
-      s.u[k] = h.u;
-      s.v[k] = h.v;
-      s.triangle[k] = h.triangle_id;
-      s.instance[k] = h.instance_id;
-      hit_bits |= 1u << lane;
+      hit_bits |= s.triangle[k0 + static_cast<std::size_t>(lane)] != kInvalidId ? (1u << lane) : 0u;
     }
     s.block_hits[b] = static_cast<std::uint8_t>(hit_bits & pixels);
   }
@@ -518,39 +515,31 @@ std::uint64_t trace_shadow_rays(const Scene& scene, TriangleTest test, bool pack
     tile_bound.add_lanes(o, d, kZeros, &s.s_tmax[i], (1u << n) - 1u);
   }
   cull_objects(scene, tile_bound, lists.tile);
+  RayPacket packet;
+  std::memcpy(packet.t_min, kZeros, sizeof(packet.t_min));
   for (std::size_t i = 0; i < padded; i += kPacketSize) {
     const std::size_t n = std::min<std::size_t>(kPacketSize, s.shadow_count - i);
-    const std::uint32_t active = (1u << n) - 1u;
     counters.rays += n;
     if (lists.tile.empty()) continue;
-    const float* const o[3] = {&s.so_x[i], &s.so_y[i], &s.so_z[i]};
-    const float* const d[3] = {&s.sd_x[i], &s.sd_y[i], &s.sd_z[i]};
-    lists.packet.clear();
-    if (lists.tile.size() == 1) {
-      lists.packet.push_back(lists.tile[0]);
-    } else {
-      cull_objects_for_packet(scene, o, d, kZeros, &s.s_tmax[i], active, lists.tile, lists.packet);
-    }
-    if (lists.packet.empty()) continue;
-    RayPacket packet;
-    std::memcpy(packet.ox, o[0], sizeof(packet.ox));
-    std::memcpy(packet.oy, o[1], sizeof(packet.oy));
-    std::memcpy(packet.oz, o[2], sizeof(packet.oz));
-    std::memcpy(packet.dx, d[0], sizeof(packet.dx));
-    std::memcpy(packet.dy, d[1], sizeof(packet.dy));
-    std::memcpy(packet.dz, d[2], sizeof(packet.dz));
-    std::memcpy(packet.t_min, kZeros, sizeof(packet.t_min));
+    std::memcpy(packet.ox, &s.so_x[i], sizeof(packet.ox));
+    std::memcpy(packet.oy, &s.so_y[i], sizeof(packet.oy));
+    std::memcpy(packet.oz, &s.so_z[i], sizeof(packet.oz));
+    std::memcpy(packet.dx, &s.sd_x[i], sizeof(packet.dx));
+    std::memcpy(packet.dy, &s.sd_y[i], sizeof(packet.dy));
+    std::memcpy(packet.dz, &s.sd_z[i], sizeof(packet.dz));
     std::memcpy(packet.t_max, &s.s_tmax[i], sizeof(packet.t_max));
-    packet.active = static_cast<std::uint8_t>(active);
+    packet.active = static_cast<std::uint8_t>((1u << n) - 1u);
+    cull_for_packet(scene, packet, lists);
+    if (lists.packet.empty()) continue;
     const ObjectFilter filter{lists.packet};
-    TraversalCounters packet_counters;
-    const int small = occluded_packet_small_statics(scene, packet, test, filter, &packet_counters);
+    TraversalCounters work;
+    const int small = occluded_packet_small_statics(scene, packet, test, filter, &work);
     const std::uint32_t blocked =
-        small >= 0 ? static_cast<std::uint32_t>(small) : occluded_packet(scene, packet, test, &packet_counters, &filter);
-    counters.node_visits += packet_counters.node_visits;
-    counters.object_visits += packet_counters.object_visits;
-    counters.triangle_tests += packet_counters.triangle_tests;
-    for (std::uint32_t m = blocked & active; m != 0; m &= m - 1) block(i + static_cast<std::size_t>(std::countr_zero(m)));
+        small >= 0 ? static_cast<std::uint32_t>(small) : occluded_packet(scene, packet, test, &work, &filter);
+    add_work(counters, work);
+    for (std::uint32_t m = blocked & packet.active; m != 0; m &= m - 1) {
+      block(i + static_cast<std::size_t>(std::countr_zero(m)));
+    }
   }
   return blocked_count;
 }

@@ -215,7 +215,7 @@ void trace_primary_packet(RTCScene scene, RTCIntersectContext* context, const Ve
   alignas(64) int valid[W];
   for (int i = 0; i < W; ++i) {
     const std::size_t lane = k + static_cast<std::size_t>(i);
-    valid[i] = (s.block_pixels[lane / rt::kBlockLanes] >> (lane % rt::kBlockLanes) & 1u) ? -1 : 0;
+    valid[i] = s.is_pixel(lane) ? -1 : 0;
     rh.ray.org_x[i] = eye.x;
     rh.ray.org_y[i] = eye.y;
     rh.ray.org_z[i] = eye.z;
@@ -333,7 +333,7 @@ Expected<EmbreeRenderStats> EmbreeTracer::render(const rt::Scene& scene, const r
           s.t[k] = std::numeric_limits<float>::infinity();
           s.triangle[k] = s.instance[k] = kInvalidId;
           s.u[k] = s.v[k] = 0.0f;
-          if (!(s.block_pixels[k / rt::kBlockLanes] >> (k % rt::kBlockLanes) & 1u)) continue;
+          if (!s.is_pixel(k)) continue;
           RTCRayHit rh;
           rh.ray.org_x = eye.x;
           rh.ray.org_y = eye.y;
@@ -422,7 +422,7 @@ Expected<EmbreeRenderStats> EmbreeTracer::render(const rt::Scene& scene, const r
     if (out.want_color()) rt::shade_and_write(settings, lights, out, s);
     if (!hits.empty()) {
       for (std::size_t k = 0; k < s.lanes; ++k) {
-        if (!(s.block_pixels[k / rt::kBlockLanes] >> (k % rt::kBlockLanes) & 1u)) continue;
+        if (!s.is_pixel(k)) continue;
         const std::size_t pixel = static_cast<std::size_t>(s.pixel_y(k)) * static_cast<std::size_t>(w) +
                                   static_cast<std::size_t>(s.pixel_x(k));
         hits[pixel] = s.triangle[k] == kInvalidId ? Hit{} : Hit{s.t[k], s.u[k], s.v[k], s.triangle[k], s.instance[k]};

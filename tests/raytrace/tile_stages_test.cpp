@@ -217,7 +217,7 @@ TEST(TileStages, CameraDirectionsAreTheCameraRays) {
   rt::generate_camera_rays(camera, s);
   std::size_t pixels = 0;
   for (std::size_t k = 0; k < s.lanes; ++k) {
-    if (!(s.block_pixels[k / rt::kBlockLanes] >> (k % rt::kBlockLanes) & 1u)) continue;
+    if (!s.is_pixel(k)) continue;
     ++pixels;
     const Ray ray = camera.ray(s.pixel_x(k), s.pixel_y(k));
     ASSERT_EQ(std::bit_cast<std::uint32_t>(s.dir_x[k]), std::bit_cast<std::uint32_t>(ray.direction.x)) << k;
