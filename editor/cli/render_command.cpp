@@ -1,5 +1,6 @@
 #include "editor/cli/render_command.h"
 
+#include <array>
 #include <unistd.h>
 
 #include <algorithm>
@@ -41,7 +42,7 @@ const std::vector<cli::FlagSpec>& render_flags() {
       {"--size"},        {"--out"},              {"--pose-space"}, {"--clips"},        {"--samples"},
       {"--seed"},        {"--shadows"},          {"--light"},      {"--threads"},      {"--instances"},
       {"--frames"},      {"--triangle-test"},    {"--bone-boxes"}, {"--fallback"},     {"--limits"},
-      {"--ground"},
+      {"--ground"},      {"--packet-rays"},
   };
   return flags;
 }
@@ -149,6 +150,10 @@ Status parse_run(const cli::ParsedArgs& args, RenderOptions& o) {
     SINEW_ASSIGN_OR_RETURN(const int i, cli::parse_choice("--triangle-test", *text, {"fast", "watertight"}));
     o.triangle_test = i == 0 ? rt::TriangleTest::kFast : rt::TriangleTest::kWatertight;
   }
+  if (const auto text = args.value("--packet-rays")) {
+    SINEW_ASSIGN_OR_RETURN(const int i, cli::parse_choice("--packet-rays", *text, {"1", "8", "64", "256"}));
+    o.packet_rays = std::array<int, 4>{1, 8, 64, 256}[static_cast<std::size_t>(i)];
+  }
   if (const auto text = args.value("--bone-boxes")) {
     SINEW_ASSIGN_OR_RETURN(const int i, cli::parse_choice("--bone-boxes", *text, {"exact", "cheap"}));
     o.bone_boxes = i == 0 ? rt::BoneBoxMode::kExact : rt::BoneBoxMode::kCheap;
@@ -248,6 +253,13 @@ Expected<std::string> stats_document(const RenderOptions& options, const Importe
   doc["phases"] = phases;
   doc["frame_ms"] = {{"median_ms", s.median_frame_ms}};
   doc["rays"] = {{"primary", s.primary_rays}, {"shadow", s.shadow_rays}};
+  const auto work = [](const rt::TraversalCounters& c) {
+    return nlohmann::json{{"rays", c.rays},
+                          {"node_visits", c.node_visits},
+                          {"object_visits", c.object_visits},
+                          {"triangle_tests", c.triangle_tests}};
+  };
+  doc["work"] = {{"primary", work(s.primary_work)}, {"shadow", work(s.shadow_work)}};
   doc["escapes"] = {{"escaped_checks", s.escaped_checks},
                     {"escaped_triangles", s.escaped_triangles},
                     {"total_escaped_checks", s.total_escaped_checks},
@@ -376,6 +388,7 @@ std::string render_usage() {
          "  --instances N             copies side by side along +X, each 0.37 s later (default 1)\n"
          "  --frames N                frames rendered at 30 fps from --time; the last is written (default 1)\n"
          "  --triangle-test fast|watertight   ray-triangle test (default fast)\n"
+         "  --packet-rays 1|8|64|256  rays traced together: single rays, 4x2, 8x8 or 16x16 pixels (default 64)\n"
          "  --bone-boxes exact|cheap  per-frame bone boxes (default exact)\n"
          "  --fallback on|off         exact rendering of triangles outside their fuzzy boxes (default on)\n"
          "  --ground on|off           the ground quad under the model (default on)\n"
@@ -469,6 +482,7 @@ Expected<RenderOutputs> render_model(const RenderOptions& options) {
   frame_options.fallback = options.fallback;
   rt::RenderSettings settings;
   settings.triangle_test = options.triangle_test;
+  settings.packet_rays = options.packet_rays;
   settings.shadows = options.shadows;
 
   const std::size_t pixels = static_cast<std::size_t>(options.width) * static_cast<std::size_t>(options.height);
@@ -524,6 +538,8 @@ Expected<RenderOutputs> render_model(const RenderOptions& options) {
     frame_ms.push_back(total);
     stats.primary_rays = rendered.primary_rays;
     stats.shadow_rays = rendered.shadow_rays;
+    stats.primary_work = rendered.primary;
+    stats.shadow_work = rendered.shadow;
     stats.escaped_checks = frame.escaped_checks;
     stats.escaped_triangles = frame.escaped_triangles;
     stats.total_escaped_checks += frame.escaped_checks;
@@ -561,6 +577,14 @@ void print_summary(const RenderOptions& options, const RenderOutputs& o, std::os
     text << "  " << phase.name << std::string(phase.name.size() < 14 ? 14 - phase.name.size() : 1, ' ')
          << phase.median_ms << " ms\n";
   }
+  const auto per_ray = [&](const char* name, const rt::TraversalCounters& c) {
+    const double n = c.rays > 0 ? static_cast<double>(c.rays) : 1.0;
+    text << "  " << name << " work per ray: " << static_cast<double>(c.node_visits) / n << " node visits, "
+         << static_cast<double>(c.object_visits) / n << " objects, " << static_cast<double>(c.triangle_tests) / n
+         << " triangle tests\n";
+  };
+  per_ray("primary", s.primary_work);
+  if (s.shadow_work.rays > 0) per_ray("shadow", s.shadow_work);
   text << "escapes (last frame): " << s.escaped_checks << " checks, " << s.escaped_triangles
        << " triangles; over all frames: " << s.total_escaped_checks << " checks, " << s.total_escaped_triangles
        << " triangles\n";

@@ -68,6 +68,7 @@ struct RenderOptions {
   int instances = 1;
   int frames = 1;
   rt::TriangleTest triangle_test = rt::TriangleTest::kFast;
+  int packet_rays = rt::RenderSettings{}.packet_rays;  // 1, 8, 64 or 256 rays traced together
   rt::BoneBoxMode bone_boxes = rt::BoneBoxMode::kExact;
   bool fallback = true;
   bool ground = true;  // the ground quad under the model (--ground off: characters alone)
@@ -89,6 +90,8 @@ struct RenderStatsSummary {
   double median_frame_ms = 0.0;
   std::uint64_t primary_rays = 0;  // last frame
   std::uint64_t shadow_rays = 0;   // last frame
+  rt::TraversalCounters primary_work;  // last frame
+  rt::TraversalCounters shadow_work;   // last frame
   std::size_t escaped_checks = 0;  // last frame
   std::size_t escaped_triangles = 0;
   std::size_t total_escaped_checks = 0;  // over all frames

@@ -179,7 +179,7 @@ bool RayBound::Test::may_enter(const Aabb& box, float grow) const {
   return !(t_enter > t_leave);
 }
 
-void cull_objects(const Scene& scene, const RayBound& bound, std::vector<std::uint32_t>& out) {
+void cull_objects(const Scene& scene, const RayBound& bound, std::vector<std::uint32_t>& out, float extra_grow) {
   const TopLevel& top = scene.top_level();
   const KdTreeView tree = top.view();
   if (tree.empty() || bound.empty()) return;
@@ -188,7 +188,7 @@ void cull_objects(const Scene& scene, const RayBound& bound, std::vector<std::ui
   // One grow for every box and cell: the largest slack of any box in the
   // scene. A point within an object's slack of the object lies within that
   // much of a cell that lists the object.
-  const float grow = bound.world_slack_bound(detail::max_abs(tree.bounds));
+  const float grow = bound.world_slack_bound(detail::max_abs(tree.bounds)) + extra_grow;
   if (!test.may_enter(tree.bounds, grow)) return;
   // Walk the top-level tree over the cells the set may enter; each object
   // is tested once (objects straddle splits and sit in several leaves).

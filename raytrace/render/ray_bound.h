@@ -86,8 +86,10 @@ class RayBound {
 };
 
 // The top-level objects (indices into scene.top_level().objects(), in
-// ascending order) that some ray of `bound` may enter. Appends to `out`.
-void cull_objects(const Scene& scene, const RayBound& bound, std::vector<std::uint32_t>& out);
+// ascending order) that some ray of `bound` may enter, every box grown by
+// extra_grow beyond the bound's own slack bound. Appends to `out`.
+void cull_objects(const Scene& scene, const RayBound& bound, std::vector<std::uint32_t>& out,
+                  float extra_grow = 0.0f);
 
 // Of `among` (object indices), those that some lane of `lanes` of an
 // eight-ray SoA packet may enter, by each lane's own slab test against the

@@ -145,10 +145,12 @@ Expected<OutputPlanes> output_planes(const FrameBuffers& buffers) {
 void render_tile(const Scene& scene, const PinholeCamera& camera, const RenderSettings& settings,
                  std::span<const Light> lights, const OutputPlanes& out, const Tile& tile, TileRecord& record) {
   TileScratch& s = tile_scratch();
-  s.prepare(tile);
+  int region_x = 1, region_y = 1;
+  packet_region_blocks(settings.packet_rays, region_x, region_y);
+  s.prepare(tile, region_x, region_y);
   const auto t0 = Clock::now();
   generate_camera_rays(camera, s);
-  trace_primary(scene, camera, settings.triangle_test, settings.packets, s, record.primary);
+  trace_primary(scene, camera, settings.triangle_test, settings.packet_rays, s, record.primary);
   const auto t1 = Clock::now();
   for (std::size_t b = 0; b < s.lanes / kBlockLanes; ++b) {
     record.hits += static_cast<std::uint64_t>(std::popcount(static_cast<unsigned>(s.block_hits[b])));
@@ -162,7 +164,8 @@ void render_tile(const Scene& scene, const PinholeCamera& camera, const RenderSe
     for (std::size_t l = 0; l < lights.size(); ++l) {
       make_shadow_rays(lights[l], static_cast<int>(l), s);
       record.shadowed +=
-          trace_shadow_rays(scene, settings.triangle_test, settings.packets, static_cast<int>(l), s, record.shadow);
+          trace_shadow_rays(scene, settings.triangle_test, settings.packet_rays, static_cast<int>(l), s,
+                            record.shadow);
     }
     shadow_ns = nanoseconds(shadow_start, Clock::now());
   }
@@ -182,6 +185,9 @@ Expected<RenderStats> Renderer::render(const Scene& scene, const PinholeCamera& 
     return invalid_argument("buffers.width x height",
                             std::to_string(buffers.width) + "x" + std::to_string(buffers.height),
                             "differs from the camera's image size");
+  }
+  if (!valid_packet_rays(settings.packet_rays)) {
+    return invalid_argument("settings.packet_rays", std::to_string(settings.packet_rays), "must be 1, 8, 64 or 256");
   }
   if (settings.tile_size < 1) {
     return invalid_argument("settings.tile_size", std::to_string(settings.tile_size), "must be at least 1");

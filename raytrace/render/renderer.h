@@ -52,9 +52,12 @@ struct RenderSettings {
   Vec3 background{0.32f, 0.36f, 0.42f};
   Vec3 default_albedo{0.7f};  // meshes without material colors
   int tile_size = 32;
-  // Trace primary rays as 4x2-pixel packets and shadow rays as packets of
-  // eight hits (render/packet_traversal.h). Same images either way.
-  bool packets = true;
+  // Rays traced together: 1 (single rays), 8 (4x2-pixel packets,
+  // render/packet_traversal.h), 64 or 256 (8x8- or 16x16-pixel packets
+  // culled cell by cell, render/large_packet.h). Shadow rays are packed
+  // from the same pixels. The hits agree (large packets may pick another
+  // triangle only at an exact tie in t); other values are refused.
+  int packet_rays = 64;
 };
 
 // Host-owned outputs; an empty span means "not requested" and is neither

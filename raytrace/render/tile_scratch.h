@@ -1,7 +1,10 @@
 // One tile's working set, structure of arrays, reused by each thread across
 // tiles and frames. The tile's pixels are laid out in blocks of 4x2 (eight
-// lanes: one ray packet, one Float8): pixel k = 8 * block + lane, lane =
-// 4 * (y % 2) + x % 4, blocks row-major over the tile. Every stage
+// lanes: one ray group, one Float8): pixel k = 8 * block + lane, lane =
+// 4 * (y % 2) + x % 4. Blocks are grouped into regions (the large packets
+// of render/large_packet.h: 8x8 or 16x16 pixels, or one block each),
+// regions row-major over the tile and blocks row-major within a region, so
+// a region's blocks, rays and hits are consecutive. Every stage
 // (render/tile_stages.h) walks the blocks, so the rays, hits and surfaces of
 // a block stay in cache from ray generation through the shadow rays to the
 // shading. Shared by the renderer and by tracers that stand in for it (the
@@ -26,6 +29,9 @@ struct TileScratch {
   int blocks_y = 0;
   std::size_t lanes = 0;  // 8 * blocks
 
+  // Region r holds blocks [region_begin[r], region_begin[r + 1]).
+  std::vector<std::uint32_t> region_begin;
+  std::vector<int> block_x0, block_y0;     // per block: its top-left pixel
   std::vector<std::uint8_t> block_pixels;  // per block: bit i set when lane i is a pixel of the image
   std::vector<std::uint8_t> block_hits;    // per block: bit i set when lane i hit
   // Primary rays: unit directions (the origin is the camera's eye).
@@ -44,19 +50,24 @@ struct TileScratch {
   std::size_t shadow_count = 0;
   std::vector<std::uint32_t> shadow_pixel;  // the lane index k each ray belongs to
   std::vector<float> so_x, so_y, so_z, sd_x, sd_y, sd_z, s_tmax;
+  // Shadow ray r's region: rays [shadow_region_begin[r], shadow_region_begin[r + 1])
+  // come from one region's pixels (regions without a ray have no entry).
+  std::vector<std::uint32_t> shadow_region_begin;
+  bool shadow_common_end = false;  // every ray ends at the light (a point light)
 
-  // Lays out `t`'s pixels and sizes every array (padded to whole packets).
-  void prepare(const Tile& area);
+  // Lays out `area`'s pixels in regions of region_blocks_x by
+  // region_blocks_y blocks (clipped at the tile's edges) and sizes every
+  // array (padded to whole groups, plus one group of slack for the shadow
+  // rays' unaligned groups).
+  void prepare(const Tile& area, int region_blocks_x = 1, int region_blocks_y = 1);
 
+  std::size_t blocks() const { return lanes / kBlockLanes; }
+  std::size_t regions() const { return region_begin.empty() ? 0 : region_begin.size() - 1; }
   int pixel_x(std::size_t k) const {
-    const std::size_t block = k / kBlockLanes;
-    return tile.x0 + static_cast<int>(block % static_cast<std::size_t>(blocks_x)) * kBlockWidth +
-           static_cast<int>(k % kBlockWidth);
+    return block_x0[k / kBlockLanes] + static_cast<int>(k % kBlockWidth);
   }
   int pixel_y(std::size_t k) const {
-    const std::size_t block = k / kBlockLanes;
-    return tile.y0 + static_cast<int>(block / static_cast<std::size_t>(blocks_x)) * kBlockHeight +
-           static_cast<int>((k % kBlockLanes) / kBlockWidth);
+    return block_y0[k / kBlockLanes] + static_cast<int>((k % kBlockLanes) / kBlockWidth);
   }
   bool is_pixel(std::size_t k) const { return (block_pixels[k / kBlockLanes] >> (k % kBlockLanes) & 1u) != 0; }
   bool hit(std::size_t k) const { return (block_hits[k / kBlockLanes] >> (k % kBlockLanes) & 1u) != 0; }

@@ -8,9 +8,11 @@
 #include <limits>
 #include <vector>
 
+#include "raytrace/render/large_packet.h"
 #include "raytrace/render/packet_traversal.h"
 #include "raytrace/render/ray_bound.h"
 #include "raytrace/render/traversal.h"
+#include "raytrace/render/traversal_shared.h"
 #include "runtime/math/float8.h"
 
 namespace sinew::rt {
@@ -121,6 +123,11 @@ void store3(const Vec3x8& v, std::vector<float>& x, std::vector<float>& y, std::
   v.x.store(&x[k]);
   v.y.store(&y[k]);
   v.z.store(&z[k]);
+}
+void store_lanes(const Vec3x8& v, float (&out)[3][8]) {
+  v.x.store(out[0]);
+  v.y.store(out[1]);
+  v.z.store(out[2]);
 }
 
 // Per-thread lists of the objects a tile's and a packet's rays may enter.
@@ -239,7 +246,7 @@ void set_miss(TileScratch& s, std::size_t k) {
 
 }  // namespace
 
-void TileScratch::prepare(const Tile& area) {
+void TileScratch::prepare(const Tile& area, int region_blocks_x, int region_blocks_y) {
   tile = area;
   blocks_x = (area.x1 - area.x0 + kBlockWidth - 1) / kBlockWidth;
   blocks_y = (area.y1 - area.y0 + kBlockHeight - 1) / kBlockHeight;
@@ -248,28 +255,47 @@ void TileScratch::prepare(const Tile& area) {
   if (block_pixels.size() < blocks) {
     block_pixels.resize(blocks);
     block_hits.resize(blocks);
+    block_x0.resize(blocks);
+    block_y0.resize(blocks);
   }
-  if (capacity_ < lanes) {
+  // One spare group: a region's shadow rays start anywhere in the compacted
+  // arrays and are read a whole group at a time.
+  const std::size_t arrays = lanes + kBlockLanes;
+  if (capacity_ < arrays) {
     for (std::vector<float>* a : {&dir_x, &dir_y, &dir_z, &t, &u, &v, &px, &py, &pz, &gx, &gy, &gz, &nx, &ny,
                                   &nz, &ar, &ag, &ab, &error, &so_x, &so_y, &so_z, &sd_x, &sd_y, &sd_z, &s_tmax}) {
-      a->resize(lanes);
+      a->resize(arrays);
     }
-    triangle.resize(lanes);
-    instance.resize(lanes);
-    lit.resize(lanes);
-    shadow_pixel.resize(lanes);
-    capacity_ = lanes;
+    triangle.resize(arrays);
+    instance.resize(arrays);
+    lit.resize(arrays);
+    shadow_pixel.resize(arrays);
+    capacity_ = arrays;
   }
-  for (std::size_t b = 0; b < blocks; ++b) {
-    const int bx = area.x0 + static_cast<int>(b % static_cast<std::size_t>(blocks_x)) * kBlockWidth;
-    const int by = area.y0 + static_cast<int>(b / static_cast<std::size_t>(blocks_x)) * kBlockHeight;
-    const int w = std::min(kBlockWidth, area.x1 - bx);
-    const int h = std::min(kBlockHeight, area.y1 - by);
-    const std::uint32_t row = (1u << w) - 1u;
-    block_pixels[b] = static_cast<std::uint8_t>(h == 2 ? row | (row << kBlockWidth) : row);
-    block_hits[b] = 0;
+  const int rx = std::max(1, region_blocks_x), ry = std::max(1, region_blocks_y);
+  region_begin.clear();
+  std::size_t b = 0;
+  for (int y0 = 0; y0 < blocks_y; y0 += ry) {
+    for (int x0 = 0; x0 < blocks_x; x0 += rx) {
+      region_begin.push_back(static_cast<std::uint32_t>(b));
+      for (int y = y0; y < std::min(blocks_y, y0 + ry); ++y) {
+        for (int x = x0; x < std::min(blocks_x, x0 + rx); ++x, ++b) {
+          const int px0 = area.x0 + x * kBlockWidth;
+          const int py0 = area.y0 + y * kBlockHeight;
+          block_x0[b] = px0;
+          block_y0[b] = py0;
+          const int w = std::min(kBlockWidth, area.x1 - px0);
+          const int h = std::min(kBlockHeight, area.y1 - py0);
+          const std::uint32_t row = (1u << w) - 1u;
+          block_pixels[b] = static_cast<std::uint8_t>(h == 2 ? row | (row << kBlockWidth) : row);
+          block_hits[b] = 0;
+        }
+      }
+    }
   }
+  region_begin.push_back(static_cast<std::uint32_t>(b));
   shadow_count = 0;
+  shadow_region_begin.clear();
 }
 
 void generate_camera_rays(const PinholeCamera& camera, TileScratch& s) {
@@ -285,11 +311,128 @@ void generate_camera_rays(const PinholeCamera& camera, TileScratch& s) {
   }
 }
 
-void trace_primary(const Scene& scene, const PinholeCamera& camera, TriangleTest test, bool packets,
+namespace {
+
+// Ray arrays every large packet of primary rays shares: the eye, t in [0, inf).
+struct PrimaryLanes {
+  alignas(32) float o[3][kMaxPacketGroups * kBlockLanes];
+  alignas(32) float t_min[kMaxPacketGroups * kBlockLanes];
+  alignas(32) float t_max[kMaxPacketGroups * kBlockLanes];
+  Vec3 eye{std::numeric_limits<float>::quiet_NaN()};
+  PrimaryLanes() {
+    std::fill(std::begin(t_min), std::end(t_min), 0.0f);
+    std::fill(std::begin(t_max), std::end(t_max), kInf);
+  }
+  void set_eye(const Vec3& e) {
+    if (e.x == eye.x && e.y == eye.y && e.z == eye.z) return;
+    eye = e;
+    for (int a = 0; a < 3; ++a) std::fill(std::begin(o[a]), std::end(o[a]), e[a]);
+  }
+};
+
+// One large packet per region: its blocks are consecutive in `s`.
+void trace_primary_large(const Scene& scene, const Vec3& eye, TriangleTest test,
+                         const std::vector<std::uint32_t>& objects, TileScratch& s, TraversalCounters& counters) {
+  thread_local PrimaryLanes shared;
+  shared.set_eye(eye);
+  for (std::size_t r = 0; r < s.regions(); ++r) {
+    const std::size_t b0 = s.region_begin[r], b1 = s.region_begin[r + 1];
+    const std::size_t k0 = b0 * kBlockLanes;
+    for (std::size_t b = b0; b < b1; ++b) counters.rays += static_cast<std::uint64_t>(std::popcount(s.block_pixels[b]));
+    if (objects.empty()) {
+      for (std::size_t k = k0; k < b1 * kBlockLanes; ++k) set_miss(s, k);
+      for (std::size_t b = b0; b < b1; ++b) s.block_hits[b] = 0;
+      continue;
+    }
+    LargePacketRays rays;
+    rays.groups = static_cast<int>(b1 - b0);
+    for (int a = 0; a < 3; ++a) rays.o[a] = shared.o[a];
+    rays.d[0] = &s.dir_x[k0];
+    rays.d[1] = &s.dir_y[k0];
+    rays.d[2] = &s.dir_z[k0];
+    rays.t_min = shared.t_min;
+    rays.t_max = shared.t_max;
+    rays.active = &s.block_pixels[b0];
+    TraversalCounters work;
+    intersect_large_packet(scene, rays, test, objects,
+                           PacketHits{&s.t[k0], &s.u[k0], &s.v[k0], &s.triangle[k0], &s.instance[k0]}, &work);
+    add_work(counters, work);
+    for (std::size_t b = b0; b < b1; ++b) {
+      std::uint32_t hit_bits = 0;
+      for (int lane = 0; lane < kBlockLanes; ++lane) {
+        hit_bits |= s.triangle[b * kBlockLanes + static_cast<std::size_t>(lane)] != kInvalidId ? (1u << lane) : 0u;
+      }
+      s.block_hits[b] = static_cast<std::uint8_t>(hit_bits & s.block_pixels[b]);
+    }
+  }
+}
+
+// One large packet per region's run of shadow rays.
+std::uint64_t trace_shadow_large(const Scene& scene, TriangleTest test, const std::vector<std::uint32_t>& objects,
+                                 int l, TileScratch& s, TraversalCounters& counters) {
+  static const std::vector<float> zeros(kMaxPacketGroups * kBlockLanes, 0.0f);
+  const std::uint8_t dark = static_cast<std::uint8_t>(~(1u << l));
+  std::uint64_t blocked_count = 0;
+  std::array<std::uint8_t, kMaxPacketGroups> active{}, blocked{};
+  for (std::size_t r = 0; r + 1 < s.shadow_region_begin.size(); ++r) {
+    const std::size_t i0 = s.shadow_region_begin[r], i1 = s.shadow_region_begin[r + 1];
+    counters.rays += i1 - i0;
+    if (objects.empty()) continue;
+    for (std::size_t i = i0; i < i1; i += kBlockLanes) {
+      const std::size_t n = std::min<std::size_t>(kBlockLanes, i1 - i);
+      const std::size_t g = (i - i0) / kBlockLanes;
+      active[g] = static_cast<std::uint8_t>((1u << n) - 1u);
+    }
+    LargePacketRays rays;
+    rays.groups = static_cast<int>((i1 - i0 + kBlockLanes - 1) / kBlockLanes);
+    rays.o[0] = &s.so_x[i0];
+    rays.o[1] = &s.so_y[i0];
+    rays.o[2] = &s.so_z[i0];
+    rays.d[0] = &s.sd_x[i0];
+    rays.d[1] = &s.sd_y[i0];
+    rays.d[2] = &s.sd_z[i0];
+    rays.t_min = zeros.data();
+    rays.t_max = &s.s_tmax[i0];
+    rays.active = active.data();
+    rays.common_end = s.shadow_common_end;
+    TraversalCounters work;
+    occluded_large_packet(scene, rays, test, objects, blocked.data(), &work);
+    add_work(counters, work);
+    for (int g = 0; g < rays.groups; ++g) {
+      for (std::uint32_t m = blocked[static_cast<std::size_t>(g)] & active[static_cast<std::size_t>(g)]; m != 0;
+           m &= m - 1) {
+        const std::size_t i = i0 + static_cast<std::size_t>(g) * kBlockLanes + static_cast<std::size_t>(std::countr_zero(m));
+        s.lit[s.shadow_pixel[i]] &= dark;
+        ++blocked_count;
+      }
+    }
+  }
+  return blocked_count;
+}
+
+}  // namespace
+
+bool valid_packet_rays(int packet_rays) {
+  return packet_rays == 1 || packet_rays == 8 || packet_rays == 64 || packet_rays == 256;
+}
+
+void packet_region_blocks(int packet_rays, int& blocks_x, int& blocks_y) {
+  // Square regions of 4x2 blocks: 8x8 pixels are 2x4 blocks, 16x16 are 4x8.
+  blocks_x = blocks_y = 1;
+  if (packet_rays == 64) {
+    blocks_x = 2;
+    blocks_y = 4;
+  } else if (packet_rays == 256) {
+    blocks_x = 4;
+    blocks_y = 8;
+  }
+}
+
+void trace_primary(const Scene& scene, const PinholeCamera& camera, TriangleTest test, int packet_rays,
                    TileScratch& s, TraversalCounters& counters) {
   const std::size_t blocks = s.lanes / kBlockLanes;
   const Vec3 eye = camera.eye();
-  if (!packets) {
+  if (packet_rays <= 1) {
     for (std::size_t b = 0; b < blocks; ++b) {
       std::uint32_t hits = 0;
       for (int lane = 0; lane < kBlockLanes; ++lane) {
@@ -325,6 +468,10 @@ void trace_primary(const Scene& scene, const PinholeCamera& camera, TriangleTest
     tile_bound.add_lanes(eye, lane_dirs(b * kBlockLanes).data(), 0.0f, kInf, s.block_pixels[b]);
   }
   cull_objects(scene, tile_bound, lists.tile);
+  if (packet_rays > kPacketSize) {
+    trace_primary_large(scene, eye, test, lists.tile, s, counters);
+    return;
+  }
   RayPacket packet;
   for (int lane = 0; lane < kPacketSize; ++lane) {
     packet.ox[lane] = eye.x;
@@ -434,7 +581,17 @@ void make_shadow_rays(const Light& light, int l, TileScratch& s) {
   const Vec3x8 light_at{Float8(light.position.x), Float8(light.position.y), Float8(light.position.z)};
   const Vec3x8 light_dir{Float8(light.direction.x), Float8(light.direction.y), Float8(light.direction.z)};
   s.shadow_count = 0;
+  s.shadow_region_begin.clear();
+  s.shadow_common_end = point;
+  std::size_t region = 0;
   for (std::size_t b = 0; b < blocks; ++b) {
+    if (b == s.region_begin[region]) {
+      // A new region: its rays start a new run (when it has any).
+      if (s.shadow_region_begin.empty() || s.shadow_region_begin.back() != s.shadow_count) {
+        s.shadow_region_begin.push_back(static_cast<std::uint32_t>(s.shadow_count));
+      }
+      ++region;
+    }
     const std::uint32_t hits = s.block_hits[b];
     if (hits == 0) continue;
     const std::size_t k0 = b * kBlockLanes;
@@ -474,9 +631,14 @@ void make_shadow_rays(const Light& light, int l, TileScratch& s) {
       s.s_tmax[i] = point ? 1.0f : kInf;
     }
   }
+  // Close the last run; drop a trailing start that no ray followed.
+  if (!s.shadow_region_begin.empty() && s.shadow_region_begin.back() == s.shadow_count) {
+    s.shadow_region_begin.pop_back();
+  }
+  if (s.shadow_count > 0) s.shadow_region_begin.push_back(static_cast<std::uint32_t>(s.shadow_count));
 }
 
-std::uint64_t trace_shadow_rays(const Scene& scene, TriangleTest test, bool packets, int l, TileScratch& s,
+std::uint64_t trace_shadow_rays(const Scene& scene, TriangleTest test, int packet_rays, int l, TileScratch& s,
                                 TraversalCounters& counters) {
   const std::uint8_t dark = static_cast<std::uint8_t>(~(1u << l));
   std::uint64_t blocked_count = 0;
@@ -484,7 +646,7 @@ std::uint64_t trace_shadow_rays(const Scene& scene, TriangleTest test, bool pack
     s.lit[s.shadow_pixel[i]] &= dark;
     ++blocked_count;
   };
-  if (!packets) {
+  if (packet_rays <= 1) {
     for (std::size_t i = 0; i < s.shadow_count; ++i) {
       Ray ray;
       ray.origin = Vec3(s.so_x[i], s.so_y[i], s.so_z[i]);
@@ -496,9 +658,10 @@ std::uint64_t trace_shadow_rays(const Scene& scene, TriangleTest test, bool pack
     return blocked_count;
   }
   if (s.shadow_count == 0) return 0;
-  // Pad the last packet's lanes (inactive, but the arithmetic reads them).
+  // Pad a group past the last ray (inactive lanes, but the arithmetic
+  // reads them; a large packet's groups start anywhere).
   const std::size_t padded = (s.shadow_count + kPacketSize - 1) / kPacketSize * kPacketSize;
-  for (std::size_t i = s.shadow_count; i < padded; ++i) {
+  for (std::size_t i = s.shadow_count; i < s.shadow_count + kPacketSize; ++i) {
     s.so_x[i] = s.so_y[i] = s.so_z[i] = 0.0f;
     s.sd_x[i] = s.sd_y[i] = 0.0f;
     s.sd_z[i] = 1.0f;
@@ -508,13 +671,41 @@ std::uint64_t trace_shadow_rays(const Scene& scene, TriangleTest test, bool pack
   CullLists& lists = cull_lists();
   lists.tile.clear();
   RayBound tile_bound;
+  float extra_grow = 0.0f;
   for (std::size_t i = 0; i < padded; i += kPacketSize) {
-    const float* const o[3] = {&s.so_x[i], &s.so_y[i], &s.so_z[i]};
-    const float* const d[3] = {&s.sd_x[i], &s.sd_y[i], &s.sd_z[i]};
     const std::size_t n = std::min<std::size_t>(kPacketSize, s.shadow_count - i);
-    tile_bound.add_lanes(o, d, kZeros, &s.s_tmax[i], (1u << n) - 1u);
+    const std::uint32_t lanes = (1u << n) - 1u;
+    if (s.shadow_common_end) {
+      // Rays to a point light, bounded from the light: o + d - s d, s in
+      // [0, 1]. Far tighter than the origins' spread times the directions'.
+      alignas(32) float end[3][8], back[3][8];
+      const Vec3x8 o = load3(s.so_x, s.so_y, s.so_z, i);
+      const Vec3x8 d = load3(s.sd_x, s.sd_y, s.sd_z, i);
+      store_lanes(o + d, end);
+      store_lanes(Vec3x8{-d.x, -d.y, -d.z}, back);
+      const float* const oe[3] = {end[0], end[1], end[2]};
+      const float* const db[3] = {back[0], back[1], back[2]};
+      static const float kOnes[kPacketSize] = {1, 1, 1, 1, 1, 1, 1, 1};
+      tile_bound.add_lanes(oe, db, kZeros, kOnes, lanes);
+      const Mask8 use = Mask8::from_bits(lanes);
+      const auto mag = [&](const Vec3x8& v) {
+        return reduce_max(select(use, max(max(abs(v.x), abs(v.y)), abs(v.z)), Float8(0.0f)));
+      };
+      extra_grow = std::max(extra_grow, mag(o) + mag(d));
+    } else {
+      const float* const o[3] = {&s.so_x[i], &s.so_y[i], &s.so_z[i]};
+      const float* const d[3] = {&s.sd_x[i], &s.sd_y[i], &s.sd_z[i]};
+      tile_bound.add_lanes(o, d, kZeros, &s.s_tmax[i], lanes);
+    }
   }
-  cull_objects(scene, tile_bound, lists.tile);
+  if (s.shadow_common_end) {
+    // The traversal's slack is relative to the rays' own origins and
+    // reach, which the reversed bound does not see; and o + d rounds.
+    const float scene_magnitude = detail::max_abs(scene.top_level().bounds());
+    extra_grow = kFrameRelativeSlack * 4.0f * (extra_grow + scene_magnitude) + 0x1.0p-22f * extra_grow;
+  }
+  cull_objects(scene, tile_bound, lists.tile, extra_grow);
+  if (packet_rays > kPacketSize) return trace_shadow_large(scene, test, lists.tile, l, s, counters);
   RayPacket packet;
   std::memcpy(packet.t_min, kZeros, sizeof(packet.t_min));
   for (std::size_t i = 0; i < padded; i += kPacketSize) {
@@ -587,8 +778,8 @@ void shade_and_write(const RenderSettings& settings, std::span<const Light> ligh
         if (out.rgba8.wanted()) srgb_pixels(color, pixels_rgba8);
       }
     }
-    const int bx = s.tile.x0 + static_cast<int>(b % static_cast<std::size_t>(s.blocks_x)) * kBlockWidth;
-    const int by = s.tile.y0 + static_cast<int>(b / static_cast<std::size_t>(s.blocks_x)) * kBlockHeight;
+    const int bx = s.block_x0[b];
+    const int by = s.block_y0[b];
     if (pixels == 0xFFu && (hits == 0xFFu || hits == 0u)) {
       // A whole block of one kind: each output's two rows of four pixels
       // are contiguous.

@@ -24,11 +24,18 @@ namespace sinew::rt {
 // the arithmetic stays finite); bit-identical to PinholeCamera::ray.
 void generate_camera_rays(const PinholeCamera& camera, TileScratch& s);
 
+// Whether `packet_rays` is one RenderSettings::packet_rays accepts, and the
+// region (in blocks) its packets cover: one block for 1 and 8 rays.
+bool valid_packet_rays(int packet_rays);
+void packet_region_blocks(int packet_rays, int& blocks_x, int& blocks_y);
+
 // Nearest hits of the tile's pixels, with the tile's primary rays culled
 // against the top level as one bound and each packet's again (render/
-// ray_bound.h). `packets` off: one single-ray query per pixel, no culling.
-// Fills t, u, v, triangle, instance and block_hits.
-void trace_primary(const Scene& scene, const PinholeCamera& camera, TriangleTest test, bool packets,
+// ray_bound.h). packet_rays (RenderSettings): 1 is one single-ray query per
+// pixel, no culling; 64 and 256 need `s` prepared with the matching
+// regions (packet_region_blocks). Fills t, u, v, triangle, instance and
+// block_hits.
+void trace_primary(const Scene& scene, const PinholeCamera& camera, TriangleTest test, int packet_rays,
                    TileScratch& s, TraversalCounters& counters);
 
 // The surfaces at the hits (positions, camera-facing geometric and
@@ -41,9 +48,11 @@ void reconstruct_surfaces(const Scene& scene, const Vec3& default_albedo, TileSc
 // along a directional light (t_max inf).
 void make_shadow_rays(const Light& light, int l, TileScratch& s);
 
-// Traces s.shadow_* as packets of eight (culled like the primary rays) or
-// one by one; blocked rays clear bit l of s.lit. Returns how many were blocked.
-std::uint64_t trace_shadow_rays(const Scene& scene, TriangleTest test, bool packets, int l, TileScratch& s,
+// Traces s.shadow_* one by one, as packets of eight, or as one large
+// packet per region (culled like the primary rays; rays to a point light
+// culled from the light); blocked rays clear bit l of s.lit. Returns how
+// many were blocked.
+std::uint64_t trace_shadow_rays(const Scene& scene, TriangleTest test, int packet_rays, int l, TileScratch& s,
                                 TraversalCounters& counters);
 
 // Diffuse shading (ambient + each unblocked light's N.L) and the requested

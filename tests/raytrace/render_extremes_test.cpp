@@ -297,7 +297,7 @@ TEST(Renderer, AovsAreTheTraversalsHitsAndImagesDoNotDependOnThreads) {
     std::vector<Vec3> normal;
     std::vector<std::uint32_t> triangle, instance;
   };
-  const auto render = [&](JobSystem& jobs, TriangleTest test, bool packets = true) {
+  const auto render = [&](JobSystem& jobs, TriangleTest test, int packet_rays = 64) {
     Images im;
     const std::size_t n = static_cast<std::size_t>(w * h);
     im.color.resize(4 * n);
@@ -308,7 +308,7 @@ TEST(Renderer, AovsAreTheTraversalsHitsAndImagesDoNotDependOnThreads) {
     rt::FrameBuffers buffers{w, h, im.color, {}, im.depth, im.normal, im.triangle, im.instance, {}};
     rt::RenderSettings settings;
     settings.triangle_test = test;
-    settings.packets = packets;
+    settings.packet_rays = packet_rays;
     rt::Renderer renderer;
     auto stats = renderer.render(scene, *camera, settings, buffers, jobs);
     EXPECT_TRUE(stats.ok()) << stats.status().message();
@@ -326,11 +326,13 @@ TEST(Renderer, AovsAreTheTraversalsHitsAndImagesDoNotDependOnThreads) {
     EXPECT_EQ(a.depth, b.depth);
     EXPECT_EQ(a.triangle, b.triangle);
     EXPECT_EQ(a.instance, b.instance);
-    // Packets and single rays give the same image.
-    const Images c = render(two, test, /*packets=*/false);
-    EXPECT_EQ(a.color, c.color);
-    EXPECT_EQ(a.depth, c.depth);
-    EXPECT_EQ(a.triangle, c.triangle);
+    // Packets of every size and single rays give the same image.
+    for (const int packet_rays : {1, 8, 256}) {
+      const Images c = render(two, test, packet_rays);
+      EXPECT_EQ(a.color, c.color) << packet_rays;
+      EXPECT_EQ(a.depth, c.depth) << packet_rays;
+      EXPECT_EQ(a.triangle, c.triangle) << packet_rays;
+    }
     std::size_t character_pixels = 0;
     for (int y = 0; y < h; ++y) {
       for (int x = 0; x < w; ++x) {
@@ -456,10 +458,10 @@ TEST(RenderStatic, AFloorAtExactlyZeroDoesNotShadowItself) {
   desc.target = Vec3(0.0f, 0.0f, 0.0f);
   auto camera = rt::PinholeCamera::create(desc, 64, 64);
   ASSERT_TRUE(camera.ok());
-  for (const bool packets : {true, false}) {
+  for (const int packet_rays : {1, 8, 64, 256}) {
     rt::RenderSettings settings;
     settings.light.position = Vec3(6.0f, 12.0f, 4.0f);
-    settings.packets = packets;
+    settings.packet_rays = packet_rays;
     std::vector<std::uint8_t> color(64 * 64 * 4);
     rt::FrameBuffers buffers;
     buffers.width = buffers.height = 64;
@@ -468,7 +470,7 @@ TEST(RenderStatic, AFloorAtExactlyZeroDoesNotShadowItself) {
     auto stats = renderer.render(scene, *camera, settings, buffers, jobs);
     ASSERT_TRUE(stats.ok());
     EXPECT_GT(stats->shadow_rays, 1000u);
-    EXPECT_EQ(stats->shadowed, 0u) << (packets ? "packets" : "single rays");
+    EXPECT_EQ(stats->shadowed, 0u) << packet_rays << " rays per packet";
   }
 }
 

@@ -241,7 +241,7 @@ TEST(TileStages, SurfacesAndShadowOriginsAreTheScalarOnes) {
       s.prepare(Tile{tx, ty, tx + 16, ty + 16, 0});
       rt::generate_camera_rays(camera, s);
       rt::TraversalCounters counters;
-      rt::trace_primary(sc, camera, TriangleTest::kFast, true, s, counters);
+      rt::trace_primary(sc, camera, TriangleTest::kFast, 8, s, counters);
       std::fill(s.lit.begin(), s.lit.end(), std::uint8_t{1});
       rt::reconstruct_surfaces(sc, Vec3(0.7f), s);
       rt::make_shadow_rays(light, 0, s);
@@ -287,7 +287,7 @@ struct Frame {
   std::vector<std::uint32_t> triangle, instance;
 };
 
-Frame render(const rt::Scene& sc, const rt::PinholeCamera& camera, int tile, bool packets, TriangleTest test,
+Frame render(const rt::Scene& sc, const rt::PinholeCamera& camera, int tile, int packet_rays, TriangleTest test,
              JobSystem& jobs) {
   const std::size_t n = static_cast<std::size_t>(camera.width() * camera.height());
   Frame f;
@@ -299,7 +299,7 @@ Frame render(const rt::Scene& sc, const rt::PinholeCamera& camera, int tile, boo
   rt::FrameBuffers buffers{camera.width(), camera.height(), f.color, {}, f.depth, f.normal, f.triangle, f.instance, {}};
   rt::RenderSettings settings;
   settings.tile_size = tile;
-  settings.packets = packets;
+  settings.packet_rays = packet_rays;
   settings.triangle_test = test;
   rt::Renderer renderer;
   EXPECT_TRUE(renderer.render(sc, camera, settings, buffers, jobs).ok());
@@ -326,13 +326,15 @@ TEST(Renderer, PacketsMatchSingleRaysAndBruteForceAtEdgesAndInsideCharacters) {
     for (const auto& [w, h] : sizes) {
       const auto camera = rt::PinholeCamera::create(desc, w, h).value();
       for (const TriangleTest test : kTests) {
-        const Frame single = render(sc, camera, 16, false, test, jobs);
-        for (const int tile : {1, 3, 5, 16, 64}) {
-          const Frame packets = render(sc, camera, tile, true, test, jobs);
-          EXPECT_EQ(packets.triangle, single.triangle) << "tile " << tile;
-          EXPECT_EQ(packets.instance, single.instance) << "tile " << tile;
-          EXPECT_EQ(packets.depth, single.depth) << "tile " << tile;
-          EXPECT_EQ(packets.color, single.color) << "tile " << tile;
+        const Frame single = render(sc, camera, 16, 1, test, jobs);
+        for (const int packet_rays : {8, 64, 256}) {
+          for (const int tile : {1, 3, 5, 16, 64}) {
+            const Frame packets = render(sc, camera, tile, packet_rays, test, jobs);
+            EXPECT_EQ(packets.triangle, single.triangle) << "tile " << tile << ", " << packet_rays << " rays";
+            EXPECT_EQ(packets.instance, single.instance) << "tile " << tile << ", " << packet_rays << " rays";
+            EXPECT_EQ(packets.depth, single.depth) << "tile " << tile << ", " << packet_rays << " rays";
+            EXPECT_EQ(packets.color, single.color) << "tile " << tile << ", " << packet_rays << " rays";
+          }
         }
         for (int y = 0; y < h; ++y) {
           for (int x = 0; x < w; ++x) {

@@ -1,0 +1,696 @@
+#include "raytrace/render/large_packet.h"
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "raytrace/geometry/triangle_intersect8.h"
+#include "raytrace/render/interval_bound.h"
+#include "raytrace/render/traversal_shared.h"
+#include "runtime/math/float8.h"
+
+#if defined(__AVX2__) && defined(__FMA__)
+#define SINEW_LARGE_PACKET_AVX2 1
+#else
+#define SINEW_LARGE_PACKET_AVX2 0
+#endif
+
+namespace sinew::rt {
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+constexpr int kLanes = 8;
+
+// One group's eight rays as an 8-ray packet (lanes of `lanes` active).
+RayPacket group_packet(const LargePacketRays& rays, int g, const float* t_max, std::uint32_t lanes) {
+  RayPacket p;
+  const std::size_t k0 = static_cast<std::size_t>(g) * kLanes;
+  for (int i = 0; i < kLanes; ++i) {
+    const std::size_t k = k0 + static_cast<std::size_t>(i);
+    p.ox[i] = rays.o[0][k];
+    p.oy[i] = rays.o[1][k];
+    p.oz[i] = rays.o[2][k];
+    p.dx[i] = rays.d[0][k];
+    p.dy[i] = rays.d[1][k];
+    p.dz[i] = rays.d[2][k];
+    p.t_min[i] = rays.t_min[k];
+    p.t_max[i] = t_max[i];
+  }
+  p.active = static_cast<std::uint8_t>(lanes);
+  return p;
+}
+
+}  // namespace
+
+#if SINEW_LARGE_PACKET_AVX2
+namespace {
+
+using detail::max_abs;
+
+template <class Fn>
+void for_each_bit(std::uint32_t mask, Fn&& fn) {
+  while (mask != 0) {
+    const int i = std::countr_zero(mask);
+    mask &= mask - 1;
+    fn(i);
+  }
+}
+
+// One group's rays in world space (invalid or inactive lanes hold the
+// default Ray, so eight-wide arithmetic stays finite).
+struct alignas(32) Group {
+  float o[3][kLanes];
+  float d[3][kLanes];
+  float inv[3][kLanes];
+  float t_min[kLanes];
+  float t_limit[kLanes];  // closest hit: the best t so far (exclusive); any-hit: t_max
+  float o_mag[kLanes];    // max |origin| coordinate
+  float d_mag[kLanes];    // max |direction| coordinate
+  Vec3x8 origin() const { return {Float8::load(o[0]), Float8::load(o[1]), Float8::load(o[2])}; }
+  Vec3x8 direction() const { return {Float8::load(d[0]), Float8::load(d[1]), Float8::load(d[2])}; }
+};
+
+// A group's part in one object visit: the lanes that entered the object,
+// their interval, and (in a bone's tree) the group's bound and slack.
+struct alignas(32) VisitGroup {
+  float t0[kLanes];
+  float t1[kLanes];
+  std::uint32_t lanes = 0;
+  float eps = 0.0f;  // the largest slack of its lanes, plus the bound's own rounding
+  IntervalBound bound;
+};
+
+// Per object visit, which groups have tested a triangle: a triangle whose
+// fuzzy box straddles splits is listed in several leaves. Direct-mapped on
+// the id's low bits; a group that tests a triangle twice (after an
+// eviction) gets the same answer, which cannot beat its best t strictly.
+class GroupMailbox {
+ public:
+  void reset() { ids_.fill(kInvalidId); }
+  // Of `groups`, those that have not tested `id` yet (marking them).
+  std::uint32_t untested(std::uint32_t id, std::uint32_t groups) {
+    const std::size_t slot = id & (ids_.size() - 1);
+    if (ids_[slot] != id) {
+      ids_[slot] = id;
+      groups_[slot] = groups;
+      return groups;
+    }
+    const std::uint32_t fresh = groups & ~groups_[slot];
+    groups_[slot] |= groups;
+    return fresh;
+  }
+
+ private:
+  std::array<std::uint32_t, 64> ids_{};
+  std::array<std::uint32_t, 64> groups_{};
+};
+
+// The single-ray traversal's slack for a world-space box of magnitude
+// `box_magnitude` reached up to t_end (render/traversal.cpp world_eps),
+// per lane.
+Float8 world_eps(const Group& g, float box_magnitude, Float8 t_end) {
+  const Mask8 finite_end = abs(t_end) <= Float8(std::numeric_limits<float>::max());
+  const Float8 reach = select(finite_end, t_end * Float8::load(g.d_mag), Float8(0.0f));
+  return Float8(kFrameRelativeSlack) * ((Float8::load(g.o_mag) + reach) + Float8(box_magnitude));
+}
+
+// clip_to_box (render/traversal_shared.h) for eight lanes of rays o + t d
+// with reciprocals inv: [t0, t1] clipped to `box` grown by each lane's eps;
+// returns the lanes of `mask` left with t0 <= t1.
+std::uint32_t clip_lanes(const Aabb& box, Float8 eps, const Vec3x8& o, const Vec3x8& d, const Vec3x8& inv,
+                         std::uint32_t mask, Float8& t0, Float8& t1) {
+  const Float8* const oc[3] = {&o.x, &o.y, &o.z};
+  const Float8* const dc[3] = {&d.x, &d.y, &d.z};
+  const Float8* const ic[3] = {&inv.x, &inv.y, &inv.z};
+  std::uint32_t outside = 0;
+  for (int a = 0; a < 3; ++a) {
+    const Float8 lo = Float8(box.lower[a]) - eps;
+    const Float8 hi = Float8(box.upper[a]) + eps;
+    const Mask8 parallel = *dc[a] == Float8(0.0f);
+    outside |= (parallel & !((*oc[a] >= lo) & (*oc[a] <= hi))).bits();
+    const Float8 n = (lo - *oc[a]) * *ic[a];
+    const Float8 f = (hi - *oc[a]) * *ic[a];
+    const Mask8 swap = n > f;
+    t0 = select(parallel, t0, max(select(swap, f, n), t0));
+    t1 = select(parallel, t1, min(select(swap, n, f), t1));
+  }
+  return (t0 <= t1).bits() & ~outside & mask;
+}
+
+// A kd-tree cell waiting on the stack, with its entry bound.
+struct Cell {
+  Aabb box;
+  std::uint32_t node;
+  float entry;
+};
+
+template <TriangleTest kTest, bool kAnyHit>
+class LargeQuery {
+ public:
+  LargeQuery(const Scene& scene, const LargePacketRays& rays, PacketHits out)
+      : scene_(scene), rays_(rays), out_(out), groups_(std::clamp(rays.groups, 0, kMaxPacketGroups)) {
+    const Ray none{};
+    for (int g = 0; g < groups_; ++g) {
+      const std::size_t k0 = static_cast<std::size_t>(g) * kLanes;
+      Group& gr = group_[g];
+      // valid_ray() per lane: finite origin and direction, a non-zero
+      // direction, t_min < t_max (false for NaN).
+      const Float8 t_min = Float8::load(rays.t_min + k0), t_max = Float8::load(rays.t_max + k0);
+      Mask8 valid = t_min < t_max;
+      Mask8 nonzero = Mask8::from_bits(0);
+      Float8 o[3], d[3];
+      for (int a = 0; a < 3; ++a) {
+        o[a] = Float8::load(rays.o[a] + k0);
+        d[a] = Float8::load(rays.d[a] + k0);
+        valid = valid & is_finite(o[a]) & is_finite(d[a]);
+        nonzero = nonzero | !(d[a] == Float8(0.0f));
+      }
+      live_[g] = (valid & nonzero).bits() & rays.active[g];
+      valid_[g] = live_[g];
+      const Mask8 use = Mask8::from_bits(live_[g]);
+      Float8 o_mag(0.0f), d_mag(0.0f);
+      for (int a = 0; a < 3; ++a) {
+        o[a] = select(use, o[a], Float8(none.origin[a]));
+        d[a] = select(use, d[a], Float8(none.direction[a]));
+        o[a].store(gr.o[a]);
+        d[a].store(gr.d[a]);
+        (Float8(1.0f) / d[a]).store(gr.inv[a]);  // correctly rounded, like the single ray's
+        o_mag = max(o_mag, abs(o[a]));
+        d_mag = max(d_mag, abs(d[a]));
+      }
+      o_mag.store(gr.o_mag);
+      d_mag.store(gr.d_mag);
+      select(use, t_min, Float8(none.t_min)).store(gr.t_min);
+      select(use, t_max, Float8(none.t_max)).store(gr.t_limit);
+      if (live_[g] != 0) alive_groups_ |= 1u << g;
+      if constexpr (kTest == TriangleTest::kWatertight) {
+        for_each_bit(live_[g], [&](int lane) { watertight_[g][lane] = prepare_watertight(world_ray(g, lane)); });
+      }
+      if constexpr (!kAnyHit) {
+        for (int lane = 0; lane < kLanes; ++lane) {
+          const std::size_t k = k0 + static_cast<std::size_t>(lane);
+          out_.t[k] = kInf;
+          out_.u[k] = out_.v[k] = 0.0f;
+          out_.triangle[k] = out_.instance[k] = kInvalidId;
+        }
+      }
+    }
+  }
+
+  void run(std::span<const std::uint32_t> objects) {
+    if (alive_groups_ == 0 || objects.empty()) return;
+    const std::span<const TopLevelObject> all = scene_.top_level().objects();
+    // The packet's bound in world space and a bound on the slack of every
+    // single-ray box clip (RayBound::world_slack_bound's reasoning: a
+    // finite reach ends inside the scene).
+    RayRanges ranges;
+    bool first = true;
+    float o_mag = 0.0f, d_mag = 0.0f, t_hi = 0.0f;
+    const bool reversed = use_reversed();
+    for_each_bit(alive_groups_, [&](int g) {
+      const Group& gr = group_[g];
+      const Mask8 use = Mask8::from_bits(live_[g]);
+      const Float8 t_max = Float8::load(gr.t_limit);
+      const RayRanges r = reversed ? reversed_ranges(gr.origin(), gr.direction(), Float8::load(gr.t_min), t_max,
+                                                     t_max, live_[g])
+                                   : lane_ranges(gr.origin(), gr.direction(), Float8::load(gr.t_min), t_max,
+                                                 live_[g]);
+      if (first) {
+        ranges = r;
+        first = false;
+      } else {
+        ranges.unite(r);
+      }
+      o_mag = std::max(o_mag, reduce_max(select(use, Float8::load(gr.o_mag), Float8(0.0f))));
+      d_mag = std::max(d_mag, reduce_max(select(use, Float8::load(gr.d_mag), Float8(0.0f))));
+      t_hi = std::max(t_hi, reduce_max(select(use, t_max, Float8(0.0f))));
+    });
+    const IntervalBound bound(ranges);
+    const float scene_magnitude = max_abs(scene_.top_level().bounds());
+    float reach = 1.01f * (o_mag + scene_magnitude);
+    if (std::isfinite(t_hi)) reach = std::max(reach, t_hi * d_mag * 1.01f);
+    float slack = kFrameRelativeSlack * 1.01f * (o_mag + reach + scene_magnitude);
+    if (reversed) slack += reversed_slack(o_mag, d_mag, t_hi);
+    const float grow = bound.grow_for(scene_.top_level().bounds(), slack);
+    struct Candidate {
+      float entry;
+      std::uint32_t object;
+    };
+    std::array<Candidate, 256> stack_candidates;
+    std::vector<Candidate> heap_candidates;
+    std::size_t count = 0;
+    const auto add = [&](Candidate c) {
+      if (count < stack_candidates.size()) {
+        stack_candidates[count++] = c;
+        return;
+      }
+      if (heap_candidates.empty()) heap_candidates.assign(stack_candidates.begin(), stack_candidates.end());
+      heap_candidates.push_back(c);
+      ++count;
+    };
+    for (const std::uint32_t object : objects) {
+      const float e = bound.entry(all[object].box, grow);
+      if (e != kInf) add({e != e ? -kInf : e, object});
+    }
+    Candidate* const begin = heap_candidates.empty() ? stack_candidates.data() : heap_candidates.data();
+    if constexpr (!kAnyHit) {
+      // Front to back: an object entered after every lane's best hit is skipped.
+      std::sort(begin, begin + count, [](const Candidate& a, const Candidate& b) {
+        return a.entry < b.entry || (a.entry == b.entry && a.object < b.object);
+      });
+    }
+    for (std::size_t i = 0; i < count; ++i) {
+      if (alive_groups_ == 0) return;
+      if constexpr (!kAnyHit) {
+        if (begin[i].entry > packet_limit(alive_groups_, nullptr)) return;
+      }
+      visit(all[begin[i].object], begin[i].object);
+    }
+  }
+
+  std::uint32_t valid_lanes(int g) const { return valid_[g]; }
+  std::uint8_t blocked(int g) const { return static_cast<std::uint8_t>(blocked_[g]); }
+  const TraversalCounters& counters() const { return counters_; }
+
+ private:
+  // Any-hit rays that all end at finite t_max at one shared point.
+  bool use_reversed() const {
+    if (!kAnyHit || !rays_.common_end) return false;
+    bool finite = true;
+    for_each_bit(alive_groups_, [&](int g) {
+      const Float8 t = select(Mask8::from_bits(live_[g]), Float8::load(group_[g].t_limit), Float8(0.0f));
+      finite = finite && (is_finite(t).bits() == 0xFFu);
+    });
+    return finite;
+  }
+
+  // The ranges of rays o + t d, t in [t0, t1], written backwards from
+  // their end o + t_end d: base - s d with s in [t_end - t1, t_end - t0],
+  // widened for the rounding of t_end - t (t0 >= 0, so |t_end - t| <= t_end).
+  static RayRanges reversed_ranges(const Vec3x8& o, const Vec3x8& d, Float8 t0, Float8 t1, Float8 t_end,
+                                   std::uint32_t mask) {
+    const Vec3x8 base = o + t_end * d;
+    const Vec3x8 back{Float8(0.0f) - d.x, Float8(0.0f) - d.y, Float8(0.0f) - d.z};
+    const Float8 widen = Float8(0x1.0p-22f) * abs(t_end);
+    return lane_ranges(base, back, (t_end - t1) - widen, (t_end - t0) + widen, mask);
+  }
+  // The rounding of base = o + t_end d, as a growth of every box.
+  static float reversed_slack(float o_mag, float d_mag, float t_end_max) {
+    return 0x1.0p-22f * (o_mag + t_end_max * d_mag);
+  }
+
+  // The largest t any lane of `groups` still looks for: its best hit (or
+  // t_max), capped by its exit from the current object when `visit` holds it.
+  float packet_limit(std::uint32_t groups, const VisitGroup* visit) const {
+    float limit = -kInf;
+    for_each_bit(groups, [&](int g) { limit = std::max(limit, group_limit(g, visit)); });
+    return limit;
+  }
+  float group_limit(int g, const VisitGroup* visit) const {
+    const std::uint32_t lanes = visit ? visit[g].lanes & live_[g] : live_[g];
+    if (lanes == 0) return -kInf;
+    Float8 t = Float8::load(group_[g].t_limit);
+    if (visit) t = min(t, Float8::load(visit[g].t1));
+    return reduce_max(select(Mask8::from_bits(lanes), t, Float8(-kInf)));
+  }
+
+  Ray world_ray(int g, int lane) const {
+    const Group& gr = group_[g];
+    Ray r;
+    r.origin = Vec3(gr.o[0][lane], gr.o[1][lane], gr.o[2][lane]);
+    r.direction = Vec3(gr.d[0][lane], gr.d[1][lane], gr.d[2][lane]);
+    r.t_min = gr.t_min[lane];
+    r.t_max = gr.t_limit[lane];
+    return r;
+  }
+
+  // Enters one object: each group's lanes clipped to its box as the single
+  // ray clips them (render/traversal.cpp visit).
+  void visit(const TopLevelObject& object, std::uint32_t object_index) {
+    std::uint32_t groups = 0;
+    const float box_magnitude = max_abs(object.box);
+    for_each_bit(alive_groups_, [&](int g) {
+      const Group& gr = group_[g];
+      VisitGroup& vg = visit_[g];
+      Float8 t0 = Float8::load(gr.t_min), t1 = Float8::load(gr.t_limit);
+      const Float8 eps = world_eps(gr, box_magnitude, t1);
+      const Vec3x8 inv{Float8::load(gr.inv[0]), Float8::load(gr.inv[1]), Float8::load(gr.inv[2])};
+      vg.lanes = clip_lanes(object.box, eps, gr.origin(), gr.direction(), inv, live_[g], t0, t1);
+      t0.store(vg.t0);
+      t1.store(vg.t1);
+      if (vg.lanes != 0) {
+        groups |= 1u << g;
+        counters_.object_visits += static_cast<std::uint64_t>(std::popcount(vg.lanes));
+      }
+    });
+    if (groups == 0) return;
+    mailbox_.reset();
+    switch (object.kind) {
+      case TopLevelObject::Kind::kBone:
+        visit_bone(scene_.instances()[object.index], object.bone, groups);
+        return;
+      case TopLevelObject::Kind::kStatic: {
+        const Scene::StaticMesh& mesh = scene_.static_meshes()[object.index];
+        if (mesh.desc.triangles.size() <= detail::kBruteForceStaticTriangles) {
+          visit_small_static(mesh, groups);
+        } else {
+          visit_with_small_packets(object_index, groups);
+        }
+        return;
+      }
+      case TopLevelObject::Kind::kFallback:
+        visit_with_small_packets(object_index, groups);
+        return;
+    }
+  }
+
+  void visit_small_static(const Scene::StaticMesh& mesh, std::uint32_t groups) {
+    for (std::uint32_t t = 0; t < mesh.desc.triangles.size() && groups != 0; ++t) {
+      const auto& v = mesh.desc.triangles[t];
+      const Vec3& p0 = mesh.desc.positions[v[0]];
+      const Vec3& p1 = mesh.desc.positions[v[1]];
+      const Vec3& p2 = mesh.desc.positions[v[2]];
+      for_each_bit(groups, [&](int g) { test(g, visit_[g].lanes, p0, p1, p2, t, mesh.instance_id); });
+      groups &= alive_groups_;
+    }
+  }
+
+  // Static meshes with a tree and the escape fallback are rare: each group
+  // traces them as an 8-ray packet filtered to the one object.
+  void visit_with_small_packets(std::uint32_t object_index, std::uint32_t groups) {
+    const std::uint32_t list[1] = {object_index};
+    const ObjectFilter filter{list};
+    for_each_bit(groups, [&](int g) {
+      const std::uint32_t lanes = visit_[g].lanes & live_[g];
+      if (lanes == 0) return;
+      const RayPacket p = group_packet(rays_, g, group_[g].t_limit, lanes);
+      TraversalCounters work;
+      if constexpr (kAnyHit) {
+        const std::uint32_t blocked = occluded_packet(scene_, p, kTest, &work, &filter) & lanes;
+        for_each_bit(blocked, [&](int lane) { retire(g, lane); });
+      } else {
+        Hit hits[kPacketSize];
+        intersect_packet(scene_, p, kTest, hits, &work, &filter);
+        for_each_bit(lanes, [&](int lane) {
+          const Hit& h = hits[lane];
+          if (h.valid() && h.t < group_[g].t_limit[lane]) record(g, lane, h.t, h.u, h.v, h.triangle_id, h.instance_id);
+        });
+      }
+      counters_.node_visits += work.node_visits;
+      counters_.triangle_tests += work.triangle_tests;
+    });
+  }
+
+  void visit_bone(const InstanceFrame& frame, std::uint32_t bone, std::uint32_t groups) {
+    const Scene::Character& character = scene_.characters()[frame.character];
+    const KdTreeView tree = character.fuzzy.bone_tree(bone);
+    if (tree.empty()) return;
+    const Affine3& to_bone = frame.bone_from_world[bone];
+    const InstanceFrame::BoneCarry& carry = frame.bone_carry[bone];
+    const bool reversed = use_reversed();
+    // Each group's rays in the bone frame (Affine3::transform_point /
+    // transform_vector term by term, as the single ray), clipped to the
+    // tree's root box with each lane's own slack, then bounded.
+    std::uint32_t in_tree = 0;
+    RayRanges ranges;
+    float packet_eps = 0.0f;
+    for_each_bit(groups, [&](int g) {
+      const Group& gr = group_[g];
+      VisitGroup& vg = visit_[g];
+      const Vec3x8 wo = gr.origin(), wd = gr.direction();
+      const Mask8 use = Mask8::from_bits(vg.lanes);
+      Vec3x8 o, d;
+      Float8* const oc[3] = {&o.x, &o.y, &o.z};
+      Float8* const dc[3] = {&d.x, &d.y, &d.z};
+      Float8 o_mag(0.0f), d_mag(0.0f);
+      for (int a = 0; a < 3; ++a) {
+        const Vec4& row = to_bone.rows[a];
+        const Float8 rx(row.x), ry(row.y), rz(row.z);
+        *oc[a] = select(use, ((rx * wo.x + ry * wo.y) + rz * wo.z) + Float8(row.w), Float8(0.0f));
+        *dc[a] = select(use, (rx * wd.x + ry * wd.y) + rz * wd.z, Float8(1.0f));
+        o_mag = max(o_mag, abs(*oc[a]));
+        d_mag = max(d_mag, abs(*dc[a]));
+      }
+      const Vec3x8 inv{Float8(1.0f) / d.x, Float8(1.0f) / d.y, Float8(1.0f) / d.z};
+      Float8 t0 = Float8::load(vg.t0), t1 = Float8::load(vg.t1);
+      // 2 tolerance + slack * (((carried + |o|) + t1 |d|) + |bounds|), with
+      // carried = linear_norm * |world origin| + translation magnitude.
+      const Float8 carried =
+          Float8(carry.linear_norm) * Float8::load(gr.o_mag) + Float8(carry.translation_magnitude);
+      const Float8 eps = Float8(2.0f * frame.tolerance[bone]) +
+                         Float8(kFrameRelativeSlack) * (((carried + o_mag) + t1 * d_mag) + Float8(carry.bounds_magnitude));
+      vg.lanes = clip_lanes(tree.bounds, eps, o, d, inv, vg.lanes, t0, t1);
+      if (vg.lanes == 0) return;
+      t0.store(vg.t0);
+      t1.store(vg.t1);
+      const Mask8 kept = Mask8::from_bits(vg.lanes);
+      float group_eps = reduce_max(select(kept, eps, Float8(0.0f)));
+      RayRanges r;
+      if (reversed) {
+        const Float8 t_end = Float8::load(gr.t_limit);
+        r = reversed_ranges(o, d, t0, t1, t_end, vg.lanes);
+        group_eps += reversed_slack(reduce_max(select(kept, o_mag, Float8(0.0f))),
+                                    reduce_max(select(kept, d_mag, Float8(0.0f))),
+                                    reduce_max(select(kept, t_end, Float8(0.0f))));
+      } else {
+        r = lane_ranges(o, d, t0, t1, vg.lanes);
+      }
+      vg.bound = IntervalBound(r);
+      vg.eps = vg.bound.grow_for(tree.bounds, group_eps);
+      if (in_tree == 0) {
+        ranges = r;
+      } else {
+        ranges.unite(r);
+      }
+      packet_eps = std::max(packet_eps, group_eps);
+      in_tree |= 1u << g;
+    });
+    if (in_tree == 0) return;
+    const IntervalBound bound(ranges);
+    const float grow = bound.grow_for(tree.bounds, packet_eps);
+    const SkinnedMesh& mesh = *character.mesh;
+    const auto leaf = [&](std::span<const std::uint32_t> triangles, std::uint32_t groups_here) {
+      for (const std::uint32_t t : triangles) {
+        std::uint32_t need = mailbox_.untested(t, groups_here) & alive_groups_;
+        if (need == 0) continue;
+        const auto& v = mesh.triangles[t];
+        const Vec3& p0 = frame.positions[v[0]];
+        const Vec3& p1 = frame.positions[v[1]];
+        const Vec3& p2 = frame.positions[v[2]];
+        for_each_bit(need, [&](int g) { test(g, visit_[g].lanes, p0, p1, p2, t, frame.instance_id); });
+        if (kAnyHit && (in_tree & alive_groups_) == 0) return true;
+      }
+      return false;
+    };
+    traverse(tree, bound, grow, in_tree, leaf);
+  }
+
+  // Front to back over the cells the packet's bound reaches; at a leaf,
+  // the groups whose own bound reaches it test its triangles. `leaf`
+  // returns true to stop (every lane answered).
+  template <class LeafFn>
+  void traverse(const KdTreeView& tree, const IntervalBound& bound, float grow, std::uint32_t groups,
+                LeafFn& leaf) {
+    // The packet's limit changes only when a lane records a hit.
+    std::uint64_t seen = ~std::uint64_t{0};
+    float cached = kInf;
+    const auto limit = [&]() {
+      if constexpr (kAnyHit) {
+        return bound.t_hi();
+      } else {
+        if (seen != hits_recorded_) {
+          seen = hits_recorded_;
+          cached = packet_limit(groups & alive_groups_, visit_.data());
+        }
+        return cached;
+      }
+    };
+    std::array<Cell, kMaxTraversalDepth + 2> stack;
+    std::size_t top = 0;
+    Cell cur{tree.bounds, 0, bound.entry(tree.bounds, grow, limit())};
+    if (cur.entry == kInf) return;
+    for (;;) {
+      if (!(cur.entry > limit())) {
+        ++counters_.node_visits;
+        const KdNode node = tree.nodes[cur.node];
+        if (!node.is_leaf()) {
+          const int a = node.axis();
+          const float split = node.split();
+          Cell below{cur.box, cur.node + 1, 0.0f};
+          Cell above{cur.box, node.above_child(), 0.0f};
+          below.box.upper[a] = std::min(below.box.upper[a], split);
+          above.box.lower[a] = std::max(above.box.lower[a], split);
+          const float t_hi = limit();
+          below.entry = bound.entry(below.box, grow, t_hi);
+          above.entry = bound.entry(above.box, grow, t_hi);
+          const bool below_first = !(above.entry < below.entry);
+          const Cell& near = below_first ? below : above;
+          const Cell& far = below_first ? above : below;
+          if (near.entry != kInf) {
+            if (far.entry != kInf) stack[top++] = far;
+            cur = near;
+            continue;
+          }
+        } else if (node.item_count() > 0) {
+          std::uint32_t reaching = 0;
+          for_each_bit(groups & alive_groups_, [&](int g) {
+            const float t_hi = kAnyHit ? visit_[g].bound.t_hi() : group_limit(g, visit_.data());
+            if (visit_[g].bound.entry(cur.box, visit_[g].eps, t_hi) != kInf) reaching |= 1u << g;
+          });
+          if (reaching != 0 && leaf(tree.items.subspan(node.first_item(), node.item_count()), reaching)) return;
+        }
+      }
+      if (top == 0) return;
+      cur = stack[--top];
+    }
+  }
+
+  // Tests one world-space triangle for the live lanes of `lanes` of group g.
+  void test(int g, std::uint32_t lanes, const Vec3& p0, const Vec3& p1, const Vec3& p2, std::uint32_t triangle,
+            std::uint32_t instance) {
+    lanes &= live_[g];
+    if (lanes == 0) return;
+    counters_.triangle_tests += static_cast<std::uint64_t>(std::popcount(lanes));
+    Group& gr = group_[g];
+    if constexpr (kTest == TriangleTest::kWatertight) {
+      for_each_bit(lanes, [&](int lane) {
+        TriangleHit h;
+        if (intersect_triangle_watertight(watertight_[g][lane], world_ray(g, lane), gr.t_limit[lane], p0, p1, p2,
+                                          h)) {
+          if constexpr (kAnyHit) {
+            retire(g, lane);
+          } else {
+            record(g, lane, h.t, h.u, h.v, triangle, instance);
+          }
+        }
+      });
+    } else {
+      alignas(32) float t[kLanes], u[kLanes], v[kLanes];
+      const RayLanes8 lanes8{gr.o, gr.d, gr.t_min, gr.t_limit};
+      const std::uint32_t hit = intersect_triangle_fast8(lanes8, lanes, p0, p1, p2, t, u, v);
+      // The scalar test's last check, once per triangle.
+      if (hit == 0 || detail::zero_area(p1 - p0, p2 - p0)) return;
+      for_each_bit(hit, [&](int lane) {
+        if constexpr (kAnyHit) {
+          retire(g, lane);
+        } else {
+          record(g, lane, t[lane], u[lane], v[lane], triangle, instance);
+        }
+      });
+    }
+  }
+
+  void record(int g, int lane, float t, float u, float v, std::uint32_t triangle, std::uint32_t instance) {
+    group_[g].t_limit[lane] = t;
+    ++hits_recorded_;
+    const std::size_t k = static_cast<std::size_t>(g) * kLanes + static_cast<std::size_t>(lane);
+    out_.t[k] = t;
+    out_.u[k] = u;
+    out_.v[k] = v;
+    out_.triangle[k] = triangle;
+    out_.instance[k] = instance;
+  }
+
+  void retire(int g, int lane) {
+    blocked_[g] |= 1u << lane;
+    live_[g] &= ~(1u << lane);
+    if (live_[g] == 0) alive_groups_ &= ~(1u << g);
+  }
+
+  const Scene& scene_;
+  const LargePacketRays& rays_;
+  PacketHits out_;
+  int groups_;
+  std::array<Group, kMaxPacketGroups> group_;
+  std::array<VisitGroup, kMaxPacketGroups> visit_;
+  std::array<std::array<WatertightRay, kLanes>, kTest == TriangleTest::kWatertight ? kMaxPacketGroups : 1>
+      watertight_;
+  std::array<std::uint32_t, kMaxPacketGroups> live_{};
+  std::array<std::uint32_t, kMaxPacketGroups> valid_{};
+  std::array<std::uint32_t, kMaxPacketGroups> blocked_{};
+  std::uint32_t alive_groups_ = 0;
+  std::uint64_t hits_recorded_ = 0;
+  GroupMailbox mailbox_;
+  TraversalCounters counters_;
+};
+
+template <TriangleTest kTest, bool kAnyHit>
+void run_query(const Scene& scene, const LargePacketRays& rays, std::span<const std::uint32_t> objects, PacketHits out,
+               std::uint8_t* blocked, TraversalCounters* counters) {
+  LargeQuery<kTest, kAnyHit> query(scene, rays, out);
+  query.run(objects);
+  std::uint64_t rays_valid = 0;
+  for (int g = 0; g < std::clamp(rays.groups, 0, kMaxPacketGroups); ++g) {
+    rays_valid += static_cast<std::uint64_t>(std::popcount(query.valid_lanes(g)));
+    if (blocked) blocked[g] = query.blocked(g);
+  }
+  if (counters) {
+    counters->rays += rays_valid;
+    counters->node_visits += query.counters().node_visits;
+    counters->object_visits += query.counters().object_visits;
+    counters->triangle_tests += query.counters().triangle_tests;
+  }
+}
+
+}  // namespace
+
+void intersect_large_packet(const Scene& scene, const LargePacketRays& rays, TriangleTest test,
+                            std::span<const std::uint32_t> objects, PacketHits out, TraversalCounters* counters) {
+  if (test == TriangleTest::kWatertight) {
+    run_query<TriangleTest::kWatertight, false>(scene, rays, objects, out, nullptr, counters);
+  } else {
+    run_query<TriangleTest::kFast, false>(scene, rays, objects, out, nullptr, counters);
+  }
+}
+
+void occluded_large_packet(const Scene& scene, const LargePacketRays& rays, TriangleTest test,
+                           std::span<const std::uint32_t> objects, std::uint8_t* blocked,
+                           TraversalCounters* counters) {
+  const PacketHits none{nullptr, nullptr, nullptr, nullptr, nullptr};
+  if (test == TriangleTest::kWatertight) {
+    run_query<TriangleTest::kWatertight, true>(scene, rays, objects, none, blocked, counters);
+  } else {
+    run_query<TriangleTest::kFast, true>(scene, rays, objects, none, blocked, counters);
+  }
+}
+
+#else
+
+// Without AVX2 each group is an 8-ray packet (which is itself the single-ray
+// query per lane there).
+void intersect_large_packet(const Scene& scene, const LargePacketRays& rays, TriangleTest test,
+                            std::span<const std::uint32_t> objects, PacketHits out, TraversalCounters* counters) {
+  const ObjectFilter filter{objects};
+  (void)filter;
+  for (int g = 0; g < std::clamp(rays.groups, 0, kMaxPacketGroups); ++g) {
+    const std::size_t k0 = static_cast<std::size_t>(g) * kLanes;
+    const RayPacket p = group_packet(rays, g, rays.t_max + k0, rays.active[g]);
+    Hit hits[kPacketSize];
+    intersect_packet(scene, p, test, hits, counters);
+    for (int lane = 0; lane < kLanes; ++lane) {
+      const std::size_t k = k0 + static_cast<std::size_t>(lane);
+      out.t[k] = hits[lane].t;
+      out.u[k] = hits[lane].u;
+      out.v[k] = hits[lane].v;
+      out.triangle[k] = hits[lane].triangle_id;
+      out.instance[k] = hits[lane].instance_id;
+    }
+  }
+}
+
+void occluded_large_packet(const Scene& scene, const LargePacketRays& rays, TriangleTest test,
+                           std::span<const std::uint32_t> /*objects*/, std::uint8_t* blocked,
+                           TraversalCounters* counters) {
+  for (int g = 0; g < std::clamp(rays.groups, 0, kMaxPacketGroups); ++g) {
+    const std::size_t k0 = static_cast<std::size_t>(g) * kLanes;
+    const RayPacket p = group_packet(rays, g, rays.t_max + k0, rays.active[g]);
+    blocked[g] = occluded_packet(scene, p, test, counters);
+  }
+}
+
+#endif  // SINEW_LARGE_PACKET_AVX2
+
+}  // namespace sinew::rt

@@ -1,0 +1,65 @@
+// Large packets: up to 32 groups of eight rays (a tile's 8x8- or 16x16-pixel
+// region) traced together through the top level and every kd-tree. Where
+// the 8-ray packets of render/packet_traversal.h make each lane repeat the
+// single ray's walk, a large packet walks a tree once for all its rays,
+// culling whole cells with a conservative interval bound on the rays
+// (render/interval_bound.h): a cell costs one box test whatever the number
+// of rays, and a leaf's triangles are tested only by the groups whose own
+// bound reaches its cell.
+//
+// The bounds are carried into each bone's frame by bounding the rays after
+// the frame change (the transform is affine, so a ray stays a ray), and
+// every cell is grown by an upper bound on the single-ray traversal's
+// slack over the packet, so a lane reaches every cell its single ray
+// reaches. The triangle tests are the single ray's own, in world space, so
+// each lane's nearest hit has the single ray's t, u and v; the triangle can
+// differ only where two triangles give exactly the same t.
+//
+// Shadow rays to a point light all end at the light: their culling bounds
+// start there (the rays reversed), which is as tight as a camera's frustum
+// however far apart the shadowed points are.
+#pragma once
+
+#include <cstdint>
+#include <span>
+
+#include "raytrace/geometry/triangle_intersect.h"
+#include "raytrace/render/packet_traversal.h"
+#include "raytrace/render/traversal.h"
+#include "raytrace/scene/scene.h"
+
+namespace sinew::rt {
+
+inline constexpr int kMaxPacketGroups = 32;  // 256 rays: a 16x16-pixel region
+
+// A large packet's rays in place: 8 * groups lanes, every array contiguous
+// over them (unaligned is fine). Lanes whose bit in `active[group]` is 0 are
+// ignored but must hold finite values.
+struct LargePacketRays {
+  int groups = 0;  // 1 to kMaxPacketGroups
+  const float* o[3] = {};
+  const float* d[3] = {};
+  const float* t_min = nullptr;
+  const float* t_max = nullptr;
+  const std::uint8_t* active = nullptr;  // per group, bit i: lane i
+  // Every ray ends at one point, o + t_max d (shadow rays to a point
+  // light, t_max = 1 and d = light - o, up to rounding): culling bounds
+  // start there. Only an any-hit query reads it.
+  bool common_end = false;
+};
+
+// The nearest hits of every active lane, written to 8 * groups entries of
+// `out` (misses: t = inf, ids kInvalidId). `objects`: the top-level objects
+// (indices into scene.top_level().objects()) the rays may enter, in any
+// order; a superset is fine, the packet culls them again. Counters as the
+// 8-ray packets count them (node visits once per cell the packet fetches).
+void intersect_large_packet(const Scene& scene, const LargePacketRays& rays, TriangleTest test,
+                            std::span<const std::uint32_t> objects, PacketHits out, TraversalCounters* counters);
+
+// Occlusion of every active lane: blocked[g] bit i = lane i of group g is
+// blocked within [t_min, t_max).
+void occluded_large_packet(const Scene& scene, const LargePacketRays& rays, TriangleTest test,
+                           std::span<const std::uint32_t> objects, std::uint8_t* blocked,
+                           TraversalCounters* counters);
+
+}  // namespace sinew::rt
