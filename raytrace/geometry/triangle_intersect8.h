@@ -89,6 +89,83 @@ inline std::uint32_t intersect_triangle_fast8(const RayLanes8& r, std::uint32_t 
   return hit;
 }
 
+// A triangle's terms that depend only on the ray origin: for rays from one
+// point (a camera's, in a large packet) they are computed once per
+// triangle, not once per eight rays. Same expressions as the scalar test.
+struct CommonOriginTriangle {
+  Vec3 e1, e2;
+  Vec3 tv;          // origin - p0
+  Vec3 q;           // tv x e1
+  float t_numerator = 0.0f;  // e2 . q
+};
+
+inline CommonOriginTriangle prepare_common_origin(const Vec3& origin, const Vec3& p0, const Vec3& p1,
+                                                  const Vec3& p2) {
+  CommonOriginTriangle c;
+  c.e1 = p1 - p0;
+  c.e2 = p2 - p0;
+  c.tv = origin - p0;
+  c.q = Vec3(c.tv.y * c.e1.z - c.tv.z * c.e1.y, c.tv.z * c.e1.x - c.tv.x * c.e1.z,
+             c.tv.x * c.e1.y - c.tv.y * c.e1.x);
+  c.t_numerator = (c.e2.x * c.q.x + c.e2.y * c.q.y) + c.e2.z * c.q.z;
+  return c;
+}
+
+// intersect_triangle_fast8 for rays that all start at the origin `c` was
+// prepared with (r.o is not read): per lane the same values, bit for bit.
+inline std::uint32_t intersect_triangle_fast8_common_origin(const RayLanes8& r, std::uint32_t lanes,
+                                                            const CommonOriginTriangle& c, float* t_out,
+                                                            float* u_out, float* v_out) {
+  const __m256 e1x = _mm256_set1_ps(c.e1.x), e1y = _mm256_set1_ps(c.e1.y), e1z = _mm256_set1_ps(c.e1.z);
+  const __m256 e2x = _mm256_set1_ps(c.e2.x), e2y = _mm256_set1_ps(c.e2.y), e2z = _mm256_set1_ps(c.e2.z);
+  const __m256 dx = _mm256_load_ps(r.d[0]), dy = _mm256_load_ps(r.d[1]), dz = _mm256_load_ps(r.d[2]);
+  const auto mul = [](__m256 a, __m256 b) { return _mm256_mul_ps(a, b); };
+  const auto add = [](__m256 a, __m256 b) { return _mm256_add_ps(a, b); };
+  const auto sub = [](__m256 a, __m256 b) { return _mm256_sub_ps(a, b); };
+  const __m256 sign = _mm256_set1_ps(-0.0f);
+  const auto abs = [&sign](__m256 a) { return _mm256_andnot_ps(sign, a); };
+
+  const __m256 dy_e2z = mul(dy, e2z), dz_e2y = mul(dz, e2y);
+  const __m256 dz_e2x = mul(dz, e2x), dx_e2z = mul(dx, e2z);
+  const __m256 dx_e2y = mul(dx, e2y), dy_e2x = mul(dy, e2x);
+  const __m256 px = sub(dy_e2z, dz_e2y);
+  const __m256 py = sub(dz_e2x, dx_e2z);
+  const __m256 pz = sub(dx_e2y, dy_e2x);
+  const __m256 det = add(add(mul(e1x, px), mul(e1y, py)), mul(e1z, pz));
+  const __m256 abs_det = abs(det);
+  __m256 ok = _mm256_and_ps(_mm256_cmp_ps(abs_det, _mm256_setzero_ps(), _CMP_GT_OQ),
+                            _mm256_cmp_ps(abs_det, _mm256_set1_ps(detail::kFloatMax), _CMP_LE_OQ));
+  const __m256 det_bound = add(add(mul(abs(e1x), add(abs(dy_e2z), abs(dz_e2y))),
+                                   mul(abs(e1y), add(abs(dz_e2x), abs(dx_e2z)))),
+                               mul(abs(e1z), add(abs(dx_e2y), abs(dy_e2x))));
+  ok = _mm256_and_ps(ok, _mm256_cmp_ps(abs_det, mul(_mm256_set1_ps(detail::kFastDetTolerance), det_bound),
+                                       _CMP_GT_OQ));
+  if (_mm256_testz_ps(ok, ok) != 0) return 0;
+  const __m256 inv_det = _mm256_div_ps(_mm256_set1_ps(1.0f), det);
+  const __m256 u = mul(add(add(mul(_mm256_set1_ps(c.tv.x), px), mul(_mm256_set1_ps(c.tv.y), py)),
+                           mul(_mm256_set1_ps(c.tv.z), pz)),
+                       inv_det);
+  const __m256 v = mul(add(add(mul(dx, _mm256_set1_ps(c.q.x)), mul(dy, _mm256_set1_ps(c.q.y))),
+                           mul(dz, _mm256_set1_ps(c.q.z))),
+                       inv_det);
+  const __m256 t = mul(_mm256_set1_ps(c.t_numerator), inv_det);
+  const __m256 zero = _mm256_setzero_ps();
+  const __m256 one = _mm256_set1_ps(1.0f);
+  ok = _mm256_and_ps(ok, _mm256_and_ps(_mm256_cmp_ps(u, zero, _CMP_GE_OQ), _mm256_cmp_ps(u, one, _CMP_LE_OQ)));
+  ok = _mm256_and_ps(ok, _mm256_and_ps(_mm256_cmp_ps(v, zero, _CMP_GE_OQ),
+                                       _mm256_cmp_ps(add(u, v), one, _CMP_LE_OQ)));
+  ok = _mm256_and_ps(ok, _mm256_cmp_ps(t, _mm256_load_ps(r.t_min), _CMP_GE_OQ));
+  ok = _mm256_and_ps(ok, _mm256_cmp_ps(t, _mm256_load_ps(r.t_max), _CMP_LT_OQ));
+  ok = _mm256_and_ps(ok, _mm256_cmp_ps(t, _mm256_set1_ps(detail::kFloatMax), _CMP_LE_OQ));
+  const std::uint32_t hit = static_cast<std::uint32_t>(_mm256_movemask_ps(ok)) & lanes;
+  if (hit != 0) {
+    _mm256_storeu_ps(t_out, t);
+    _mm256_storeu_ps(u_out, u);
+    _mm256_storeu_ps(v_out, v);
+  }
+  return hit;
+}
+
 }  // namespace sinew::rt
 
 #endif  // __AVX2__

@@ -111,6 +111,13 @@ class IntervalBound {
       rlo[a] = lo - std::fabs(lo) * kRelativeMargin;
       rhi[a] = hi + std::fabs(hi) * kRelativeMargin;
     }
+    for (int a = 0; a < 3; ++a) {
+      axis_[a].o_lo = olo[a];
+      axis_[a].o_hi = ohi[a];
+      axis_[a].r_lo = rlo[a];
+      axis_[a].r_hi = rhi[a];
+      axis_[a].sign = pos[a] != 0.0f ? 1 : neg[a] != 0.0f ? -1 : 0;
+    }
     o_lo_ = _mm_load_ps(olo);
     o_hi_ = _mm_load_ps(ohi);
     r_lo_ = _mm_load_ps(rlo);
@@ -178,9 +185,34 @@ class IntervalBound {
   }
   float entry(const Aabb& box, float grow) const { return entry(box, grow, t_hi_); }
 
+  // The direction sign of every ray of the set on axis a: +1, -1, or 0
+  // (mixed, zero or too small to bound).
+  int sign(int a) const { return axis_[a].sign; }
+
+  // For an axis of fixed sign: bounds on the parameter at which the rays
+  // cross the plane x_a = plane, over every ray of the set (the plane
+  // offset by the caller's growth).
+  float crossing_lo(int a, float plane) const {
+    const Axis& x = axis_[a];
+    const float a0 = plane - x.o_hi, a1 = plane - x.o_lo;
+    const float mn = std::min(std::min(a0 * x.r_lo, a0 * x.r_hi), std::min(a1 * x.r_lo, a1 * x.r_hi));
+    return mn - std::fabs(mn) * kRelativeMargin;
+  }
+  float crossing_hi(int a, float plane) const {
+    const Axis& x = axis_[a];
+    const float a0 = plane - x.o_hi, a1 = plane - x.o_lo;
+    const float mx = std::max(std::max(a0 * x.r_lo, a0 * x.r_hi), std::max(a1 * x.r_lo, a1 * x.r_hi));
+    return mx + std::fabs(mx) * kRelativeMargin;
+  }
+
  private:
   __m128 o_lo_{}, o_hi_{}, r_lo_{}, r_hi_{};
   __m128 positive_{}, negative_{}, not_rising_{}, not_falling_{};
+  struct Axis {
+    float o_lo = 0.0f, o_hi = 0.0f, r_lo = 0.0f, r_hi = 0.0f;
+    int sign = 0;
+  };
+  Axis axis_[3];
   float t_lo_ = 0.0f, t_hi_ = 0.0f, o_mag_ = 0.0f;
   bool unbounded_ = false;
 };

@@ -140,11 +140,12 @@ std::uint32_t clip_lanes(const Aabb& box, Float8 eps, const Vec3x8& o, const Vec
   return (t0 <= t1).bits() & ~outside & mask;
 }
 
-// A kd-tree cell waiting on the stack, with its entry bound.
+// A kd-tree cell waiting on the stack, with the parameter range that
+// holds every ray's passage through it.
 struct Cell {
   Aabb box;
   std::uint32_t node;
-  float entry;
+  float t0, t1;
 };
 
 template <TriangleTest kTest, bool kAnyHit>
@@ -185,17 +186,26 @@ class LargeQuery {
       d_mag.store(gr.d_mag);
       select(use, t_min, Float8(none.t_min)).store(gr.t_min);
       select(use, t_max, Float8(none.t_max)).store(gr.t_limit);
-      if (live_[g] != 0) alive_groups_ |= 1u << g;
+      if (live_[g] != 0) {
+        if (alive_groups_ == 0) {
+          const int lane = std::countr_zero(live_[g]);
+          common_origin_at_ = Vec3(gr.o[0][lane], gr.o[1][lane], gr.o[2][lane]);
+          common_origin_ = true;
+        }
+        const Mask8 same = (o[0] == Float8(common_origin_at_.x)) & (o[1] == Float8(common_origin_at_.y)) &
+                           (o[2] == Float8(common_origin_at_.z));
+        common_origin_ = common_origin_ && (same.bits() & live_[g]) == live_[g];
+        alive_groups_ |= 1u << g;
+      }
       if constexpr (kTest == TriangleTest::kWatertight) {
         for_each_bit(live_[g], [&](int lane) { watertight_[g][lane] = prepare_watertight(world_ray(g, lane)); });
       }
       if constexpr (!kAnyHit) {
-        for (int lane = 0; lane < kLanes; ++lane) {
-          const std::size_t k = k0 + static_cast<std::size_t>(lane);
-          out_.t[k] = kInf;
-          out_.u[k] = out_.v[k] = 0.0f;
-          out_.triangle[k] = out_.instance[k] = kInvalidId;
-        }
+        Float8(kInf).store(out_.t + k0);
+        Float8(0.0f).store(out_.u + k0);
+        Float8(0.0f).store(out_.v + k0);
+        std::fill_n(out_.triangle + k0, kLanes, kInvalidId);
+        std::fill_n(out_.instance + k0, kLanes, kInvalidId);
       }
     }
   }
@@ -373,7 +383,7 @@ class LargeQuery {
       const Vec3& p0 = mesh.desc.positions[v[0]];
       const Vec3& p1 = mesh.desc.positions[v[1]];
       const Vec3& p2 = mesh.desc.positions[v[2]];
-      for_each_bit(groups, [&](int g) { test(g, visit_[g].lanes, p0, p1, p2, t, mesh.instance_id); });
+      test_groups(groups, p0, p1, p2, t, mesh.instance_id);
       groups &= alive_groups_;
     }
   }
@@ -480,7 +490,7 @@ class LargeQuery {
         const Vec3& p0 = frame.positions[v[0]];
         const Vec3& p1 = frame.positions[v[1]];
         const Vec3& p2 = frame.positions[v[2]];
-        for_each_bit(need, [&](int g) { test(g, visit_[g].lanes, p0, p1, p2, t, frame.instance_id); });
+        test_groups(need, p0, p1, p2, t, frame.instance_id);
         if (kAnyHit && (in_tree & alive_groups_) == 0) return true;
       }
       return false;
@@ -488,9 +498,13 @@ class LargeQuery {
     traverse(tree, bound, grow, in_tree, leaf);
   }
 
-  // Front to back over the cells the packet's bound reaches; at a leaf,
-  // the groups whose own bound reaches it test its triangles. `leaf`
-  // returns true to stop (every lane answered).
+  // Front to back over the cells the packet's bound reaches, each with a
+  // parameter range [t0, t1] that holds every ray's passage through it: on
+  // a split axis where every ray has one sign, the child ranges are cut at
+  // the bounds on where the rays cross the (thick) split plane, one
+  // product pair per node; elsewhere each child box is tested whole. At a
+  // leaf, the groups whose own bound reaches its cell test its triangles.
+  // `leaf` returns true to stop (every lane answered).
   template <class LeafFn>
   void traverse(const KdTreeView& tree, const IntervalBound& bound, float grow, std::uint32_t groups,
                 LeafFn& leaf) {
@@ -510,27 +524,51 @@ class LargeQuery {
     };
     std::array<Cell, kMaxTraversalDepth + 2> stack;
     std::size_t top = 0;
-    Cell cur{tree.bounds, 0, bound.entry(tree.bounds, grow, limit())};
-    if (cur.entry == kInf) return;
+    Cell cur{tree.bounds, 0, bound.entry(tree.bounds, grow, limit()), bound.t_hi()};
+    if (cur.t0 == kInf) return;
     for (;;) {
-      if (!(cur.entry > limit())) {
+      cur.t1 = std::min(cur.t1, limit());
+      if (cur.t0 <= cur.t1) {
         ++counters_.node_visits;
         const KdNode node = tree.nodes[cur.node];
         if (!node.is_leaf()) {
           const int a = node.axis();
           const float split = node.split();
-          Cell below{cur.box, cur.node + 1, 0.0f};
-          Cell above{cur.box, node.above_child(), 0.0f};
+          Cell below{cur.box, cur.node + 1, cur.t0, cur.t1};
+          Cell above{cur.box, node.above_child(), cur.t0, cur.t1};
           below.box.upper[a] = std::min(below.box.upper[a], split);
           above.box.lower[a] = std::max(above.box.lower[a], split);
-          const float t_hi = limit();
-          below.entry = bound.entry(below.box, grow, t_hi);
-          above.entry = bound.entry(above.box, grow, t_hi);
-          const bool below_first = !(above.entry < below.entry);
+          const int sign = bound.sign(a);
+          bool below_first = true;
+          if (sign > 0) {
+            // Rising rays: below until they cross split + grow, above from split - grow.
+            below.t1 = std::min(cur.t1, bound.crossing_hi(a, split + grow));
+            above.t0 = std::max(cur.t0, bound.crossing_lo(a, split - grow));
+          } else if (sign < 0) {
+            above.t1 = std::min(cur.t1, bound.crossing_hi(a, split - grow));
+            below.t0 = std::max(cur.t0, bound.crossing_lo(a, split + grow));
+            below_first = false;
+          } else {
+            const float eb = bound.entry(below.box, grow, cur.t1);
+            const float ea = bound.entry(above.box, grow, cur.t1);
+            below.t0 = std::max(cur.t0, eb);
+            above.t0 = std::max(cur.t0, ea);
+            if (eb == kInf) below.t0 = kInf;
+            if (ea == kInf) above.t0 = kInf;
+            below_first = !(above.t0 < below.t0);
+          }
           const Cell& near = below_first ? below : above;
           const Cell& far = below_first ? above : below;
-          if (near.entry != kInf) {
-            if (far.entry != kInf) stack[top++] = far;
+          const bool near_open = near.t0 <= near.t1;
+          if (far.t0 <= far.t1) {
+            if (near_open) {
+              stack[top++] = far;
+            } else {
+              cur = far;
+              continue;
+            }
+          }
+          if (near_open) {
             cur = near;
             continue;
           }
@@ -546,6 +584,34 @@ class LargeQuery {
       if (top == 0) return;
       cur = stack[--top];
     }
+  }
+
+  // Tests one world-space triangle for the live lanes of each group of
+  // `groups` that entered the current object (visit_[g].lanes).
+  void test_groups(std::uint32_t groups, const Vec3& p0, const Vec3& p1, const Vec3& p2, std::uint32_t triangle,
+                   std::uint32_t instance) {
+    if constexpr (kTest == TriangleTest::kFast) {
+      if (common_origin_) {
+        // The origin's terms once for every group; the zero-area check of
+        // the scalar test once per triangle, on the hit path.
+        const CommonOriginTriangle c = prepare_common_origin(common_origin_at_, p0, p1, p2);
+        int zero_area = -1;
+        for_each_bit(groups, [&](int g) {
+          const std::uint32_t lanes = visit_[g].lanes & live_[g];
+          if (lanes == 0) return;
+          counters_.triangle_tests += static_cast<std::uint64_t>(std::popcount(lanes));
+          Group& gr = group_[g];
+          alignas(32) float t[kLanes], u[kLanes], v[kLanes];
+          const RayLanes8 lanes8{gr.o, gr.d, gr.t_min, gr.t_limit};
+          const std::uint32_t hit = intersect_triangle_fast8_common_origin(lanes8, lanes, c, t, u, v);
+          if (hit == 0) return;
+          if (zero_area < 0) zero_area = detail::zero_area(c.e1, c.e2) ? 1 : 0;
+          if (zero_area == 0) record_lanes(g, hit, t, u, v, triangle, instance);
+        });
+        return;
+      }
+    }
+    for_each_bit(groups, [&](int g) { test(g, visit_[g].lanes, p0, p1, p2, triangle, instance); });
   }
 
   // Tests one world-space triangle for the live lanes of `lanes` of group g.
@@ -573,13 +639,32 @@ class LargeQuery {
       const std::uint32_t hit = intersect_triangle_fast8(lanes8, lanes, p0, p1, p2, t, u, v);
       // The scalar test's last check, once per triangle.
       if (hit == 0 || detail::zero_area(p1 - p0, p2 - p0)) return;
-      for_each_bit(hit, [&](int lane) {
-        if constexpr (kAnyHit) {
-          retire(g, lane);
-        } else {
-          record(g, lane, t[lane], u[lane], v[lane], triangle, instance);
-        }
+      if constexpr (kAnyHit) {
+        for_each_bit(hit, [&](int lane) { retire(g, lane); });
+      } else {
+        record_lanes(g, hit, t, u, v, triangle, instance);
+      }
+    }
+  }
+
+  // The hits of `lanes` of group g, eight lanes at once.
+  void record_lanes(int g, std::uint32_t lanes, const float* t, const float* u, const float* v,
+                    std::uint32_t triangle, std::uint32_t instance) {
+    if constexpr (kAnyHit) {
+      for_each_bit(lanes, [&](int lane) { retire(g, lane); });
+    } else {
+      const std::size_t k0 = static_cast<std::size_t>(g) * kLanes;
+      const Mask8 m = Mask8::from_bits(lanes);
+      const Float8 tt = Float8::load(t);
+      select(m, tt, Float8::load(group_[g].t_limit)).store(group_[g].t_limit);
+      select(m, tt, Float8::load(out_.t + k0)).store(out_.t + k0);
+      select(m, Float8::load(u), Float8::load(out_.u + k0)).store(out_.u + k0);
+      select(m, Float8::load(v), Float8::load(out_.v + k0)).store(out_.v + k0);
+      for_each_bit(lanes, [&](int lane) {
+        out_.triangle[k0 + static_cast<std::size_t>(lane)] = triangle;
+        out_.instance[k0 + static_cast<std::size_t>(lane)] = instance;
       });
+      ++hits_recorded_;
     }
   }
 
@@ -613,6 +698,8 @@ class LargeQuery {
   std::array<std::uint32_t, kMaxPacketGroups> blocked_{};
   std::uint32_t alive_groups_ = 0;
   std::uint64_t hits_recorded_ = 0;
+  bool common_origin_ = false;  // every live lane starts at common_origin_at_
+  Vec3 common_origin_at_{0.0f};
   GroupMailbox mailbox_;
   TraversalCounters counters_;
 };
