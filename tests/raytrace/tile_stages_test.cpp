@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -18,6 +19,7 @@
 #include <vector>
 
 #include "raytrace/camera/camera.h"
+#include "raytrace/render/large_packet.h"
 #include "raytrace/render/packet_traversal.h"
 #include "raytrace/render/ray_bound.h"
 #include "raytrace/render/renderer.h"
@@ -206,6 +208,174 @@ TEST(PacketCulling, CulledPacketsFindTheSingleRayHits) {
     }
   }
   EXPECT_GT(hits, checked / 5);
+}
+
+// Random large packets (1 to 32 groups) around the characters: shared
+// origins with coherent directions, scattered origins with mixed direction
+// signs, origins inside bone boxes, partial lane masks and finite t ranges,
+// invalid lanes; given every object or only the tile's cull. Each lane's
+// nearest hit and occlusion are the single ray's (the fallback instance
+// goes through the 8-ray path, the ground through the small-static tests).
+TEST(LargePackets, FindTheSingleRayHits) {
+  const rt::Scene& s = scene();
+  std::mt19937 g(23);
+  const Vec3 c(0.0f, 0.9f, 0.0f);
+  const std::span<const rt::TopLevelObject> objects = s.top_level().objects();
+  std::vector<std::uint32_t> every(objects.size());
+  for (std::uint32_t i = 0; i < every.size(); ++i) every[i] = i;
+  std::size_t hits = 0, checked = 0;
+  for (int p = 0; p < 240; ++p) {
+    const int groups = std::array<int, 4>{1, 3, 8, 32}[static_cast<std::size_t>(p % 4)];
+    const std::size_t n = static_cast<std::size_t>(groups) * 8;
+    std::vector<float> o[3], d[3], t0(n, 0.0f), t1(n, kInf);
+    for (int a = 0; a < 3; ++a) {
+      o[a].resize(n);
+      d[a].resize(n);
+    }
+    std::vector<std::uint8_t> active(static_cast<std::size_t>(groups));
+    const int mode = (p / 4) % 4;
+    const Vec3 shared = c + Vec3(unit(g) - 0.5f, unit(g) - 0.5f, unit(g) - 0.5f) * 4.0f;
+    const Vec3 aim = c + Vec3(unit(g) - 0.5f, unit(g) * 1.6f - 0.8f, unit(g) - 0.5f);
+    const float spread = p % 3 == 0 ? 0.05f : 0.6f;
+    for (std::size_t k = 0; k < n; ++k) {
+      Vec3 origin;
+      if (mode == 0) {
+        origin = shared;
+      } else if (mode == 1) {
+        origin = c + Vec3(unit(g) - 0.5f, unit(g) - 0.5f, unit(g) - 0.5f) * 2.0f;
+      } else {
+        const Aabb& box = objects[g() % objects.size()].box;
+        origin = box.lower + Vec3(unit(g), unit(g), unit(g)) * (box.upper - box.lower);
+      }
+      const Vec3 target = aim + Vec3(unit(g) - 0.5f, unit(g) - 0.5f, unit(g) - 0.5f) * spread;
+      Vec3 dir = mode == 3 ? Vec3(unit(g) - 0.5f, unit(g) - 0.5f, unit(g) - 0.5f) : target - origin;
+      if (dir == Vec3(0.0f)) dir = Vec3(0.0f, -1.0f, 0.0f);
+      if (p % 5 == 0) t1[k] = 0.5f + unit(g);
+      if (k == 5 && p % 6 == 0) dir = Vec3(0.0f);  // invalid: zero direction
+      if (k == 9 && p % 6 == 0) origin.x = std::numeric_limits<float>::quiet_NaN();
+      for (int a = 0; a < 3; ++a) {
+        o[a][k] = origin[a];
+        d[a][k] = dir[a];
+      }
+    }
+    for (auto& bits : active) bits = static_cast<std::uint8_t>(p % 7 == 0 ? (g() & 0xFFu) : 0xFFu);
+    rt::LargePacketRays rays;
+    rays.groups = groups;
+    for (int a = 0; a < 3; ++a) {
+      rays.o[a] = o[a].data();
+      rays.d[a] = d[a].data();
+    }
+    rays.t_min = t0.data();
+    rays.t_max = t1.data();
+    rays.active = active.data();
+    // The tile's cull, as the renderer does, or every object.
+    std::vector<std::uint32_t> tile;
+    rt::RayBound bound;
+    for (int gr = 0; gr < groups; ++gr) {
+      const std::size_t k0 = static_cast<std::size_t>(gr) * 8;
+      const float* const op[3] = {&o[0][k0], &o[1][k0], &o[2][k0]};
+      const float* const dp[3] = {&d[0][k0], &d[1][k0], &d[2][k0]};
+      bound.add_lanes(op, dp, &t0[k0], &t1[k0], active[static_cast<std::size_t>(gr)]);
+    }
+    rt::cull_objects(s, bound, tile);
+    const std::vector<std::uint32_t>& candidates = p % 2 == 0 ? tile : every;
+    for (const TriangleTest test : kTests) {
+      std::vector<float> ht(n), hu(n), hv(n);
+      std::vector<std::uint32_t> htri(n), hinst(n);
+      rt::TraversalCounters counters;
+      rt::intersect_large_packet(s, rays, test, candidates,
+                                 rt::PacketHits{ht.data(), hu.data(), hv.data(), htri.data(), hinst.data()},
+                                 &counters);
+      std::vector<std::uint8_t> blocked(static_cast<std::size_t>(groups));
+      rt::occluded_large_packet(s, rays, test, candidates, blocked.data(), nullptr);
+      for (std::size_t k = 0; k < n; ++k) {
+        const bool on = (active[k / 8] >> (k % 8) & 1u) != 0;
+        Ray ray;
+        ray.origin = Vec3(o[0][k], o[1][k], o[2][k]);
+        ray.direction = Vec3(d[0][k], d[1][k], d[2][k]);
+        ray.t_min = t0[k];
+        ray.t_max = t1[k];
+        const Hit single = on ? rt::intersect(s, ray, test) : Hit{};
+        ++checked;
+        hits += single.valid() ? 1 : 0;
+        ASSERT_EQ(htri[k], single.triangle_id) << "packet " << p << " ray " << k;
+        ASSERT_EQ(hinst[k], single.instance_id) << "packet " << p << " ray " << k;
+        if (single.valid()) {
+          ASSERT_EQ(ht[k], single.t) << "packet " << p << " ray " << k;
+        }
+        ASSERT_EQ((blocked[k / 8] >> (k % 8) & 1u) != 0, on && rt::occluded(s, ray, test))
+            << "packet " << p << " ray " << k;
+      }
+    }
+  }
+  EXPECT_GT(hits, checked / 6);
+}
+
+// Shadow rays from surface points to a point light (common_end: culled
+// from the light), the light outside, inside a character's bone box and
+// on the ground; the occlusion of every ray is the single ray's.
+TEST(LargePackets, ShadowRaysToAPointLightMatchSingleRays) {
+  const rt::Scene& s = scene();
+  std::mt19937 g(5);
+  const std::span<const rt::TopLevelObject> objects = s.top_level().objects();
+  const Vec3 lights[] = {Vec3(2.0f, 4.0f, 3.0f), objects[objects.size() / 2].box.center(),
+                         Vec3(0.3f, 0.0f, 0.8f), Vec3(-0.4f, 1.1f, -0.6f)};
+  std::size_t blocked_count = 0, checked = 0;
+  for (const Vec3& light : lights) {
+    for (int p = 0; p < 60; ++p) {
+      const int groups = 1 + static_cast<int>(g() % 32);
+      const std::size_t n = static_cast<std::size_t>(groups) * 8;
+      std::vector<float> o[3], d[3], t0(n, 0.0f), t1(n, 1.0f);
+      for (int a = 0; a < 3; ++a) {
+        o[a].resize(n);
+        d[a].resize(n);
+      }
+      // Points on the characters and the ground, found by rays from a
+      // camera-like point through the scene.
+      const Vec3 eye(unit(g) * 4.0f - 2.0f, 0.5f + unit(g) * 2.0f, 3.0f);
+      const Vec3 aim(unit(g) - 0.5f, unit(g) * 1.8f, unit(g) - 0.5f);
+      for (std::size_t k = 0; k < n; ++k) {
+        Ray ray;
+        ray.origin = eye;
+        ray.direction = aim + Vec3(unit(g) - 0.5f, unit(g) - 0.5f, unit(g) - 0.5f) * 0.4f - eye;
+        const Hit hit = rt::intersect(s, ray, TriangleTest::kFast);
+        const Vec3 at = hit.valid() ? ray.at(hit.t * 0.9999f) : Vec3(unit(g), 0.001f, unit(g));
+        for (int a = 0; a < 3; ++a) {
+          o[a][k] = at[a];
+          d[a][k] = light[a] - at[a];
+        }
+      }
+      std::vector<std::uint8_t> active(static_cast<std::size_t>(groups), 0xFFu);
+      rt::LargePacketRays rays;
+      rays.groups = groups;
+      for (int a = 0; a < 3; ++a) {
+        rays.o[a] = o[a].data();
+        rays.d[a] = d[a].data();
+      }
+      rays.t_min = t0.data();
+      rays.t_max = t1.data();
+      rays.active = active.data();
+      rays.common_end = true;
+      std::vector<std::uint32_t> every(objects.size());
+      for (std::uint32_t i = 0; i < every.size(); ++i) every[i] = i;
+      for (const TriangleTest test : kTests) {
+        std::vector<std::uint8_t> blocked(static_cast<std::size_t>(groups));
+        rt::occluded_large_packet(s, rays, test, every, blocked.data(), nullptr);
+        for (std::size_t k = 0; k < n; ++k) {
+          Ray ray;
+          ray.origin = Vec3(o[0][k], o[1][k], o[2][k]);
+          ray.direction = Vec3(d[0][k], d[1][k], d[2][k]);
+          ray.t_max = 1.0f;
+          const bool single = rt::occluded(s, ray, test);
+          ++checked;
+          blocked_count += single ? 1 : 0;
+          ASSERT_EQ((blocked[k / 8] >> (k % 8) & 1u) != 0, single) << "ray " << k;
+        }
+      }
+    }
+  }
+  EXPECT_GT(blocked_count, checked / 20);
+  EXPECT_LT(blocked_count, checked - checked / 20);
 }
 
 TEST(TileStages, CameraDirectionsAreTheCameraRays) {
