@@ -172,11 +172,44 @@ MeshRefs mesh_refs(const Scene& scene, const Scene::ObjectSlot& slot) {
 }
 
 // Each lane's corners, corner normals and albedo, lane by lane (lanes
-// without a hit get a harmless unit triangle).
-void gather_lanes(const Scene& scene, const TileScratch& s, std::size_t k0, std::uint32_t hits,
+// without a hit get a harmless unit triangle). Returns true when every lane
+// hit one triangle, loaded once and broadcast.
+bool gather_lanes(const Scene& scene, const TileScratch& s, std::size_t k0, std::uint32_t hits,
                   const Vec3& default_albedo, float (&p)[3][3][8], float (&n)[3][3][8], float (&albedo)[3][8],
                   std::uint32_t& with_normals) {
   const std::span<const Scene::ObjectSlot> slots = scene.object_slots();
+  // One triangle under every hit lane (most blocks of a ground or of a
+  // close-up): load it once and broadcast it.
+  const int first = std::countr_zero(hits);
+  bool uniform = true;
+  for (int lane = first + 1; lane < kBlockLanes && uniform; ++lane) {
+    const std::size_t k = k0 + static_cast<std::size_t>(lane);
+    uniform = !(hits >> lane & 1u) ||
+              (s.triangle[k] == s.triangle[k0 + static_cast<std::size_t>(first)] &&
+               s.instance[k] == s.instance[k0 + static_cast<std::size_t>(first)]);
+  }
+  if (uniform && hits == 0xFFu) {
+    const std::size_t k = k0 + static_cast<std::size_t>(first);
+    const MeshRefs mesh = mesh_refs(scene, slots[s.instance[k]]);
+    const std::uint32_t tri = s.triangle[k];
+    const auto& v = mesh.triangles[tri];
+    const bool normals = !mesh.normals.empty();
+    for (int i = 0; i < 3; ++i) {
+      const Vec3& c = mesh.positions[v[static_cast<std::size_t>(i)]];
+      const Vec3 nn = normals ? mesh.normals[v[static_cast<std::size_t>(i)]] : Vec3(0.0f);
+      for (int a = 0; a < 3; ++a) {
+        Float8(c[a]).store(p[i][a]);
+        Float8(nn[a]).store(n[i][a]);
+      }
+    }
+    if (normals) with_normals = 0xFFu;
+    const std::uint32_t m = tri < mesh.triangle_material.size() ? mesh.triangle_material[tri]
+                            : mesh.is_static                     ? 0u
+                                                                 : kInvalidId;
+    const Vec3 color = m < mesh.material_colors.size() ? mesh.material_colors[m] : default_albedo;
+    for (int a = 0; a < 3; ++a) Float8(color[a]).store(albedo[a]);
+    return true;
+  }
     // The mesh behind the last instance seen: neighbouring lanes mostly hit
     // the same one.
     std::uint32_t resolved = kInvalidId;
@@ -213,6 +246,7 @@ void gather_lanes(const Scene& scene, const TileScratch& s, std::size_t k0, std:
       }
       for (int a = 0; a < 3; ++a) albedo[a][lane] = color[a];
     }
+    return false;
 }
 
 // Of the tile's objects, those `packet` may enter, into lists.packet. With
@@ -531,7 +565,7 @@ void reconstruct_surfaces(const Scene& scene, const Vec3& default_albedo, TileSc
     alignas(32) float albedo[3][8];
     std::uint32_t with_normals = 0;
     // Lane by lane: AVX2 gathers measured slower here (Zen 4).
-    gather_lanes(scene, s, k0, hits, default_albedo, p, n, albedo, with_normals);
+    const bool uniform = gather_lanes(scene, s, k0, hits, default_albedo, p, n, albedo, with_normals);
     // surface_at's arithmetic, eight lanes at once.
     const auto corner = [&](const float (&c)[3][3][8], int i) {
       return Vec3x8{Float8::load(c[i][0]), Float8::load(c[i][1]), Float8::load(c[i][2])};
@@ -545,19 +579,35 @@ void reconstruct_surfaces(const Scene& scene, const Vec3& default_albedo, TileSc
     for (const Vec3x8* c : {&p0, &p1, &p2}) {
       magnitude = max(magnitude, max(max(abs(c->x), abs(c->y)), abs(c->z)));
     }
-    const Vec3x8 cross_n = cross(p1 - p0, p2 - p0);
-    const Float8 length = sqrt(dot(cross_n, cross_n));
-    const Mask8 usable = (length > Float8(0.0f)) & is_finite(length);
-    Vec3x8 geometric = select(usable, Vec3x8{cross_n.x / length, cross_n.y / length, cross_n.z / length},
-                              Vec3x8{Float8(0.0f), Float8(0.0f), Float8(1.0f)});
-    const Vec3x8 shading_sum = (w * corner(n, 0) + u * corner(n, 1)) + v * corner(n, 2);
-    const Float8 shading_length =
-        select(Mask8::from_bits(with_normals), sqrt(dot(shading_sum, shading_sum)), Float8(0.0f));
-    const Mask8 shading_usable = (shading_length > Float8(0.0f)) & is_finite(shading_length);
-    Vec3x8 shading = select(shading_usable,
-                            Vec3x8{shading_sum.x / shading_length, shading_sum.y / shading_length,
-                                   shading_sum.z / shading_length},
-                            geometric);
+    Vec3x8 geometric;
+    if (uniform) {
+      // One triangle: its normal once, with the lanes' very expressions.
+      const Vec3 q0(p[0][0][0], p[0][1][0], p[0][2][0]), q1(p[1][0][0], p[1][1][0], p[1][2][0]),
+          q2(p[2][0][0], p[2][1][0], p[2][2][0]);
+      const Vec3 a = q1 - q0, c = q2 - q0;
+      const Vec3 cross_n(a.y * c.z - c.y * a.z, a.z * c.x - c.z * a.x, a.x * c.y - c.x * a.y);
+      const float length = std::sqrt(cross_n.x * cross_n.x + cross_n.y * cross_n.y + cross_n.z * cross_n.z);
+      const bool usable = length > 0.0f && std::isfinite(length);
+      const Vec3 g = usable ? Vec3(cross_n.x / length, cross_n.y / length, cross_n.z / length) : Vec3(0, 0, 1);
+      geometric = Vec3x8{Float8(g.x), Float8(g.y), Float8(g.z)};
+    } else {
+      const Vec3x8 cross_n = cross(p1 - p0, p2 - p0);
+      const Float8 length = sqrt(dot(cross_n, cross_n));
+      const Mask8 usable = (length > Float8(0.0f)) & is_finite(length);
+      geometric = select(usable, Vec3x8{cross_n.x / length, cross_n.y / length, cross_n.z / length},
+                         Vec3x8{Float8(0.0f), Float8(0.0f), Float8(1.0f)});
+    }
+    Vec3x8 shading = geometric;
+    if (with_normals != 0) {
+      const Vec3x8 shading_sum = (w * corner(n, 0) + u * corner(n, 1)) + v * corner(n, 2);
+      const Float8 shading_length =
+          select(Mask8::from_bits(with_normals), sqrt(dot(shading_sum, shading_sum)), Float8(0.0f));
+      const Mask8 shading_usable = (shading_length > Float8(0.0f)) & is_finite(shading_length);
+      shading = select(shading_usable,
+                       Vec3x8{shading_sum.x / shading_length, shading_sum.y / shading_length,
+                              shading_sum.z / shading_length},
+                       geometric);
+    }
     // Both normals onto the camera's side of the surface.
     const Vec3x8 dir = load3(s.dir_x, s.dir_y, s.dir_z, k0);
     const Mask8 back = dot(geometric, dir) > Float8(0.0f);
@@ -611,25 +661,19 @@ void make_shadow_rays(const Light& light, int l, TileScratch& s) {
     const Vec3x8 moved = position + offset;
     const Vec3x8 origin{step_away(moved.x, offset.x), step_away(moved.y, offset.y), step_away(moved.z, offset.z)};
     const Vec3x8 direction = point ? light_at - origin : light_dir;
-    alignas(32) float o[3][8], d[3][8];
-    origin.x.store(o[0]);
-    origin.y.store(o[1]);
-    origin.z.store(o[2]);
-    direction.x.store(d[0]);
-    direction.y.store(d[1]);
-    direction.z.store(d[2]);
-    for (std::uint32_t m = toward; m != 0; m &= m - 1) {
-      const int lane = std::countr_zero(m);
-      const std::size_t i = s.shadow_count++;
-      s.shadow_pixel[i] = static_cast<std::uint32_t>(k0 + static_cast<std::size_t>(lane));
-      s.so_x[i] = o[0][lane];
-      s.so_y[i] = o[1][lane];
-      s.so_z[i] = o[2][lane];
-      s.sd_x[i] = d[0][lane];
-      s.sd_y[i] = d[1][lane];
-      s.sd_z[i] = d[2][lane];
-      s.s_tmax[i] = point ? 1.0f : kInf;
-    }
+    // Compacted eight lanes at a time (the arrays have a spare group).
+    const std::size_t i = s.shadow_count;
+    compress_store(&s.so_x[i], origin.x, toward);
+    compress_store(&s.so_y[i], origin.y, toward);
+    compress_store(&s.so_z[i], origin.z, toward);
+    compress_store(&s.sd_x[i], direction.x, toward);
+    compress_store(&s.sd_y[i], direction.y, toward);
+    compress_store(&s.sd_z[i], direction.z, toward);
+    Float8(point ? 1.0f : kInf).store(&s.s_tmax[i]);
+    alignas(32) std::uint32_t pixel[8];
+    for (int lane = 0; lane < 8; ++lane) pixel[lane] = static_cast<std::uint32_t>(k0) + static_cast<std::uint32_t>(lane);
+    compress_store(&s.shadow_pixel[i], pixel, toward);
+    s.shadow_count += static_cast<std::size_t>(std::popcount(toward));
   }
   // Close the last run; drop a trailing start that no ray followed.
   if (!s.shadow_region_begin.empty() && s.shadow_region_begin.back() == s.shadow_count) {

@@ -92,6 +92,35 @@ inline float reduce_max(Float8 a) {
   return _mm_cvtss_f32(m);
 }
 
+namespace detail {
+// Per 8-bit mask, the lanes it selects packed to the front (a permutation).
+struct CompressTable {
+  alignas(32) std::int32_t index[256][8];
+  CompressTable() {
+    for (int m = 0; m < 256; ++m) {
+      int n = 0;
+      for (int i = 0; i < 8; ++i) {
+        if (m >> i & 1) index[m][n++] = i;
+      }
+      for (; n < 8; ++n) index[m][n] = 0;
+    }
+  }
+};
+inline const CompressTable kCompressTable;
+}  // namespace detail
+
+// Writes the lanes of `mask` (bit i: lane i) to out[0 .. popcount - 1], in
+// lane order; out must have room for eight (the rest is overwritten).
+inline void compress_store(float* out, Float8 a, std::uint32_t mask) {
+  const __m256i perm = _mm256_load_si256(reinterpret_cast<const __m256i*>(detail::kCompressTable.index[mask & 0xFFu]));
+  _mm256_storeu_ps(out, _mm256_permutevar8x32_ps(a.v, perm));
+}
+inline void compress_store(std::uint32_t* out, const std::uint32_t* in, std::uint32_t mask) {
+  const __m256i perm = _mm256_load_si256(reinterpret_cast<const __m256i*>(detail::kCompressTable.index[mask & 0xFFu]));
+  const __m256i v = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(in));
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(out), _mm256_permutevar8x32_epi32(v, perm));
+}
+
 #else  // lane by lane
 
 struct Mask8 {
@@ -172,6 +201,18 @@ inline float reduce_max(Float8 a) {
   float m = a.v[0];
   for (int i = 1; i < 8; ++i) m = a.v[i] > m ? a.v[i] : m;
   return m;
+}
+inline void compress_store(float* out, Float8 a, std::uint32_t mask) {
+  int n = 0;
+  for (int i = 0; i < 8; ++i) {
+    if (mask >> i & 1u) out[n++] = a.v[i];
+  }
+}
+inline void compress_store(std::uint32_t* out, const std::uint32_t* in, std::uint32_t mask) {
+  int n = 0;
+  for (int i = 0; i < 8; ++i) {
+    if (mask >> i & 1u) out[n++] = in[i];
+  }
 }
 
 #endif
