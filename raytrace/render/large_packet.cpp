@@ -78,34 +78,42 @@ struct alignas(32) Group {
 struct alignas(32) VisitGroup {
   float t0[kLanes];
   float t1[kLanes];
-  std::uint32_t lanes = 0;
-  float eps = 0.0f;  // the largest slack of its lanes, plus the bound's own rounding
-  IntervalBound bound;
+  // In a bone's tree: the lanes' rays in the bone frame and their slack,
+  // for the exact lane clip against a leaf's cell.
+  float o[3][kLanes], d[3][kLanes], inv[3][kLanes];
+  float lane_eps[kLanes];
+  std::uint32_t lanes = 0;       // the lanes that entered the object
+  std::uint32_t leaf_lanes = 0;  // of those, the ones whose ray reaches the current leaf (or object)
+  Vec3x8 origin() const { return {Float8::load(o[0]), Float8::load(o[1]), Float8::load(o[2])}; }
+  Vec3x8 direction() const { return {Float8::load(d[0]), Float8::load(d[1]), Float8::load(d[2])}; }
+  Vec3x8 inverse() const { return {Float8::load(inv[0]), Float8::load(inv[1]), Float8::load(inv[2])}; }
 };
 
-// Per object visit, which groups have tested a triangle: a triangle whose
-// fuzzy box straddles splits is listed in several leaves. Direct-mapped on
-// the id's low bits; a group that tests a triangle twice (after an
-// eviction) gets the same answer, which cannot beat its best t strictly.
-class GroupMailbox {
+// Per object visit, which lanes of each group have tested a triangle: a
+// triangle whose fuzzy box straddles splits is listed in several leaves.
+// Direct-mapped on (triangle, group); a lane that tests a triangle twice
+// (after an eviction) gets the same answer, which cannot beat its best t
+// strictly.
+class LaneMailbox {
  public:
-  void reset() { ids_.fill(kInvalidId); }
-  // Of `groups`, those that have not tested `id` yet (marking them).
-  std::uint32_t untested(std::uint32_t id, std::uint32_t groups) {
-    const std::size_t slot = id & (ids_.size() - 1);
-    if (ids_[slot] != id) {
-      ids_[slot] = id;
-      groups_[slot] = groups;
-      return groups;
+  void reset() { keys_.fill(kInvalidId); }
+  // Of `lanes` of group g, those that have not tested `id` yet (marking them).
+  std::uint32_t untested(std::uint32_t id, int g, std::uint32_t lanes) {
+    const std::uint32_t key = id * kMaxPacketGroups + static_cast<std::uint32_t>(g);
+    const std::size_t slot = (id * 7u + static_cast<std::uint32_t>(g)) & (keys_.size() - 1);
+    if (keys_[slot] != key) {
+      keys_[slot] = key;
+      lanes_[slot] = static_cast<std::uint8_t>(lanes);
+      return lanes;
     }
-    const std::uint32_t fresh = groups & ~groups_[slot];
-    groups_[slot] |= groups;
+    const std::uint32_t fresh = lanes & ~std::uint32_t{lanes_[slot]};
+    lanes_[slot] = static_cast<std::uint8_t>(lanes_[slot] | lanes);
     return fresh;
   }
 
  private:
-  std::array<std::uint32_t, 64> ids_{};
-  std::array<std::uint32_t, 64> groups_{};
+  std::array<std::uint32_t, 256> keys_{};
+  std::array<std::uint8_t, 256> lanes_{};
 };
 
 // The single-ray traversal's slack for a world-space box of magnitude
@@ -151,8 +159,17 @@ struct Cell {
 template <TriangleTest kTest, bool kAnyHit>
 class LargeQuery {
  public:
-  LargeQuery(const Scene& scene, const LargePacketRays& rays, PacketHits out)
-      : scene_(scene), rays_(rays), out_(out), groups_(std::clamp(rays.groups, 0, kMaxPacketGroups)) {
+  // The query's state is tens of kilobytes: one object per thread is
+  // reused, start() resetting what one packet reads.
+  void start(const Scene& scene, const LargePacketRays& rays, PacketHits out) {
+    scene_p_ = &scene;
+    rays_p_ = &rays;
+    out_ = out;
+    groups_ = std::clamp(rays.groups, 0, kMaxPacketGroups);
+    alive_groups_ = 0;
+    hits_recorded_ = 0;
+    common_origin_ = false;
+    counters_ = {};
     const Ray none{};
     for (int g = 0; g < groups_; ++g) {
       const std::size_t k0 = static_cast<std::size_t>(g) * kLanes;
@@ -171,6 +188,7 @@ class LargeQuery {
       }
       live_[g] = (valid & nonzero).bits() & rays.active[g];
       valid_[g] = live_[g];
+      blocked_[g] = 0;
       const Mask8 use = Mask8::from_bits(live_[g]);
       Float8 o_mag(0.0f), d_mag(0.0f);
       for (int a = 0; a < 3; ++a) {
@@ -178,7 +196,6 @@ class LargeQuery {
         d[a] = select(use, d[a], Float8(none.direction[a]));
         o[a].store(gr.o[a]);
         d[a].store(gr.d[a]);
-        (Float8(1.0f) / d[a]).store(gr.inv[a]);  // correctly rounded, like the single ray's
         o_mag = max(o_mag, abs(o[a]));
         d_mag = max(d_mag, abs(d[a]));
       }
@@ -212,39 +229,35 @@ class LargeQuery {
 
   void run(std::span<const std::uint32_t> objects) {
     if (alive_groups_ == 0 || objects.empty()) return;
-    const std::span<const TopLevelObject> all = scene_.top_level().objects();
+    const std::span<const TopLevelObject> all = scene_ref().top_level().objects();
     // The packet's bound in world space and a bound on the slack of every
     // single-ray box clip (RayBound::world_slack_bound's reasoning: a
     // finite reach ends inside the scene).
-    RayRanges ranges;
-    bool first = true;
-    float o_mag = 0.0f, d_mag = 0.0f, t_hi = 0.0f;
+    RangeAccumulator acc;
+    Float8 o_mag8(0.0f), d_mag8(0.0f), t_hi8(0.0f);
     const bool reversed = use_reversed();
     for_each_bit(alive_groups_, [&](int g) {
       const Group& gr = group_[g];
       const Mask8 use = Mask8::from_bits(live_[g]);
       const Float8 t_max = Float8::load(gr.t_limit);
-      const RayRanges r = reversed ? reversed_ranges(gr.origin(), gr.direction(), Float8::load(gr.t_min), t_max,
-                                                     t_max, live_[g])
-                                   : lane_ranges(gr.origin(), gr.direction(), Float8::load(gr.t_min), t_max,
-                                                 live_[g]);
-      if (first) {
-        ranges = r;
-        first = false;
+      if (reversed) {
+        add_reversed(acc, gr.origin(), gr.direction(), Float8::load(gr.t_min), t_max, t_max, live_[g]);
       } else {
-        ranges.unite(r);
+        acc.add(gr.origin(), gr.direction(), Float8::load(gr.t_min), t_max, live_[g]);
       }
-      o_mag = std::max(o_mag, reduce_max(select(use, Float8::load(gr.o_mag), Float8(0.0f))));
-      d_mag = std::max(d_mag, reduce_max(select(use, Float8::load(gr.d_mag), Float8(0.0f))));
-      t_hi = std::max(t_hi, reduce_max(select(use, t_max, Float8(0.0f))));
+      o_mag8 = max(o_mag8, select(use, Float8::load(gr.o_mag), Float8(0.0f)));
+      d_mag8 = max(d_mag8, select(use, Float8::load(gr.d_mag), Float8(0.0f)));
+      t_hi8 = max(t_hi8, select(use, t_max, Float8(0.0f)));
     });
+    const RayRanges ranges = acc.ranges();
+    const float o_mag = reduce_max(o_mag8), d_mag = reduce_max(d_mag8), t_hi = reduce_max(t_hi8);
     const IntervalBound bound(ranges);
-    const float scene_magnitude = max_abs(scene_.top_level().bounds());
+    const float scene_magnitude = max_abs(scene_ref().top_level().bounds());
     float reach = 1.01f * (o_mag + scene_magnitude);
     if (std::isfinite(t_hi)) reach = std::max(reach, t_hi * d_mag * 1.01f);
     float slack = kFrameRelativeSlack * 1.01f * (o_mag + reach + scene_magnitude);
     if (reversed) slack += reversed_slack(o_mag, d_mag, t_hi);
-    const float grow = bound.grow_for(scene_.top_level().bounds(), slack);
+    const float grow = bound.grow_for(scene_ref().top_level().bounds(), slack);
     struct Candidate {
       float entry;
       std::uint32_t object;
@@ -272,6 +285,25 @@ class LargeQuery {
         return a.entry < b.entry || (a.entry == b.entry && a.object < b.object);
       });
     }
+    if (small_statics_only(begin, count, all)) {
+      // A ground quad and the like: every triangle against every group, in
+      // order, without box clips (as the 8-ray packets' short cut; the
+      // nearest hit is the same).
+      for (std::size_t i = 0; i < count && alive_groups_ != 0; ++i) {
+        const Scene::StaticMesh& mesh = scene_ref().static_meshes()[all[begin[i].object].index];
+        for_each_bit(alive_groups_, [&](int g) {
+          visit_[g].leaf_lanes = live_[g];
+          counters_.object_visits += static_cast<std::uint64_t>(std::popcount(live_[g]));
+        });
+        visit_small_static(mesh, alive_groups_);
+      }
+      return;
+    }
+    // The reciprocals for the box clips (correctly rounded, like the single ray's).
+    for_each_bit(alive_groups_, [&](int g) {
+      Group& gr = group_[g];
+      for (int a = 0; a < 3; ++a) (Float8(1.0f) / Float8::load(gr.d[a])).store(gr.inv[a]);
+    });
     for (std::size_t i = 0; i < count; ++i) {
       if (alive_groups_ == 0) return;
       if constexpr (!kAnyHit) {
@@ -286,9 +318,26 @@ class LargeQuery {
   const TraversalCounters& counters() const { return counters_; }
 
  private:
+  // Whether every candidate is a static mesh the fast test takes triangle by triangle.
+  static bool small_statics_only_impl(const Scene& scene, const auto* begin, std::size_t count,
+                                      std::span<const TopLevelObject> all) {
+    if (kTest != TriangleTest::kFast || count == 0) return false;
+    for (std::size_t i = 0; i < count; ++i) {
+      const TopLevelObject& o = all[begin[i].object];
+      if (o.kind != TopLevelObject::Kind::kStatic ||
+          scene.static_meshes()[o.index].desc.triangles.size() > detail::kBruteForceStaticTriangles) {
+        return false;
+      }
+    }
+    return true;
+  }
+  bool small_statics_only(const auto* begin, std::size_t count, std::span<const TopLevelObject> all) const {
+    return small_statics_only_impl(scene_ref(), begin, count, all);
+  }
+
   // Any-hit rays that all end at finite t_max at one shared point.
   bool use_reversed() const {
-    if (!kAnyHit || !rays_.common_end) return false;
+    if (!kAnyHit || !rays_p_->common_end) return false;
     bool finite = true;
     for_each_bit(alive_groups_, [&](int g) {
       const Float8 t = select(Mask8::from_bits(live_[g]), Float8::load(group_[g].t_limit), Float8(0.0f));
@@ -300,12 +349,12 @@ class LargeQuery {
   // The ranges of rays o + t d, t in [t0, t1], written backwards from
   // their end o + t_end d: base - s d with s in [t_end - t1, t_end - t0],
   // widened for the rounding of t_end - t (t0 >= 0, so |t_end - t| <= t_end).
-  static RayRanges reversed_ranges(const Vec3x8& o, const Vec3x8& d, Float8 t0, Float8 t1, Float8 t_end,
-                                   std::uint32_t mask) {
+  static void add_reversed(RangeAccumulator& acc, const Vec3x8& o, const Vec3x8& d, Float8 t0, Float8 t1,
+                           Float8 t_end, std::uint32_t mask) {
     const Vec3x8 base = o + t_end * d;
     const Vec3x8 back{Float8(0.0f) - d.x, Float8(0.0f) - d.y, Float8(0.0f) - d.z};
     const Float8 widen = Float8(0x1.0p-22f) * abs(t_end);
-    return lane_ranges(base, back, (t_end - t1) - widen, (t_end - t0) + widen, mask);
+    acc.add(base, back, (t_end - t1) - widen, (t_end - t0) + widen, mask);
   }
   // The rounding of base = o + t_end d, as a growth of every box.
   static float reversed_slack(float o_mag, float d_mag, float t_end_max) {
@@ -349,6 +398,7 @@ class LargeQuery {
       const Float8 eps = world_eps(gr, box_magnitude, t1);
       const Vec3x8 inv{Float8::load(gr.inv[0]), Float8::load(gr.inv[1]), Float8::load(gr.inv[2])};
       vg.lanes = clip_lanes(object.box, eps, gr.origin(), gr.direction(), inv, live_[g], t0, t1);
+      vg.leaf_lanes = vg.lanes;
       t0.store(vg.t0);
       t1.store(vg.t1);
       if (vg.lanes != 0) {
@@ -360,10 +410,10 @@ class LargeQuery {
     mailbox_.reset();
     switch (object.kind) {
       case TopLevelObject::Kind::kBone:
-        visit_bone(scene_.instances()[object.index], object.bone, groups);
+        visit_bone(scene_ref().instances()[object.index], object.bone, groups);
         return;
       case TopLevelObject::Kind::kStatic: {
-        const Scene::StaticMesh& mesh = scene_.static_meshes()[object.index];
+        const Scene::StaticMesh& mesh = scene_ref().static_meshes()[object.index];
         if (mesh.desc.triangles.size() <= detail::kBruteForceStaticTriangles) {
           visit_small_static(mesh, groups);
         } else {
@@ -396,14 +446,14 @@ class LargeQuery {
     for_each_bit(groups, [&](int g) {
       const std::uint32_t lanes = visit_[g].lanes & live_[g];
       if (lanes == 0) return;
-      const RayPacket p = group_packet(rays_, g, group_[g].t_limit, lanes);
+      const RayPacket p = group_packet(*rays_p_, g, group_[g].t_limit, lanes);
       TraversalCounters work;
       if constexpr (kAnyHit) {
-        const std::uint32_t blocked = occluded_packet(scene_, p, kTest, &work, &filter) & lanes;
+        const std::uint32_t blocked = occluded_packet(scene_ref(), p, kTest, &work, &filter) & lanes;
         for_each_bit(blocked, [&](int lane) { retire(g, lane); });
       } else {
         Hit hits[kPacketSize];
-        intersect_packet(scene_, p, kTest, hits, &work, &filter);
+        intersect_packet(scene_ref(), p, kTest, hits, &work, &filter);
         for_each_bit(lanes, [&](int lane) {
           const Hit& h = hits[lane];
           if (h.valid() && h.t < group_[g].t_limit[lane]) record(g, lane, h.t, h.u, h.v, h.triangle_id, h.instance_id);
@@ -415,7 +465,7 @@ class LargeQuery {
   }
 
   void visit_bone(const InstanceFrame& frame, std::uint32_t bone, std::uint32_t groups) {
-    const Scene::Character& character = scene_.characters()[frame.character];
+    const Scene::Character& character = scene_ref().characters()[frame.character];
     const KdTreeView tree = character.fuzzy.bone_tree(bone);
     if (tree.empty()) return;
     const Affine3& to_bone = frame.bone_from_world[bone];
@@ -425,7 +475,7 @@ class LargeQuery {
     // transform_vector term by term, as the single ray), clipped to the
     // tree's root box with each lane's own slack, then bounded.
     std::uint32_t in_tree = 0;
-    RayRanges ranges;
+    RangeAccumulator acc;
     float packet_eps = 0.0f;
     for_each_bit(groups, [&](int g) {
       const Group& gr = group_[g];
@@ -456,35 +506,40 @@ class LargeQuery {
       if (vg.lanes == 0) return;
       t0.store(vg.t0);
       t1.store(vg.t1);
+      const Float8* const oc8[3] = {&o.x, &o.y, &o.z};
+      const Float8* const dc8[3] = {&d.x, &d.y, &d.z};
+      const Float8* const ic8[3] = {&inv.x, &inv.y, &inv.z};
+      for (int a = 0; a < 3; ++a) {
+        oc8[a]->store(vg.o[a]);
+        dc8[a]->store(vg.d[a]);
+        ic8[a]->store(vg.inv[a]);
+      }
+      eps.store(vg.lane_eps);
       const Mask8 kept = Mask8::from_bits(vg.lanes);
       float group_eps = reduce_max(select(kept, eps, Float8(0.0f)));
-      RayRanges r;
       if (reversed) {
         const Float8 t_end = Float8::load(gr.t_limit);
-        r = reversed_ranges(o, d, t0, t1, t_end, vg.lanes);
+        add_reversed(acc, o, d, t0, t1, t_end, vg.lanes);
         group_eps += reversed_slack(reduce_max(select(kept, o_mag, Float8(0.0f))),
                                     reduce_max(select(kept, d_mag, Float8(0.0f))),
                                     reduce_max(select(kept, t_end, Float8(0.0f))));
       } else {
-        r = lane_ranges(o, d, t0, t1, vg.lanes);
-      }
-      vg.bound = IntervalBound(r);
-      vg.eps = vg.bound.grow_for(tree.bounds, group_eps);
-      if (in_tree == 0) {
-        ranges = r;
-      } else {
-        ranges.unite(r);
+        acc.add(o, d, t0, t1, vg.lanes);
       }
       packet_eps = std::max(packet_eps, group_eps);
       in_tree |= 1u << g;
     });
     if (in_tree == 0) return;
-    const IntervalBound bound(ranges);
+    const IntervalBound bound(acc.ranges());
     const float grow = bound.grow_for(tree.bounds, packet_eps);
     const SkinnedMesh& mesh = *character.mesh;
     const auto leaf = [&](std::span<const std::uint32_t> triangles, std::uint32_t groups_here) {
       for (const std::uint32_t t : triangles) {
-        std::uint32_t need = mailbox_.untested(t, groups_here) & alive_groups_;
+        std::uint32_t need = 0;
+        for_each_bit(groups_here & alive_groups_, [&](int g) {
+          visit_[g].leaf_lanes = mailbox_.untested(t, g, leaf_lanes_[g]) & live_[g];
+          if (visit_[g].leaf_lanes != 0) need |= 1u << g;
+        });
         if (need == 0) continue;
         const auto& v = mesh.triangles[t];
         const Vec3& p0 = frame.positions[v[0]];
@@ -573,10 +628,16 @@ class LargeQuery {
             continue;
           }
         } else if (node.item_count() > 0) {
+          // Each group's lanes clipped to the cell exactly, as their single
+          // rays would be (grown by each lane's own slack).
           std::uint32_t reaching = 0;
           for_each_bit(groups & alive_groups_, [&](int g) {
-            const float t_hi = kAnyHit ? visit_[g].bound.t_hi() : group_limit(g, visit_.data());
-            if (visit_[g].bound.entry(cur.box, visit_[g].eps, t_hi) != kInf) reaching |= 1u << g;
+            const VisitGroup& vg = visit_[g];
+            Float8 t0 = Float8::load(vg.t0), t1 = Float8::load(vg.t1);
+            if constexpr (!kAnyHit) t1 = min(t1, Float8::load(group_[g].t_limit));
+            leaf_lanes_[g] = clip_lanes(cur.box, Float8::load(vg.lane_eps), vg.origin(), vg.direction(),
+                                        vg.inverse(), vg.lanes & live_[g], t0, t1);
+            if (leaf_lanes_[g] != 0) reaching |= 1u << g;
           });
           if (reaching != 0 && leaf(tree.items.subspan(node.first_item(), node.item_count()), reaching)) return;
         }
@@ -587,7 +648,7 @@ class LargeQuery {
   }
 
   // Tests one world-space triangle for the live lanes of each group of
-  // `groups` that entered the current object (visit_[g].lanes).
+  // `groups` that reach it (visit_[g].leaf_lanes).
   void test_groups(std::uint32_t groups, const Vec3& p0, const Vec3& p1, const Vec3& p2, std::uint32_t triangle,
                    std::uint32_t instance) {
     if constexpr (kTest == TriangleTest::kFast) {
@@ -597,7 +658,7 @@ class LargeQuery {
         const CommonOriginTriangle c = prepare_common_origin(common_origin_at_, p0, p1, p2);
         int zero_area = -1;
         for_each_bit(groups, [&](int g) {
-          const std::uint32_t lanes = visit_[g].lanes & live_[g];
+          const std::uint32_t lanes = visit_[g].leaf_lanes & live_[g];
           if (lanes == 0) return;
           counters_.triangle_tests += static_cast<std::uint64_t>(std::popcount(lanes));
           Group& gr = group_[g];
@@ -611,7 +672,7 @@ class LargeQuery {
         return;
       }
     }
-    for_each_bit(groups, [&](int g) { test(g, visit_[g].lanes, p0, p1, p2, triangle, instance); });
+    for_each_bit(groups, [&](int g) { test(g, visit_[g].leaf_lanes, p0, p1, p2, triangle, instance); });
   }
 
   // Tests one world-space triangle for the live lanes of `lanes` of group g.
@@ -685,12 +746,14 @@ class LargeQuery {
     if (live_[g] == 0) alive_groups_ &= ~(1u << g);
   }
 
-  const Scene& scene_;
-  const LargePacketRays& rays_;
-  PacketHits out_;
-  int groups_;
+  const Scene* scene_p_ = nullptr;
+  const LargePacketRays* rays_p_ = nullptr;
+  const Scene& scene_ref() const { return *scene_p_; }
+  PacketHits out_{};
+  int groups_ = 0;
   std::array<Group, kMaxPacketGroups> group_;
   std::array<VisitGroup, kMaxPacketGroups> visit_;
+  std::array<std::uint32_t, kMaxPacketGroups> leaf_lanes_{};  // per group: the lanes reaching the current leaf
   std::array<std::array<WatertightRay, kLanes>, kTest == TriangleTest::kWatertight ? kMaxPacketGroups : 1>
       watertight_;
   std::array<std::uint32_t, kMaxPacketGroups> live_{};
@@ -700,14 +763,15 @@ class LargeQuery {
   std::uint64_t hits_recorded_ = 0;
   bool common_origin_ = false;  // every live lane starts at common_origin_at_
   Vec3 common_origin_at_{0.0f};
-  GroupMailbox mailbox_;
+  LaneMailbox mailbox_;
   TraversalCounters counters_;
 };
 
 template <TriangleTest kTest, bool kAnyHit>
 void run_query(const Scene& scene, const LargePacketRays& rays, std::span<const std::uint32_t> objects, PacketHits out,
                std::uint8_t* blocked, TraversalCounters* counters) {
-  LargeQuery<kTest, kAnyHit> query(scene, rays, out);
+  thread_local LargeQuery<kTest, kAnyHit> query;
+  query.start(scene, rays, out);
   query.run(objects);
   std::uint64_t rays_valid = 0;
   for (int g = 0; g < std::clamp(rays.groups, 0, kMaxPacketGroups); ++g) {
