@@ -150,10 +150,12 @@ std::uint32_t clip_lanes(const Aabb& box, Float8 eps, const Vec3x8& o, const Vec
 
 // A kd-tree cell waiting on the stack, with the parameter range that
 // holds every ray's passage through it.
+// Plain arrays: glm's operator[] is a switch on the index.
 struct Cell {
-  Aabb box;
+  float lo[3], hi[3];
   std::uint32_t node;
   float t0, t1;
+  Aabb box() const { return {Vec3(lo[0], lo[1], lo[2]), Vec3(hi[0], hi[1], hi[2])}; }
 };
 
 template <TriangleTest kTest, bool kAnyHit>
@@ -579,7 +581,11 @@ class LargeQuery {
     };
     std::array<Cell, kMaxTraversalDepth + 2> stack;
     std::size_t top = 0;
-    Cell cur{tree.bounds, 0, bound.entry(tree.bounds, grow, limit()), bound.t_hi()};
+    Cell cur{{tree.bounds.lower.x, tree.bounds.lower.y, tree.bounds.lower.z},
+             {tree.bounds.upper.x, tree.bounds.upper.y, tree.bounds.upper.z},
+             0,
+             bound.entry(tree.bounds, grow, limit()),
+             bound.t_hi()};
     if (cur.t0 == kInf) return;
     for (;;) {
       cur.t1 = std::min(cur.t1, limit());
@@ -589,10 +595,11 @@ class LargeQuery {
         if (!node.is_leaf()) {
           const int a = node.axis();
           const float split = node.split();
-          Cell below{cur.box, cur.node + 1, cur.t0, cur.t1};
-          Cell above{cur.box, node.above_child(), cur.t0, cur.t1};
-          below.box.upper[a] = std::min(below.box.upper[a], split);
-          above.box.lower[a] = std::max(above.box.lower[a], split);
+          Cell below = cur, above = cur;
+          below.node = cur.node + 1;
+          above.node = node.above_child();
+          below.hi[a] = std::min(below.hi[a], split);
+          above.lo[a] = std::max(above.lo[a], split);
           const int sign = bound.sign(a);
           bool below_first = true;
           if (sign > 0) {
@@ -604,8 +611,8 @@ class LargeQuery {
             below.t0 = std::max(cur.t0, bound.crossing_lo(a, split + grow));
             below_first = false;
           } else {
-            const float eb = bound.entry(below.box, grow, cur.t1);
-            const float ea = bound.entry(above.box, grow, cur.t1);
+            const float eb = bound.entry(below.box(), grow, cur.t1);
+            const float ea = bound.entry(above.box(), grow, cur.t1);
             below.t0 = std::max(cur.t0, eb);
             above.t0 = std::max(cur.t0, ea);
             if (eb == kInf) below.t0 = kInf;
@@ -631,11 +638,12 @@ class LargeQuery {
           // Each group's lanes clipped to the cell exactly, as their single
           // rays would be (grown by each lane's own slack).
           std::uint32_t reaching = 0;
+          const Aabb cell = cur.box();
           for_each_bit(groups & alive_groups_, [&](int g) {
             const VisitGroup& vg = visit_[g];
             Float8 t0 = Float8::load(vg.t0), t1 = Float8::load(vg.t1);
             if constexpr (!kAnyHit) t1 = min(t1, Float8::load(group_[g].t_limit));
-            leaf_lanes_[g] = clip_lanes(cur.box, Float8::load(vg.lane_eps), vg.origin(), vg.direction(),
+            leaf_lanes_[g] = clip_lanes(cell, Float8::load(vg.lane_eps), vg.origin(), vg.direction(),
                                         vg.inverse(), vg.lanes & live_[g], t0, t1);
             if (leaf_lanes_[g] != 0) reaching |= 1u << g;
           });
