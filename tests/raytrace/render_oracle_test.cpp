@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -156,10 +157,10 @@ struct Mismatch {
   std::string first;
 };
 
-// Every pixel's single-ray hit and the renderer's (culled 4x2 packets in
-// 16x16 tiles, render/tile_stages.h) against brute force.
+// Every pixel's single-ray hit and the renderer's (culled packets of
+// `packet_rays` rays, render/tile_stages.h) against brute force.
 void compare_primary(const rt::Scene& scene, std::span<const SoupTriangle> soup, const rt::CameraDesc& desc,
-                     int size, TriangleTest test, JobSystem& jobs, Mismatch& m) {
+                     int size, TriangleTest test, JobSystem& jobs, Mismatch& m, int packet_rays) {
   auto camera = rt::PinholeCamera::create(desc, size, size);
   ASSERT_TRUE(camera.ok()) << camera.status().message();
   const testing_support::ScreenBinner binner(soup, *camera);
@@ -173,6 +174,7 @@ void compare_primary(const rt::Scene& scene, std::span<const SoupTriangle> soup,
   buffers.instance_id = instance;
   rt::RenderSettings settings;
   settings.triangle_test = test;
+  settings.packet_rays = packet_rays;
   rt::Renderer renderer;
   ASSERT_TRUE(renderer.render(scene, *camera, settings, buffers, jobs).ok());
   for (int y = 0; y < size; ++y) {
@@ -184,8 +186,8 @@ void compare_primary(const rt::Scene& scene, std::span<const SoupTriangle> soup,
       const Hit packet{depth[i] / glm::length(ray.direction), 0.0f, 0.0f, triangle[i], instance[i]};
       m.checked += 2;
       if (!testing_support::same_nearest(packet, ref, soup, ray, test) && m.wrong++ == 0) {
-        m.first = "pixel (" + std::to_string(x) + "," + std::to_string(y) + ") " + test_name(test) +
-                  ", renderer packets: t=" + std::to_string(packet.t) + " tri=" + std::to_string(packet.triangle_id) +
+        m.first = "pixel (" + std::to_string(x) + "," + std::to_string(y) + ") " + test_name(test) + ", " +
+                  std::to_string(packet_rays) + "-ray packets: t=" + std::to_string(packet.t) + " tri=" + std::to_string(packet.triangle_id) +
                   " ref t=" + std::to_string(ref.t) + " tri=" + std::to_string(ref.triangle_id);
       }
       if (!testing_support::same_nearest(ours, ref, soup, ray, test)) {
@@ -274,7 +276,11 @@ TEST_P(RenderOracle, PosesInsideThePoseSpaceMatchBruteForce) {
     for (std::size_t c = 0; c < cameras.size(); ++c) {
       if (!full && c != k % cameras.size()) continue;
       const int size = full ? 256 : (big ? 32 : 48);
-      for (const TriangleTest test : kTests) compare_primary(scene, soup, cameras[c], size, test, jobs, primary);
+      // Packets of 8, 64 and 256 rays in turn.
+      const int packet_rays = std::array<int, 3>{8, 64, 256}[(k + c) % 3];
+      for (const TriangleTest test : kTests) {
+        compare_primary(scene, soup, cameras[c], size, test, jobs, primary, packet_rays);
+      }
     }
     // 2000 random rays per pose (10^5 over 50 poses), fewer for big meshes
     // so that brute force stays near 10^9 triangle tests per model.
@@ -334,7 +340,10 @@ TEST(SubdividedCallyOracle, LevelsOneToFourMatchBruteForce) {
       const std::vector<SoupTriangle> soup = testing_support::world_triangles(scene);
       const Aabb posed = bounds_of(scene.instances()[0].positions);
       const auto cameras = cameras_around(posed, 2);
-      for (const TriangleTest test : kTests) compare_primary(scene, soup, cameras[k % cameras.size()], 48, test, jobs, primary);
+      for (const TriangleTest test : kTests) {
+        compare_primary(scene, soup, cameras[k % cameras.size()], 48, test, jobs, primary,
+                        std::array<int, 3>{8, 64, 256}[k % 3]);
+      }
       compare_random(scene, soup, posed, 100, random, rays);
     }
     EXPECT_EQ(escapes, 0u) << "a sampled pose left its fuzzy boxes";
