@@ -24,25 +24,6 @@ namespace {
 constexpr float kInf = std::numeric_limits<float>::infinity();
 constexpr int kLanes = 8;
 
-// One group's eight rays as an 8-ray packet (lanes of `lanes` active).
-RayPacket group_packet(const LargePacketRays& rays, int g, const float* t_max, std::uint32_t lanes) {
-  RayPacket p;
-  const std::size_t k0 = static_cast<std::size_t>(g) * kLanes;
-  for (int i = 0; i < kLanes; ++i) {
-    const std::size_t k = k0 + static_cast<std::size_t>(i);
-    p.ox[i] = rays.o[0][k];
-    p.oy[i] = rays.o[1][k];
-    p.oz[i] = rays.o[2][k];
-    p.dx[i] = rays.d[0][k];
-    p.dy[i] = rays.d[1][k];
-    p.dz[i] = rays.d[2][k];
-    p.t_min[i] = rays.t_min[k];
-    p.t_max[i] = t_max[i];
-  }
-  p.active = static_cast<std::uint8_t>(lanes);
-  return p;
-}
-
 }  // namespace
 
 #if SINEW_LARGE_PACKET_AVX2
@@ -311,7 +292,7 @@ class LargeQuery {
       if constexpr (!kAnyHit) {
         if (begin[i].entry > packet_limit(alive_groups_, nullptr)) return;
       }
-      visit(all[begin[i].object], begin[i].object);
+      visit(all[begin[i].object]);
     }
   }
 
@@ -390,7 +371,7 @@ class LargeQuery {
 
   // Enters one object: each group's lanes clipped to its box as the single
   // ray clips them (render/traversal.cpp visit).
-  void visit(const TopLevelObject& object, std::uint32_t object_index) {
+  void visit(const TopLevelObject& object) {
     std::uint32_t groups = 0;
     const float box_magnitude = max_abs(object.box);
     for_each_bit(alive_groups_, [&](int g) {
@@ -418,14 +399,32 @@ class LargeQuery {
         const Scene::StaticMesh& mesh = scene_ref().static_meshes()[object.index];
         if (mesh.desc.triangles.size() <= detail::kBruteForceStaticTriangles) {
           visit_small_static(mesh, groups);
-        } else {
-          visit_with_small_packets(object_index, groups);
+          return;
         }
+        const auto leaf = [&](std::span<const std::uint32_t> triangles, std::uint32_t groups_here) {
+          return test_leaf(triangles, groups_here, [&](std::uint32_t t) {
+            const auto& v = mesh.desc.triangles[t];
+            test_groups(need_, mesh.desc.positions[v[0]], mesh.desc.positions[v[1]], mesh.desc.positions[v[2]], t,
+                        mesh.instance_id);
+          });
+        };
+        visit_world_tree(mesh.tree.view(), groups, leaf);
         return;
       }
-      case TopLevelObject::Kind::kFallback:
-        visit_with_small_packets(object_index, groups);
+      case TopLevelObject::Kind::kFallback: {
+        const InstanceFrame& frame = scene_ref().instances()[object.index];
+        const SkinnedMesh& mesh = *scene_ref().characters()[frame.character].mesh;
+        const auto leaf = [&](std::span<const std::uint32_t> items, std::uint32_t groups_here) {
+          return test_leaf(items, groups_here, [&](std::uint32_t item) {
+            const std::uint32_t t = frame.escaped_triangles[item];
+            const auto& v = mesh.triangles[t];
+            test_groups(need_, frame.positions[v[0]], frame.positions[v[1]], frame.positions[v[2]], t,
+                        frame.instance_id);
+          });
+        };
+        visit_world_tree(frame.fallback.view(), groups, leaf);
         return;
+      }
     }
   }
 
@@ -440,30 +439,71 @@ class LargeQuery {
     }
   }
 
-  // Static meshes with a tree and the escape fallback are rare: each group
-  // traces them as an 8-ray packet filtered to the one object.
-  void visit_with_small_packets(std::uint32_t object_index, std::uint32_t groups) {
-    const std::uint32_t list[1] = {object_index};
-    const ObjectFilter filter{list};
+  // A leaf's items for the groups reaching it: per item (mailboxed by its
+  // index) the groups with lanes left to test it, handed to `test` in need_.
+  // Returns true when every lane is answered (any hit).
+  template <class TestFn>
+  bool test_leaf(std::span<const std::uint32_t> items, std::uint32_t groups_here, TestFn&& test) {
+    const std::uint32_t groups = groups_here & alive_groups_;
+    for (const std::uint32_t item : items) {
+      need_ = 0;
+      for_each_bit(groups & alive_groups_, [&](int g) {
+        visit_[g].leaf_lanes = mailbox_.untested(item, g, leaf_lanes_[g]) & live_[g];
+        if (visit_[g].leaf_lanes != 0) need_ |= 1u << g;
+      });
+      if (need_ == 0) continue;
+      test(item);
+      // Done only when every group in the tree is (not just this leaf's).
+      if (kAnyHit && (tree_groups_ & alive_groups_) == 0) return true;
+    }
+    return false;
+  }
+
+  // A world-space tree below the top level (a static mesh's, the escape
+  // fallback's): the world rays with the single ray's slack for the tree.
+  template <class LeafFn>
+  void visit_world_tree(const KdTreeView& tree, std::uint32_t groups, LeafFn& leaf) {
+    if (tree.empty()) return;
+    const bool reversed = use_reversed();
+    const float box_magnitude = max_abs(tree.bounds);
+    RangeAccumulator acc;
+    float packet_eps = 0.0f;
+    std::uint32_t in_tree = 0;
     for_each_bit(groups, [&](int g) {
-      const std::uint32_t lanes = visit_[g].lanes & live_[g];
-      if (lanes == 0) return;
-      const RayPacket p = group_packet(*rays_p_, g, group_[g].t_limit, lanes);
-      TraversalCounters work;
-      if constexpr (kAnyHit) {
-        const std::uint32_t blocked = occluded_packet(scene_ref(), p, kTest, &work, &filter) & lanes;
-        for_each_bit(blocked, [&](int lane) { retire(g, lane); });
-      } else {
-        Hit hits[kPacketSize];
-        intersect_packet(scene_ref(), p, kTest, hits, &work, &filter);
-        for_each_bit(lanes, [&](int lane) {
-          const Hit& h = hits[lane];
-          if (h.valid() && h.t < group_[g].t_limit[lane]) record(g, lane, h.t, h.u, h.v, h.triangle_id, h.instance_id);
-        });
+      const Group& gr = group_[g];
+      VisitGroup& vg = visit_[g];
+      const Vec3x8 o = gr.origin(), d = gr.direction();
+      const Vec3x8 inv{Float8::load(gr.inv[0]), Float8::load(gr.inv[1]), Float8::load(gr.inv[2])};
+      Float8 t0 = Float8::load(vg.t0), t1 = Float8::load(vg.t1);
+      const Float8 eps = world_eps(gr, box_magnitude, t1);
+      vg.lanes = clip_lanes(tree.bounds, eps, o, d, inv, vg.lanes, t0, t1);
+      if (vg.lanes == 0) return;
+      t0.store(vg.t0);
+      t1.store(vg.t1);
+      for (int a = 0; a < 3; ++a) {
+        std::copy_n(gr.o[a], kLanes, vg.o[a]);
+        std::copy_n(gr.d[a], kLanes, vg.d[a]);
+        std::copy_n(gr.inv[a], kLanes, vg.inv[a]);
       }
-      counters_.node_visits += work.node_visits;
-      counters_.triangle_tests += work.triangle_tests;
+      eps.store(vg.lane_eps);
+      const Mask8 kept = Mask8::from_bits(vg.lanes);
+      float group_eps = reduce_max(select(kept, eps, Float8(0.0f)));
+      if (reversed) {
+        const Float8 t_end = Float8::load(gr.t_limit);
+        add_reversed(acc, o, d, t0, t1, t_end, vg.lanes);
+        group_eps += reversed_slack(reduce_max(select(kept, Float8::load(gr.o_mag), Float8(0.0f))),
+                                    reduce_max(select(kept, Float8::load(gr.d_mag), Float8(0.0f))),
+                                    reduce_max(select(kept, t_end, Float8(0.0f))));
+      } else {
+        acc.add(o, d, t0, t1, vg.lanes);
+      }
+      packet_eps = std::max(packet_eps, group_eps);
+      in_tree |= 1u << g;
     });
+    if (in_tree == 0) return;
+    const IntervalBound bound(acc.ranges());
+    tree_groups_ = in_tree;
+    traverse(tree, bound, bound.grow_for(tree.bounds, packet_eps), in_tree, leaf);
   }
 
   void visit_bone(const InstanceFrame& frame, std::uint32_t bone, std::uint32_t groups) {
@@ -536,22 +576,13 @@ class LargeQuery {
     const float grow = bound.grow_for(tree.bounds, packet_eps);
     const SkinnedMesh& mesh = *character.mesh;
     const auto leaf = [&](std::span<const std::uint32_t> triangles, std::uint32_t groups_here) {
-      for (const std::uint32_t t : triangles) {
-        std::uint32_t need = 0;
-        for_each_bit(groups_here & alive_groups_, [&](int g) {
-          visit_[g].leaf_lanes = mailbox_.untested(t, g, leaf_lanes_[g]) & live_[g];
-          if (visit_[g].leaf_lanes != 0) need |= 1u << g;
-        });
-        if (need == 0) continue;
+      return test_leaf(triangles, groups_here, [&](std::uint32_t t) {
         const auto& v = mesh.triangles[t];
-        const Vec3& p0 = frame.positions[v[0]];
-        const Vec3& p1 = frame.positions[v[1]];
-        const Vec3& p2 = frame.positions[v[2]];
-        test_groups(need, p0, p1, p2, t, frame.instance_id);
-        if (kAnyHit && (in_tree & alive_groups_) == 0) return true;
-      }
-      return false;
+        test_groups(need_, frame.positions[v[0]], frame.positions[v[1]], frame.positions[v[2]], t,
+                    frame.instance_id);
+      });
     };
+    tree_groups_ = in_tree;
     traverse(tree, bound, grow, in_tree, leaf);
   }
 
@@ -762,6 +793,8 @@ class LargeQuery {
   std::array<Group, kMaxPacketGroups> group_;
   std::array<VisitGroup, kMaxPacketGroups> visit_;
   std::array<std::uint32_t, kMaxPacketGroups> leaf_lanes_{};  // per group: the lanes reaching the current leaf
+  std::uint32_t tree_groups_ = 0;  // the groups walking the current tree
+  std::uint32_t need_ = 0;  // test_leaf: the groups with lanes left to test the current item
   std::array<std::array<WatertightRay, kLanes>, kTest == TriangleTest::kWatertight ? kMaxPacketGroups : 1>
       watertight_;
   std::array<std::uint32_t, kMaxPacketGroups> live_{};
@@ -817,6 +850,28 @@ void occluded_large_packet(const Scene& scene, const LargePacketRays& rays, Tria
 }
 
 #else
+
+namespace {
+// One group's eight rays as an 8-ray packet (lanes of `lanes` active).
+RayPacket group_packet(const LargePacketRays& rays, int g, const float* t_max, std::uint32_t lanes) {
+  RayPacket p;
+  const std::size_t k0 = static_cast<std::size_t>(g) * kLanes;
+  for (int i = 0; i < kLanes; ++i) {
+    const std::size_t k = k0 + static_cast<std::size_t>(i);
+    p.ox[i] = rays.o[0][k];
+    p.oy[i] = rays.o[1][k];
+    p.oz[i] = rays.o[2][k];
+    p.dx[i] = rays.d[0][k];
+    p.dy[i] = rays.d[1][k];
+    p.dz[i] = rays.d[2][k];
+    p.t_min[i] = rays.t_min[k];
+    p.t_max[i] = t_max[i];
+  }
+  p.active = static_cast<std::uint8_t>(lanes);
+  return p;
+}
+
+}  // namespace
 
 // Without AVX2 each group is an 8-ray packet (which is itself the single-ray
 // query per lane there).
