@@ -1,5 +1,9 @@
 #include "raytrace/render/tile_stages.h"
 
+#if defined(__AVX2__)
+#include <immintrin.h>
+#endif
+
 #include <algorithm>
 #include <array>
 #include <bit>
@@ -43,11 +47,15 @@ class SrgbTable {
       bytes_[i] = static_cast<std::uint8_t>(std::lround(encode_srgb(linear) * 255.0f));
     }
     bytes_[0] = 0;  // index 0 also stands for "not > 0" (srgb_indices); it encodes to 0 anyway
+    for (std::size_t i = 0; i < bytes_.size(); ++i) words_[i] = bytes_[i];
   }
   std::uint8_t operator[](std::int32_t i) const { return bytes_[static_cast<std::size_t>(i)]; }
+  // The same bytes widened to 32 bits, for eight-lane gathers.
+  const std::int32_t* words() const { return words_.data(); }
 
  private:
   std::array<std::uint8_t, kSize> bytes_{};
+  std::array<std::int32_t, kSize> words_{};
 };
 
 // Built once at start-up, not behind a function-local static's guard.
@@ -72,10 +80,22 @@ void srgb_pixels(const Vec3x8& linear, std::uint32_t* out) {
   srgb_indices(linear.x, r);
   srgb_indices(linear.y, g);
   srgb_indices(linear.z, b);
+#if defined(__AVX2__)
+  // Three gathers from the widened table instead of 24 byte loads.
+  const std::int32_t* words = kSrgbTable.words();
+  const auto gather = [&](const std::int32_t* index) {
+    return _mm256_i32gather_epi32(words, _mm256_load_si256(reinterpret_cast<const __m256i*>(index)), 4);
+  };
+  const __m256i rgba = _mm256_or_si256(
+      _mm256_or_si256(gather(r), _mm256_slli_epi32(gather(g), 8)),
+      _mm256_or_si256(_mm256_slli_epi32(gather(b), 16), _mm256_set1_epi32(static_cast<int>(0xFF000000u))));
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(out), rgba);
+#else
   for (int i = 0; i < 8; ++i) {
     out[i] = std::uint32_t{kSrgbTable[r[i]]} | std::uint32_t{kSrgbTable[g[i]]} << 8 |
              std::uint32_t{kSrgbTable[b[i]]} << 16 | 0xFF000000u;
   }
+#endif
 }
 
 // Bit i: bit l of lit[i], for eight bytes (each lane's bit gathered into
