@@ -23,6 +23,24 @@ struct RayLanes8 {
   const float* t_max;
 };
 
+namespace detail {
+// The last checks of both eight-lane tests (t_min <= t < t_max, finite t):
+// the hit lanes of `lanes`, their t, u, v stored when there are any.
+inline std::uint32_t accept_hits8(const RayLanes8& r, std::uint32_t lanes, __m256 ok, __m256 t, __m256 u, __m256 v,
+                                  float* t_out, float* u_out, float* v_out) {
+  ok = _mm256_and_ps(ok, _mm256_cmp_ps(t, _mm256_load_ps(r.t_min), _CMP_GE_OQ));
+  ok = _mm256_and_ps(ok, _mm256_cmp_ps(t, _mm256_load_ps(r.t_max), _CMP_LT_OQ));
+  ok = _mm256_and_ps(ok, _mm256_cmp_ps(t, _mm256_set1_ps(kFloatMax), _CMP_LE_OQ));
+  const std::uint32_t hit = static_cast<std::uint32_t>(_mm256_movemask_ps(ok)) & lanes;
+  if (hit != 0) {
+    _mm256_storeu_ps(t_out, t);
+    _mm256_storeu_ps(u_out, u);
+    _mm256_storeu_ps(v_out, v);
+  }
+  return hit;
+}
+}  // namespace detail
+
 // Returns the lanes of `lanes` that hit (t_min <= t < t_max, finite t, u, v),
 // with their t, u, v in the out arrays (other lanes' entries are garbage).
 // Zero-area triangles are the caller's check (detail::zero_area), once per
@@ -77,16 +95,7 @@ inline std::uint32_t intersect_triangle_fast8(const RayLanes8& r, std::uint32_t 
   if (_mm256_testz_ps(ok, ok) != 0) return 0;
 
   const __m256 t = mul(add(add(mul(e2x, qx), mul(e2y, qy)), mul(e2z, qz)), inv_det);
-  ok = _mm256_and_ps(ok, _mm256_cmp_ps(t, _mm256_load_ps(r.t_min), _CMP_GE_OQ));
-  ok = _mm256_and_ps(ok, _mm256_cmp_ps(t, _mm256_load_ps(r.t_max), _CMP_LT_OQ));
-  ok = _mm256_and_ps(ok, _mm256_cmp_ps(t, _mm256_set1_ps(detail::kFloatMax), _CMP_LE_OQ));
-  const std::uint32_t hit = static_cast<std::uint32_t>(_mm256_movemask_ps(ok)) & lanes;
-  if (hit != 0) {
-    _mm256_storeu_ps(t_out, t);
-    _mm256_storeu_ps(u_out, u);
-    _mm256_storeu_ps(v_out, v);
-  }
-  return hit;
+  return detail::accept_hits8(r, lanes, ok, t, u, v, t_out, u_out, v_out);
 }
 
 // A triangle's terms that depend only on the ray origin: for rays from one
@@ -154,16 +163,7 @@ inline std::uint32_t intersect_triangle_fast8_common_origin(const RayLanes8& r, 
   ok = _mm256_and_ps(ok, _mm256_and_ps(_mm256_cmp_ps(u, zero, _CMP_GE_OQ), _mm256_cmp_ps(u, one, _CMP_LE_OQ)));
   ok = _mm256_and_ps(ok, _mm256_and_ps(_mm256_cmp_ps(v, zero, _CMP_GE_OQ),
                                        _mm256_cmp_ps(add(u, v), one, _CMP_LE_OQ)));
-  ok = _mm256_and_ps(ok, _mm256_cmp_ps(t, _mm256_load_ps(r.t_min), _CMP_GE_OQ));
-  ok = _mm256_and_ps(ok, _mm256_cmp_ps(t, _mm256_load_ps(r.t_max), _CMP_LT_OQ));
-  ok = _mm256_and_ps(ok, _mm256_cmp_ps(t, _mm256_set1_ps(detail::kFloatMax), _CMP_LE_OQ));
-  const std::uint32_t hit = static_cast<std::uint32_t>(_mm256_movemask_ps(ok)) & lanes;
-  if (hit != 0) {
-    _mm256_storeu_ps(t_out, t);
-    _mm256_storeu_ps(u_out, u);
-    _mm256_storeu_ps(v_out, v);
-  }
-  return hit;
+  return detail::accept_hits8(r, lanes, ok, t, u, v, t_out, u_out, v_out);
 }
 
 }  // namespace sinew::rt

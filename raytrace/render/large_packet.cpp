@@ -23,6 +23,10 @@ namespace {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 constexpr int kLanes = 8;
+// Bone trees with more nodes than this (finely subdivided meshes) are
+// walked by each group as an 8-ray packet: one walk per packet would reach
+// every cell in the packet's whole bound up to its farthest hit.
+constexpr std::size_t kLargePacketMaxTreeNodes = 2048;
 
 }  // namespace
 
@@ -292,7 +296,7 @@ class LargeQuery {
       if constexpr (!kAnyHit) {
         if (begin[i].entry > packet_limit(alive_groups_, nullptr)) return;
       }
-      visit(all[begin[i].object]);
+      visit(all[begin[i].object], begin[i].object);
     }
   }
 
@@ -371,7 +375,7 @@ class LargeQuery {
 
   // Enters one object: each group's lanes clipped to its box as the single
   // ray clips them (render/traversal.cpp visit).
-  void visit(const TopLevelObject& object) {
+  void visit(const TopLevelObject& object, std::uint32_t object_index) {
     std::uint32_t groups = 0;
     const float box_magnitude = max_abs(object.box);
     for_each_bit(alive_groups_, [&](int g) {
@@ -392,9 +396,16 @@ class LargeQuery {
     if (groups == 0) return;
     mailbox_.reset();
     switch (object.kind) {
-      case TopLevelObject::Kind::kBone:
-        visit_bone(scene_ref().instances()[object.index], object.bone, groups);
+      case TopLevelObject::Kind::kBone: {
+        const InstanceFrame& frame = scene_ref().instances()[object.index];
+        if (scene_ref().characters()[frame.character].fuzzy.bone_tree(object.bone).nodes.size() >
+            kLargePacketMaxTreeNodes) {
+          visit_with_small_packets(object_index, groups);
+        } else {
+          visit_bone(frame, object.bone, groups);
+        }
         return;
+      }
       case TopLevelObject::Kind::kStatic: {
         const Scene::StaticMesh& mesh = scene_ref().static_meshes()[object.index];
         if (mesh.desc.triangles.size() <= detail::kBruteForceStaticTriangles) {
@@ -439,6 +450,45 @@ class LargeQuery {
     }
   }
 
+  // Trees too fine for one walk per packet: each group is an 8-ray packet
+  // filtered to the one object (render/packet_traversal.h), whose lanes
+  // walk only the cells their own rays reach and stop at their own hits.
+  void visit_with_small_packets(std::uint32_t object_index, std::uint32_t groups) {
+    const std::uint32_t list[1] = {object_index};
+    const ObjectFilter filter{list};
+    for_each_bit(groups, [&](int g) {
+      const std::uint32_t lanes = visit_[g].lanes & live_[g];
+      if (lanes == 0) return;
+      const Group& gr = group_[g];
+      RayPacket p;
+      for (int lane = 0; lane < kLanes; ++lane) {
+        p.ox[lane] = gr.o[0][lane];
+        p.oy[lane] = gr.o[1][lane];
+        p.oz[lane] = gr.o[2][lane];
+        p.dx[lane] = gr.d[0][lane];
+        p.dy[lane] = gr.d[1][lane];
+        p.dz[lane] = gr.d[2][lane];
+        p.t_min[lane] = gr.t_min[lane];
+        p.t_max[lane] = gr.t_limit[lane];
+      }
+      p.active = static_cast<std::uint8_t>(lanes);
+      TraversalCounters work;
+      if constexpr (kAnyHit) {
+        const std::uint32_t blocked = occluded_packet(scene_ref(), p, kTest, &work, &filter) & lanes;
+        for_each_bit(blocked, [&](int lane) { retire(g, lane); });
+      } else {
+        Hit hits[kPacketSize];
+        intersect_packet(scene_ref(), p, kTest, hits, &work, &filter);
+        for_each_bit(lanes, [&](int lane) {
+          const Hit& h = hits[lane];
+          if (h.valid()) record(g, lane, h.t, h.u, h.v, h.triangle_id, h.instance_id);
+        });
+      }
+      counters_.node_visits += work.node_visits;
+      counters_.triangle_tests += work.triangle_tests;
+    });
+  }
+
   // A leaf's items for the groups reaching it: per item (mailboxed by its
   // index) the groups with lanes left to test it, handed to `test` in need_.
   // Returns true when every lane is answered (any hit).
@@ -464,46 +514,15 @@ class LargeQuery {
   template <class LeafFn>
   void visit_world_tree(const KdTreeView& tree, std::uint32_t groups, LeafFn& leaf) {
     if (tree.empty()) return;
-    const bool reversed = use_reversed();
     const float box_magnitude = max_abs(tree.bounds);
-    RangeAccumulator acc;
-    float packet_eps = 0.0f;
-    std::uint32_t in_tree = 0;
+    TreeEntry entry(use_reversed());
     for_each_bit(groups, [&](int g) {
       const Group& gr = group_[g];
-      VisitGroup& vg = visit_[g];
-      const Vec3x8 o = gr.origin(), d = gr.direction();
       const Vec3x8 inv{Float8::load(gr.inv[0]), Float8::load(gr.inv[1]), Float8::load(gr.inv[2])};
-      Float8 t0 = Float8::load(vg.t0), t1 = Float8::load(vg.t1);
-      const Float8 eps = world_eps(gr, box_magnitude, t1);
-      vg.lanes = clip_lanes(tree.bounds, eps, o, d, inv, vg.lanes, t0, t1);
-      if (vg.lanes == 0) return;
-      t0.store(vg.t0);
-      t1.store(vg.t1);
-      for (int a = 0; a < 3; ++a) {
-        std::copy_n(gr.o[a], kLanes, vg.o[a]);
-        std::copy_n(gr.d[a], kLanes, vg.d[a]);
-        std::copy_n(gr.inv[a], kLanes, vg.inv[a]);
-      }
-      eps.store(vg.lane_eps);
-      const Mask8 kept = Mask8::from_bits(vg.lanes);
-      float group_eps = reduce_max(select(kept, eps, Float8(0.0f)));
-      if (reversed) {
-        const Float8 t_end = Float8::load(gr.t_limit);
-        add_reversed(acc, o, d, t0, t1, t_end, vg.lanes);
-        group_eps += reversed_slack(reduce_max(select(kept, Float8::load(gr.o_mag), Float8(0.0f))),
-                                    reduce_max(select(kept, Float8::load(gr.d_mag), Float8(0.0f))),
-                                    reduce_max(select(kept, t_end, Float8(0.0f))));
-      } else {
-        acc.add(o, d, t0, t1, vg.lanes);
-      }
-      packet_eps = std::max(packet_eps, group_eps);
-      in_tree |= 1u << g;
+      const Float8 eps = world_eps(gr, box_magnitude, Float8::load(visit_[g].t1));
+      enter_tree(entry, tree, g, gr.origin(), gr.direction(), inv, eps, Float8::load(gr.o_mag), Float8::load(gr.d_mag));
     });
-    if (in_tree == 0) return;
-    const IntervalBound bound(acc.ranges());
-    tree_groups_ = in_tree;
-    traverse(tree, bound, bound.grow_for(tree.bounds, packet_eps), in_tree, leaf);
+    walk_tree(tree, entry, leaf);
   }
 
   void visit_bone(const InstanceFrame& frame, std::uint32_t bone, std::uint32_t groups) {
@@ -512,18 +531,14 @@ class LargeQuery {
     if (tree.empty()) return;
     const Affine3& to_bone = frame.bone_from_world[bone];
     const InstanceFrame::BoneCarry& carry = frame.bone_carry[bone];
-    const bool reversed = use_reversed();
     // Each group's rays in the bone frame (Affine3::transform_point /
-    // transform_vector term by term, as the single ray), clipped to the
-    // tree's root box with each lane's own slack, then bounded.
-    std::uint32_t in_tree = 0;
-    RangeAccumulator acc;
-    float packet_eps = 0.0f;
+    // transform_vector term by term, as the single ray), with each lane's
+    // slack there.
+    TreeEntry entry(use_reversed());
     for_each_bit(groups, [&](int g) {
       const Group& gr = group_[g];
-      VisitGroup& vg = visit_[g];
       const Vec3x8 wo = gr.origin(), wd = gr.direction();
-      const Mask8 use = Mask8::from_bits(vg.lanes);
+      const Mask8 use = Mask8::from_bits(visit_[g].lanes);
       Vec3x8 o, d;
       Float8* const oc[3] = {&o.x, &o.y, &o.z};
       Float8* const dc[3] = {&d.x, &d.y, &d.z};
@@ -537,43 +552,15 @@ class LargeQuery {
         d_mag = max(d_mag, abs(*dc[a]));
       }
       const Vec3x8 inv{Float8(1.0f) / d.x, Float8(1.0f) / d.y, Float8(1.0f) / d.z};
-      Float8 t0 = Float8::load(vg.t0), t1 = Float8::load(vg.t1);
       // 2 tolerance + slack * (((carried + |o|) + t1 |d|) + |bounds|), with
       // carried = linear_norm * |world origin| + translation magnitude.
       const Float8 carried =
           Float8(carry.linear_norm) * Float8::load(gr.o_mag) + Float8(carry.translation_magnitude);
       const Float8 eps = Float8(2.0f * frame.tolerance[bone]) +
-                         Float8(kFrameRelativeSlack) * (((carried + o_mag) + t1 * d_mag) + Float8(carry.bounds_magnitude));
-      vg.lanes = clip_lanes(tree.bounds, eps, o, d, inv, vg.lanes, t0, t1);
-      if (vg.lanes == 0) return;
-      t0.store(vg.t0);
-      t1.store(vg.t1);
-      const Float8* const oc8[3] = {&o.x, &o.y, &o.z};
-      const Float8* const dc8[3] = {&d.x, &d.y, &d.z};
-      const Float8* const ic8[3] = {&inv.x, &inv.y, &inv.z};
-      for (int a = 0; a < 3; ++a) {
-        oc8[a]->store(vg.o[a]);
-        dc8[a]->store(vg.d[a]);
-        ic8[a]->store(vg.inv[a]);
-      }
-      eps.store(vg.lane_eps);
-      const Mask8 kept = Mask8::from_bits(vg.lanes);
-      float group_eps = reduce_max(select(kept, eps, Float8(0.0f)));
-      if (reversed) {
-        const Float8 t_end = Float8::load(gr.t_limit);
-        add_reversed(acc, o, d, t0, t1, t_end, vg.lanes);
-        group_eps += reversed_slack(reduce_max(select(kept, o_mag, Float8(0.0f))),
-                                    reduce_max(select(kept, d_mag, Float8(0.0f))),
-                                    reduce_max(select(kept, t_end, Float8(0.0f))));
-      } else {
-        acc.add(o, d, t0, t1, vg.lanes);
-      }
-      packet_eps = std::max(packet_eps, group_eps);
-      in_tree |= 1u << g;
+                         Float8(kFrameRelativeSlack) *
+                             (((carried + o_mag) + Float8::load(visit_[g].t1) * d_mag) + Float8(carry.bounds_magnitude));
+      enter_tree(entry, tree, g, o, d, inv, eps, o_mag, d_mag);
     });
-    if (in_tree == 0) return;
-    const IntervalBound bound(acc.ranges());
-    const float grow = bound.grow_for(tree.bounds, packet_eps);
     const SkinnedMesh& mesh = *character.mesh;
     const auto leaf = [&](std::span<const std::uint32_t> triangles, std::uint32_t groups_here) {
       return test_leaf(triangles, groups_here, [&](std::uint32_t t) {
@@ -582,8 +569,59 @@ class LargeQuery {
                     frame.instance_id);
       });
     };
-    tree_groups_ = in_tree;
-    traverse(tree, bound, grow, in_tree, leaf);
+    walk_tree(tree, entry, leaf);
+  }
+
+  // Entering a tree: the groups' lanes clipped to its root box, their rays
+  // in the tree's frame kept for the leaf clips, and the packet's bound.
+  struct TreeEntry {
+    explicit TreeEntry(bool reversed_rays) : reversed(reversed_rays) {}
+    bool reversed;
+    RangeAccumulator ranges;
+    float eps = 0.0f;  // the largest lane slack
+    std::uint32_t groups = 0;
+  };
+
+  // Group g's rays o + t d in the tree's frame (reciprocals inv, lane
+  // slack eps, coordinate magnitudes o_mag and d_mag).
+  void enter_tree(TreeEntry& entry, const KdTreeView& tree, int g, const Vec3x8& o, const Vec3x8& d,
+                  const Vec3x8& inv, Float8 eps, Float8 o_mag, Float8 d_mag) {
+    VisitGroup& vg = visit_[g];
+    Float8 t0 = Float8::load(vg.t0), t1 = Float8::load(vg.t1);
+    vg.lanes = clip_lanes(tree.bounds, eps, o, d, inv, vg.lanes, t0, t1);
+    if (vg.lanes == 0) return;
+    t0.store(vg.t0);
+    t1.store(vg.t1);
+    const Float8* const oc[3] = {&o.x, &o.y, &o.z};
+    const Float8* const dc[3] = {&d.x, &d.y, &d.z};
+    const Float8* const ic[3] = {&inv.x, &inv.y, &inv.z};
+    for (int a = 0; a < 3; ++a) {
+      oc[a]->store(vg.o[a]);
+      dc[a]->store(vg.d[a]);
+      ic[a]->store(vg.inv[a]);
+    }
+    eps.store(vg.lane_eps);
+    const Mask8 kept = Mask8::from_bits(vg.lanes);
+    float group_eps = reduce_max(select(kept, eps, Float8(0.0f)));
+    if (entry.reversed) {
+      const Float8 t_end = Float8::load(group_[g].t_limit);
+      add_reversed(entry.ranges, o, d, t0, t1, t_end, vg.lanes);
+      group_eps += reversed_slack(reduce_max(select(kept, o_mag, Float8(0.0f))),
+                                  reduce_max(select(kept, d_mag, Float8(0.0f))),
+                                  reduce_max(select(kept, t_end, Float8(0.0f))));
+    } else {
+      entry.ranges.add(o, d, t0, t1, vg.lanes);
+    }
+    entry.eps = std::max(entry.eps, group_eps);
+    entry.groups |= 1u << g;
+  }
+
+  template <class LeafFn>
+  void walk_tree(const KdTreeView& tree, const TreeEntry& entry, LeafFn& leaf) {
+    if (entry.groups == 0) return;
+    const IntervalBound bound(entry.ranges.ranges());
+    tree_groups_ = entry.groups;
+    traverse(tree, bound, bound.grow_for(tree.bounds, entry.eps), entry.groups, leaf);
   }
 
   // Front to back over the cells the packet's bound reaches, each with a

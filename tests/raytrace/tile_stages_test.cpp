@@ -210,6 +210,41 @@ TEST(PacketCulling, CulledPacketsFindTheSingleRayHits) {
   EXPECT_GT(hits, checked / 5);
 }
 
+// A large packet's arrays (8 lanes per group) and the view over them.
+struct PacketArrays {
+  explicit PacketArrays(int groups, float t_max)
+      : n(static_cast<std::size_t>(groups) * 8), t0(n, 0.0f), t1(n, t_max),
+        active(static_cast<std::size_t>(groups), 0xFFu) {
+    for (int a = 0; a < 3; ++a) {
+      o[a].resize(n);
+      d[a].resize(n);
+    }
+    rays.groups = groups;
+  }
+  const rt::LargePacketRays& view() {
+    for (int a = 0; a < 3; ++a) {
+      rays.o[a] = o[a].data();
+      rays.d[a] = d[a].data();
+    }
+    rays.t_min = t0.data();
+    rays.t_max = t1.data();
+    rays.active = active.data();
+    return rays;
+  }
+  Ray ray(std::size_t k) const {
+    Ray r;
+    r.origin = Vec3(o[0][k], o[1][k], o[2][k]);
+    r.direction = Vec3(d[0][k], d[1][k], d[2][k]);
+    r.t_min = t0[k];
+    r.t_max = t1[k];
+    return r;
+  }
+  std::size_t n;
+  std::vector<float> o[3], d[3], t0, t1;
+  std::vector<std::uint8_t> active;
+  rt::LargePacketRays rays;
+};
+
 // Random large packets (1 to 32 groups) around the characters: shared
 // origins with coherent directions, scattered origins with mixed direction
 // signs, origins inside bone boxes, partial lane masks and finite t ranges,
@@ -226,13 +261,13 @@ TEST(LargePackets, FindTheSingleRayHits) {
   std::size_t hits = 0, checked = 0;
   for (int p = 0; p < 240; ++p) {
     const int groups = std::array<int, 4>{1, 3, 8, 32}[static_cast<std::size_t>(p % 4)];
-    const std::size_t n = static_cast<std::size_t>(groups) * 8;
-    std::vector<float> o[3], d[3], t0(n, 0.0f), t1(n, kInf);
-    for (int a = 0; a < 3; ++a) {
-      o[a].resize(n);
-      d[a].resize(n);
-    }
-    std::vector<std::uint8_t> active(static_cast<std::size_t>(groups));
+    PacketArrays arrays(groups, kInf);
+    const std::size_t n = arrays.n;
+    auto& o = arrays.o;
+    auto& d = arrays.d;
+    auto& t0 = arrays.t0;
+    auto& t1 = arrays.t1;
+    auto& active = arrays.active;
     const int mode = (p / 4) % 4;
     const Vec3 shared = c + Vec3(unit(g) - 0.5f, unit(g) - 0.5f, unit(g) - 0.5f) * 4.0f;
     const Vec3 aim = c + Vec3(unit(g) - 0.5f, unit(g) * 1.6f - 0.8f, unit(g) - 0.5f);
@@ -259,15 +294,7 @@ TEST(LargePackets, FindTheSingleRayHits) {
       }
     }
     for (auto& bits : active) bits = static_cast<std::uint8_t>(p % 7 == 0 ? (g() & 0xFFu) : 0xFFu);
-    rt::LargePacketRays rays;
-    rays.groups = groups;
-    for (int a = 0; a < 3; ++a) {
-      rays.o[a] = o[a].data();
-      rays.d[a] = d[a].data();
-    }
-    rays.t_min = t0.data();
-    rays.t_max = t1.data();
-    rays.active = active.data();
+    const rt::LargePacketRays& rays = arrays.view();
     // The tile's cull, as the renderer does, or every object.
     std::vector<std::uint32_t> tile;
     rt::RayBound bound;
@@ -290,11 +317,7 @@ TEST(LargePackets, FindTheSingleRayHits) {
       rt::occluded_large_packet(s, rays, test, candidates, blocked.data(), nullptr);
       for (std::size_t k = 0; k < n; ++k) {
         const bool on = (active[k / 8] >> (k % 8) & 1u) != 0;
-        Ray ray;
-        ray.origin = Vec3(o[0][k], o[1][k], o[2][k]);
-        ray.direction = Vec3(d[0][k], d[1][k], d[2][k]);
-        ray.t_min = t0[k];
-        ray.t_max = t1[k];
+        const Ray ray = arrays.ray(k);
         const Hit single = on ? rt::intersect(s, ray, test) : Hit{};
         ++checked;
         hits += single.valid() ? 1 : 0;
@@ -324,12 +347,10 @@ TEST(LargePackets, ShadowRaysToAPointLightMatchSingleRays) {
   for (const Vec3& light : lights) {
     for (int p = 0; p < 60; ++p) {
       const int groups = 1 + static_cast<int>(g() % 32);
-      const std::size_t n = static_cast<std::size_t>(groups) * 8;
-      std::vector<float> o[3], d[3], t0(n, 0.0f), t1(n, 1.0f);
-      for (int a = 0; a < 3; ++a) {
-        o[a].resize(n);
-        d[a].resize(n);
-      }
+      PacketArrays arrays(groups, 1.0f);
+      const std::size_t n = arrays.n;
+      auto& o = arrays.o;
+      auto& d = arrays.d;
       // Points on the characters and the ground, found by rays from a
       // camera-like point through the scene.
       const Vec3 eye(unit(g) * 4.0f - 2.0f, 0.5f + unit(g) * 2.0f, 3.0f);
@@ -345,16 +366,7 @@ TEST(LargePackets, ShadowRaysToAPointLightMatchSingleRays) {
           d[a][k] = light[a] - at[a];
         }
       }
-      std::vector<std::uint8_t> active(static_cast<std::size_t>(groups), 0xFFu);
-      rt::LargePacketRays rays;
-      rays.groups = groups;
-      for (int a = 0; a < 3; ++a) {
-        rays.o[a] = o[a].data();
-        rays.d[a] = d[a].data();
-      }
-      rays.t_min = t0.data();
-      rays.t_max = t1.data();
-      rays.active = active.data();
+      rt::LargePacketRays rays = arrays.view();
       rays.common_end = true;
       std::vector<std::uint32_t> every(objects.size());
       for (std::uint32_t i = 0; i < every.size(); ++i) every[i] = i;
@@ -362,11 +374,7 @@ TEST(LargePackets, ShadowRaysToAPointLightMatchSingleRays) {
         std::vector<std::uint8_t> blocked(static_cast<std::size_t>(groups));
         rt::occluded_large_packet(s, rays, test, every, blocked.data(), nullptr);
         for (std::size_t k = 0; k < n; ++k) {
-          Ray ray;
-          ray.origin = Vec3(o[0][k], o[1][k], o[2][k]);
-          ray.direction = Vec3(d[0][k], d[1][k], d[2][k]);
-          ray.t_max = 1.0f;
-          const bool single = rt::occluded(s, ray, test);
+          const bool single = rt::occluded(s, arrays.ray(k), test);
           ++checked;
           blocked_count += single ? 1 : 0;
           ASSERT_EQ((blocked[k / 8] >> (k % 8) & 1u) != 0, single) << "ray " << k;
