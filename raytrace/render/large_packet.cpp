@@ -22,11 +22,34 @@ namespace sinew::rt {
 namespace {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
-constexpr int kLanes = 8;
 // Bone trees with more nodes than this (finely subdivided meshes) are
 // walked by each group as an 8-ray packet: one walk per packet would reach
 // every cell in the packet's whole bound up to its farthest hit.
 constexpr std::size_t kLargePacketMaxTreeNodes = 2048;
+
+}  // namespace
+
+namespace {
+
+constexpr int kLanes = 8;
+
+// Eight rays (arrays of eight lanes) as an 8-ray packet, lanes of `lanes` active.
+RayPacket packet_of(const float* const o[3], const float* const d[3], const float* t_min, const float* t_max,
+                    std::uint32_t lanes) {
+  RayPacket p;
+  for (int i = 0; i < kLanes; ++i) {
+    p.ox[i] = o[0][i];
+    p.oy[i] = o[1][i];
+    p.oz[i] = o[2][i];
+    p.dx[i] = d[0][i];
+    p.dy[i] = d[1][i];
+    p.dz[i] = d[2][i];
+    p.t_min[i] = t_min[i];
+    p.t_max[i] = t_max[i];
+  }
+  p.active = static_cast<std::uint8_t>(lanes);
+  return p;
+}
 
 }  // namespace
 
@@ -460,18 +483,9 @@ class LargeQuery {
       const std::uint32_t lanes = visit_[g].lanes & live_[g];
       if (lanes == 0) return;
       const Group& gr = group_[g];
-      RayPacket p;
-      for (int lane = 0; lane < kLanes; ++lane) {
-        p.ox[lane] = gr.o[0][lane];
-        p.oy[lane] = gr.o[1][lane];
-        p.oz[lane] = gr.o[2][lane];
-        p.dx[lane] = gr.d[0][lane];
-        p.dy[lane] = gr.d[1][lane];
-        p.dz[lane] = gr.d[2][lane];
-        p.t_min[lane] = gr.t_min[lane];
-        p.t_max[lane] = gr.t_limit[lane];
-      }
-      p.active = static_cast<std::uint8_t>(lanes);
+      const float* const o[3] = {gr.o[0], gr.o[1], gr.o[2]};
+      const float* const d[3] = {gr.d[0], gr.d[1], gr.d[2]};
+      const RayPacket p = packet_of(o, d, gr.t_min, gr.t_limit, lanes);
       TraversalCounters work;
       if constexpr (kAnyHit) {
         const std::uint32_t blocked = occluded_packet(scene_ref(), p, kTest, &work, &filter) & lanes;
@@ -890,38 +904,23 @@ void occluded_large_packet(const Scene& scene, const LargePacketRays& rays, Tria
 #else
 
 namespace {
-// One group's eight rays as an 8-ray packet (lanes of `lanes` active).
-RayPacket group_packet(const LargePacketRays& rays, int g, const float* t_max, std::uint32_t lanes) {
-  RayPacket p;
+RayPacket group_of(const LargePacketRays& rays, int g) {
   const std::size_t k0 = static_cast<std::size_t>(g) * kLanes;
-  for (int i = 0; i < kLanes; ++i) {
-    const std::size_t k = k0 + static_cast<std::size_t>(i);
-    p.ox[i] = rays.o[0][k];
-    p.oy[i] = rays.o[1][k];
-    p.oz[i] = rays.o[2][k];
-    p.dx[i] = rays.d[0][k];
-    p.dy[i] = rays.d[1][k];
-    p.dz[i] = rays.d[2][k];
-    p.t_min[i] = rays.t_min[k];
-    p.t_max[i] = t_max[i];
-  }
-  p.active = static_cast<std::uint8_t>(lanes);
-  return p;
+  const float* const o[3] = {rays.o[0] + k0, rays.o[1] + k0, rays.o[2] + k0};
+  const float* const d[3] = {rays.d[0] + k0, rays.d[1] + k0, rays.d[2] + k0};
+  return packet_of(o, d, rays.t_min + k0, rays.t_max + k0, rays.active[g]);
 }
-
 }  // namespace
 
 // Without AVX2 each group is an 8-ray packet (which is itself the single-ray
 // query per lane there).
 void intersect_large_packet(const Scene& scene, const LargePacketRays& rays, TriangleTest test,
-                            std::span<const std::uint32_t> objects, PacketHits out, TraversalCounters* counters) {
-  const ObjectFilter filter{objects};
-  (void)filter;
+                            std::span<const std::uint32_t> /*objects: culling only saves time*/, PacketHits out,
+                            TraversalCounters* counters) {
   for (int g = 0; g < std::clamp(rays.groups, 0, kMaxPacketGroups); ++g) {
     const std::size_t k0 = static_cast<std::size_t>(g) * kLanes;
-    const RayPacket p = group_packet(rays, g, rays.t_max + k0, rays.active[g]);
     Hit hits[kPacketSize];
-    intersect_packet(scene, p, test, hits, counters);
+    intersect_packet(scene, group_of(rays, g), test, hits, counters);
     for (int lane = 0; lane < kLanes; ++lane) {
       const std::size_t k = k0 + static_cast<std::size_t>(lane);
       out.t[k] = hits[lane].t;
@@ -937,9 +936,7 @@ void occluded_large_packet(const Scene& scene, const LargePacketRays& rays, Tria
                            std::span<const std::uint32_t> /*objects*/, std::uint8_t* blocked,
                            TraversalCounters* counters) {
   for (int g = 0; g < std::clamp(rays.groups, 0, kMaxPacketGroups); ++g) {
-    const std::size_t k0 = static_cast<std::size_t>(g) * kLanes;
-    const RayPacket p = group_packet(rays, g, rays.t_max + k0, rays.active[g]);
-    blocked[g] = occluded_packet(scene, p, test, counters);
+    blocked[g] = occluded_packet(scene, group_of(rays, g), test, counters);
   }
 }
 
