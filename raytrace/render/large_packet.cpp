@@ -22,9 +22,9 @@ namespace sinew::rt {
 namespace {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
-// Bone trees with more nodes than this (finely subdivided meshes) are
-// walked by each group as an 8-ray packet: one walk per packet would reach
-// every cell in the packet's whole bound up to its farthest hit.
+// Trees with more nodes than this (finely subdivided meshes, large static
+// meshes) are walked by each group as an 8-ray packet: one walk per packet
+// would reach every cell in the packet's whole bound up to its farthest hit.
 constexpr std::size_t kLargePacketMaxTreeNodes = 2048;
 
 }  // namespace
@@ -435,6 +435,10 @@ class LargeQuery {
           visit_small_static(mesh, groups);
           return;
         }
+        if (mesh.tree.nodes.size() > kLargePacketMaxTreeNodes) {
+          visit_with_small_packets(object_index, groups);
+          return;
+        }
         const auto leaf = [&](std::span<const std::uint32_t> triangles, std::uint32_t groups_here) {
           return test_leaf(triangles, groups_here, [&](std::uint32_t t) {
             const auto& v = mesh.desc.triangles[t];
@@ -447,6 +451,10 @@ class LargeQuery {
       }
       case TopLevelObject::Kind::kFallback: {
         const InstanceFrame& frame = scene_ref().instances()[object.index];
+        if (frame.fallback.nodes.size() > kLargePacketMaxTreeNodes) {
+          visit_with_small_packets(object_index, groups);
+          return;
+        }
         const SkinnedMesh& mesh = *scene_ref().characters()[frame.character].mesh;
         const auto leaf = [&](std::span<const std::uint32_t> items, std::uint32_t groups_here) {
           return test_leaf(items, groups_here, [&](std::uint32_t item) {
@@ -473,7 +481,7 @@ class LargeQuery {
     }
   }
 
-  // Trees too fine for one walk per packet: each group is an 8-ray packet
+  // Trees too big for one walk per packet: each group is an 8-ray packet
   // filtered to the one object (render/packet_traversal.h), whose lanes
   // walk only the cells their own rays reach and stop at their own hits.
   void visit_with_small_packets(std::uint32_t object_index, std::uint32_t groups) {
