@@ -289,8 +289,11 @@ class LargeQuery {
       if (e != kInf) add({e != e ? -kInf : e, object});
     }
     Candidate* const begin = heap_candidates.empty() ? stack_candidates.data() : heap_candidates.data();
-    if constexpr (!kAnyHit) {
-      // Front to back: an object entered after every lane's best hit is skipped.
+    // Closest hit: front to back, so an object entered after every lane's
+    // best hit is skipped. Rays bounded from their end (shadow rays to a
+    // point light): from the light, so a lane blocked on the way retires
+    // before it walks the tree it starts in, which costs most.
+    if (!kAnyHit || reversed) {
       std::sort(begin, begin + count, [](const Candidate& a, const Candidate& b) {
         return a.entry < b.entry || (a.entry == b.entry && a.object < b.object);
       });
