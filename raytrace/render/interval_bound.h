@@ -37,17 +37,6 @@ struct RayRanges {
   float t_lo = 0.0f, t_hi = 0.0f;
   bool finite = true;
 
-  void unite(const RayRanges& other) {
-    for (int a = 0; a < 3; ++a) {
-      o_lo[a] = std::min(o_lo[a], other.o_lo[a]);
-      o_hi[a] = std::max(o_hi[a], other.o_hi[a]);
-      d_lo[a] = std::min(d_lo[a], other.d_lo[a]);
-      d_hi[a] = std::max(d_hi[a], other.d_hi[a]);
-    }
-    t_lo = std::min(t_lo, other.t_lo);
-    t_hi = std::max(t_hi, other.t_hi);
-    finite = finite && other.finite;
-  }
   // The largest |origin| coordinate.
   float origin_magnitude() const {
     float m = 0.0f;
@@ -55,30 +44,6 @@ struct RayRanges {
     return m;
   }
 };
-
-// The ranges of the lanes in `mask` (non-empty) of eight rays
-// o + t d, t in [t0, t1]. finite is false when an origin, a direction or t0
-// of those lanes is not finite (t1 may be +inf).
-inline RayRanges lane_ranges(const Vec3x8& o, const Vec3x8& d, Float8 t0, Float8 t1, std::uint32_t mask) {
-  constexpr float kInf = std::numeric_limits<float>::infinity();
-  const Mask8 use = Mask8::from_bits(mask);
-  const Float8 plus(kInf), minus(-kInf);
-  RayRanges r;
-  Mask8 finite = is_finite(t0);
-  const Float8* const oc[3] = {&o.x, &o.y, &o.z};
-  const Float8* const dc[3] = {&d.x, &d.y, &d.z};
-  for (int a = 0; a < 3; ++a) {
-    r.o_lo[a] = reduce_min(select(use, *oc[a], plus));
-    r.o_hi[a] = reduce_max(select(use, *oc[a], minus));
-    r.d_lo[a] = reduce_min(select(use, *dc[a], plus));
-    r.d_hi[a] = reduce_max(select(use, *dc[a], minus));
-    finite = finite & is_finite(*oc[a]) & is_finite(*dc[a]);
-  }
-  r.t_lo = reduce_min(select(use, t0, plus));
-  r.t_hi = reduce_max(select(use, t1, minus));
-  r.finite = (finite.bits() & mask) == mask;
-  return r;
-}
 
 // The ranges of many groups of eight rays, kept lane by lane and reduced
 // once: adding a group costs a dozen min/max, not a dozen reductions.

@@ -298,7 +298,11 @@ class LargeQuery {
         return a.entry < b.entry || (a.entry == b.entry && a.object < b.object);
       });
     }
-    if (small_statics_only(begin, count, all)) {
+    const bool small_statics_only =
+        kTest == TriangleTest::kFast && count > 0 &&
+        std::all_of(begin, begin + count,
+                    [&](const Candidate& c) { return detail::is_small_static(scene_ref(), all[c.object]); });
+    if (small_statics_only) {
       // A ground quad and the like: every triangle against every group, in
       // order, without box clips (as the 8-ray packets' short cut; the
       // nearest hit is the same).
@@ -331,23 +335,6 @@ class LargeQuery {
   const TraversalCounters& counters() const { return counters_; }
 
  private:
-  // Whether every candidate is a static mesh the fast test takes triangle by triangle.
-  static bool small_statics_only_impl(const Scene& scene, const auto* begin, std::size_t count,
-                                      std::span<const TopLevelObject> all) {
-    if (kTest != TriangleTest::kFast || count == 0) return false;
-    for (std::size_t i = 0; i < count; ++i) {
-      const TopLevelObject& o = all[begin[i].object];
-      if (o.kind != TopLevelObject::Kind::kStatic ||
-          scene.static_meshes()[o.index].desc.triangles.size() > detail::kBruteForceStaticTriangles) {
-        return false;
-      }
-    }
-    return true;
-  }
-  bool small_statics_only(const auto* begin, std::size_t count, std::span<const TopLevelObject> all) const {
-    return small_statics_only_impl(scene_ref(), begin, count, all);
-  }
-
   // Any-hit rays that all end at finite t_max at one shared point.
   bool use_reversed() const {
     if (!kAnyHit || !rays_p_->common_end) return false;

@@ -674,14 +674,8 @@ std::uint8_t any_hits(const Scene& scene, const RayPacket& packet, TraversalCoun
 bool small_statics_only(const Scene& scene, TriangleTest test, const ObjectFilter& filter) {
   if (test != TriangleTest::kFast) return false;
   const std::span<const TopLevelObject> objects = scene.top_level().objects();
-  for (const std::uint32_t object : filter.objects) {
-    const TopLevelObject& o = objects[object];
-    if (o.kind != TopLevelObject::Kind::kStatic ||
-        scene.static_meshes()[o.index].desc.triangles.size() > detail::kBruteForceStaticTriangles) {
-      return false;
-    }
-  }
-  return true;
+  return std::all_of(filter.objects.begin(), filter.objects.end(),
+                     [&](std::uint32_t object) { return detail::is_small_static(scene, objects[object]); });
 }
 
 // Every triangle of the filter's static meshes against the packet, in

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <utility>
 
+#include "raytrace/scene/scene.h"
 #include "runtime/math/aabb.h"
 #include "runtime/math/ray.h"
 
@@ -31,6 +32,12 @@ inline bool valid_ray(const Ray& ray) {
 // costs more than the tests, and testing every triangle gives the same
 // nearest hit. Single rays and packets both do it, so they stay alike.
 inline constexpr std::size_t kBruteForceStaticTriangles = 8;
+
+// Whether a top-level object is such a static mesh.
+inline bool is_small_static(const Scene& scene, const TopLevelObject& object) {
+  return object.kind == TopLevelObject::Kind::kStatic &&
+         scene.static_meshes()[object.index].desc.triangles.size() <= kBruteForceStaticTriangles;
+}
 
 // Clips [t0, t1] to the ray's passage through `box` grown by `eps` on every
 // side. The growth absorbs the rounding of the slab arithmetic, which is
