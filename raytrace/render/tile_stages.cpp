@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "raytrace/render/large_packet.h"
+#include "raytrace/render/small_static_tiles.h"
 #include "raytrace/render/packet_traversal.h"
 #include "raytrace/render/ray_bound.h"
 #include "raytrace/render/traversal.h"
@@ -522,6 +523,11 @@ void trace_primary(const Scene& scene, const PinholeCamera& camera, TriangleTest
     tile_bound.add_lanes(eye, lane_dirs(b * kBlockLanes).data(), 0.0f, kInf, s.block_pixels[b]);
   }
   cull_objects(scene, tile_bound, lists.tile);
+  if (small_statics_tile(scene, test, lists.tile)) {
+    for (std::size_t b = 0; b < blocks; ++b) counters.rays += static_cast<std::uint64_t>(std::popcount(s.block_pixels[b]));
+    intersect_small_statics_tile(scene, eye, lists.tile, s, counters);
+    return;
+  }
   if (packet_rays > kPacketSize) {
     trace_primary_large(scene, eye, test, lists.tile, s, counters);
     return;
@@ -769,6 +775,10 @@ std::uint64_t trace_shadow_rays(const Scene& scene, TriangleTest test, int packe
     extra_grow = kFrameRelativeSlack * 4.0f * (extra_grow + scene_magnitude) + 0x1.0p-22f * extra_grow;
   }
   cull_objects(scene, tile_bound, lists.tile, extra_grow);
+  if (small_statics_tile(scene, test, lists.tile)) {
+    counters.rays += s.shadow_count;
+    return occluded_small_statics_tile(scene, lists.tile, l, s, counters);
+  }
   if (packet_rays > kPacketSize) return trace_shadow_large(scene, test, lists.tile, l, s, counters);
   RayPacket packet;
   std::memcpy(packet.t_min, kZeros, sizeof(packet.t_min));

@@ -23,6 +23,7 @@
 #include "raytrace/render/packet_traversal.h"
 #include "raytrace/render/ray_bound.h"
 #include "raytrace/render/renderer.h"
+#include "raytrace/render/small_static_tiles.h"
 #include "raytrace/render/tile_stages.h"
 #include "raytrace/render/traversal.h"
 #include "raytrace/scene/scene.h"
@@ -384,6 +385,114 @@ TEST(LargePackets, ShadowRaysToAPointLightMatchSingleRays) {
   }
   EXPECT_GT(blocked_count, checked / 20);
   EXPECT_LT(blocked_count, checked - checked / 20);
+}
+
+// Ground and wall quads and a mesh with a zero-area triangle: a scene of
+// small static meshes only, whose tiles take the direct tests.
+std::unique_ptr<rt::Scene> make_static_scene() {
+  auto scene = std::make_unique<rt::Scene>();
+  rt::StaticMeshDesc ground;
+  ground.positions = {{-5, 0, -5}, {5, 0, -5}, {-5, 0, 5}, {5, 0, 5}};
+  ground.triangles = {{0, 2, 1}, {1, 2, 3}};
+  rt::StaticMeshDesc wall;  // tilted, crossing the ground
+  wall.positions = {{-1, -0.5f, -1}, {1, -0.5f, -1.2f}, {-1, 2, -0.4f}, {1, 2, -0.6f}};
+  wall.triangles = {{0, 1, 2}, {1, 3, 2}};
+  rt::StaticMeshDesc sliver;  // a collinear triangle before a real one
+  sliver.positions = {{-0.5f, 0.2f, 0.5f}, {0.0f, 0.7f, 0.5f}, {0.5f, 1.2f, 0.5f}, {0.6f, 0.1f, 0.4f}};
+  sliver.triangles = {{0, 1, 2}, {0, 3, 2}};
+  for (const rt::StaticMeshDesc* mesh : {&ground, &wall, &sliver}) EXPECT_TRUE(scene->add_static_mesh(*mesh).ok());
+  JobSystem jobs(1);
+  EXPECT_TRUE(scene->prepare_frame(rt::FrameOptions{}, jobs).ok());
+  return scene;
+}
+
+// Tiles that reach only small static meshes: each camera ray's hit and each
+// shadow ray's occlusion are the single ray's (and brute force's), with
+// partial blocks at the image edge, invalid lanes and finite and infinite
+// t ranges; the watertight test keeps the general path.
+TEST(SmallStaticTiles, FindTheSingleRayHits) {
+  const std::unique_ptr<rt::Scene> sc = make_static_scene();
+  const std::vector<testing_support::SoupTriangle> soup = testing_support::world_triangles(*sc);
+  std::vector<std::uint32_t> objects(sc->top_level().objects().size());
+  for (std::uint32_t i = 0; i < objects.size(); ++i) objects[i] = i;
+  ASSERT_EQ(objects.size(), 3u);
+  EXPECT_TRUE(rt::small_statics_tile(*sc, TriangleTest::kFast, objects));
+  EXPECT_FALSE(rt::small_statics_tile(*sc, TriangleTest::kWatertight, objects));
+  EXPECT_FALSE(rt::small_statics_tile(*sc, TriangleTest::kFast, {}));
+  EXPECT_FALSE(rt::small_statics_tile(scene(), TriangleTest::kFast, std::vector<std::uint32_t>{0}))
+      << "a bone of the mannequins";
+
+  const auto camera =
+      rt::PinholeCamera::create({Vec3(0.3f, 1.1f, 3.0f), Vec3(0.0f, 0.5f, 0.0f), Vec3(0, 1, 0), 70.0f}, 13, 11)
+          .value();
+  rt::TileScratch s;
+  s.prepare(Tile{0, 0, 13, 11, 0});  // partial blocks on the right and bottom
+  rt::generate_camera_rays(camera, s);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  s.dir_x[3] = nan;
+  s.dir_x[9] = s.dir_y[9] = s.dir_z[9] = 0.0f;
+  s.dir_z[17] = -kInf;
+  rt::TraversalCounters counters;
+  rt::intersect_small_statics_tile(*sc, camera.eye(), objects, s, counters);
+  EXPECT_GT(counters.triangle_tests, 0u);
+  std::size_t hits = 0;
+  std::array<std::size_t, 3> per_mesh{};
+  for (std::size_t k = 0; k < s.lanes; ++k) {
+    Ray ray;
+    ray.origin = camera.eye();
+    ray.direction = Vec3(s.dir_x[k], s.dir_y[k], s.dir_z[k]);
+    const Hit single = s.is_pixel(k) ? rt::intersect(*sc, ray, TriangleTest::kFast) : Hit{};
+    ASSERT_EQ(s.triangle[k], single.triangle_id) << k;
+    ASSERT_EQ(s.instance[k], single.instance_id) << k;
+    ASSERT_EQ(s.hit(k), single.valid()) << k;
+    if (!single.valid()) {
+      ASSERT_EQ(s.t[k], kInf) << k;
+      continue;
+    }
+    ++hits;
+    ++per_mesh[single.instance_id];
+    ASSERT_EQ(std::bit_cast<std::uint32_t>(s.t[k]), std::bit_cast<std::uint32_t>(single.t)) << k;
+    ASSERT_EQ(std::bit_cast<std::uint32_t>(s.u[k]), std::bit_cast<std::uint32_t>(single.u)) << k;
+    ASSERT_EQ(std::bit_cast<std::uint32_t>(s.v[k]), std::bit_cast<std::uint32_t>(single.v)) << k;
+    const Hit ref = testing_support::nearest(soup, ray, TriangleTest::kFast);
+    ASSERT_TRUE(testing_support::same_nearest(single, ref, soup, ray, TriangleTest::kFast)) << k;
+  }
+  EXPECT_GT(hits, 60u);
+  for (const std::size_t n : per_mesh) EXPECT_GT(n, 0u) << "every mesh is seen";
+
+  // Shadow rays: scattered origins, mixed directions, to a point (t_max 1)
+  // or unbounded; a count that leaves a partial last group.
+  std::mt19937 g(5);
+  s.shadow_count = 61;
+  std::fill(s.lit.begin(), s.lit.end(), std::uint8_t{0b11});
+  std::size_t blocked = 0;
+  for (std::size_t i = 0; i < s.shadow_count; ++i) {
+    s.shadow_pixel[i] = static_cast<std::uint32_t>(i);
+    const Vec3 o(4.0f * unit(g) - 2.0f, 2.0f * unit(g) + 0.01f, 4.0f * unit(g) - 2.0f);
+    const Vec3 d(4.0f * unit(g) - 2.0f, 3.0f * unit(g) - 2.0f, 4.0f * unit(g) - 2.0f);
+    s.so_x[i] = o.x;
+    s.so_y[i] = o.y;
+    s.so_z[i] = o.z;
+    s.sd_x[i] = i == 7 ? nan : d.x;
+    s.sd_y[i] = d.y;
+    s.sd_z[i] = d.z;
+    s.s_tmax[i] = i % 3 == 0 ? kInf : 1.0f;
+  }
+  const std::uint64_t count = rt::occluded_small_statics_tile(*sc, objects, 1, s, counters);
+  for (std::size_t i = 0; i < s.shadow_count; ++i) {
+    Ray ray;
+    ray.origin = Vec3(s.so_x[i], s.so_y[i], s.so_z[i]);
+    ray.direction = Vec3(s.sd_x[i], s.sd_y[i], s.sd_z[i]);
+    ray.t_max = s.s_tmax[i];
+    const bool single = rt::occluded(*sc, ray, TriangleTest::kFast);
+    ASSERT_EQ(single, testing_support::any_hit(soup, ray, TriangleTest::kFast)) << i;
+    ASSERT_EQ((s.lit[i] & 0b10) == 0, single) << i;
+    ASSERT_EQ(s.lit[i] & 0b01, 1) << "other lights untouched";
+    blocked += single ? 1 : 0;
+  }
+  EXPECT_EQ(count, blocked);
+  EXPECT_GT(blocked, 5u);
+  EXPECT_LT(blocked, s.shadow_count - 5);
 }
 
 TEST(TileStages, CameraDirectionsAreTheCameraRays) {

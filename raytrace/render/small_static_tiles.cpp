@@ -1,0 +1,248 @@
+#include "raytrace/render/small_static_tiles.h"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "raytrace/render/traversal_shared.h"
+
+#if defined(__AVX2__) && defined(__FMA__)
+#include "raytrace/geometry/triangle_intersect8.h"
+#include "runtime/math/float8.h"
+#define SINEW_SMALL_STATICS_AVX2 1
+#else
+#define SINEW_SMALL_STATICS_AVX2 0
+#endif
+
+namespace sinew::rt {
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+struct StaticTriangle {
+  Vec3 p0, p1, p2;
+  std::uint32_t triangle;
+  std::uint32_t instance;
+  bool zero_area;  // never hit (the scalar test's last check, once per triangle)
+  bool first;      // its mesh's first triangle: the rays enter a new object
+};
+
+// The objects' triangles in list order, mesh by mesh (per thread, reused).
+const std::vector<StaticTriangle>& gather_triangles(const Scene& scene, std::span<const std::uint32_t> objects) {
+  thread_local std::vector<StaticTriangle> triangles;
+  triangles.clear();
+  const std::span<const TopLevelObject> all = scene.top_level().objects();
+  for (const std::uint32_t object : objects) {
+    const Scene::StaticMesh& mesh = scene.static_meshes()[all[object].index];
+    for (std::uint32_t t = 0; t < mesh.desc.triangles.size(); ++t) {
+      const auto& v = mesh.desc.triangles[t];
+      const Vec3& p0 = mesh.desc.positions[v[0]];
+      const Vec3& p1 = mesh.desc.positions[v[1]];
+      const Vec3& p2 = mesh.desc.positions[v[2]];
+      triangles.push_back({p0, p1, p2, t, mesh.instance_id, detail::zero_area(p1 - p0, p2 - p0), t == 0});
+    }
+  }
+  return triangles;
+}
+
+}  // namespace
+
+bool small_statics_tile(const Scene& scene, TriangleTest test, std::span<const std::uint32_t> objects) {
+  if (test != TriangleTest::kFast || objects.empty()) return false;
+  const std::span<const TopLevelObject> all = scene.top_level().objects();
+  return std::all_of(objects.begin(), objects.end(),
+                     [&](std::uint32_t object) { return detail::is_small_static(scene, all[object]); });
+}
+
+#if SINEW_SMALL_STATICS_AVX2
+
+namespace {
+
+// One group's rays, aligned for the eight-lane tests.
+struct alignas(32) GroupRays {
+  float o[3][kBlockLanes];
+  float d[3][kBlockLanes];
+  float t_min[kBlockLanes];
+  float t_limit[kBlockLanes];  // closest hit: the best t so far (exclusive); any hit: t_max
+  RayLanes8 lanes() const { return {o, d, t_min, t_limit}; }
+};
+
+// valid_ray (render/traversal_shared.h) per lane.
+std::uint32_t valid_lanes(const GroupRays& r) {
+  Mask8 valid = Float8::load(r.t_min) < Float8::load(r.t_limit);
+  Mask8 nonzero = Mask8::from_bits(0);
+  for (int a = 0; a < 3; ++a) {
+    const Float8 d = Float8::load(r.d[a]);
+    valid = valid & is_finite(Float8::load(r.o[a])) & is_finite(d);
+    nonzero = nonzero | !(d == Float8(0.0f));
+  }
+  return (valid & nonzero).bits();
+}
+
+}  // namespace
+
+void intersect_small_statics_tile(const Scene& scene, const Vec3& eye, std::span<const std::uint32_t> objects,
+                                  TileScratch& s, TraversalCounters& counters) {
+  const std::vector<StaticTriangle>& triangles = gather_triangles(scene, objects);
+  // The origin's terms once per triangle for the whole tile.
+  thread_local std::vector<CommonOriginTriangle> prepared;
+  prepared.clear();
+  for (const StaticTriangle& tri : triangles) prepared.push_back(prepare_common_origin(eye, tri.p0, tri.p1, tri.p2));
+  GroupRays r;
+  for (int a = 0; a < 3; ++a) Float8(eye[a]).store(r.o[a]);
+  Float8(0.0f).store(r.t_min);
+  const std::uint64_t objects_visited = objects.size();
+  for (std::size_t b = 0; b < s.blocks(); ++b) {
+    const std::size_t k0 = b * kBlockLanes;
+    Float8::load(&s.dir_x[k0]).store(r.d[0]);
+    Float8::load(&s.dir_y[k0]).store(r.d[1]);
+    Float8::load(&s.dir_z[k0]).store(r.d[2]);
+    Float8(kInf).store(r.t_limit);
+    const std::uint32_t live = valid_lanes(r) & s.block_pixels[b];
+    alignas(32) float best_u[kBlockLanes] = {}, best_v[kBlockLanes] = {};
+    std::uint32_t best[kBlockLanes];  // index into triangles
+    std::uint32_t hits = 0;
+    if (live != 0) {
+      const std::uint64_t lanes = static_cast<std::uint64_t>(std::popcount(live));
+      counters.object_visits += objects_visited * lanes;
+      counters.triangle_tests += triangles.size() * lanes;
+      for (std::size_t i = 0; i < triangles.size(); ++i) {
+        alignas(32) float t[kBlockLanes], u[kBlockLanes], v[kBlockLanes];
+        const std::uint32_t hit = intersect_triangle_fast8_common_origin(r.lanes(), live, prepared[i], t, u, v);
+        if (hit == 0 || triangles[i].zero_area) continue;
+        const Mask8 m = Mask8::from_bits(hit);
+        select(m, Float8::load(t), Float8::load(r.t_limit)).store(r.t_limit);
+        select(m, Float8::load(u), Float8::load(best_u)).store(best_u);
+        select(m, Float8::load(v), Float8::load(best_v)).store(best_v);
+        for (std::uint32_t bits = hit; bits != 0; bits &= bits - 1) best[std::countr_zero(bits)] = static_cast<std::uint32_t>(i);
+        hits |= hit;
+      }
+    }
+    Float8::load(r.t_limit).store(&s.t[k0]);
+    Float8::load(best_u).store(&s.u[k0]);
+    Float8::load(best_v).store(&s.v[k0]);
+    for (int lane = 0; lane < kBlockLanes; ++lane) {
+      const std::size_t k = k0 + static_cast<std::size_t>(lane);
+      const bool hit = (hits >> lane & 1u) != 0;
+      s.triangle[k] = hit ? triangles[best[lane]].triangle : kInvalidId;
+      s.instance[k] = hit ? triangles[best[lane]].instance : kInvalidId;
+    }
+    s.block_hits[b] = static_cast<std::uint8_t>(hits);
+  }
+}
+
+std::uint64_t occluded_small_statics_tile(const Scene& scene, std::span<const std::uint32_t> objects, int l,
+                                          TileScratch& s, TraversalCounters& counters) {
+  const std::vector<StaticTriangle>& triangles = gather_triangles(scene, objects);
+  const std::uint8_t dark = static_cast<std::uint8_t>(~(1u << l));
+  std::uint64_t blocked_count = 0;
+  GroupRays r;
+  Float8(0.0f).store(r.t_min);
+  for (std::size_t i = 0; i < s.shadow_count; i += kBlockLanes) {
+    // The arrays hold a spare group past the last ray (tile_scratch.h).
+    const std::size_t n = std::min<std::size_t>(kBlockLanes, s.shadow_count - i);
+    Float8::load(&s.so_x[i]).store(r.o[0]);
+    Float8::load(&s.so_y[i]).store(r.o[1]);
+    Float8::load(&s.so_z[i]).store(r.o[2]);
+    Float8::load(&s.sd_x[i]).store(r.d[0]);
+    Float8::load(&s.sd_y[i]).store(r.d[1]);
+    Float8::load(&s.sd_z[i]).store(r.d[2]);
+    Float8::load(&s.s_tmax[i]).store(r.t_limit);
+    std::uint32_t live = valid_lanes(r) & ((1u << n) - 1u);
+    std::uint32_t blocked = 0;
+    for (std::size_t t = 0; t < triangles.size() && live != 0; ++t) {
+      const std::uint64_t lanes = static_cast<std::uint64_t>(std::popcount(live));
+      const StaticTriangle& tri = triangles[t];
+      if (tri.first) counters.object_visits += lanes;
+      counters.triangle_tests += lanes;
+      alignas(32) float th[kBlockLanes], u[kBlockLanes], v[kBlockLanes];
+      const std::uint32_t hit = intersect_triangle_fast8(r.lanes(), live, tri.p0, tri.p1, tri.p2, th, u, v);
+      if (hit == 0 || tri.zero_area) continue;
+      blocked |= hit;
+      live &= ~hit;
+    }
+    for (std::uint32_t m = blocked; m != 0; m &= m - 1) {
+      s.lit[s.shadow_pixel[i + static_cast<std::size_t>(std::countr_zero(m))]] &= dark;
+      ++blocked_count;
+    }
+  }
+  return blocked_count;
+}
+
+#else  // lane by lane with the scalar test, which the eight-lane tests equal bit for bit
+
+namespace {
+template <class Fn>
+void for_each_triangle(const std::vector<StaticTriangle>& triangles, Fn&& fn) {
+  for (const StaticTriangle& tri : triangles) {
+    if (!fn(tri)) return;
+  }
+}
+}  // namespace
+
+void intersect_small_statics_tile(const Scene& scene, const Vec3& eye, std::span<const std::uint32_t> objects,
+                                  TileScratch& s, TraversalCounters& counters) {
+  const std::vector<StaticTriangle>& triangles = gather_triangles(scene, objects);
+  for (std::size_t b = 0; b < s.blocks(); ++b) {
+    std::uint32_t hits = 0;
+    for (int lane = 0; lane < kBlockLanes; ++lane) {
+      const std::size_t k = b * kBlockLanes + static_cast<std::size_t>(lane);
+      s.t[k] = kInf;
+      s.u[k] = s.v[k] = 0.0f;
+      s.triangle[k] = s.instance[k] = kInvalidId;
+      Ray ray;
+      ray.origin = eye;
+      ray.direction = Vec3(s.dir_x[k], s.dir_y[k], s.dir_z[k]);
+      if (!(s.block_pixels[b] >> lane & 1u) || !detail::valid_ray(ray)) continue;
+      counters.object_visits += objects.size();
+      counters.triangle_tests += triangles.size();
+      for_each_triangle(triangles, [&](const StaticTriangle& tri) {
+        TriangleHit h;
+        if (intersect_triangle_fast(ray, s.t[k], tri.p0, tri.p1, tri.p2, h)) {
+          s.t[k] = h.t;
+          s.u[k] = h.u;
+          s.v[k] = h.v;
+          s.triangle[k] = tri.triangle;
+          s.instance[k] = tri.instance;
+          hits |= 1u << lane;
+        }
+        return true;
+      });
+    }
+    s.block_hits[b] = static_cast<std::uint8_t>(hits);
+  }
+}
+
+std::uint64_t occluded_small_statics_tile(const Scene& scene, std::span<const std::uint32_t> objects, int l,
+                                          TileScratch& s, TraversalCounters& counters) {
+  const std::vector<StaticTriangle>& triangles = gather_triangles(scene, objects);
+  const std::uint8_t dark = static_cast<std::uint8_t>(~(1u << l));
+  std::uint64_t blocked_count = 0;
+  for (std::size_t i = 0; i < s.shadow_count; ++i) {
+    Ray ray;
+    ray.origin = Vec3(s.so_x[i], s.so_y[i], s.so_z[i]);
+    ray.direction = Vec3(s.sd_x[i], s.sd_y[i], s.sd_z[i]);
+    ray.t_min = 0.0f;
+    ray.t_max = s.s_tmax[i];
+    if (!detail::valid_ray(ray)) continue;
+    bool blocked = false;
+    for_each_triangle(triangles, [&](const StaticTriangle& tri) {
+      if (tri.first) ++counters.object_visits;
+      ++counters.triangle_tests;
+      TriangleHit h;
+      blocked = intersect_triangle_fast(ray, ray.t_max, tri.p0, tri.p1, tri.p2, h);
+      return !blocked;
+    });
+    if (blocked) {
+      s.lit[s.shadow_pixel[i]] &= dark;
+      ++blocked_count;
+    }
+  }
+  return blocked_count;
+}
+
+#endif  // SINEW_SMALL_STATICS_AVX2
+
+}  // namespace sinew::rt
