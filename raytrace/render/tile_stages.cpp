@@ -816,16 +816,23 @@ void shade_and_write(const RenderSettings& settings, std::span<const Light> ligh
   const std::array<std::uint8_t, 4> background_bytes = {srgb_byte(settings.background.x),
                                                          srgb_byte(settings.background.y),
                                                          srgb_byte(settings.background.z), 255};
+  // A row of a block that missed, whole.
+  std::uint32_t background_row[kBlockWidth];
+  for (std::uint32_t& pixel : background_row) std::memcpy(&pixel, background_bytes.data(), 4);
+  static constexpr float kMissDepths[kBlockWidth] = {kInf, kInf, kInf, kInf};
   for (std::size_t b = 0; b < blocks; ++b) {
     const std::size_t k0 = b * kBlockLanes;
     const std::uint32_t pixels = s.block_pixels[b];
     const std::uint32_t hits = s.block_hits[b];
-    // Filled below for blocks with hits; zeroed so no path reads garbage.
-    alignas(32) float depth[8] = {}, linear[3][8] = {};
-    alignas(32) std::uint32_t pixels_rgba8[8] = {};
+    // Filled below for blocks with hits, each only when its output is
+    // wanted, and read only then (so not zeroed per block).
+    alignas(32) float depth[8], linear[3][8];
+    alignas(32) std::uint32_t pixels_rgba8[8];
     if (hits != 0) {
-      const Vec3x8 dir = load3(s.dir_x, s.dir_y, s.dir_z, k0);
-      (Float8::load(&s.t[k0]) * sqrt(dot(dir, dir))).store(depth);
+      if (out.depth.wanted()) {
+        const Vec3x8 dir = load3(s.dir_x, s.dir_y, s.dir_z, k0);
+        (Float8::load(&s.t[k0]) * sqrt(dot(dir, dir))).store(depth);
+      }
       if (want_color) {
         const Vec3x8 position = load3(s.px, s.py, s.pz, k0);
         const Vec3x8 n = load3(s.nx, s.ny, s.nz, k0);
@@ -863,10 +870,10 @@ void shade_and_write(const RenderSettings& settings, std::span<const Light> ligh
         if (out.triangle.wanted()) std::memcpy(out.triangle.at(bx, y), &s.triangle[k], 4 * sizeof(std::uint32_t));
         if (out.instance.wanted()) std::memcpy(out.instance.at(bx, y), &s.instance[k], 4 * sizeof(std::uint32_t));
         if (hits == 0u) {
+          if (out.depth.wanted()) std::memcpy(out.depth.at(bx, y), kMissDepths, sizeof(kMissDepths));
+          if (out.rgba8.wanted()) std::memcpy(out.rgba8.at(bx, y), background_row, sizeof(background_row));
           for (int i = 0; i < kBlockWidth; ++i) {
-            if (out.depth.wanted()) out.depth.at(bx, y)[i] = kInf;
             if (out.normal.wanted()) out.normal.at(bx, y)[i] = Vec3(0.0f);
-            if (out.rgba8.wanted()) std::memcpy(out.rgba8.at(bx + i, y), background_bytes.data(), 4);
             if (out.rgba32f.wanted()) {
               float* rgba = out.rgba32f.at(bx + i, y);
               for (int c = 0; c < 3; ++c) rgba[c] = settings.background[c];
