@@ -1,4 +1,5 @@
 #include "game_demo/input_script.h"
+#include "runtime/io/regular_file.h"
 
 #include <algorithm>
 #include <charconv>
@@ -70,6 +71,7 @@ Expected<InputScript> InputScript::parse(std::string_view text, const std::strin
 }
 
 Expected<InputScript> InputScript::load(const std::string& path) {
+  SINEW_RETURN_IF_ERROR(check_regular_file(path));
   std::ifstream in(path, std::ios::binary);
   if (!in) return make_error(ErrorCode::kIoError, path, "", "", "cannot open the input script");
   std::ostringstream text;

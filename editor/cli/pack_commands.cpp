@@ -430,7 +430,12 @@ void print_bake_memory(const BakeMemory& m, long rss_before_kib, long rss_after_
 
 int run_bake(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
   auto parsed = parse_bake_options(args);
-  if (!parsed.ok()) return usage_error(err, "bake", parsed.status(), bake_usage());
+  if (!parsed.ok()) {
+    // A scene recipe is read while parsing: an error naming a file is about
+    // its contents (exit 1), one naming only an option is a usage error.
+    if (!parsed.status().file().empty()) return fail(err, "bake", parsed.status());
+    return usage_error(err, "bake", parsed.status(), bake_usage());
+  }
   const BakeOptions& o = *parsed;
   if (o.help) {
     out << bake_usage();

@@ -1,4 +1,5 @@
 #include "editor/import/cal3d_importer.h"
+#include "runtime/io/regular_file.h"
 
 #include <algorithm>
 #include <array>
@@ -67,13 +68,7 @@ Status cal3d_error(const std::string& file, std::string_view what) {
 // Cal3D's loaders open files themselves; checking first gives a clear
 // kNotFound instead of Cal3D's generic message, and keeps directories
 // (which some loaders would "read" as empty) out.
-Status check_file(const std::string& path) {
-  std::error_code ec;
-  if (!fs::is_regular_file(path, ec)) {
-    return make_error(ErrorCode::kNotFound, path, "", "", "no such file");
-  }
-  return {};
-}
+Status check_file(const std::string& path) { return check_regular_file(path); }
 
 Status validate_binary(const std::string& path);
 

@@ -1,4 +1,5 @@
 #include "editor/import/gltf_importer.h"
+#include "runtime/io/regular_file.h"
 
 #include <tiny_gltf.h>
 
@@ -1147,10 +1148,7 @@ bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, in
 }  // namespace
 
 Expected<ImportedModel> import_gltf(const std::string& path) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) {
-    return make_error(ErrorCode::kNotFound, path, "", "", "no such file");
-  }
+  SINEW_RETURN_IF_ERROR(check_regular_file(path));
   char magic[4] = {};
   {
     std::ifstream f(path, std::ios::binary);

@@ -8,6 +8,7 @@
 #include "editor/pack/character_pack.h"
 #if SINEW_HAVE_CAL3D
 #include "editor/import/cal3d_importer.h"
+#include "runtime/io/regular_file.h"
 #endif
 
 namespace sinew::editor {
@@ -25,10 +26,7 @@ Expected<ImportedModel> load_model(const std::string& path) {
     return make_error(ErrorCode::kInvalidArgument, path, "extension", ext.empty() ? "(none)" : ext,
                       "unsupported model format (expected .gltf, .glb, .cfg or .pack)");
   }
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) {
-    return make_error(ErrorCode::kNotFound, path, "", "", "no such file");
-  }
+  SINEW_RETURN_IF_ERROR(check_regular_file(path));
   if (gltf) return import_gltf(path);
   if (ext == ".pack") {
     SINEW_ASSIGN_OR_RETURN(CharacterPack pack, CharacterPack::open(path));

@@ -1,4 +1,5 @@
 #include "editor/scene/scene_recipe.h"
+#include "runtime/io/regular_file.h"
 
 #include <algorithm>
 #include <cmath>
@@ -79,6 +80,7 @@ Expected<SceneRecipe> parse_scene_recipe(std::string_view text, const std::strin
 }
 
 Expected<SceneRecipe> load_scene_recipe(const std::string& path) {
+  SINEW_RETURN_IF_ERROR(check_regular_file(path));
   std::ifstream in(path, std::ios::binary);
   if (!in) return make_error(ErrorCode::kIoError, path, "", "", "cannot open the scene recipe");
   std::ostringstream text;

@@ -1,5 +1,7 @@
 #include "runtime/io/atomic_file.h"
 
+#include "runtime/io/regular_file.h"
+
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -168,6 +170,7 @@ Status replace_file_atomic(const std::string& temp_path, const std::string& path
 }
 
 Expected<std::string> read_file_text(const std::string& path) {
+  SINEW_RETURN_IF_ERROR(check_regular_file(path));
   std::FILE* f = std::fopen(path.c_str(), "rb");
   if (f == nullptr) {
     const int err = errno;

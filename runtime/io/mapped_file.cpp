@@ -1,5 +1,7 @@
 #include "runtime/io/mapped_file.h"
 
+#include "runtime/io/regular_file.h"
+
 #include <fcntl.h>
 #include <sys/mman.h>
 #include <sys/stat.h>
@@ -37,7 +39,10 @@ void MappedFile::release() {
 }
 
 Expected<MappedFile> MappedFile::open(const std::string& path) {
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  SINEW_RETURN_IF_ERROR(check_regular_file(path));
+  // Non-blocking: a path swapped for a FIFO after the check must not hang
+  // the open (fstat below refuses it).
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
   if (fd < 0) {
     const int err = errno;
     return make_error(err == ENOENT ? ErrorCode::kNotFound : ErrorCode::kIoError, path, "", "",

@@ -3,13 +3,18 @@
 // pack kept when a bake fails, and rendering from a pack equal to rendering
 // after an in-memory bake of the same pose space.
 #include <gtest/gtest.h>
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
+#include <atomic>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "editor/cli/pack_commands.h"
@@ -185,6 +190,61 @@ TEST_F(PackCommands, ASceneRecipeBakesOnlyItsClips) {
   const CommandRun bad = run(run_bake, {kCesiumMan, "--scene", dir + "/bad.json", "-o", dir + "/y.pack"});
   EXPECT_EQ(bad.code, 1);
   EXPECT_NE(bad.err.find("no_such_clip"), std::string::npos) << bad.err;
+}
+
+// Named pipes given as a model, a pack or a scene recipe are refused at
+// once with a message saying what they are. A reader that blocked in
+// open() instead would wait for a writer forever: the watchdog plays that
+// writer (so a regression fails instead of hanging) and records that it
+// was needed.
+TEST_F(PackCommands, NonRegularFilesAreRefusedWithoutBlocking) {
+  const std::string dir = fresh_dir("fifo");
+  std::vector<std::string> fifos;
+  for (const char* name : {"a.pack", "a.glb", "a.gltf", "a.cfg", "scene.json"}) {
+    fifos.push_back(dir + "/" + name);
+    ASSERT_EQ(::mkfifo(fifos.back().c_str(), 0600), 0) << fifos.back();
+  }
+  std::filesystem::create_directory(dir + "/folder.pack");
+  std::atomic<bool> stop{false}, reader_blocked{false};
+  std::thread watchdog([&] {
+    while (!stop) {
+      for (const std::string& f : fifos) {
+        // Succeeds only while some reader sits in open(): then it returns.
+        const int fd = ::open(f.c_str(), O_WRONLY | O_NONBLOCK);
+        if (fd >= 0) {
+          reader_blocked = true;
+          ::close(fd);
+        }
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+  });
+  struct Case {
+    int (*command)(const std::vector<std::string>&, std::ostream&, std::ostream&);
+    std::vector<std::string> args;
+    std::string file;
+  };
+  const std::vector<Case> cases = {
+      {run_validate, {fifos[0]}, fifos[0]},
+      {run_inspect, {fifos[0]}, fifos[0]},
+      {run_render, {fifos[0], "--frames", "1", "--out", dir + "/out"}, fifos[0]},
+      {run_bake, {fifos[1], "-o", dir + "/x.pack"}, fifos[1]},
+      {run_bake, {fifos[2], "-o", dir + "/x.pack"}, fifos[2]},
+      {run_bake, {fifos[3], "-o", dir + "/x.pack"}, fifos[3]},
+      {run_bake, {kCesiumMan, "--scene", fifos[4], "-o", dir + "/x.pack"}, fifos[4]},
+      {run_render, {dir + "/folder.pack", "--frames", "1", "--out", dir + "/out"}, dir + "/folder.pack"},
+  };
+  for (const Case& c : cases) {
+    const CommandRun r = run(c.command, c.args);
+    EXPECT_EQ(r.code, 1) << c.args[0] << ": " << r.err;
+    EXPECT_NE(r.err.find(c.file + ": is a"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("not a regular file"), std::string::npos) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << "one line: " << r.err;
+  }
+  stop = true;
+  watchdog.join();
+  EXPECT_FALSE(reader_blocked) << "some command blocked opening a FIFO";
+  EXPECT_FALSE(std::filesystem::exists(dir + "/x.pack"));
 }
 
 TEST_F(PackCommands, UsageAndUserErrorsHaveTheirExitCodes) {

@@ -390,7 +390,7 @@ TEST(RenderCommand, UserErrorsAreOneClearLine) {
       {{kCesiumMan, "--out", dir, "--clip", "nope"},
        "sinew-editor: " + kCesiumMan + ": clip = 'nope': no such clip (clips: animation_0)"},
       {{kCesiumMan, "--out", dir, "--clip", "#1"}, "clip = '#1': no such clip"},
-      {{"model.pack", "--out", dir}, "sinew-editor: model.pack: cannot open: No such file or directory"},
+      {{"model.pack", "--out", dir}, "sinew-editor: model.pack: no such file"},
       {{"model.obj", "--out", dir}, "model.obj: extension = .obj: unsupported model format"},
       {{kCesiumMan, "--out", dir, "--pose-space", "limits", "--limits", dir + "-nope.json"}, dir + "-nope.json"},
   };

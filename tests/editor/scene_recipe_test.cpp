@@ -55,7 +55,7 @@ TEST(SceneRecipe, BadRecipesNameTheFieldAndValue) {
   auto broken = parse_scene_recipe("{\"clips\": [", "broken.json");
   ASSERT_FALSE(broken.ok());
   EXPECT_NE(broken.status().message().find("not valid JSON"), std::string::npos);
-  EXPECT_EQ(load_scene_recipe("/nonexistent/scene.json").status().code(), ErrorCode::kIoError);
+  EXPECT_EQ(load_scene_recipe("/nonexistent/scene.json").status().code(), ErrorCode::kNotFound);
 }
 
 TEST(SceneRecipe, KeepsOnlyTheRecipesClipsInItsOrder) {

@@ -125,10 +125,10 @@ TEST(InputScript, BadLinesAreRejectedWithTheLineAndTheToken) {
   }
 }
 
-TEST(InputScript, AMissingFileIsAnIoError) {
+TEST(InputScript, AMissingFileIsNotFound) {
   auto script = InputScript::load("/nonexistent/keys.script");
   ASSERT_FALSE(script.ok());
-  EXPECT_EQ(script.status().code(), ErrorCode::kIoError);
+  EXPECT_EQ(script.status().code(), ErrorCode::kNotFound);
   EXPECT_NE(script.status().message().find("/nonexistent/keys.script"), std::string::npos);
 }
 

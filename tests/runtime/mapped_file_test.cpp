@@ -1,4 +1,5 @@
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <cstring>
 #include <string>
@@ -44,7 +45,25 @@ TEST(MappedFile, FolderIsRejected) {
   testing_support::TempDir dir;
   auto file = MappedFile::open(dir.path().string());
   ASSERT_FALSE(file.ok());
-  EXPECT_EQ(file.status().code(), ErrorCode::kIoError);
+  EXPECT_EQ(file.status().code(), ErrorCode::kInvalidArgument);
+  EXPECT_NE(file.status().message().find("is a directory, not a regular file"), std::string::npos)
+      << file.status().message();
+}
+
+// A FIFO is refused from its kind, before any open() that would wait for
+// a writer (the test would hang there); so is it by read_file_text.
+TEST(MappedFile, FifoIsRefusedWithoutOpeningIt) {
+  testing_support::TempDir dir;
+  const std::string path = dir.file("pipe.pack");
+  ASSERT_EQ(::mkfifo(path.c_str(), 0600), 0);
+  auto file = MappedFile::open(path);
+  ASSERT_FALSE(file.ok());
+  EXPECT_EQ(file.status().code(), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(file.status().file(), path);
+  EXPECT_NE(file.status().message().find("FIFO"), std::string::npos) << file.status().message();
+  auto text = read_file_text(path);
+  ASSERT_FALSE(text.ok());
+  EXPECT_NE(text.status().message().find("FIFO"), std::string::npos) << text.status().message();
 }
 
 }  // namespace
