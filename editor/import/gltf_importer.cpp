@@ -1,5 +1,6 @@
 #include "editor/import/gltf_importer.h"
-#include "runtime/io/regular_file.h"
+#include "editor/import/gltf_container.h"
+#include "runtime/io/atomic_file.h"
 
 #include <tiny_gltf.h>
 
@@ -1148,14 +1149,21 @@ bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, in
 }  // namespace
 
 Expected<ImportedModel> import_gltf(const std::string& path) {
-  SINEW_RETURN_IF_ERROR(check_regular_file(path));
-  char magic[4] = {};
-  {
-    std::ifstream f(path, std::ios::binary);
-    if (!f) return make_error(ErrorCode::kIoError, path, "", "", "cannot open the file");
-    f.read(magic, 4);
+  SINEW_ASSIGN_OR_RETURN(const std::string bytes, read_file_text(path));
+  // tinygltf takes 32-bit lengths.
+  if (bytes.size() > std::numeric_limits<unsigned int>::max()) {
+    return make_error(ErrorCode::kLimitExceeded, path, "", std::to_string(bytes.size()) + " bytes",
+                      "glTF files of 4 GiB or more are not supported");
   }
-  const bool binary = std::memcmp(magic, "glTF", 4) == 0;
+  const bool binary = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
+  // Bounded nesting before tinygltf's recursive parser sees the JSON.
+  if (binary) {
+    const Expected<std::string_view> json = check_glb(bytes, path);
+    if (!json.ok()) return json.status();
+  } else {
+    SINEW_RETURN_IF_ERROR(check_json_nesting(bytes, kMaxJsonNesting, path, "json"));
+  }
+  const std::string base_dir = std::filesystem::path(path).parent_path().string();
 
   tinygltf::Model model;
   tinygltf::TinyGLTF loader;
@@ -1163,8 +1171,11 @@ Expected<ImportedModel> import_gltf(const std::string& path) {
   std::string err, warn;
   bool loaded = false;
   try {
-    loaded = binary ? loader.LoadBinaryFromFile(&model, &err, &warn, path)
-                    : loader.LoadASCIIFromFile(&model, &err, &warn, path);
+    const auto length = static_cast<unsigned int>(bytes.size());
+    loaded = binary ? loader.LoadBinaryFromMemory(&model, &err, &warn,
+                                                  reinterpret_cast<const unsigned char*>(bytes.data()), length,
+                                                  base_dir)
+                    : loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(), length, base_dir);
   } catch (const std::exception& e) {
     // tinygltf or its JSON parser may throw on hostile input; we must not.
     err = e.what();
@@ -1177,6 +1188,13 @@ Expected<ImportedModel> import_gltf(const std::string& path) {
     while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();
     return make_error(ErrorCode::kInvalidData, path, binary ? "glb" : "json", "",
                       "tinygltf could not parse the file: " + (err.empty() ? warn : err));
+  }
+  // asset.version is "major.minor"; only major version 2 is this format.
+  const std::string& version = model.asset.version;
+  if (version.rfind("2.", 0) != 0) {
+    return make_error(ErrorCode::kUnsupportedVersion, path, "asset.version", version.empty() ? "(none)" : version,
+                      version.rfind("1.", 0) == 0 ? "glTF 1.0 is not supported (glTF 2.0 only)"
+                                                  : "only glTF 2.x is supported");
   }
   const Ctx c{model, path};
   return convert(c);

@@ -19,6 +19,7 @@
 
 #include "animation/pose.h"
 #include "animation/reference_skinning.h"
+#include "editor/import/gltf_container.h"
 #include "editor/import/gltf_importer.h"
 
 namespace sinew::editor {
@@ -762,6 +763,101 @@ TEST_F(GltfSynthetic, TwoSkinsOverTheSameJointsMerge) {
 
 TEST_F(GltfSynthetic, TwoSkinsWithConflictingBindsAreAnError) {
   expect_error(two_skins("[1, 2]"), "skins[1].inverseBindMatrices[0]");
+}
+
+// The synthetic model as a .glb: its buffer in the BIN chunk, `trailing`
+// bytes after the declared end.
+std::string write_glb(const fs::path& path, Synthetic s, const std::string& trailing = "") {
+  const auto at = s.json.find("\"uri\": \"synthetic.bin\", ");
+  EXPECT_NE(at, std::string::npos);
+  s.json.erase(at, std::string("\"uri\": \"synthetic.bin\", ").size());
+  std::string json = s.json;
+  while (json.size() % 4 != 0) json += ' ';
+  std::string bin(s.bin.begin(), s.bin.end());
+  while (bin.size() % 4 != 0) bin += '\0';
+  const auto u32 = [](std::uint32_t v) { return std::string(reinterpret_cast<const char*>(&v), 4); };
+  const std::uint32_t length = static_cast<std::uint32_t>(12 + 8 + json.size() + 8 + bin.size());
+  const std::string bytes = "glTF" + u32(2) + u32(length) + u32(static_cast<std::uint32_t>(json.size())) +
+                            u32(0x4E4F534Au) + json + u32(static_cast<std::uint32_t>(bin.size())) +
+                            u32(0x004E4942u) + bin + trailing;
+  std::ofstream(path, std::ios::binary) << bytes;
+  return path.string();
+}
+
+// JSON nested thousands of levels deep overflowed the stack of tinygltf's
+// recursive parser (a crash); nesting is now bounded by a scan first, in
+// .gltf and .glb alike. The limit is exact, and brackets inside strings do
+// not count.
+TEST_F(GltfSynthetic, DeepNestingIsRefusedBeforeParsing) {
+  const auto with_extras = [](const std::string& extras) {
+    Synthetic s = synthetic();
+    replace(s.json, "\"scene\": 0,", "\"scene\": 0, \"extras\": " + extras + ",");
+    return s;
+  };
+  const auto arrays = [](std::size_t n) { return std::string(n, '[') + std::string(n, ']'); };
+  const auto objects = [](std::size_t n) {
+    std::string j;
+    for (std::size_t i = 0; i < n; ++i) j += "{\"a\": ";
+    return j + "1" + std::string(n, '}');
+  };
+  // The document's own object is the first level.
+  const std::size_t limit = kMaxJsonNesting;
+  for (const bool glb : {false, true}) {
+    for (const std::string& extras : {arrays(15000), objects(15000), arrays(limit), objects(limit)}) {
+      const Synthetic s = with_extras(extras);
+      const std::string path = glb ? write_glb(dir_ / "deep.glb", s) : write(s);
+      const auto m = import_gltf(path);
+      ASSERT_FALSE(m.ok());
+      EXPECT_EQ(m.status().code(), ErrorCode::kLimitExceeded);
+      EXPECT_EQ(m.status().file(), path);
+      EXPECT_NE(m.status().message().find("nested deeper than 256 levels"), std::string::npos)
+          << m.status().message();
+    }
+    for (const std::string& extras :
+         {arrays(limit - 1), objects(limit - 1), "\"" + std::string(20000, '[') + "\\\"{{\""}) {
+      const Synthetic s = with_extras(extras);
+      const std::string path = glb ? write_glb(dir_ / "deep.glb", s) : write(s);
+      const auto m = import_gltf(path);
+      EXPECT_TRUE(m.ok()) << m.status().message();
+    }
+  }
+}
+
+// Bytes past a .glb's declared length were ignored; the header must
+// describe the whole file.
+TEST_F(GltfSynthetic, GlbLengthMustBeTheFileSize) {
+  ASSERT_TRUE(import_gltf(write_glb(dir_ / "ok.glb", synthetic())).ok());
+  for (const std::string& trailing : {std::string("x"), std::string(4, '\0'), std::string(1000, 'g')}) {
+    const std::string path = write_glb(dir_ / "long.glb", synthetic(), trailing);
+    const auto m = import_gltf(path);
+    ASSERT_FALSE(m.ok());
+    EXPECT_EQ(m.status().file(), path);
+    EXPECT_NE(m.status().message().find("glb.header.length"), std::string::npos) << m.status().message();
+    EXPECT_NE(m.status().message().find("data past the declared end"), std::string::npos) << m.status().message();
+  }
+}
+
+// asset.version is major.minor: 2.x is glTF 2.0; 1.0 and 3.0 are other formats.
+TEST_F(GltfSynthetic, AssetVersionMustBeTwo) {
+  struct Case {
+    std::string version;
+    bool ok;
+    std::string message;
+  };
+  for (const Case& c : {Case{"2.1", true, ""}, Case{"3.0", false, "asset.version = 3.0: only glTF 2.x"},
+                        Case{"1.0", false, "asset.version = 1.0: glTF 1.0 is not supported"},
+                        Case{"20.0", false, "only glTF 2.x"}}) {
+    Synthetic s = synthetic();
+    replace(s.json, "\"version\": \"2.0\"", "\"version\": \"" + c.version + "\"");
+    for (const bool glb : {false, true}) {
+      const std::string path = glb ? write_glb(dir_ / "v.glb", s) : write(s);
+      const auto m = import_gltf(path);
+      ASSERT_EQ(m.ok(), c.ok) << c.version << ": " << (m.ok() ? "" : m.status().message());
+      if (!c.ok) {
+        EXPECT_NE(m.status().message().find(c.message), std::string::npos) << m.status().message();
+      }
+    }
+  }
 }
 
 TEST_F(GltfSynthetic, MissingFile) {
