@@ -48,15 +48,22 @@ Status validate_track(Track<T>& track, std::string_view source, const std::strin
     for (std::size_t v = 0; v < track.values.size(); ++v) {
       // Tangents of a cubic spline may be zero; the key values may not.
       const bool is_value = per_key == 1 || v % 3 == 1;
-      const float len = glm::length(track.values[v]);
-      if (is_value && len < 1e-6f) {
+      // In double: the squares of finite float components (up to 3.4e38)
+      // overflow float, not double, and tiny ones do not underflow.
+      const Quat& q = track.values[v];
+      const double x = q.x, y = q.y, z = q.z, w = q.w;
+      const double len = std::sqrt(x * x + y * y + z * z + w * w);
+      if (is_value && len < 1e-6) {
         return make_error(ErrorCode::kInvalidData, source, field + ".values[" + std::to_string(v) + "]",
                           "0", "zero-length rotation quaternion");
       }
       // Already unit (within rounding): kept as is, so that building a clip
       // from stored, normalised keys (a content pack) keeps their bits.
-      constexpr float kUnitTolerance = 4.0f * std::numeric_limits<float>::epsilon();
-      if (is_value && std::fabs(len - 1.0f) > kUnitTolerance) track.values[v] = track.values[v] / len;
+      constexpr double kUnitTolerance = 4.0 * static_cast<double>(std::numeric_limits<float>::epsilon());
+      if (is_value && std::fabs(len - 1.0) > kUnitTolerance) {
+        track.values[v] = Quat(static_cast<float>(w / len), static_cast<float>(x / len), static_cast<float>(y / len),
+                               static_cast<float>(z / len));
+      }
     }
   }
   return {};

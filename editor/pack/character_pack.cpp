@@ -431,7 +431,12 @@ Expected<std::vector<std::byte>> serialize_character_pack(const CharacterPackCon
 
 Status write_character_pack(const std::string& path, const CharacterPackContents& contents) {
   SINEW_ASSIGN_OR_RETURN(const PackWriter writer, character_pack_writer(contents));
-  return writer.write(path);
+  return writer.write(path, [](const std::string& written) -> Status {
+    auto loaded = CharacterPack::open(written);
+    if (loaded.ok()) return {};
+    return make_error(loaded.status().code(), "", "", "",
+                      "the written pack does not load, so nothing was replaced: " + loaded.status().message());
+  });
 }
 
 Expected<CharacterPack> CharacterPack::open(const std::string& path) {

@@ -60,7 +60,9 @@ struct CharacterPackContents {
 // The pack's bytes: the same contents give the same bytes.
 Expected<std::vector<std::byte>> serialize_character_pack(const CharacterPackContents& contents);
 // Written atomically: `path` keeps its old contents unless the whole new
-// pack is in place.
+// pack is in place, and the new pack replaces it only after it loaded and
+// validated (CharacterPack::open) from the written bytes: a pack that
+// would not load is never left behind.
 Status write_character_pack(const std::string& path, const CharacterPackContents& contents);
 
 class CharacterPack {

@@ -132,7 +132,8 @@ Expected<std::vector<std::byte>> PackWriter::serialize() const {
   return out;
 }
 
-Status PackWriter::write(const std::string& path) const {
+Status PackWriter::write(const std::string& path,
+                         const std::function<Status(const std::string& written)>& verify) const {
   auto named = [&path](Status status) { return status.with_file(path); };
   auto layout = this->layout();
   if (!layout.ok()) return named(layout.status());
@@ -155,6 +156,12 @@ Status PackWriter::write(const std::string& path) const {
     written += sections_[i].payload.size();
   }
   SINEW_RETURN_IF_ERROR(named(pad_to(layout->file_size)));
+  if (verify) {
+    if (Status s = verify(writer->temp_path()); !s.ok()) {
+      writer->discard();
+      return named(s);
+    }
+  }
   return named(writer->commit());
 }
 

@@ -13,6 +13,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <string>
 #include <vector>
@@ -38,9 +39,12 @@ class PackWriter {
   Expected<std::vector<std::byte>> serialize() const;
 
   // Writes the pack to `path` atomically, streaming the payloads (the file is
-  // never assembled in memory). Errors: kIoError naming the path, and those
-  // of serialize().
-  Status write(const std::string& path) const;
+  // never assembled in memory). `verify`, when given, reads the complete
+  // temporary file (its path) before it replaces anything; its error
+  // aborts the write. Errors: kIoError naming the path, those of
+  // serialize(), and verify's, named after `path`.
+  Status write(const std::string& path,
+               const std::function<Status(const std::string& written)>& verify = {}) const;
 
  private:
   struct Section {

@@ -149,6 +149,42 @@ TEST(Clip, UntouchedJointsKeepTheirPose) {
   EXPECT_EQ(pose[0].translation, Vec3(0, 0, 0));
 }
 
+// Rotation keys of any finite size are normalised: squares of components
+// past about 1.8e19 overflowed float, and such a key was stored as
+// (0, 0, 0, 0), which a pack then refused. Unit keys keep their bits.
+TEST(Clip, HugeAndTinyRotationKeysAreNormalised) {
+  const float big = 3.0e38f;
+  const std::pair<Quat, Quat> cases[] = {
+      {Quat(1.8e19f, 0, 0, 1.8e19f), Quat(0.70710678f, 0, 0, 0.70710678f)},
+      {Quat(big, big, big, big), Quat(0.5f, 0.5f, 0.5f, 0.5f)},
+      {Quat(-big, 0, 0, 0), Quat(-1, 0, 0, 0)},
+      {Quat(0, 2.0e-6f, 0, 0), Quat(0, 1, 0, 0)},
+  };
+  for (const auto& [key, unit] : cases) {
+    RawClip raw;
+    raw.name = "r";
+    raw.tracks.resize(1);
+    raw.tracks[0].rotation.times = {0.0f};
+    raw.tracks[0].rotation.values = {key};
+    auto c = Clip::build(std::move(raw), three_joints(), "r.caf");
+    ASSERT_TRUE(c.ok()) << c.status().message();
+    const Quat q = c->tracks()[0].rotation.values[0];
+    for (int i = 0; i < 4; ++i) {
+      EXPECT_NEAR(q[i], unit[i], 1e-6f) << i;
+      EXPECT_TRUE(std::isfinite(q[i]));
+    }
+  }
+  const Quat unit = glm::normalize(Quat(0.3f, -0.4f, 0.5f, 0.7f));
+  RawClip raw;
+  raw.name = "u";
+  raw.tracks.resize(1);
+  raw.tracks[0].rotation.times = {0.0f};
+  raw.tracks[0].rotation.values = {unit};
+  auto c = Clip::build(std::move(raw), three_joints(), "u.caf");
+  ASSERT_TRUE(c.ok());
+  for (int i = 0; i < 4; ++i) EXPECT_EQ(c->tracks()[0].rotation.values[0][i], unit[i]) << "bits kept";
+}
+
 TEST(Clip, RejectsBadKeysNamingTheField) {
   auto expect_error = [](RawClip raw, ErrorCode code, const char* field) {
     auto c = Clip::build(std::move(raw), three_joints(), "walk.caf");

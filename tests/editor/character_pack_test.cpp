@@ -4,6 +4,7 @@
 // error naming the section and field, never a crash (this suite also runs
 // under ASan + UBSan).
 #include <gtest/gtest.h>
+#include <fstream>
 
 #include <cmath>
 #include <cstring>
@@ -21,6 +22,7 @@
 #include "raytrace/camera/camera.h"
 #include "raytrace/render/renderer.h"
 #include "raytrace/scene/scene.h"
+#include "runtime/io/atomic_file.h"
 #include "runtime/jobs/job_system.h"
 #include "runtime/pack/pack_writer.h"
 #include "tests/support/same_model.h"
@@ -138,6 +140,36 @@ void check_round_trip(ImportedModel model) {
   for (std::uint32_t t : in_memory.triangles) hits += t != kInvalidId ? 1 : 0;
   EXPECT_GT(hits, 500u) << "the character should fill part of the image";
   std::filesystem::remove(path);
+}
+
+// write_character_pack loads what it wrote before the rename: contents
+// the loader refuses (here a NaN vertex, which nothing before the loader
+// checks) leave an existing pack byte-identical and no temporary file.
+TEST(CharacterPack, APackThatWouldNotLoadReplacesNothing) {
+  auto model = content::make_mannequin();
+  ASSERT_TRUE(model.ok());
+  JobSystem jobs(2);
+  const Baked good = bake(std::move(*model), jobs);
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "sinew_pack_not_replaced";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  const std::string path = (dir / "character.pack").string();
+  ASSERT_TRUE(write_character_pack(path, contents_of(good)).ok());
+  const auto read_all = [&] { return read_file_text(path).value(); };
+  const std::string before = read_all();
+  Baked broken = good;
+  broken.model.mesh.positions[0].y = std::numeric_limits<float>::quiet_NaN();
+  ASSERT_TRUE(serialize_character_pack(contents_of(broken)).ok()) << "the writer alone does not see it";
+  const Status s = write_character_pack(path, contents_of(broken));
+  ASSERT_FALSE(s.ok());
+  EXPECT_EQ(s.file(), path);
+  EXPECT_NE(s.message().find("the written pack does not load, so nothing was replaced"), std::string::npos)
+      << s.message();
+  EXPECT_NE(s.message().find("MESH.positions[0]"), std::string::npos) << s.message();
+  EXPECT_EQ(read_all(), before);
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir), std::filesystem::directory_iterator{}), 1)
+      << "no temporary file left";
+  std::filesystem::remove_all(dir);
 }
 
 TEST(CharacterPack, MannequinRoundTripRendersBitIdentically) {
