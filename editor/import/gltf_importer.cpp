@@ -473,23 +473,17 @@ Expected<NodeGraph> build_graph(const Ctx& c) {
     SINEW_RETURN_IF_ERROR(node_local(c, i, g.local[i], g.local_trs[i], trs_ok));
     g.trs_ok[i] = trs_ok;
   }
-  // With one parent per node, a node that never reaches a root within n
-  // steps sits on a cycle.
-  for (std::size_t i = 0; i < n; ++i) {
-    int p = g.parent[i];
-    for (std::size_t steps = 0; p != -1; ++steps) {
-      if (steps > n) {
-        return c.error(ErrorCode::kInvalidData, idx("nodes", i) + ".children", "",
-                       "the node hierarchy has a cycle through this node");
-      }
-      p = g.parent[static_cast<std::size_t>(p)];
-    }
-  }
   // Globals top-down from each root, iteratively (hierarchies can be deep).
+  // With one parent per node this reaches each node at most once, and every
+  // node it does not reach has no root above it: it sits on a cycle or
+  // below one. Linear in the nodes (walking each node up to its root was
+  // quadratic on long chains).
   std::vector<std::size_t> stack;
+  std::vector<bool> reached(n, false);
   for (std::size_t i = 0; i < n; ++i) {
     if (g.parent[i] != -1) continue;
     g.global[i] = g.local[i];
+    reached[i] = true;
     stack.push_back(i);
     while (!stack.empty()) {
       const std::size_t cur = stack.back();
@@ -497,9 +491,22 @@ Expected<NodeGraph> build_graph(const Ctx& c) {
       for (const int child : nodes[cur].children) {
         const std::size_t ch = static_cast<std::size_t>(child);
         g.global[ch] = g.global[cur] * g.local[ch];
+        reached[ch] = true;
         stack.push_back(ch);
       }
     }
+  }
+  const auto unreached = std::find(reached.begin(), reached.end(), false);
+  if (unreached != reached.end()) {
+    // Up from there, the first node met twice is on the cycle.
+    std::vector<bool> seen(n, false);
+    std::size_t at = static_cast<std::size_t>(unreached - reached.begin());
+    while (!seen[at]) {
+      seen[at] = true;
+      at = static_cast<std::size_t>(g.parent[at]);
+    }
+    return c.error(ErrorCode::kInvalidData, idx("nodes", at) + ".children", "",
+                   "the node hierarchy has a cycle through this node");
   }
   return g;
 }
