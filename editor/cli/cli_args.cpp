@@ -1,5 +1,7 @@
 #include "editor/cli/cli_args.h"
 
+#include <filesystem>
+
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -170,6 +172,22 @@ Expected<int> parse_choice(std::string_view flag, const std::string& text,
 Expected<bool> parse_on_off(std::string_view flag, const std::string& text) {
   SINEW_ASSIGN_OR_RETURN(const int index, parse_choice(flag, text, {"on", "off"}));
   return index == 0;
+}
+
+Expected<std::vector<std::string>> parse_folder_list(std::string_view flag, const std::string& text) {
+  std::vector<std::string> folders;
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    const std::size_t end = std::min(text.find(':', start), text.size());
+    const std::string folder = text.substr(start, end - start);
+    std::error_code ec;
+    if (folder.empty() || !std::filesystem::is_directory(folder, ec)) {
+      return invalid_argument(flag, text, "'" + folder + "' is not a folder");
+    }
+    folders.push_back(folder);
+    start = end + 1;
+  }
+  return folders;
 }
 
 }  // namespace sinew::editor::cli

@@ -64,5 +64,7 @@ Expected<int> parse_choice(std::string_view flag, const std::string& text,
                            std::initializer_list<std::string_view> choices);
 // "on" or "off".
 Expected<bool> parse_on_off(std::string_view flag, const std::string& text);
+// Folders separated by ':', each existing.
+Expected<std::vector<std::string>> parse_folder_list(std::string_view flag, const std::string& text);
 
 }  // namespace sinew::editor::cli

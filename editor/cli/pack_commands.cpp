@@ -45,6 +45,7 @@ struct BakeOptions {
   rt::CandidateBones candidates = rt::CandidateBones::kAll;
   int threads = 0;
   std::size_t max_memory_bytes = BakeRequest{}.max_memory_bytes;
+  GltfImportOptions gltf;
   bool help = false;
 };
 
@@ -52,6 +53,8 @@ std::string bake_usage() {
   return "usage: sinew-editor bake MODEL -o OUT.pack [options]\n"
          "       sinew-editor bake --scene RECIPE.json [MODEL] -o OUT.pack [options]\n"
          "  MODEL                 .gltf, .glb, .cfg (Cal3D) or a model-only .pack\n"
+         "  --asset-roots A:B     more folders a glTF file's buffers may be read from (by\n"
+         "                        default only its own folder and below)\n"
          "  --scene RECIPE.json   bake only what a scene needs: the pose space of the recipe's\n"
          "                        clips, and only those clips in the pack (content/scenes/)\n"
          "  -o, --out OUT.pack    the pack to write (atomically: an existing file is replaced\n"
@@ -76,7 +79,7 @@ const std::vector<cli::FlagSpec>& bake_flags() {
   static const std::vector<cli::FlagSpec> flags = {
       {"--help", false}, {"-h", false},      {"--out"},     {"--pose-space"}, {"--clips"},
       {"--samples"},     {"--seed"},         {"--limits"}, {"--pad"},  {"--candidates"}, {"--threads"},
-      {"--scene"},       {"--max-memory-mib"},
+      {"--scene"},       {"--max-memory-mib"}, {"--asset-roots"},
   };
   return flags;
 }
@@ -110,6 +113,9 @@ Expected<BakeOptions> parse_bake_options(std::vector<std::string> args) {
   }
   if (!parsed.positionals.empty()) o.model_path = parsed.positionals.front();
   if (auto v = parsed.value("--out")) o.out_path = *v;
+  if (auto v = parsed.value("--asset-roots")) {
+    SINEW_ASSIGN_OR_RETURN(o.gltf.asset_roots, cli::parse_folder_list("--asset-roots", *v));
+  }
   if (o.out_path.empty()) return invalid_argument("-o", "", "missing: where to write the pack");
   if (!is_pack_path(o.out_path)) return invalid_argument("-o", o.out_path, "expected a .pack file name");
   bool samples_given = false;
@@ -442,7 +448,7 @@ int run_bake(const std::vector<std::string>& args, std::ostream& out, std::ostre
     return 0;
   }
   const auto start = Clock::now();
-  auto model = load_model(o.model_path);
+  auto model = load_model(o.model_path, o.gltf);
   if (!model.ok()) return fail(err, "bake", model.status());
   for (const std::string& warning : model->warnings) err << "sinew-editor bake: warning: " << warning << "\n";
   if (o.scene) {  // model only what the scene plays

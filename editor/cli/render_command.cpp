@@ -42,7 +42,7 @@ const std::vector<cli::FlagSpec>& render_flags() {
       {"--size"},        {"--out"},              {"--pose-space"}, {"--clips"},        {"--samples"},
       {"--seed"},        {"--shadows"},          {"--light"},      {"--threads"},      {"--instances"},
       {"--frames"},      {"--triangle-test"},    {"--bone-boxes"}, {"--fallback"},     {"--limits"},
-      {"--ground"},      {"--packet-rays"},
+      {"--ground"},      {"--packet-rays"},      {"--asset-roots"},
   };
   return flags;
 }
@@ -149,6 +149,9 @@ Status parse_run(const cli::ParsedArgs& args, RenderOptions& o) {
   if (const auto text = args.value("--triangle-test")) {
     SINEW_ASSIGN_OR_RETURN(const int i, cli::parse_choice("--triangle-test", *text, {"fast", "watertight"}));
     o.triangle_test = i == 0 ? rt::TriangleTest::kFast : rt::TriangleTest::kWatertight;
+  }
+  if (const auto text = args.value("--asset-roots")) {
+    SINEW_ASSIGN_OR_RETURN(o.gltf.asset_roots, cli::parse_folder_list("--asset-roots", *text));
   }
   if (const auto text = args.value("--packet-rays")) {
     SINEW_ASSIGN_OR_RETURN(const int i, cli::parse_choice("--packet-rays", *text, {"1", "8", "64", "256"}));
@@ -389,6 +392,8 @@ std::string render_usage() {
          "  --frames N                frames rendered at 30 fps from --time; the last is written (default 1)\n"
          "  --triangle-test fast|watertight   ray-triangle test (default fast)\n"
          "  --packet-rays 1|8|64|256  rays traced together: single rays, 4x2, 8x8 or 16x16 pixels (default 64)\n"
+         "  --asset-roots A:B     more folders a glTF file's buffers may be read from (by default\n"
+         "                        only its own folder and below)\n"
          "  --bone-boxes exact|cheap  per-frame bone boxes (default exact)\n"
          "  --fallback on|off         exact rendering of triangles outside their fuzzy boxes (default on)\n"
          "  --ground on|off           the ground quad under the model (default on)\n"
@@ -434,7 +439,7 @@ Expected<RenderOutputs> render_model(const RenderOptions& options) {
   ImportedModel imported;
   if (!pack) {
     report(options, "importing " + options.model_path);
-    SINEW_ASSIGN_OR_RETURN(imported, load_model(options.model_path));
+    SINEW_ASSIGN_OR_RETURN(imported, load_model(options.model_path, options.gltf));
     for (const std::string& warning : imported.warnings) report(options, "warning: " + warning);
   }
   const ImportedModel& model = pack ? pack->model() : imported;

@@ -41,6 +41,7 @@
 
 #include "animation/pose_space.h"
 #include "editor/bake/in_memory_bake.h"
+#include "editor/import/gltf_importer.h"
 #include "editor/import/imported_model.h"
 #include "raytrace/camera/camera.h"
 #include "raytrace/geometry/triangle_intersect.h"
@@ -69,6 +70,7 @@ struct RenderOptions {
   int frames = 1;
   rt::TriangleTest triangle_test = rt::TriangleTest::kFast;
   int packet_rays = rt::RenderSettings{}.packet_rays;  // 1, 8, 64 or 256 rays traced together
+  GltfImportOptions gltf;                               // --asset-roots
   rt::BoneBoxMode bone_boxes = rt::BoneBoxMode::kExact;
   bool fallback = true;
   bool ground = true;  // the ground quad under the model (--ground off: characters alone)

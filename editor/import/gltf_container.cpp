@@ -1,7 +1,10 @@
 #include "editor/import/gltf_container.h"
 
+#include <cctype>
 #include <cstdint>
 #include <cstring>
+#include <nlohmann/json.hpp>
+#include <system_error>
 
 namespace sinew::editor {
 namespace {
@@ -77,6 +80,119 @@ Expected<std::string_view> check_glb(std::string_view bytes, const std::string& 
   const std::string_view json = bytes.substr(kHeader + kChunkHeader, json_length);
   SINEW_RETURN_IF_ERROR(check_json_nesting(json, kMaxJsonNesting, file, "glb.chunks[0]"));
   return json;
+}
+
+namespace {
+
+std::filesystem::path resolved(const std::filesystem::path& p) {
+  std::error_code ec;
+  std::filesystem::path r = std::filesystem::weakly_canonical(std::filesystem::absolute(p, ec), ec);
+  if (ec) return std::filesystem::absolute(p, ec).lexically_normal();
+  return r;
+}
+
+bool inside(const std::filesystem::path& path, const std::filesystem::path& root) {
+  const auto rel = path.lexically_relative(root);
+  return !rel.empty() && *rel.begin() != "..";
+}
+
+int hex_value(char c) {
+  if (c >= '0' && c <= '9') return c - '0';
+  if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+  if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+  return -1;
+}
+
+// A scheme ("http:", "file:", "C:") before any '/'.
+bool has_scheme(std::string_view uri) {
+  const std::size_t colon = uri.find(':');
+  if (colon == std::string_view::npos || colon == 0) return false;
+  const std::size_t slash = uri.find('/');
+  if (slash != std::string_view::npos && slash < colon) return false;
+  if (!std::isalpha(static_cast<unsigned char>(uri[0]))) return false;
+  for (std::size_t i = 1; i < colon; ++i) {
+    const unsigned char c = static_cast<unsigned char>(uri[i]);
+    if (!std::isalnum(c) && c != '+' && c != '-' && c != '.') return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+AssetRoots::AssetRoots(const std::string& asset_file, const std::vector<std::string>& extra) {
+  roots_.push_back(resolved(std::filesystem::path(asset_file).parent_path().empty()
+                                ? std::filesystem::path(".")
+                                : std::filesystem::path(asset_file).parent_path()));
+  for (const std::string& e : extra) roots_.push_back(resolved(e));
+}
+
+std::filesystem::path AssetRoots::root_of(const std::filesystem::path& path) const {
+  const std::filesystem::path p = resolved(path);
+  for (const std::filesystem::path& root : roots_) {
+    if (inside(p, root)) return root;
+  }
+  return {};
+}
+
+bool percent_decode(std::string_view uri, std::string& out) {
+  out.clear();
+  for (std::size_t i = 0; i < uri.size(); ++i) {
+    if (uri[i] != '%') {
+      out += uri[i];
+      continue;
+    }
+    if (i + 2 >= uri.size()) return false;
+    const int hi = hex_value(uri[i + 1]), lo = hex_value(uri[i + 2]);
+    if (hi < 0 || lo < 0) return false;
+    out += static_cast<char>(hi * 16 + lo);
+    i += 2;
+  }
+  return true;
+}
+
+Status check_external_uris(std::string_view json, const std::string& file, const AssetRoots& roots) {
+  nlohmann::json doc;
+  try {
+    doc = nlohmann::json::parse(json.begin(), json.end());
+  } catch (const std::exception&) {
+    return {};  // not JSON: tinygltf reports it, with its own message
+  }
+  if (!doc.is_object()) return {};
+  for (const char* array : {"buffers", "images"}) {
+    const auto it = doc.find(array);
+    if (it == doc.end() || !it->is_array()) continue;
+    for (std::size_t i = 0; i < it->size(); ++i) {
+      const nlohmann::json& entry = (*it)[i];
+      if (!entry.is_object()) continue;
+      const auto uri_it = entry.find("uri");
+      if (uri_it == entry.end() || !uri_it->is_string()) continue;
+      const std::string& uri = uri_it->get_ref<const std::string&>();
+      if (uri.rfind("data:", 0) == 0) continue;
+      const std::string field = std::string(array) + "[" + std::to_string(i) + "].uri";
+      std::string decoded;
+      if (!percent_decode(uri, decoded)) {
+        return make_error(ErrorCode::kInvalidData, file, field, uri, "a malformed percent escape");
+      }
+      if (decoded.find('\0') != std::string::npos) {
+        return make_error(ErrorCode::kInvalidData, file, field, uri, "a NUL byte in the file name");
+      }
+      if (!decoded.empty() && (decoded[0] == '/' || decoded[0] == '\\')) {
+        return make_error(ErrorCode::kInvalidData, file, field, uri,
+                          "absolute paths are not allowed (a glTF file names its files relative to itself)");
+      }
+      if (has_scheme(decoded)) {
+        return make_error(ErrorCode::kInvalidData, file, field, uri,
+                          "only relative file names and data: URIs are supported");
+      }
+      const std::filesystem::path target = roots.asset_folder() / decoded;
+      if (roots.root_of(target).empty()) {
+        return make_error(ErrorCode::kInvalidData, file, field, uri,
+                          "resolves to " + resolved(target).string() + ", outside the asset's folder " +
+                              roots.asset_folder().string() + " (allow more folders with --asset-roots)");
+      }
+    }
+  }
+  return {};
 }
 
 }  // namespace sinew::editor

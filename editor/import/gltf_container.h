@@ -6,8 +6,10 @@
 #pragma once
 
 #include <cstddef>
+#include <filesystem>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "runtime/core/expected.h"
 
@@ -26,5 +28,29 @@ Status check_json_nesting(std::string_view json, std::size_t max_depth, const st
 // to the file's size), the first chunk being JSON inside the file, and its
 // JSON's nesting. Returns the JSON chunk.
 Expected<std::string_view> check_glb(std::string_view bytes, const std::string& file);
+
+// Where external buffer and image files may be read from: the asset's own
+// folder, plus `extra` folders the user allows. Paths are compared after
+// resolving "..", "." and symbolic links.
+class AssetRoots {
+ public:
+  AssetRoots(const std::string& asset_file, const std::vector<std::string>& extra);
+  // The folder (resolved) holding `path` when it is inside a root, else empty.
+  std::filesystem::path root_of(const std::filesystem::path& path) const;
+  const std::filesystem::path& asset_folder() const { return roots_.front(); }
+
+ private:
+  std::vector<std::filesystem::path> roots_;  // resolved; the asset's folder first
+};
+
+// Every buffers[i].uri and images[i].uri of the glTF JSON that is not a
+// data: URI, percent-decoded as tinygltf decodes it, must be a relative
+// reference resolving inside `roots`: absolute paths, other schemes and ".."
+// escapes are refused, naming the field and the URI. (tinygltf's own reads
+// are guarded too: it also looks in the current directory.)
+Status check_external_uris(std::string_view json, const std::string& file, const AssetRoots& roots);
+
+// RFC 3986 percent-decoding ("%2e%2E" -> ".."); false for a malformed escape.
+bool percent_decode(std::string_view uri, std::string& out);
 
 }  // namespace sinew::editor

@@ -1,5 +1,6 @@
 #include "editor/import/gltf_importer.h"
 #include "editor/import/gltf_container.h"
+#include "runtime/io/regular_file.h"
 #include "runtime/io/atomic_file.h"
 
 #include <tiny_gltf.h>
@@ -1153,9 +1154,34 @@ bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, in
   return true;
 }
 
+// tinygltf's file reads, kept inside the asset roots (it also looks in the
+// current directory) and to regular files.
+struct GuardedFs {
+  const AssetRoots* roots = nullptr;
+  std::string refused, why;  // the first path refused, and why
+};
+
+bool guarded_read(std::vector<unsigned char>* out, std::string* err, const std::string& filepath, void* user) {
+  auto& fs = *static_cast<GuardedFs*>(user);
+  std::string why;
+  if (fs.roots->root_of(filepath).empty()) {
+    why = "outside the asset's folder " + fs.roots->asset_folder().string();
+  } else if (Status s = check_regular_file(filepath); !s.ok()) {
+    why = s.message();
+  } else {
+    return tinygltf::ReadWholeFile(out, err, filepath, nullptr);
+  }
+  if (fs.refused.empty()) {
+    fs.refused = filepath;
+    fs.why = why;
+  }
+  if (err) *err += why;
+  return false;
+}
+
 }  // namespace
 
-Expected<ImportedModel> import_gltf(const std::string& path) {
+Expected<ImportedModel> import_gltf(const std::string& path, const GltfImportOptions& options) {
   SINEW_ASSIGN_OR_RETURN(const std::string bytes, read_file_text(path));
   // tinygltf takes 32-bit lengths.
   if (bytes.size() > std::numeric_limits<unsigned int>::max()) {
@@ -1164,17 +1190,25 @@ Expected<ImportedModel> import_gltf(const std::string& path) {
   }
   const bool binary = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
   // Bounded nesting before tinygltf's recursive parser sees the JSON.
+  std::string_view json = bytes;
   if (binary) {
-    const Expected<std::string_view> json = check_glb(bytes, path);
-    if (!json.ok()) return json.status();
+    const Expected<std::string_view> chunk = check_glb(bytes, path);
+    if (!chunk.ok()) return chunk.status();
+    json = *chunk;
   } else {
     SINEW_RETURN_IF_ERROR(check_json_nesting(bytes, kMaxJsonNesting, path, "json"));
   }
+  // External files only from the asset's folder (and the allowed roots).
+  const AssetRoots roots(path, options.asset_roots);
+  SINEW_RETURN_IF_ERROR(check_external_uris(json, path, roots));
   const std::string base_dir = std::filesystem::path(path).parent_path().string();
 
   tinygltf::Model model;
   tinygltf::TinyGLTF loader;
   loader.SetImageLoader(skip_image, nullptr);
+  GuardedFs guarded{&roots, {}, {}};
+  loader.SetFsCallbacks(tinygltf::FsCallbacks{&tinygltf::FileExists, &tinygltf::ExpandFilePath, &guarded_read,
+                                              &tinygltf::WriteWholeFile, &guarded});
   std::string err, warn;
   bool loaded = false;
   try {
@@ -1190,6 +1224,9 @@ Expected<ImportedModel> import_gltf(const std::string& path) {
   } catch (...) {
     err = "unknown exception";
     loaded = false;
+  }
+  if (!loaded && !guarded.refused.empty()) {
+    return make_error(ErrorCode::kInvalidData, path, "uri", guarded.refused, "not read: " + guarded.why);
   }
   if (!loaded) {
     while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();

@@ -44,6 +44,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "editor/import/imported_model.h"
 #include "runtime/core/expected.h"
@@ -54,6 +55,13 @@ namespace sinew::editor {
 // Every failure is a Status naming the file and the offending field, e.g.
 // "m.gltf: meshes[0].primitives[1].attributes.WEIGHTS_0[17] = 0: the
 // vertex's weights are all zero".
-Expected<ImportedModel> import_gltf(const std::string& path);
+//
+// External buffers and images are read only from the file's own folder and
+// `asset_roots` (relative references; data: URIs are always fine): a URI
+// of "../../etc/passwd" or "/etc/passwd" is refused before anything is read.
+struct GltfImportOptions {
+  std::vector<std::string> asset_roots;  // more folders external files may come from
+};
+Expected<ImportedModel> import_gltf(const std::string& path, const GltfImportOptions& options = {});
 
 }  // namespace sinew::editor

@@ -19,15 +19,15 @@ std::string lower_extension(const std::string& path) {
   return ext;
 }
 
-Expected<ImportedModel> load_model(const std::string& path) {
+Expected<ImportedModel> load_model(const std::string& path, const GltfImportOptions& gltf) {
   const std::string ext = lower_extension(path);
-  const bool gltf = ext == ".gltf" || ext == ".glb";
-  if (!gltf && ext != ".cfg" && ext != ".pack") {
+  const bool is_gltf = ext == ".gltf" || ext == ".glb";
+  if (!is_gltf && ext != ".cfg" && ext != ".pack") {
     return make_error(ErrorCode::kInvalidArgument, path, "extension", ext.empty() ? "(none)" : ext,
                       "unsupported model format (expected .gltf, .glb, .cfg or .pack)");
   }
   SINEW_RETURN_IF_ERROR(check_regular_file(path));
-  if (gltf) return import_gltf(path);
+  if (is_gltf) return import_gltf(path, gltf);
   if (ext == ".pack") {
     SINEW_ASSIGN_OR_RETURN(CharacterPack pack, CharacterPack::open(path));
     return pack.model();

@@ -896,6 +896,81 @@ TEST_F(GltfSynthetic, LongNodeChainsImportInLinearTime) {
   EXPECT_LT(node, 3 + kChain) << msg;
 }
 
+// External files come only from the asset's folder (and below) unless more
+// folders are allowed: ".." escapes (plain or percent-encoded), absolute
+// paths, other schemes and links out of the folder are refused before any
+// read, naming the field; tinygltf's own fallback to the current directory
+// is refused too. data: URIs and subfolders still work.
+TEST_F(GltfSynthetic, ExternalFilesStayInsideTheAssetFolder) {
+  const fs::path outside = dir_ / "outside";
+  const fs::path asset = dir_ / "asset";
+  fs::create_directories(outside);
+  fs::create_directories(asset / "sub");
+  const Synthetic base = synthetic();
+  const auto write_bin = [&](const fs::path& p) {
+    std::ofstream(p, std::ios::binary)
+        .write(reinterpret_cast<const char*>(base.bin.data()), static_cast<std::streamsize>(base.bin.size()));
+  };
+  write_bin(outside / "synthetic.bin");
+  write_bin(asset / "sub" / "synthetic.bin");
+  fs::create_symlink(outside / "synthetic.bin", asset / "link.bin");
+  const auto with_uri = [&](const std::string& uri, const std::string& extra = "") {
+    Synthetic s = base;
+    replace(s.json, "\"uri\": \"synthetic.bin\"", "\"uri\": \"" + uri + "\"");
+    if (!extra.empty()) replace(s.json, "\"scene\": 0,", "\"scene\": 0, " + extra + ",");
+    const std::string path = (asset / "model.gltf").string();
+    std::ofstream(path, std::ios::binary) << s.json;
+    return path;
+  };
+  struct Refused {
+    std::string uri, extra, field, message;
+  };
+  const std::string secret = (outside / "synthetic.bin").string();
+  for (const Refused& r : {
+           Refused{"../outside/synthetic.bin", "", "buffers[0].uri", "outside the asset's folder"},
+           Refused{"%2e%2e/outside/synthetic.bin", "", "buffers[0].uri", "outside the asset's folder"},
+           Refused{"sub/../../outside/synthetic.bin", "", "buffers[0].uri", "outside the asset's folder"},
+           Refused{secret, "", "buffers[0].uri", "absolute paths are not allowed"},
+           Refused{"file://" + secret, "", "buffers[0].uri", "only relative file names and data: URIs"},
+           Refused{"link.bin", "", "buffers[0].uri", "outside the asset's folder"},
+           Refused{"%zz.bin", "", "buffers[0].uri", "malformed percent escape"},
+           Refused{"sub/synthetic.bin", "\"images\": [{\"uri\": \"../../../../etc/passwd\"}]", "images[0].uri",
+                   "outside the asset's folder"},
+       }) {
+    const std::string path = with_uri(r.uri, r.extra);
+    const auto m = import_gltf(path);
+    ASSERT_FALSE(m.ok()) << r.uri;
+    EXPECT_EQ(m.status().file(), path);
+    EXPECT_NE(m.status().message().find(r.field), std::string::npos) << m.status().message();
+    EXPECT_NE(m.status().message().find(r.message), std::string::npos) << m.status().message();
+  }
+  EXPECT_TRUE(import_gltf(with_uri("sub/synthetic.bin")).ok());
+  EXPECT_TRUE(import_gltf(with_uri("sub%2Fsynthetic.bin")).ok());
+  // Another folder, once allowed.
+  const auto allowed = import_gltf(with_uri("../outside/synthetic.bin"), GltfImportOptions{{outside.string()}});
+  EXPECT_TRUE(allowed.ok()) << allowed.status().message();
+  // A data: URI needs no folder at all.
+  static const char kBase64[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string b64;
+  for (std::size_t i = 0; i < base.bin.size(); i += 3) {
+    const std::size_t n = std::min<std::size_t>(3, base.bin.size() - i);  // bytes in this group
+    std::uint32_t group = 0;
+    for (std::size_t k = 0; k < 3; ++k) group = group << 8 | (k < n ? std::uint32_t{base.bin[i + k]} : 0u);
+    for (std::size_t k = 0; k < 4; ++k) b64 += k <= n ? kBase64[(group >> (18 - 6 * k)) & 63] : '=';
+  }
+  const auto embedded = import_gltf(with_uri("data:application/octet-stream;base64," + b64));
+  EXPECT_TRUE(embedded.ok()) << embedded.status().message();
+  // A name missing beside the asset but present in the current directory:
+  // tinygltf would look there; the read is refused.
+  const fs::path cwd = fs::current_path();
+  fs::current_path(outside);
+  const auto fallback = import_gltf(with_uri("synthetic.bin"));
+  fs::current_path(cwd);
+  ASSERT_FALSE(fallback.ok());
+  EXPECT_NE(fallback.status().message().find("outside the asset's folder"), std::string::npos)
+      << fallback.status().message();
+}
+
 TEST_F(GltfSynthetic, MissingFile) {
   const auto m = import_gltf((dir_ / "nope.gltf").string());
   ASSERT_FALSE(m.ok());
