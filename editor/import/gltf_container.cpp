@@ -1,6 +1,7 @@
 #include "editor/import/gltf_container.h"
 
 #include <cctype>
+#include <climits>
 #include <cstdint>
 #include <cstring>
 #include <nlohmann/json.hpp>
@@ -150,14 +151,9 @@ bool percent_decode(std::string_view uri, std::string& out) {
   return true;
 }
 
-Status check_external_uris(std::string_view json, const std::string& file, const AssetRoots& roots) {
-  nlohmann::json doc;
-  try {
-    doc = nlohmann::json::parse(json.begin(), json.end());
-  } catch (const std::exception&) {
-    return {};  // not JSON: tinygltf reports it, with its own message
-  }
-  if (!doc.is_object()) return {};
+namespace {
+
+Status check_uris(const nlohmann::json& doc, const std::string& file, const AssetRoots& roots) {
   for (const char* array : {"buffers", "images"}) {
     const auto it = doc.find(array);
     if (it == doc.end() || !it->is_array()) continue;
@@ -193,6 +189,135 @@ Status check_external_uris(std::string_view json, const std::string& file, const
     }
   }
   return {};
+}
+
+
+// Index-valued properties of glTF 2.0 (the spec's "glTFid"s), by where they
+// sit: "a.b[]" is an array of ids, "a[].b" a property of each element.
+// tinygltf reads them as int, so 4294967297 would become 1 and a negative
+// id would read as "absent".
+Status check_id(const nlohmann::json& v, const std::string& file, const std::string& field) {
+  if (v.is_number_unsigned() && v.get<std::uint64_t>() <= static_cast<std::uint64_t>(INT32_MAX)) return {};
+  if (v.is_number_integer() && !v.is_number_unsigned()) {
+    return make_error(ErrorCode::kInvalidData, file, field, v.dump(), "a negative index");
+  }
+  if (v.is_number_unsigned()) {
+    return make_error(ErrorCode::kOutOfBounds, file, field, v.dump(), "an index past 2^31 - 1");
+  }
+  return make_error(ErrorCode::kInvalidData, file, field, v.dump().substr(0, 40), "an index must be an integer");
+}
+
+// The ids at `path` (dot-separated; "[]" after a name walks an array) below `v`.
+Status check_ids_at(const nlohmann::json& v, std::string_view path, const std::string& file,
+                    const std::string& field) {
+  if (path.empty()) return check_id(v, file, field);
+  const std::size_t dot = path.find('.');
+  std::string_view step = path.substr(0, dot);
+  const std::string_view rest = dot == std::string_view::npos ? std::string_view() : path.substr(dot + 1);
+  const bool each = step.size() > 2 && step.substr(step.size() - 2) == "[]";
+  if (each) step.remove_suffix(2);
+  if (!v.is_object()) return {};
+  const auto it = v.find(std::string(step));
+  if (it == v.end()) return {};
+  const std::string here = field.empty() ? std::string(step) : field + "." + std::string(step);
+  if (!each) return check_ids_at(*it, rest, file, here);
+  if (!it->is_array()) return {};  // tinygltf reports the wrong type
+  for (std::size_t i = 0; i < it->size(); ++i) {
+    SINEW_RETURN_IF_ERROR(check_ids_at((*it)[i], rest, file, here + "[" + std::to_string(i) + "]"));
+  }
+  return {};
+}
+
+Status check_ids(const nlohmann::json& doc, const std::string& file) {
+  static constexpr std::string_view kIdPaths[] = {
+      "scene",
+      "scenes[].nodes[]",
+      "nodes[].children[]",
+      "nodes[].mesh",
+      "nodes[].skin",
+      "nodes[].camera",
+      "skins[].joints[]",
+      "skins[].skeleton",
+      "skins[].inverseBindMatrices",
+      "meshes[].primitives[].indices",
+      "meshes[].primitives[].material",
+      "accessors[].bufferView",
+      "accessors[].sparse.indices.bufferView",
+      "accessors[].sparse.values.bufferView",
+      "bufferViews[].buffer",
+      "animations[].channels[].sampler",
+      "animations[].channels[].target.node",
+      "animations[].samplers[].input",
+      "animations[].samplers[].output",
+      "textures[].source",
+      "textures[].sampler",
+      "images[].bufferView",
+  };
+  for (const std::string_view path : kIdPaths) SINEW_RETURN_IF_ERROR(check_ids_at(doc, path, file, ""));
+  // Attribute and morph-target accessors: every value of those objects.
+  const auto meshes = doc.find("meshes");
+  if (meshes == doc.end() || !meshes->is_array()) return {};
+  for (std::size_t m = 0; m < meshes->size(); ++m) {
+    const auto prims = (*meshes)[m].is_object() ? (*meshes)[m].find("primitives") : (*meshes)[m].end();
+    if (!(*meshes)[m].is_object() || prims == (*meshes)[m].end() || !prims->is_array()) continue;
+    for (std::size_t p = 0; p < prims->size(); ++p) {
+      const nlohmann::json& prim = (*prims)[p];
+      if (!prim.is_object()) continue;
+      const std::string at = "meshes[" + std::to_string(m) + "].primitives[" + std::to_string(p) + "]";
+      const auto attributes = prim.find("attributes");
+      if (attributes != prim.end() && attributes->is_object()) {
+        for (const auto& [name, id] : attributes->items()) {
+          SINEW_RETURN_IF_ERROR(check_id(id, file, at + ".attributes." + name));
+        }
+      }
+      const auto targets = prim.find("targets");
+      if (targets == prim.end() || !targets->is_array()) continue;
+      for (std::size_t t = 0; t < targets->size(); ++t) {
+        if (!(*targets)[t].is_object()) continue;
+        for (const auto& [name, id] : (*targets)[t].items()) {
+          SINEW_RETURN_IF_ERROR(check_id(id, file, at + ".targets[" + std::to_string(t) + "]." + name));
+        }
+      }
+    }
+  }
+  return {};
+}
+
+// Extensions a file may require: ones that only change materials or
+// textures, which Sinew does not read. Any other (mesh compression,
+// quantized attributes, ...) would change the geometry we decode.
+bool ignorable_required_extension(const std::string& name) {
+  return name.rfind("KHR_materials_", 0) == 0 || name == "KHR_texture_transform" || name == "KHR_texture_basisu" ||
+         name == "EXT_texture_webp" || name == "KHR_lights_punctual";
+}
+
+Status check_required_extensions(const nlohmann::json& doc, const std::string& file) {
+  const auto it = doc.find("extensionsRequired");
+  if (it == doc.end() || !it->is_array()) return {};
+  for (std::size_t i = 0; i < it->size(); ++i) {
+    const nlohmann::json& e = (*it)[i];
+    const std::string name = e.is_string() ? e.get<std::string>() : e.dump();
+    if (!e.is_string() || !ignorable_required_extension(name)) {
+      return make_error(ErrorCode::kUnsupportedVersion, file, "extensionsRequired[" + std::to_string(i) + "]",
+                        name.substr(0, 80), "a required extension this importer does not support");
+    }
+  }
+  return {};
+}
+
+}  // namespace
+
+Status check_gltf_document(std::string_view json, const std::string& file, const AssetRoots& roots) {
+  nlohmann::json doc;
+  try {
+    doc = nlohmann::json::parse(json.begin(), json.end());
+  } catch (const std::exception&) {
+    return {};  // not JSON: tinygltf reports it, with its own message
+  }
+  if (!doc.is_object()) return {};
+  SINEW_RETURN_IF_ERROR(check_required_extensions(doc, file));
+  SINEW_RETURN_IF_ERROR(check_ids(doc, file));
+  return check_uris(doc, file, roots);
 }
 
 }  // namespace sinew::editor

@@ -43,12 +43,19 @@ class AssetRoots {
   std::vector<std::filesystem::path> roots_;  // resolved; the asset's folder first
 };
 
-// Every buffers[i].uri and images[i].uri of the glTF JSON that is not a
-// data: URI, percent-decoded as tinygltf decodes it, must be a relative
-// reference resolving inside `roots`: absolute paths, other schemes and ".."
-// escapes are refused, naming the field and the URI. (tinygltf's own reads
-// are guarded too: it also looks in the current directory.)
-Status check_external_uris(std::string_view json, const std::string& file, const AssetRoots& roots);
+// The glTF JSON's checks that need the document, done before tinygltf reads
+// it (a document that is not JSON passes, for tinygltf to report):
+// - extensionsRequired lists only extensions that change nothing Sinew
+//   reads (materials, textures, lights);
+// - every index (glTFid) is an integer in [0, 2^31 - 1]: tinygltf keeps ids
+//   in int, so larger ones wrap and negative ones read as "absent";
+// - every buffers[i].uri and images[i].uri that is not a data: URI,
+//   percent-decoded as tinygltf decodes it, is a relative reference
+//   resolving inside `roots`: absolute paths, other schemes and ".."
+//   escapes are refused (tinygltf's own reads are guarded too: it also
+//   looks in the current directory).
+// Each error names the field and the value.
+Status check_gltf_document(std::string_view json, const std::string& file, const AssetRoots& roots);
 
 // RFC 3986 percent-decoding ("%2e%2E" -> ".."); false for a malformed escape.
 bool percent_decode(std::string_view uri, std::string& out);

@@ -1200,7 +1200,7 @@ Expected<ImportedModel> import_gltf(const std::string& path, const GltfImportOpt
   }
   // External files only from the asset's folder (and the allowed roots).
   const AssetRoots roots(path, options.asset_roots);
-  SINEW_RETURN_IF_ERROR(check_external_uris(json, path, roots));
+  SINEW_RETURN_IF_ERROR(check_gltf_document(json, path, roots));
   const std::string base_dir = std::filesystem::path(path).parent_path().string();
 
   tinygltf::Model model;

@@ -971,6 +971,40 @@ TEST_F(GltfSynthetic, ExternalFilesStayInsideTheAssetFolder) {
       << fallback.status().message();
 }
 
+// Ids are integers in [0, 2^31 - 1] (tinygltf keeps them in int: 4294967297
+// read as 1, and -1 as "absent"), wherever they sit; required extensions
+// that would change the geometry are refused, material-only ones are fine.
+TEST_F(GltfSynthetic, IdsAndRequiredExtensionsFollowTheSpec) {
+  struct Case {
+    std::string from, to, field, message;
+  };
+  for (const Case& c : {
+           Case{"\"POSITION\": 0", "\"POSITION\": 4294967296", "attributes.POSITION", "past 2^31 - 1"},
+           Case{"\"indices\": 3", "\"indices\": 4294967299", "primitives[0].indices", "past 2^31 - 1"},
+           Case{"\"indices\": 3", "\"indices\": -1", "primitives[0].indices", "a negative index"},
+           Case{"\"children\": [2]", "\"children\": [-2]", "nodes[1].children[0]", "a negative index"},
+           Case{"\"joints\": [2, 1]", "\"joints\": [2, 1.5]", "skins[0].joints[1]", "must be an integer"},
+           Case{"\"input\": 5", "\"input\": 18446744073709551615", "samplers[0].input", "past 2^31 - 1"},
+           Case{"\"scene\": 0,", "\"scene\": 0, \"extensionsRequired\": [\"KHR_draco_mesh_compression\"],",
+                "extensionsRequired[0]", "does not support"},
+           Case{"\"scene\": 0,", "\"scene\": 0, \"extensionsRequired\": [\"KHR_mesh_quantization\"],",
+                "extensionsRequired[0]", "does not support"},
+       }) {
+    Synthetic s = synthetic();
+    replace(s.json, c.from, c.to);
+    expect_error(s, c.field);
+    const auto m = import_gltf(write(s));
+    ASSERT_FALSE(m.ok());
+    EXPECT_NE(m.status().message().find(c.message), std::string::npos) << m.status().message();
+  }
+  Synthetic fine = synthetic();
+  replace(fine.json, "\"scene\": 0,",
+          "\"scene\": 0, \"extensionsUsed\": [\"KHR_materials_unlit\"], "
+          "\"extensionsRequired\": [\"KHR_materials_unlit\"],");
+  const auto m = import_gltf(write(fine));
+  EXPECT_TRUE(m.ok()) << m.status().message();
+}
+
 TEST_F(GltfSynthetic, MissingFile) {
   const auto m = import_gltf((dir_ / "nope.gltf").string());
   ASSERT_FALSE(m.ok());
