@@ -844,9 +844,10 @@ Status add_primitive(const Ctx& c, const NodeGraph& g, const SkeletonPlan& plan,
   const tinygltf::Node& node = c.model.nodes[node_index];
   const tinygltf::Primitive& prim = c.model.meshes[mesh_index].primitives[prim_index];
   const std::string pfield = idx(idx("meshes", mesh_index) + ".primitives", prim_index);
-  if (prim.mode != -1 && prim.mode != TINYGLTF_MODE_TRIANGLES) {
+  const int mode = prim.mode == -1 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
+  if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP && mode != TINYGLTF_MODE_TRIANGLE_FAN) {
     return c.error(ErrorCode::kInvalidData, pfield + ".mode", std::to_string(prim.mode),
-                   "only TRIANGLES (4) primitives are supported");
+                   "only triangle primitives are supported: TRIANGLES (4), TRIANGLE_STRIP (5), TRIANGLE_FAN (6)");
   }
   const std::string afield = pfield + ".attributes";
   const int pos_acc = attribute(prim, "POSITION");
@@ -1003,8 +1004,8 @@ Status add_primitive(const Ctx& c, const NodeGraph& g, const SkeletonPlan& plan,
     }
   }
 
-  // Triangles.
-  std::vector<std::array<std::uint32_t, 3>> tris;
+  // The vertex sequence: the indices, or 0, 1, 2, ... without them.
+  std::vector<std::uint32_t> sequence;
   if (prim.indices >= 0) {
     SINEW_ASSIGN_OR_RETURN(AccessorData ind,
                            read_accessor(c, prim.indices, pfield + ".indices",
@@ -1012,11 +1013,7 @@ Status add_primitive(const Ctx& c, const NodeGraph& g, const SkeletonPlan& plan,
                                          {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
                                           TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT,
                                           TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT}));
-    if (ind.count % 3 != 0) {
-      return c.error(ErrorCode::kInvalidData, pfield + ".indices", std::to_string(ind.count),
-                     "index count is not a multiple of 3");
-    }
-    tris.resize(ind.count / 3);
+    sequence.resize(ind.count);
     for (std::size_t i = 0; i < ind.count; ++i) {
       const double v = ind.at(i, 0);
       if (v >= static_cast<double>(vcount)) {
@@ -1024,15 +1021,40 @@ Status add_primitive(const Ctx& c, const NodeGraph& g, const SkeletonPlan& plan,
                        "vertex index past the primitive's " + std::to_string(vcount) +
                            " vertices");
       }
-      tris[i / 3][i % 3] = static_cast<std::uint32_t>(v);
+      sequence[i] = static_cast<std::uint32_t>(v);
     }
   } else {
-    if (vcount % 3 != 0) {
-      return c.error(ErrorCode::kInvalidData, afield + ".POSITION", std::to_string(vcount),
-                     "non-indexed primitive whose vertex count is not a multiple of 3");
+    sequence.resize(vcount);
+    for (std::size_t i = 0; i < vcount; ++i) sequence[i] = static_cast<std::uint32_t>(i);
+  }
+  const std::string count_field = prim.indices >= 0 ? pfield + ".indices" : afield + ".POSITION";
+  // Triangles in the spec's order (glTF 2.0, 3.7.2.1): strips alternate
+  // their winding so that every triangle faces the same way, fans share the
+  // first vertex.
+  std::vector<std::array<std::uint32_t, 3>> tris;
+  const std::size_t count = sequence.size();
+  if (mode == TINYGLTF_MODE_TRIANGLES) {
+    if (count % 3 != 0) {
+      return c.error(ErrorCode::kInvalidData, count_field, std::to_string(count),
+                     prim.indices >= 0 ? "index count is not a multiple of 3"
+                                       : "non-indexed primitive whose vertex count is not a multiple of 3");
     }
-    tris.resize(vcount / 3);
-    for (std::size_t i = 0; i < vcount; ++i) tris[i / 3][i % 3] = static_cast<std::uint32_t>(i);
+    tris.resize(count / 3);
+    for (std::size_t i = 0; i < count; ++i) tris[i / 3][i % 3] = sequence[i];
+  } else {
+    if (count < 3) {
+      return c.error(ErrorCode::kInvalidData, count_field, std::to_string(count),
+                     std::string(mode == TINYGLTF_MODE_TRIANGLE_STRIP ? "a triangle strip" : "a triangle fan") +
+                         " needs at least 3 vertices");
+    }
+    tris.resize(count - 2);
+    for (std::size_t i = 0; i + 2 < count; ++i) {
+      if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
+        tris[i] = {sequence[i], sequence[i + 1 + i % 2], sequence[i + 2 - i % 2]};
+      } else {
+        tris[i] = {sequence[i + 1], sequence[i + 2], sequence[0]};
+      }
+    }
   }
 
   // Computed normals: area-weighted face normals, for missing or zero ones.

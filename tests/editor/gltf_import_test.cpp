@@ -440,17 +440,86 @@ TEST(GltfImport, AssimpOddFilesNeverCrash) {
   }
 }
 
-TEST(GltfImport, NonTriangleModesAreRejected) {
-  // Asset generator: modes 0-3 (points, lines...) and 5-6 (strips, fans).
+// The glTF Asset Generator's primitive modes: points and lines (0-3) are
+// refused naming the mode; triangles, strips and fans (4-6) import, strips
+// and fans as the spec's triangles (glTF 2.0, 3.7.2.1): strip triangle i is
+// (v_i, v_{i+1+i%2}, v_{i+2-i%2}), fan triangle i is (v_{i+1}, v_{i+2}, v_0),
+// checked against the file's own vertex sequence read through tinygltf.
+TEST(GltfImport, PrimitiveModesFollowTheSpec) {
   const std::string dir = kAssimp + "/glTF-Asset-Generator/Mesh_PrimitiveMode/";
-  int rejected = 0;
+  if (!fs::exists(dir)) GTEST_SKIP() << dir << " not found (assimp-testmodels)";
+  int refused = 0, strips = 0, fans = 0;
   for (int i = 0; i < 16; ++i) {
     char name[64];
     std::snprintf(name, sizeof name, "Mesh_PrimitiveMode_%02d.gltf", i);
-    const auto m = import_gltf(dir + name);
-    if (!m.ok() && m.status().field().find(".mode") != std::string_view::npos) ++rejected;
+    const std::string path = dir + name;
+    tinygltf::Model raw;
+    tinygltf::TinyGLTF loader;
+    std::string err, warn;
+    ASSERT_TRUE(loader.LoadASCIIFromFile(&raw, &err, &warn, path)) << err;
+    const tinygltf::Primitive& prim = raw.meshes[0].primitives[0];
+    const int mode = prim.mode == -1 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
+    const auto m = import_gltf(path);
+    if (mode < TINYGLTF_MODE_TRIANGLES) {
+      ASSERT_FALSE(m.ok()) << name;
+      EXPECT_NE(m.status().field().find(".mode"), std::string_view::npos) << m.status().message();
+      ++refused;
+      continue;
+    }
+    ASSERT_TRUE(m.ok()) << name << ": " << m.status().message();
+    // The file's positions and vertex sequence, straight from its buffers.
+    const auto element = [&](int accessor, std::size_t k, int component) {
+      const tinygltf::Accessor& a = raw.accessors[static_cast<std::size_t>(accessor)];
+      const tinygltf::BufferView& v = raw.bufferViews[static_cast<std::size_t>(a.bufferView)];
+      const std::size_t size = tinygltf::GetComponentSizeInBytes(static_cast<std::uint32_t>(a.componentType));
+      const std::size_t stride = v.byteStride != 0 ? v.byteStride
+                                                   : size * static_cast<std::size_t>(tinygltf::GetNumComponentsInType(
+                                                                static_cast<std::uint32_t>(a.type)));
+      const unsigned char* at = raw.buffers[static_cast<std::size_t>(v.buffer)].data.data() + v.byteOffset +
+                                a.byteOffset + k * stride + static_cast<std::size_t>(component) * size;
+      double value = 0.0;
+      if (a.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT) value = *reinterpret_cast<const float*>(at);
+      if (a.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE) value = *at;
+      if (a.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT) value = *reinterpret_cast<const std::uint16_t*>(at);
+      if (a.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT) value = *reinterpret_cast<const std::uint32_t*>(at);
+      return value;
+    };
+    const int pos = prim.attributes.at("POSITION");
+    const std::size_t vcount = raw.accessors[static_cast<std::size_t>(pos)].count;
+    std::vector<std::size_t> seq;
+    if (prim.indices >= 0) {
+      for (std::size_t k = 0; k < raw.accessors[static_cast<std::size_t>(prim.indices)].count; ++k) {
+        seq.push_back(static_cast<std::size_t>(element(prim.indices, k, 0)));
+      }
+    } else {
+      for (std::size_t k = 0; k < vcount; ++k) seq.push_back(k);
+    }
+    std::vector<std::array<std::size_t, 3>> expected;
+    for (std::size_t k = 0; mode == TINYGLTF_MODE_TRIANGLES && k + 2 < seq.size(); k += 3) {
+      expected.push_back({seq[k], seq[k + 1], seq[k + 2]});
+    }
+    for (std::size_t k = 0; mode == TINYGLTF_MODE_TRIANGLE_STRIP && k + 2 < seq.size(); ++k) {
+      expected.push_back({seq[k], seq[k + 1 + k % 2], seq[k + 2 - k % 2]});
+    }
+    for (std::size_t k = 0; mode == TINYGLTF_MODE_TRIANGLE_FAN && k + 2 < seq.size(); ++k) {
+      expected.push_back({seq[k + 1], seq[k + 2], seq[0]});
+    }
+    strips += mode == TINYGLTF_MODE_TRIANGLE_STRIP ? 1 : 0;
+    fans += mode == TINYGLTF_MODE_TRIANGLE_FAN ? 1 : 0;
+    ASSERT_EQ(m->mesh.triangles.size(), expected.size()) << name;
+    for (std::size_t t = 0; t < expected.size(); ++t) {
+      for (int corner = 0; corner < 3; ++corner) {
+        const Vec3& got = m->mesh.positions[m->mesh.triangles[t][static_cast<std::size_t>(corner)]];
+        for (int axis = 0; axis < 3; ++axis) {
+          EXPECT_FLOAT_EQ(got[axis], static_cast<float>(element(pos, expected[t][static_cast<std::size_t>(corner)], axis)))
+              << name << " triangle " << t << " corner " << corner;
+        }
+      }
+    }
   }
-  EXPECT_GT(rejected, 0);
+  EXPECT_EQ(refused, 8);
+  EXPECT_EQ(strips, 2);
+  EXPECT_EQ(fans, 2);
 }
 
 // Synthetic corruptions of a tiny valid skinned model: one triangle, two
