@@ -534,7 +534,14 @@ Status validate_binary(const std::string& path) {
   SINEW_RETURN_IF_ERROR(w.skip(4, "magic"));
   std::int32_t version = 0;
   SINEW_RETURN_IF_ERROR(w.i32(version, "version"));
-  return walk(w).with_file(path);
+  if (Status s = walk(w); !s.ok()) return s.with_file(path);
+  // Cal3D's loader stops where the data ends and ignores the rest.
+  if (w.left() != 0) {
+    return make_error(ErrorCode::kInvalidData, path, "size", std::to_string(bytes.size()) + " bytes",
+                      std::to_string(w.left()) + " bytes follow the end of the data at byte " +
+                          std::to_string(bytes.size() - w.left()));
+  }
+  return {};
 }
 
 Expected<anim::Skeleton> convert_skeleton(CalCoreSkeleton& core, const std::string& file,

@@ -19,7 +19,8 @@
 // * Mesh. Every node with a mesh instantiates it; triangles come in mesh
 //   array order, then per mesh its instancing nodes in node order, then
 //   primitives in order, then triangles in index order (non-indexed
-//   primitives use 0,1,2,...). Meshes no node uses are skipped. Skinned mesh
+//   primitives use 0,1,2,...; strips and fans become the spec's triangles,
+//   points and lines are refused). Meshes no node uses are skipped. Skinned mesh
 //   nodes follow the spec: their own transform is ignored, vertices are bind
 //   positions. Meshes on nodes without a skin are rigid: they are bound with
 //   weight 1 to their nearest joint ancestor (or self), or, if none, to a

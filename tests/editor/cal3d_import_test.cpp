@@ -362,6 +362,41 @@ TEST_F(Cal3dBadInput, GarbageCfgLines) {
 
 // Truncated copies of each binary file type at several lengths: an error
 // naming the truncated file, never a crash (run under ASan too).
+// Bytes after the end of the data: Cal3D's loaders stop reading there and
+// would ignore them; the import refuses them, naming the file.
+TEST_F(Cal3dBadInput, TrailingBytesAreRefused) {
+  const std::string csf = model_file("cally", "cally.csf");
+  const std::string cmf = model_file("cally", "cally_chest.cmf");
+  const std::string caf = model_file("cally", "cally_wave.caf");
+  struct Kind {
+    std::string source;
+    std::string name;
+  };
+  for (const Kind& kind : {Kind{csf, "t.csf"}, Kind{cmf, "t.cmf"}, Kind{caf, "t.caf"}}) {
+    const std::string bytes = read(kind.source);
+    for (const std::string& tail : {std::string(1, '\0'), std::string("garbage"), bytes.substr(0, 64)}) {
+      const std::string file = write(kind.name, bytes + tail);
+      const std::string skel = kind.name == "t.csf" ? file : csf;
+      std::string cfg = "skeleton=" + skel + "\n";
+      if (kind.name == "t.cmf") cfg += "mesh=" + file + "\n";
+      if (kind.name == "t.caf") cfg += "animation=" + file + "\n";
+      auto m = import_cal3d(write("t.cfg", cfg));
+      ASSERT_FALSE(m.ok()) << kind.name << " with " << tail.size() << " trailing bytes";
+      EXPECT_EQ(m.status().file(), file) << m.status().message();
+      EXPECT_NE(m.status().message().find(std::to_string(tail.size()) + " bytes follow the end of the data"),
+                std::string::npos)
+          << m.status().message();
+    }
+    // The file as it is still loads.
+    const std::string file = write(kind.name, bytes);
+    std::string cfg = "skeleton=" + (kind.name == "t.csf" ? file : csf) + "\n";
+    cfg += kind.name == "t.cmf" ? "mesh=" + file + "\n" : "mesh=" + cmf + "\n";
+    if (kind.name == "t.caf") cfg += "animation=" + file + "\n";
+    auto ok = import_cal3d(write("t.cfg", cfg));
+    EXPECT_TRUE(ok.ok()) << ok.status().message();
+  }
+}
+
 TEST_F(Cal3dBadInput, TruncatedFiles) {
   const std::string csf = model_file("cally", "cally.csf");
   const std::string cmf = model_file("cally", "cally_chest.cmf");
