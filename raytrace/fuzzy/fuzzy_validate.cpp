@@ -1,5 +1,6 @@
 #include "raytrace/fuzzy/fuzzy_character.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -63,6 +64,106 @@ Status validate_tree(const KdTreeView& tree, std::uint32_t item_limit, std::uint
     if (tree.items[i] >= item_limit) {
       return bad_character(where + ".items[" + std::to_string(i) + "]", std::to_string(tree.items[i]),
                            "not a triangle of the mesh");
+    }
+  }
+  return {};
+}
+
+// Whether a kd-tree walk reaching the cells that `box` overlaps finds
+// `item` in every leaf it must. As the builder (kdtree/kd_builder.cpp) does,
+// the box is clipped to each child's side of a split, and goes below a
+// split when it starts below it, above when it ends above it (a box flat on
+// the split goes to one side). Leaf items are sorted (checked before).
+// Recursion depth is the tree's, already bounded.
+bool listed_where_needed(const KdTreeView& tree, std::uint32_t node_index, std::uint32_t item, const Aabb& box) {
+  const KdNode& node = tree.nodes[node_index];
+  if (node.is_leaf()) {
+    const auto first = tree.items.begin() + node.first_item();
+    const auto last = first + node.item_count();
+    return std::binary_search(first, last, item);
+  }
+  const int a = node.axis();
+  const float split = node.split();
+  const bool below = box.lower[a] < split, above = box.upper[a] > split;
+  Aabb below_box = box, above_box = box;
+  below_box.upper[a] = std::min(box.upper[a], split);
+  above_box.lower[a] = std::max(box.lower[a], split);
+  if (!below && !above) {
+    return listed_where_needed(tree, node_index + 1, item, box) ||
+           listed_where_needed(tree, node.above_child(), item, box);
+  }
+  return (!below || listed_where_needed(tree, node_index + 1, item, below_box)) &&
+         (!above || listed_where_needed(tree, node.above_child(), item, above_box));
+}
+
+// The trees against the mesh: the bone slices tile the node and item arrays
+// in bone order; leaf items are increasing triangles of the tree's own bone;
+// and every triangle is inside its bone's root box and listed in every leaf
+// its fuzzy box (the union of its corners' check boxes) overlaps. Together
+// with the escape check this is what makes a ray find every triangle.
+Status validate_tree_contents(const SkinnedMesh& mesh, const FuzzyCharacterView& fuzzy) {
+  std::size_t node_at = 0, item_at = 0;
+  std::vector<std::uint32_t> per_bone(fuzzy.bone_count, 0);
+  for (const std::uint16_t b : fuzzy.triangle_bone) ++per_bone[b];
+  for (std::uint32_t b = 0; b < fuzzy.bone_count; ++b) {
+    const BoneTree& bt = fuzzy.bone_trees[b];
+    const std::string where = "bone_trees[" + std::to_string(b) + "]";
+    if (bt.node_begin != node_at || bt.item_begin != item_at) {
+      return bad_character(where + ".node_begin", std::to_string(bt.node_begin),
+                           "the bones' slices must follow each other in bone order without gaps or overlap "
+                           "(expected nodes from " + std::to_string(node_at) + ", items from " +
+                               std::to_string(item_at) + ")");
+    }
+    node_at += bt.node_count;
+    item_at += bt.item_count;
+    if (bt.triangle_count != per_bone[b]) {
+      return bad_character(where + ".triangle_count", std::to_string(bt.triangle_count),
+                           std::to_string(per_bone[b]) + " triangles are assigned to the bone");
+    }
+    if ((bt.node_count == 0) != (per_bone[b] == 0)) {
+      return bad_character(where + ".node_count", std::to_string(bt.node_count),
+                           "a bone has a tree exactly when triangles are assigned to it");
+    }
+    const KdTreeView tree = fuzzy.bone_tree(b);
+    for (std::size_t n = 0; n < tree.nodes.size(); ++n) {
+      const KdNode& node = tree.nodes[n];
+      if (!node.is_leaf()) continue;
+      if (std::size_t{node.first_item()} + node.item_count() > tree.items.size()) {
+        return bad_character(where + ".nodes[" + std::to_string(n) + "]", std::to_string(node.first_item()),
+                             "leaf items outside the item array");
+      }
+      for (std::uint32_t i = 0; i < node.item_count(); ++i) {
+        const std::uint32_t t = tree.items[node.first_item() + i];
+        if (fuzzy.triangle_bone[t] != b) {
+          return bad_character(where + ".items[" + std::to_string(node.first_item() + i) + "]", std::to_string(t),
+                               "a triangle of bone " + std::to_string(fuzzy.triangle_bone[t]));
+        }
+        if (i > 0 && !(tree.items[node.first_item() + i - 1] < t)) {
+          return bad_character(where + ".nodes[" + std::to_string(n) + "]", std::to_string(t),
+                               "leaf items must increase");
+        }
+      }
+    }
+  }
+  if (node_at != fuzzy.nodes.size() || item_at != fuzzy.items.size()) {
+    return bad_character("bone_trees", std::to_string(node_at) + " nodes, " + std::to_string(item_at) + " items",
+                         "the slices must cover the " + std::to_string(fuzzy.nodes.size()) + " nodes and " +
+                             std::to_string(fuzzy.items.size()) + " items");
+  }
+  for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
+    const std::uint32_t b = fuzzy.triangle_bone[t];
+    Aabb box;
+    for (const std::uint32_t c : fuzzy.triangle_checks[t]) box.extend(fuzzy.vertex_checks[c].box);
+    const KdTreeView tree = fuzzy.bone_tree(b);
+    const std::string field = "triangle_bone[" + std::to_string(t) + "]";
+    for (int a = 0; a < 3; ++a) {
+      if (!(box.lower[a] >= tree.bounds.lower[a] && box.upper[a] <= tree.bounds.upper[a])) {
+        return bad_character(field, std::to_string(b), "the triangle's fuzzy box leaves its bone tree's bounds");
+      }
+    }
+    if (!listed_where_needed(tree, 0, static_cast<std::uint32_t>(t), box)) {
+      return bad_character(field, std::to_string(b),
+                           "the triangle is missing from a leaf of its bone's tree that its fuzzy box overlaps");
     }
   }
   return {};
@@ -142,7 +243,7 @@ Status validate_fuzzy_character(const SkinnedMesh& mesh, const FuzzyCharacterVie
     }
     SINEW_RETURN_IF_ERROR(validate_tree(fuzzy.bone_tree(b), static_cast<std::uint32_t>(triangles), b));
   }
-  return {};
+  return validate_tree_contents(mesh, fuzzy);
 }
 
 }  // namespace sinew::rt

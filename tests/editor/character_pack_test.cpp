@@ -393,6 +393,59 @@ TEST_F(CorruptPack, BadMeshSkeletonAndClipDataAreRefused) {
 
 // Random byte changes inside each section, checksums recomputed: whatever
 // the loader accepts must render without tripping the sanitizers.
+// Well-formed but wrong fuzzy data, checksums recomputed: every fuzzy
+// section zeroed in turn, two bones' trees swapped, one triangle dropped
+// from a leaf. Each is refused by the check that the trees list every
+// triangle where its fuzzy box reaches (a zeroed tree table used to load
+// and render no character).
+TEST_F(CorruptPack, WellFormedButInconsistentFuzzyDataIsRefused) {
+  const std::pair<SectionId, const char*> sections[] = {
+      {make_section_id("FTBN"), "FTBN"}, {make_section_id("FBTR"), "FBTR"}, {make_section_id("FNOD"), "FNOD"},
+      {make_section_id("FITM"), "FITM"}, {make_section_id("FVCB"), "FVCB"}, {make_section_id("FVCK"), "FVCK"},
+      {make_section_id("FTCK"), "FTCK"}};
+  for (const auto& [id, name] : sections) {
+    const auto zeroed = repack(id, [](auto& p) { std::fill(p.begin(), p.end(), std::byte{0}); });
+    auto pack = CharacterPack::from_bytes(zeroed, "corrupt.pack");
+    EXPECT_FALSE(pack.ok()) << name << " zeroed was accepted";
+  }
+  // Two bones with triangles swap their tree entries (48 bytes each).
+  const rt::FuzzyCharacterView f = baked_->fuzzy.view();
+  std::vector<std::uint32_t> with_triangles;
+  for (std::uint32_t b = 0; b < f.bone_count; ++b) {
+    if (f.bone_trees[b].triangle_count > 0) with_triangles.push_back(b);
+  }
+  ASSERT_GE(with_triangles.size(), 2u);
+  const std::size_t a = with_triangles.front(), b = with_triangles.back();
+  expect_rejected(repack(make_section_id("FBTR"),
+                         [&](auto& p) {
+                           std::swap_ranges(p.begin() + static_cast<std::ptrdiff_t>(48 * a),
+                                            p.begin() + static_cast<std::ptrdiff_t>(48 * a + 48),
+                                            p.begin() + static_cast<std::ptrdiff_t>(48 * b));
+                         }),
+                  "bone_trees");
+  // One leaf item replaced by the next triangle of the same bone that the
+  // leaf does not list: the replaced one is then missing.
+  const rt::KdTreeView tree = f.bone_tree(static_cast<std::uint32_t>(a));
+  std::size_t leaf_item = SIZE_MAX;
+  std::uint32_t replacement = 0;
+  for (const rt::KdNode& node : tree.nodes) {
+    if (!node.is_leaf() || node.item_count() == 0) continue;
+    const std::uint32_t last = tree.items[node.first_item() + node.item_count() - 1];
+    for (std::uint32_t t = last + 1; t < f.triangle_bone.size(); ++t) {
+      if (f.triangle_bone[t] == a) {
+        leaf_item = f.bone_trees[a].item_begin + node.first_item() + node.item_count() - 1;
+        replacement = t;
+        break;
+      }
+    }
+    if (leaf_item != SIZE_MAX) break;
+  }
+  ASSERT_NE(leaf_item, SIZE_MAX);
+  expect_rejected(repack(make_section_id("FITM"),
+                         [&](auto& p) { std::memcpy(p.data() + 4 * leaf_item, &replacement, 4); }),
+                  "missing from a leaf");
+}
+
 TEST_F(CorruptPack, RandomDamageNeverCrashes) {
   auto reader = PackReader::from_bytes(*bytes_, "pristine");
   ASSERT_TRUE(reader.ok());
