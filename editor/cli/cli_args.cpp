@@ -174,6 +174,27 @@ Expected<bool> parse_on_off(std::string_view flag, const std::string& text) {
   return index == 0;
 }
 
+Status parse_import_limits(const ParsedArgs& args, ImportLimits& limits) {
+  const std::pair<const char*, std::size_t*> options[] = {
+      {"--max-triangles", &limits.max_triangles}, {"--max-clips", &limits.max_clips}, {"--max-keys", &limits.max_keys}};
+  for (const auto& [flag, value] : options) {
+    if (const auto text = args.value(flag)) {
+      SINEW_ASSIGN_OR_RETURN(const std::int64_t n, parse_int(flag, *text, 1, std::int64_t{1} << 40));
+      *value = static_cast<std::size_t>(n);
+    }
+  }
+  return {};
+}
+
+std::string import_limits_usage() {
+  const ImportLimits d;
+  return "  --max-triangles N     glTF import limit on triangles over all mesh instances (default " +
+         std::to_string(d.max_triangles) + ")\n" +
+         "  --max-clips N         glTF import limit on animations (default " + std::to_string(d.max_clips) + ")\n" +
+         "  --max-keys N          glTF import limit on animation keys over all channels (default " +
+         std::to_string(d.max_keys) + ")\n";
+}
+
 Expected<std::vector<std::string>> parse_folder_list(std::string_view flag, const std::string& text) {
   std::vector<std::string> folders;
   std::size_t start = 0;

@@ -15,6 +15,7 @@
 #include <string_view>
 #include <vector>
 
+#include "editor/import/gltf_importer.h"
 #include "runtime/core/expected.h"
 
 namespace sinew::editor::cli {
@@ -64,6 +65,10 @@ Expected<int> parse_choice(std::string_view flag, const std::string& text,
                            std::initializer_list<std::string_view> choices);
 // "on" or "off".
 Expected<bool> parse_on_off(std::string_view flag, const std::string& text);
+// --max-triangles, --max-clips and --max-keys into `limits` (each at least 1).
+Status parse_import_limits(const ParsedArgs& args, ImportLimits& limits);
+// Their help lines.
+std::string import_limits_usage();
 // Folders separated by ':', each existing.
 Expected<std::vector<std::string>> parse_folder_list(std::string_view flag, const std::string& text);
 

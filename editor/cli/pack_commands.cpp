@@ -71,7 +71,8 @@ std::string bake_usage() {
          "  --threads N           worker threads (default all cores)\n"
          "  --max-memory-mib M    refuse a bake whose working set would exceed M MiB\n"
          "                        (default 8192, at least 4; a quarter of it at most goes\n"
-         "                        to the fuzzy boxes, processed in bone chunks)\n"
+         "                        to the fuzzy boxes, processed in bone chunks)\n" +
+         cli::import_limits_usage() +
          "Set SOURCE_DATE_EPOCH for a reproducible pack (fixed date, no timings).\n";
 }
 
@@ -79,7 +80,8 @@ const std::vector<cli::FlagSpec>& bake_flags() {
   static const std::vector<cli::FlagSpec> flags = {
       {"--help", false}, {"-h", false},      {"--out"},     {"--pose-space"}, {"--clips"},
       {"--samples"},     {"--seed"},         {"--limits"}, {"--pad"},  {"--candidates"}, {"--threads"},
-      {"--scene"},       {"--max-memory-mib"}, {"--asset-roots"},
+      {"--scene"},       {"--max-memory-mib"}, {"--asset-roots"}, {"--max-triangles"}, {"--max-clips"},
+      {"--max-keys"},
   };
   return flags;
 }
@@ -116,6 +118,7 @@ Expected<BakeOptions> parse_bake_options(std::vector<std::string> args) {
   if (auto v = parsed.value("--asset-roots")) {
     SINEW_ASSIGN_OR_RETURN(o.gltf.asset_roots, cli::parse_folder_list("--asset-roots", *v));
   }
+  SINEW_RETURN_IF_ERROR(cli::parse_import_limits(parsed, o.gltf.limits));
   if (o.out_path.empty()) return invalid_argument("-o", "", "missing: where to write the pack");
   if (!is_pack_path(o.out_path)) return invalid_argument("-o", o.out_path, "expected a .pack file name");
   bool samples_given = false;

@@ -42,7 +42,8 @@ const std::vector<cli::FlagSpec>& render_flags() {
       {"--size"},        {"--out"},              {"--pose-space"}, {"--clips"},        {"--samples"},
       {"--seed"},        {"--shadows"},          {"--light"},      {"--threads"},      {"--instances"},
       {"--frames"},      {"--triangle-test"},    {"--bone-boxes"}, {"--fallback"},     {"--limits"},
-      {"--ground"},      {"--packet-rays"},      {"--asset-roots"},
+      {"--ground"},      {"--packet-rays"},      {"--asset-roots"},   {"--max-triangles"}, {"--max-clips"},
+      {"--max-keys"},
   };
   return flags;
 }
@@ -153,6 +154,7 @@ Status parse_run(const cli::ParsedArgs& args, RenderOptions& o) {
   if (const auto text = args.value("--asset-roots")) {
     SINEW_ASSIGN_OR_RETURN(o.gltf.asset_roots, cli::parse_folder_list("--asset-roots", *text));
   }
+  SINEW_RETURN_IF_ERROR(cli::parse_import_limits(args, o.gltf.limits));
   if (const auto text = args.value("--packet-rays")) {
     SINEW_ASSIGN_OR_RETURN(const int i, cli::parse_choice("--packet-rays", *text, {"1", "8", "64", "256"}));
     o.packet_rays = std::array<int, 4>{1, 8, 64, 256}[static_cast<std::size_t>(i)];
@@ -392,12 +394,13 @@ std::string render_usage() {
          "  --frames N                frames rendered at 30 fps from --time; the last is written (default 1)\n"
          "  --triangle-test fast|watertight   ray-triangle test (default fast)\n"
          "  --packet-rays 1|8|64|256  rays traced together: single rays, 4x2, 8x8 or 16x16 pixels (default 64)\n"
-         "  --asset-roots A:B     more folders a glTF file's buffers may be read from (by default\n"
-         "                        only its own folder and below)\n"
+         "  --asset-roots A:B         more folders a glTF file's buffers may be read from (by default\n"
+         "                            only its own folder and below)\n"
          "  --bone-boxes exact|cheap  per-frame bone boxes (default exact)\n"
          "  --fallback on|off         exact rendering of triangles outside their fuzzy boxes (default on)\n"
          "  --ground on|off           the ground quad under the model (default on)\n"
-         "  --help                    this text\n"
+         "  --help                    this text\n" +
+         cli::import_limits_usage() +
          "The model's up axis is the larger of its rest bounds' Y and Z extents; a ground quad lies\n"
          "under the rest bounds on that axis (unless --ground off).\n";
 }

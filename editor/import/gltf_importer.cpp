@@ -53,6 +53,15 @@ std::string num(double v) {
 struct Ctx {
   const tinygltf::Model& model;
   const std::string& file;
+  const ImportLimits& limits;
+
+  // The error for a limit, naming the option that raises it.
+  Status limit(std::string_view field, std::size_t value, std::string_view what, std::size_t max,
+               std::string_view option) const {
+    return make_error(ErrorCode::kLimitExceeded, file, field, std::to_string(value),
+                      "more " + std::string(what) + " than the import limit of " + std::to_string(max) +
+                          " (raise it with " + std::string(option) + ")");
+  }
 
   Status error(ErrorCode code, std::string_view field, std::string_view value,
                std::string_view detail) const {
@@ -719,6 +728,10 @@ Expected<std::vector<anim::Clip>> build_clips(const Ctx& c, const SkeletonPlan& 
                                               const anim::Skeleton& skeleton,
                                               const std::vector<int>& raw_to_sorted) {
   std::vector<anim::Clip> clips;
+  if (c.model.animations.size() > c.limits.max_clips) {
+    return c.limit("animations", c.model.animations.size(), "clips", c.limits.max_clips, "--max-clips");
+  }
+  std::size_t keys = 0;
   for (std::size_t a = 0; a < c.model.animations.size(); ++a) {
     const tinygltf::Animation& anim_in = c.model.animations[a];
     const std::string afield = idx("animations", a);
@@ -764,6 +777,11 @@ Expected<std::vector<anim::Clip>> build_clips(const Ctx& c, const SkeletonPlan& 
       SINEW_ASSIGN_OR_RETURN(AccessorData in,
                              read_accessor(c, sampler.input, sfield + ".input",
                                            {TINYGLTF_TYPE_SCALAR}, {TINYGLTF_COMPONENT_TYPE_FLOAT}));
+      // Channels may share samplers: every use counts, as every use is copied.
+      keys += in.count;
+      if (keys > c.limits.max_keys) {
+        return c.limit(sfield + ".input", keys, "animation keys in all", c.limits.max_keys, "--max-keys");
+      }
       const bool rot = path == "rotation";
       SINEW_ASSIGN_OR_RETURN(
           AccessorData out,
@@ -1150,6 +1168,12 @@ Expected<ImportedModel> convert(const Ctx& c) {
         const std::uint32_t material =
             mat == -1 ? static_cast<std::uint32_t>(nmat) : static_cast<std::uint32_t>(mat);
         SINEW_RETURN_IF_ERROR(add_primitive(c, g, plan, raw_to_sorted, n, m, p, material, b));
+        // Checked per primitive: a mesh instanced by many nodes is copied
+        // per node, so memory stays within the limit plus one primitive.
+        if (b.mesh.triangles.size() > c.limits.max_triangles) {
+          return c.limit(idx("nodes", n) + ".mesh", b.mesh.triangles.size(), "triangles", c.limits.max_triangles,
+                         "--max-triangles");
+        }
       }
     }
   }
@@ -1262,7 +1286,7 @@ Expected<ImportedModel> import_gltf(const std::string& path, const GltfImportOpt
                       version.rfind("1.", 0) == 0 ? "glTF 1.0 is not supported (glTF 2.0 only)"
                                                   : "only glTF 2.x is supported");
   }
-  const Ctx c{model, path};
+  const Ctx c{model, path, options.limits};
   return convert(c);
 }
 

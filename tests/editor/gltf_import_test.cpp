@@ -1016,7 +1016,9 @@ TEST_F(GltfSynthetic, ExternalFilesStayInsideTheAssetFolder) {
   EXPECT_TRUE(import_gltf(with_uri("sub/synthetic.bin")).ok());
   EXPECT_TRUE(import_gltf(with_uri("sub%2Fsynthetic.bin")).ok());
   // Another folder, once allowed.
-  const auto allowed = import_gltf(with_uri("../outside/synthetic.bin"), GltfImportOptions{{outside.string()}});
+  GltfImportOptions more_roots;
+  more_roots.asset_roots = {outside.string()};
+  const auto allowed = import_gltf(with_uri("../outside/synthetic.bin"), more_roots);
   EXPECT_TRUE(allowed.ok()) << allowed.status().message();
   // A data: URI needs no folder at all.
   static const char kBase64[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
@@ -1072,6 +1074,54 @@ TEST_F(GltfSynthetic, IdsAndRequiredExtensionsFollowTheSpec) {
           "\"extensionsRequired\": [\"KHR_materials_unlit\"],");
   const auto m = import_gltf(write(fine));
   EXPECT_TRUE(m.ok()) << m.status().message();
+}
+
+// Resource limits, generated: 5,000 nodes instancing one mesh (a few KB of
+// JSON, a triangle per node here; 23 M triangles in the report that found
+// it), an animation repeated 10,000 times, more keys than allowed. Each is
+// refused early, naming the limit and the option that raises it; raised,
+// the same file imports.
+TEST_F(GltfSynthetic, ResourceLimitsAreNamedAndCanBeRaised) {
+  Synthetic many = synthetic();
+  std::string nodes, scene_nodes;
+  for (int i = 0; i < 5000; ++i) {
+    nodes += ",\n    {\"mesh\": 0, \"skin\": 0}";
+    scene_nodes += ", " + std::to_string(3 + i);
+  }
+  replace(many.json, "{\"name\": \"knee\", \"translation\": [0, 1, 0]}",
+          "{\"name\": \"knee\", \"translation\": [0, 1, 0]}" + nodes);
+  replace(many.json, "\"nodes\": [0, 1]}", "\"nodes\": [0, 1" + scene_nodes + "]}");
+  GltfImportOptions small;
+  small.limits.max_triangles = 1000;
+  const auto refused = import_gltf(write(many), small);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_EQ(refused.status().code(), ErrorCode::kLimitExceeded);
+  EXPECT_NE(refused.status().message().find("more triangles than the import limit of 1000 (raise it with "
+                                            "--max-triangles)"),
+            std::string::npos)
+      << refused.status().message();
+  const auto raised = import_gltf(write(many));  // the default limit
+  ASSERT_TRUE(raised.ok()) << raised.status().message();
+  EXPECT_EQ(raised->mesh.triangle_count(), 5001u);
+
+  Synthetic repeated = synthetic();
+  const std::string animation =
+      "{\"channels\": [{\"sampler\": 0, \"target\": {\"node\": 1, \"path\": \"rotation\"}}],\n"
+      "                  \"samplers\": [{\"input\": 5, \"output\": 6, \"interpolation\": \"LINEAR\"}]}";
+  std::string animations = animation;
+  for (int i = 1; i < 10000; ++i) animations += ", " + animation;
+  replace(repeated.json, animation, animations);
+  const auto clips = import_gltf(write(repeated));
+  ASSERT_FALSE(clips.ok());
+  EXPECT_NE(clips.status().message().find("animations = 10000: more clips than the import limit of 1024 (raise "
+                                          "it with --max-clips)"),
+            std::string::npos)
+      << clips.status().message();
+  GltfImportOptions few_keys;
+  few_keys.limits.max_keys = 1;
+  const auto keys = import_gltf(write(synthetic()), few_keys);
+  ASSERT_FALSE(keys.ok());
+  EXPECT_NE(keys.status().message().find("--max-keys"), std::string::npos) << keys.status().message();
 }
 
 TEST_F(GltfSynthetic, MissingFile) {
