@@ -3,11 +3,13 @@
 // the exit code (0 success, 1 user error, 2 usage error), so tests run them
 // in-process.
 #include <iostream>
+#include <new>
 #include <string>
 #include <vector>
 
 #include "editor/cli/pack_commands.h"
 #include "editor/cli/render_command.h"
+#include "runtime/core/status.h"
 #ifdef SINEW_HAVE_GUI
 #include "editor/gui/editor_app.h"
 #endif
@@ -28,10 +30,32 @@ void print_help(std::ostream& out) {
          "  gui      the editor window: clips, bake, joint limits, overlays, stats\n";
 }
 
+// The command line, dispatched to the command.
+int run(const std::vector<std::string>& args);
+
 }  // namespace
 
+// Library code returns errors; what is left to catch here is memory running
+// out (an input that needs more than the machine has) and bugs. Either is
+// one line and exit 1, never an abort.
 int main(int argc, char** argv) {
   const std::vector<std::string> args(argv + 1, argv + argc);
+  const std::string command = args.empty() ? "" : args.front();
+  try {
+    return run(args);
+  } catch (const std::bad_alloc&) {
+    std::cerr << "sinew-editor " << command
+              << ": out of memory: the input needs more than this machine has (the glTF import limits "
+                 "--max-triangles, --max-clips and --max-keys, and bake's --max-memory-mib, bound it lower)\n";
+  } catch (const std::exception& e) {
+    std::cerr << "sinew-editor " << command << ": internal error: " << sinew::printable(e.what()) << "\n";
+  }
+  return 1;
+}
+
+namespace {
+
+int run(const std::vector<std::string>& args) {
   if (args.empty()) {
     std::cerr << "sinew-editor: missing command\n" << kUsage;
     return 2;
@@ -58,3 +82,5 @@ int main(int argc, char** argv) {
   std::cerr << "sinew-editor: unknown command '" << command << "'\n" << kUsage;
   return 2;
 }
+
+}  // namespace

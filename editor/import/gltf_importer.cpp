@@ -15,6 +15,7 @@
 #include <fstream>
 #include <initializer_list>
 #include <limits>
+#include <new>
 #include <set>
 #include <string_view>
 #include <utility>
@@ -1263,6 +1264,9 @@ Expected<ImportedModel> import_gltf(const std::string& path, const GltfImportOpt
                                                   reinterpret_cast<const unsigned char*>(bytes.data()), length,
                                                   base_dir)
                     : loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(), length, base_dir);
+  } catch (const std::bad_alloc&) {
+    return make_error(ErrorCode::kLimitExceeded, path, binary ? "glb" : "json", std::to_string(bytes.size()) + " bytes",
+                      "out of memory while tinygltf parsed the file");
   } catch (const std::exception& e) {
     // tinygltf or its JSON parser may throw on hostile input; we must not.
     err = e.what();
@@ -1276,6 +1280,8 @@ Expected<ImportedModel> import_gltf(const std::string& path, const GltfImportOpt
   }
   if (!loaded) {
     while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();
+    // tinygltf ends each of its messages with a newline: one line here.
+    for (std::size_t at = err.find('\n'); at != std::string::npos; at = err.find('\n', at)) err.replace(at, 1, "; ");
     return make_error(ErrorCode::kInvalidData, path, binary ? "glb" : "json", "",
                       "tinygltf could not parse the file: " + (err.empty() ? warn : err));
   }

@@ -1,5 +1,8 @@
 #include "runtime/core/status.h"
 
+#include <algorithm>
+#include <cstdint>
+
 namespace sinew {
 
 std::string_view error_code_name(ErrorCode code) {
@@ -44,20 +47,83 @@ Status& Status::operator=(const Status& other) {
   return *this;
 }
 
+namespace {
+
+// The length of the valid UTF-8 sequence at s[i] (a printable code point:
+// not a C1 control, not a surrogate, not an overlong form), or 0.
+std::size_t utf8_sequence(std::string_view s, std::size_t i) {
+  const auto byte = [&](std::size_t k) { return static_cast<unsigned char>(s[k]); };
+  const unsigned char b = byte(i);
+  std::size_t n = 0;
+  std::uint32_t cp = 0;
+  if (b >= 0xC2 && b <= 0xDF) {
+    n = 2;
+    cp = b & 0x1Fu;
+  } else if (b >= 0xE0 && b <= 0xEF) {
+    n = 3;
+    cp = b & 0x0Fu;
+  } else if (b >= 0xF0 && b <= 0xF4) {
+    n = 4;
+    cp = b & 0x07u;
+  } else {
+    return 0;
+  }
+  if (i + n > s.size()) return 0;
+  for (std::size_t k = 1; k < n; ++k) {
+    if ((byte(i + k) & 0xC0u) != 0x80u) return 0;
+    cp = cp << 6 | (byte(i + k) & 0x3Fu);
+  }
+  const std::uint32_t min[5] = {0, 0, 0x80, 0x800, 0x10000};
+  if (cp < min[n] || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF) || cp <= 0x9F) return 0;
+  return n;
+}
+
+}  // namespace
+
+std::string printable(std::string_view text, std::size_t max_bytes) {
+  static const char kHex[] = "0123456789abcdef";
+  std::string out;
+  out.reserve(std::min(text.size(), max_bytes) + 8);
+  std::size_t i = 0;
+  for (; i < text.size() && i < max_bytes;) {
+    const unsigned char c = static_cast<unsigned char>(text[i]);
+    if (c >= 0x20 && c < 0x7F) {
+      out += static_cast<char>(c);
+      ++i;
+    } else if (const std::size_t n = c >= 0x80 ? utf8_sequence(text, i) : 0; n != 0) {
+      out.append(text.substr(i, n));
+      i += n;
+    } else if (c == '\n') {
+      out += "\\n";
+      ++i;
+    } else if (c == '\t') {
+      out += "\\t";
+      ++i;
+    } else {
+      out += "\\x";
+      out += kHex[c >> 4];
+      out += kHex[c & 15u];
+      ++i;
+    }
+  }
+  if (i < text.size()) out += "...";
+  return out;
+}
+
 std::string Status::message() const {
   if (!info_) return "ok";
   std::string out;
-  if (!info_->file.empty()) out += info_->file;
+  if (!info_->file.empty()) out += printable(info_->file);
   if (!info_->field.empty()) {
     if (!out.empty()) out += ": ";
-    out += info_->field;
-    if (!info_->value.empty()) out += " = " + info_->value;
+    out += printable(info_->field);
+    if (!info_->value.empty()) out += " = " + printable(info_->value, 200);
   } else if (!info_->value.empty()) {
     if (!out.empty()) out += ": ";
-    out += "value " + info_->value;
+    out += "value " + printable(info_->value, 200);
   }
   if (!out.empty()) out += ": ";
-  out += info_->detail.empty() ? std::string(error_code_name(info_->code)) : info_->detail;
+  out += info_->detail.empty() ? std::string(error_code_name(info_->code)) : printable(info_->detail, 2048);
   return out;
 }
 

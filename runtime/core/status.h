@@ -66,6 +66,8 @@ class [[nodiscard]] Status {
   std::string_view detail() const { return info_ ? std::string_view(info_->detail) : ""; }
 
   // "file: field = value: detail", omitting empty parts; "ok" on success.
+  // Always one line of printable text: each part goes through printable()
+  // (a value read from a file may hold any bytes).
   std::string message() const;
 
   // Returns a copy whose file is `file` when this error names none yet, so a
@@ -84,6 +86,11 @@ class [[nodiscard]] Status {
 };
 
 // Shorthand constructors for the common shapes of error.
+// `text` as printable UTF-8 on one line: control characters, bytes of
+// invalid UTF-8 and C1 controls become \xHH (newline and tab \n and \t),
+// valid UTF-8 stays; past `max_bytes` of input the rest is cut to "...".
+std::string printable(std::string_view text, std::size_t max_bytes = 512);
+
 inline Status make_error(ErrorCode code, std::string_view file, std::string_view field,
                          std::string_view value, std::string_view detail) {
   return Status(code, std::string(file), std::string(field), std::string(value),

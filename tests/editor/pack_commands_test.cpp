@@ -247,6 +247,31 @@ TEST_F(PackCommands, NonRegularFilesAreRefusedWithoutBlocking) {
   EXPECT_FALSE(std::filesystem::exists(dir + "/x.pack"));
 }
 
+// Error messages are one line of printable text naming the file, whatever
+// bytes the input holds: a Cal3D .cfg line of binary garbage, a file name
+// with control bytes, and tinygltf's one-line-per-problem errors.
+TEST_F(PackCommands, MessagesAreOneLineOfPrintableText) {
+  const std::string dir = fresh_dir("messages");
+  const std::string cfg = dir + "/garbage.cfg";
+  std::ofstream(cfg, std::ios::binary) << std::string("skeleton=\x01\xff\x00\x1b[31mred\n", 17) << "mesh=\xfe\xfd\n";
+  const std::string gltf = dir + "/two_missing.gltf";
+  std::ofstream(gltf) << R"({"asset": {"version": "2.0"}, "buffers": [{"uri": "a.bin", "byteLength": 4},)"
+                      << R"({"uri": "b.bin", "byteLength": 4}]})";
+  const std::string odd = dir + "/odd\x01name\x7f.glb";
+  std::ofstream(odd, std::ios::binary) << "glTF";
+  for (const std::string& model : {cfg, gltf, odd}) {
+    const CommandRun r = run(run_bake, {model, "-o", dir + "/x.pack"});
+    EXPECT_EQ(r.code, 1) << r.err;
+    ASSERT_FALSE(r.err.empty());
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_EQ(r.err.back(), '\n');
+    for (std::size_t i = 0; i + 1 < r.err.size(); ++i) {
+      const unsigned char c = static_cast<unsigned char>(r.err[i]);
+      EXPECT_TRUE(c >= 0x20 && c < 0x7f) << "byte " << int{c} << " at " << i << " in " << r.err;
+    }
+  }
+}
+
 TEST_F(PackCommands, UsageAndUserErrorsHaveTheirExitCodes) {
   const std::string dir = fresh_dir("errors");
   struct Case {

@@ -55,6 +55,35 @@ TEST(Status, CopyIsDeepAndWithFileFillsOnlyMissingFile) {
   EXPECT_TRUE(Status{}.with_file("x").ok());
 }
 
+// Values read from files may hold any bytes: a message is one line of
+// printable text, whatever its parts hold. Valid UTF-8 (names in other
+// scripts) stays; control bytes, C1 controls, invalid or overlong UTF-8
+// and lone surrogates become \xHH; long values are cut.
+TEST(Status, MessagesArePrintableAndOneLine) {
+  using namespace std::string_literals;
+  const std::pair<std::string, std::string> cases[] = {
+      {"plain", "plain"},
+      {"Gr\xc3\xb6\xc3\x9f" "e \xe6\x97\xa5\xe6\x9c\xac \xf0\x9f\x98\x80", "Gr\xc3\xb6\xc3\x9f" "e \xe6\x97\xa5\xe6\x9c\xac \xf0\x9f\x98\x80"},
+      {"a\nb\tc", "a\\nb\\tc"},
+      {"nul\0byte"s, "nul\\x00byte"},
+      {"\x01\x1f\x7f", "\\x01\\x1f\\x7f"},
+      {"\xff\xfe", "\\xff\\xfe"},
+      {"\xc2\x85", "\\xc2\\x85"},          // U+0085, a C1 control
+      {"\xc0\xaf", "\\xc0\\xaf"},          // overlong '/'
+      {"\xed\xa0\x80", "\\xed\\xa0\\x80"},  // a surrogate
+      {"\xe6\x97", "\\xe6\\x97"},          // cut short
+  };
+  for (const auto& [raw, shown] : cases) {
+    EXPECT_EQ(printable(raw), shown) << raw;
+    const std::string message = make_error(ErrorCode::kInvalidData, raw, raw, raw, raw).message();
+    EXPECT_EQ(message, shown + ": " + shown + " = " + shown + ": " + shown);
+    EXPECT_EQ(message.find('\n'), std::string::npos);
+  }
+  const std::string long_value(1000, 'v');
+  const std::string cut = make_error(ErrorCode::kInvalidData, "f", "field", long_value, "d").message();
+  EXPECT_EQ(cut, "f: field = " + std::string(200, 'v') + "...: d");
+}
+
 TEST(Status, EveryCodeHasAName) {
   for (int c = 0; c <= static_cast<int>(ErrorCode::kInternal); ++c) {
     EXPECT_NE(error_code_name(static_cast<ErrorCode>(c)), "unknown error") << c;
