@@ -221,11 +221,7 @@ std::uint64_t occluded_small_statics_tile(const Scene& scene, std::span<const st
   const std::uint8_t dark = static_cast<std::uint8_t>(~(1u << l));
   std::uint64_t blocked_count = 0;
   for (std::size_t i = 0; i < s.shadow_count; ++i) {
-    Ray ray;
-    ray.origin = Vec3(s.so_x[i], s.so_y[i], s.so_z[i]);
-    ray.direction = Vec3(s.sd_x[i], s.sd_y[i], s.sd_z[i]);
-    ray.t_min = 0.0f;
-    ray.t_max = s.s_tmax[i];
+    const Ray ray = s.shadow_ray(i);
     if (!detail::valid_ray(ray)) continue;
     bool blocked = false;
     for_each_triangle(triangles, [&](const StaticTriangle& tri) {

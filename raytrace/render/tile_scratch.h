@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "runtime/jobs/job_system.h"
+#include "runtime/math/ray.h"
 
 namespace sinew::rt {
 
@@ -71,6 +72,15 @@ struct TileScratch {
   }
   bool is_pixel(std::size_t k) const { return (block_pixels[k / kBlockLanes] >> (k % kBlockLanes) & 1u) != 0; }
   bool hit(std::size_t k) const { return (block_hits[k / kBlockLanes] >> (k % kBlockLanes) & 1u) != 0; }
+  // Shadow ray i as a single ray: o + t d, t in [0, s_tmax).
+  Ray shadow_ray(std::size_t i) const {
+    Ray ray;
+    ray.origin = Vec3(so_x[i], so_y[i], so_z[i]);
+    ray.direction = Vec3(sd_x[i], sd_y[i], sd_z[i]);
+    ray.t_min = 0.0f;
+    ray.t_max = s_tmax[i];
+    return ray;
+  }
 
  private:
   std::size_t capacity_ = 0;  // lanes every array holds

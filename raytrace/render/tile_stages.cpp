@@ -718,12 +718,7 @@ std::uint64_t trace_shadow_rays(const Scene& scene, TriangleTest test, int packe
   };
   if (packet_rays <= 1) {
     for (std::size_t i = 0; i < s.shadow_count; ++i) {
-      Ray ray;
-      ray.origin = Vec3(s.so_x[i], s.so_y[i], s.so_z[i]);
-      ray.direction = Vec3(s.sd_x[i], s.sd_y[i], s.sd_z[i]);
-      ray.t_min = 0.0f;
-      ray.t_max = s.s_tmax[i];
-      if (occluded(scene, ray, test, &counters)) block(i);
+      if (occluded(scene, s.shadow_ray(i), test, &counters)) block(i);
     }
     return blocked_count;
   }
