@@ -670,14 +670,6 @@ std::uint8_t any_hits(const Scene& scene, const RayPacket& packet, TraversalCoun
   return bits;
 }
 
-// Whether every object of `filter` is a static mesh the short cut handles.
-bool small_statics_only(const Scene& scene, TriangleTest test, const ObjectFilter& filter) {
-  if (test != TriangleTest::kFast) return false;
-  const std::span<const TopLevelObject> objects = scene.top_level().objects();
-  return std::all_of(filter.objects.begin(), filter.objects.end(),
-                     [&](std::uint32_t object) { return detail::is_small_static(scene, objects[object]); });
-}
-
 // Every triangle of the filter's static meshes against the packet, in
 // order, as PacketQuery::test does for kFast: a lane records a hit that is
 // strictly nearer than its best so far; any-hit lanes retire on a hit.
@@ -737,7 +729,7 @@ std::uint32_t small_statics(const Scene& scene, const RayPacket& packet, const O
 
 bool intersect_packet_small_statics(const Scene& scene, const RayPacket& packet, TriangleTest test,
                                     const ObjectFilter& filter, PacketHits out, TraversalCounters* counters) {
-  if (!small_statics_only(scene, test, filter)) return false;
+  if (!detail::small_statics_only(scene, test, filter.objects)) return false;
   for (int lane = 0; lane < kLanes; ++lane) {
     out.t[lane] = kInf;
     out.u[lane] = out.v[lane] = 0.0f;
@@ -749,7 +741,7 @@ bool intersect_packet_small_statics(const Scene& scene, const RayPacket& packet,
 
 int occluded_packet_small_statics(const Scene& scene, const RayPacket& packet, TriangleTest test,
                                   const ObjectFilter& filter, TraversalCounters* counters) {
-  if (!small_statics_only(scene, test, filter)) return -1;
+  if (!detail::small_statics_only(scene, test, filter.objects)) return -1;
   return static_cast<int>(small_statics<true>(scene, packet, filter, nullptr, nullptr, nullptr, nullptr, nullptr,
                                               counters));
 }

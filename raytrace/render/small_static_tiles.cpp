@@ -50,15 +50,12 @@ const std::vector<StaticTriangle>& gather_triangles(const Scene& scene, std::spa
 }  // namespace
 
 bool small_statics_tile(const Scene& scene, TriangleTest test, std::span<const std::uint32_t> objects) {
-  if (test != TriangleTest::kFast || objects.empty()) return false;
-  const std::span<const TopLevelObject> all = scene.top_level().objects();
-  return std::all_of(objects.begin(), objects.end(),
-                     [&](std::uint32_t object) { return detail::is_small_static(scene, all[object]); });
+  return !objects.empty() && detail::small_statics_only(scene, test, objects);
 }
 
-#if SINEW_SMALL_STATICS_AVX2
-
 namespace {
+
+#if SINEW_SMALL_STATICS_AVX2
 
 // One group's rays, aligned for the eight-lane tests.
 struct alignas(32) GroupRays {
@@ -81,111 +78,104 @@ std::uint32_t valid_lanes(const GroupRays& r) {
   return (valid & nonzero).bits();
 }
 
-}  // namespace
+// The camera rays of one tile from `eye`: the triangles with their origin
+// terms computed once for the whole tile.
+class CameraBlocks {
+ public:
+  CameraBlocks(const std::vector<StaticTriangle>& triangles, const Vec3& eye) : triangles_(triangles) {
+    thread_local std::vector<CommonOriginTriangle> prepared;
+    prepared.clear();
+    for (const StaticTriangle& tri : triangles) prepared.push_back(prepare_common_origin(eye, tri.p0, tri.p1, tri.p2));
+    prepared_ = &prepared;
+    for (int a = 0; a < 3; ++a) Float8(eye[a]).store(r_.o[a]);
+    Float8(0.0f).store(r_.t_min);
+  }
 
-void intersect_small_statics_tile(const Scene& scene, const Vec3& eye, std::span<const std::uint32_t> objects,
-                                  TileScratch& s, TraversalCounters& counters) {
-  const std::vector<StaticTriangle>& triangles = gather_triangles(scene, objects);
-  // The origin's terms once per triangle for the whole tile.
-  thread_local std::vector<CommonOriginTriangle> prepared;
-  prepared.clear();
-  for (const StaticTriangle& tri : triangles) prepared.push_back(prepare_common_origin(eye, tri.p0, tri.p1, tri.p2));
-  GroupRays r;
-  for (int a = 0; a < 3; ++a) Float8(eye[a]).store(r.o[a]);
-  Float8(0.0f).store(r.t_min);
-  const std::uint64_t objects_visited = objects.size();
-  for (std::size_t b = 0; b < s.blocks(); ++b) {
+  // Block b's nearest hits into s; returns the hit lanes, counting the
+  // tests of the lanes of `pixels` that are valid rays.
+  std::uint32_t trace(TileScratch& s, std::size_t b, std::uint64_t objects, TraversalCounters& counters) {
     const std::size_t k0 = b * kBlockLanes;
-    Float8::load(&s.dir_x[k0]).store(r.d[0]);
-    Float8::load(&s.dir_y[k0]).store(r.d[1]);
-    Float8::load(&s.dir_z[k0]).store(r.d[2]);
-    Float8(kInf).store(r.t_limit);
-    const std::uint32_t live = valid_lanes(r) & s.block_pixels[b];
+    Float8::load(&s.dir_x[k0]).store(r_.d[0]);
+    Float8::load(&s.dir_y[k0]).store(r_.d[1]);
+    Float8::load(&s.dir_z[k0]).store(r_.d[2]);
+    Float8(kInf).store(r_.t_limit);
+    const std::uint32_t live = valid_lanes(r_) & s.block_pixels[b];
     alignas(32) float best_u[kBlockLanes] = {}, best_v[kBlockLanes] = {};
     std::uint32_t best[kBlockLanes];  // index into triangles
     std::uint32_t hits = 0;
     if (live != 0) {
       const std::uint64_t lanes = static_cast<std::uint64_t>(std::popcount(live));
-      counters.object_visits += objects_visited * lanes;
-      counters.triangle_tests += triangles.size() * lanes;
-      for (std::size_t i = 0; i < triangles.size(); ++i) {
+      counters.object_visits += objects * lanes;
+      counters.triangle_tests += triangles_.size() * lanes;
+      for (std::size_t i = 0; i < triangles_.size(); ++i) {
         alignas(32) float t[kBlockLanes], u[kBlockLanes], v[kBlockLanes];
-        const std::uint32_t hit = intersect_triangle_fast8_common_origin(r.lanes(), live, prepared[i], t, u, v);
-        if (hit == 0 || triangles[i].zero_area) continue;
+        const std::uint32_t hit =
+            intersect_triangle_fast8_common_origin(r_.lanes(), live, (*prepared_)[i], t, u, v);
+        if (hit == 0 || triangles_[i].zero_area) continue;
         const Mask8 m = Mask8::from_bits(hit);
-        select(m, Float8::load(t), Float8::load(r.t_limit)).store(r.t_limit);
+        select(m, Float8::load(t), Float8::load(r_.t_limit)).store(r_.t_limit);
         select(m, Float8::load(u), Float8::load(best_u)).store(best_u);
         select(m, Float8::load(v), Float8::load(best_v)).store(best_v);
-        for (std::uint32_t bits = hit; bits != 0; bits &= bits - 1) best[std::countr_zero(bits)] = static_cast<std::uint32_t>(i);
+        for (std::uint32_t bits = hit; bits != 0; bits &= bits - 1) {
+          best[std::countr_zero(bits)] = static_cast<std::uint32_t>(i);
+        }
         hits |= hit;
       }
     }
-    Float8::load(r.t_limit).store(&s.t[k0]);
+    Float8::load(r_.t_limit).store(&s.t[k0]);
     Float8::load(best_u).store(&s.u[k0]);
     Float8::load(best_v).store(&s.v[k0]);
     for (int lane = 0; lane < kBlockLanes; ++lane) {
       const std::size_t k = k0 + static_cast<std::size_t>(lane);
       const bool hit = (hits >> lane & 1u) != 0;
-      s.triangle[k] = hit ? triangles[best[lane]].triangle : kInvalidId;
-      s.instance[k] = hit ? triangles[best[lane]].instance : kInvalidId;
+      s.triangle[k] = hit ? triangles_[best[lane]].triangle : kInvalidId;
+      s.instance[k] = hit ? triangles_[best[lane]].instance : kInvalidId;
     }
-    s.block_hits[b] = static_cast<std::uint8_t>(hits);
+    return hits;
   }
-}
 
-std::uint64_t occluded_small_statics_tile(const Scene& scene, std::span<const std::uint32_t> objects, int l,
-                                          TileScratch& s, TraversalCounters& counters) {
-  const std::vector<StaticTriangle>& triangles = gather_triangles(scene, objects);
-  const std::uint8_t dark = static_cast<std::uint8_t>(~(1u << l));
-  std::uint64_t blocked_count = 0;
+ private:
+  const std::vector<StaticTriangle>& triangles_;
+  const std::vector<CommonOriginTriangle>* prepared_ = nullptr;
+  GroupRays r_;
+};
+
+// The blocked lanes of the `n` shadow rays from i (the arrays hold a spare
+// group past the last ray: tile_scratch.h).
+std::uint32_t blocked_lanes(const std::vector<StaticTriangle>& triangles, const TileScratch& s, std::size_t i,
+                            std::size_t n, TraversalCounters& counters) {
   GroupRays r;
   Float8(0.0f).store(r.t_min);
-  for (std::size_t i = 0; i < s.shadow_count; i += kBlockLanes) {
-    // The arrays hold a spare group past the last ray (tile_scratch.h).
-    const std::size_t n = std::min<std::size_t>(kBlockLanes, s.shadow_count - i);
-    Float8::load(&s.so_x[i]).store(r.o[0]);
-    Float8::load(&s.so_y[i]).store(r.o[1]);
-    Float8::load(&s.so_z[i]).store(r.o[2]);
-    Float8::load(&s.sd_x[i]).store(r.d[0]);
-    Float8::load(&s.sd_y[i]).store(r.d[1]);
-    Float8::load(&s.sd_z[i]).store(r.d[2]);
-    Float8::load(&s.s_tmax[i]).store(r.t_limit);
-    std::uint32_t live = valid_lanes(r) & ((1u << n) - 1u);
-    std::uint32_t blocked = 0;
-    for (std::size_t t = 0; t < triangles.size() && live != 0; ++t) {
-      const std::uint64_t lanes = static_cast<std::uint64_t>(std::popcount(live));
-      const StaticTriangle& tri = triangles[t];
-      if (tri.first) counters.object_visits += lanes;
-      counters.triangle_tests += lanes;
-      alignas(32) float th[kBlockLanes], u[kBlockLanes], v[kBlockLanes];
-      const std::uint32_t hit = intersect_triangle_fast8(r.lanes(), live, tri.p0, tri.p1, tri.p2, th, u, v);
-      if (hit == 0 || tri.zero_area) continue;
-      blocked |= hit;
-      live &= ~hit;
-    }
-    for (std::uint32_t m = blocked; m != 0; m &= m - 1) {
-      s.lit[s.shadow_pixel[i + static_cast<std::size_t>(std::countr_zero(m))]] &= dark;
-      ++blocked_count;
-    }
+  Float8::load(&s.so_x[i]).store(r.o[0]);
+  Float8::load(&s.so_y[i]).store(r.o[1]);
+  Float8::load(&s.so_z[i]).store(r.o[2]);
+  Float8::load(&s.sd_x[i]).store(r.d[0]);
+  Float8::load(&s.sd_y[i]).store(r.d[1]);
+  Float8::load(&s.sd_z[i]).store(r.d[2]);
+  Float8::load(&s.s_tmax[i]).store(r.t_limit);
+  std::uint32_t live = valid_lanes(r) & ((1u << n) - 1u);
+  std::uint32_t blocked = 0;
+  for (std::size_t t = 0; t < triangles.size() && live != 0; ++t) {
+    const std::uint64_t lanes = static_cast<std::uint64_t>(std::popcount(live));
+    const StaticTriangle& tri = triangles[t];
+    if (tri.first) counters.object_visits += lanes;
+    counters.triangle_tests += lanes;
+    alignas(32) float th[kBlockLanes], u[kBlockLanes], v[kBlockLanes];
+    const std::uint32_t hit = intersect_triangle_fast8(r.lanes(), live, tri.p0, tri.p1, tri.p2, th, u, v);
+    if (hit == 0 || tri.zero_area) continue;
+    blocked |= hit;
+    live &= ~hit;
   }
-  return blocked_count;
+  return blocked;
 }
 
 #else  // lane by lane with the scalar test, which the eight-lane tests equal bit for bit
 
-namespace {
-template <class Fn>
-void for_each_triangle(const std::vector<StaticTriangle>& triangles, Fn&& fn) {
-  for (const StaticTriangle& tri : triangles) {
-    if (!fn(tri)) return;
-  }
-}
-}  // namespace
+class CameraBlocks {
+ public:
+  CameraBlocks(const std::vector<StaticTriangle>& triangles, const Vec3& eye) : triangles_(triangles), eye_(eye) {}
 
-void intersect_small_statics_tile(const Scene& scene, const Vec3& eye, std::span<const std::uint32_t> objects,
-                                  TileScratch& s, TraversalCounters& counters) {
-  const std::vector<StaticTriangle>& triangles = gather_triangles(scene, objects);
-  for (std::size_t b = 0; b < s.blocks(); ++b) {
+  std::uint32_t trace(TileScratch& s, std::size_t b, std::uint64_t objects, TraversalCounters& counters) {
     std::uint32_t hits = 0;
     for (int lane = 0; lane < kBlockLanes; ++lane) {
       const std::size_t k = b * kBlockLanes + static_cast<std::size_t>(lane);
@@ -193,25 +183,58 @@ void intersect_small_statics_tile(const Scene& scene, const Vec3& eye, std::span
       s.u[k] = s.v[k] = 0.0f;
       s.triangle[k] = s.instance[k] = kInvalidId;
       Ray ray;
-      ray.origin = eye;
+      ray.origin = eye_;
       ray.direction = Vec3(s.dir_x[k], s.dir_y[k], s.dir_z[k]);
       if (!(s.block_pixels[b] >> lane & 1u) || !detail::valid_ray(ray)) continue;
-      counters.object_visits += objects.size();
-      counters.triangle_tests += triangles.size();
-      for_each_triangle(triangles, [&](const StaticTriangle& tri) {
+      counters.object_visits += objects;
+      counters.triangle_tests += triangles_.size();
+      for (const StaticTriangle& tri : triangles_) {
         TriangleHit h;
-        if (intersect_triangle_fast(ray, s.t[k], tri.p0, tri.p1, tri.p2, h)) {
-          s.t[k] = h.t;
-          s.u[k] = h.u;
-          s.v[k] = h.v;
-          s.triangle[k] = tri.triangle;
-          s.instance[k] = tri.instance;
-          hits |= 1u << lane;
-        }
-        return true;
-      });
+        if (!intersect_triangle_fast(ray, s.t[k], tri.p0, tri.p1, tri.p2, h)) continue;
+        s.t[k] = h.t;
+        s.u[k] = h.u;
+        s.v[k] = h.v;
+        s.triangle[k] = tri.triangle;
+        s.instance[k] = tri.instance;
+        hits |= 1u << lane;
+      }
     }
-    s.block_hits[b] = static_cast<std::uint8_t>(hits);
+    return hits;
+  }
+
+ private:
+  const std::vector<StaticTriangle>& triangles_;
+  Vec3 eye_;
+};
+
+std::uint32_t blocked_lanes(const std::vector<StaticTriangle>& triangles, const TileScratch& s, std::size_t i,
+                            std::size_t n, TraversalCounters& counters) {
+  std::uint32_t blocked = 0;
+  for (std::size_t lane = 0; lane < n; ++lane) {
+    const Ray ray = s.shadow_ray(i + lane);
+    if (!detail::valid_ray(ray)) continue;
+    for (const StaticTriangle& tri : triangles) {
+      if (tri.first) ++counters.object_visits;
+      ++counters.triangle_tests;
+      TriangleHit h;
+      if (intersect_triangle_fast(ray, ray.t_max, tri.p0, tri.p1, tri.p2, h)) {
+        blocked |= 1u << lane;
+        break;
+      }
+    }
+  }
+  return blocked;
+}
+
+#endif  // SINEW_SMALL_STATICS_AVX2
+
+}  // namespace
+
+void intersect_small_statics_tile(const Scene& scene, const Vec3& eye, std::span<const std::uint32_t> objects,
+                                  TileScratch& s, TraversalCounters& counters) {
+  CameraBlocks blocks(gather_triangles(scene, objects), eye);
+  for (std::size_t b = 0; b < s.blocks(); ++b) {
+    s.block_hits[b] = static_cast<std::uint8_t>(blocks.trace(s, b, objects.size(), counters));
   }
 }
 
@@ -220,25 +243,15 @@ std::uint64_t occluded_small_statics_tile(const Scene& scene, std::span<const st
   const std::vector<StaticTriangle>& triangles = gather_triangles(scene, objects);
   const std::uint8_t dark = static_cast<std::uint8_t>(~(1u << l));
   std::uint64_t blocked_count = 0;
-  for (std::size_t i = 0; i < s.shadow_count; ++i) {
-    const Ray ray = s.shadow_ray(i);
-    if (!detail::valid_ray(ray)) continue;
-    bool blocked = false;
-    for_each_triangle(triangles, [&](const StaticTriangle& tri) {
-      if (tri.first) ++counters.object_visits;
-      ++counters.triangle_tests;
-      TriangleHit h;
-      blocked = intersect_triangle_fast(ray, ray.t_max, tri.p0, tri.p1, tri.p2, h);
-      return !blocked;
-    });
-    if (blocked) {
-      s.lit[s.shadow_pixel[i]] &= dark;
+  for (std::size_t i = 0; i < s.shadow_count; i += kBlockLanes) {
+    const std::size_t n = std::min<std::size_t>(kBlockLanes, s.shadow_count - i);
+    for (std::uint32_t m = blocked_lanes(triangles, s, i, n, counters); m != 0; m &= m - 1) {
+      s.lit[s.shadow_pixel[i + static_cast<std::size_t>(std::countr_zero(m))]] &= dark;
       ++blocked_count;
     }
   }
   return blocked_count;
 }
 
-#endif  // SINEW_SMALL_STATICS_AVX2
 
 }  // namespace sinew::rt

@@ -8,8 +8,10 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <span>
 #include <utility>
 
+#include "raytrace/geometry/triangle_intersect.h"
 #include "raytrace/scene/scene.h"
 #include "runtime/math/aabb.h"
 #include "runtime/math/ray.h"
@@ -37,6 +39,15 @@ inline constexpr std::size_t kBruteForceStaticTriangles = 8;
 inline bool is_small_static(const Scene& scene, const TopLevelObject& object) {
   return object.kind == TopLevelObject::Kind::kStatic &&
          scene.static_meshes()[object.index].desc.triangles.size() <= kBruteForceStaticTriangles;
+}
+
+// Whether the short cut for such meshes applies to `objects` (indices into
+// the top level): the fast test, and every object a small static mesh.
+inline bool small_statics_only(const Scene& scene, TriangleTest test, std::span<const std::uint32_t> objects) {
+  if (test != TriangleTest::kFast) return false;
+  const std::span<const TopLevelObject> all = scene.top_level().objects();
+  return std::all_of(objects.begin(), objects.end(),
+                     [&](std::uint32_t object) { return is_small_static(scene, all[object]); });
 }
 
 // Clips [t0, t1] to the ray's passage through `box` grown by `eps` on every
