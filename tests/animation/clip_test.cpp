@@ -160,13 +160,17 @@ TEST(Clip, HugeAndTinyRotationKeysAreNormalised) {
       {Quat(-big, 0, 0, 0), Quat(-1, 0, 0, 0)},
       {Quat(0, 2.0e-6f, 0, 0), Quat(0, 1, 0, 0)},
   };
-  for (const auto& [key, unit] : cases) {
+  // A clip of one rotation key on joint 0, built.
+  const auto one_key = [](const Quat& key) {
     RawClip raw;
     raw.name = "r";
     raw.tracks.resize(1);
     raw.tracks[0].rotation.times = {0.0f};
     raw.tracks[0].rotation.values = {key};
-    auto c = Clip::build(std::move(raw), three_joints(), "r.caf");
+    return Clip::build(std::move(raw), three_joints(), "r.caf");
+  };
+  for (const auto& [key, unit] : cases) {
+    auto c = one_key(key);
     ASSERT_TRUE(c.ok()) << c.status().message();
     const Quat q = c->tracks()[0].rotation.values[0];
     for (int i = 0; i < 4; ++i) {
@@ -175,12 +179,7 @@ TEST(Clip, HugeAndTinyRotationKeysAreNormalised) {
     }
   }
   const Quat unit = glm::normalize(Quat(0.3f, -0.4f, 0.5f, 0.7f));
-  RawClip raw;
-  raw.name = "u";
-  raw.tracks.resize(1);
-  raw.tracks[0].rotation.times = {0.0f};
-  raw.tracks[0].rotation.values = {unit};
-  auto c = Clip::build(std::move(raw), three_joints(), "u.caf");
+  auto c = one_key(unit);
   ASSERT_TRUE(c.ok());
   for (int i = 0; i < 4; ++i) EXPECT_EQ(c->tracks()[0].rotation.values[0][i], unit[i]) << "bits kept";
 }

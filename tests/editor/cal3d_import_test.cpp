@@ -295,6 +295,29 @@ class Cal3dBadInput : public ::testing::Test {
     std::ofstream(path, std::ios::binary) << text;
     return path;
   }
+  // One Cally file of each binary kind, and the name its copies get.
+  struct BinaryKind {
+    std::string source;
+    std::string name;
+  };
+  static std::vector<BinaryKind> binary_kinds() {
+    return {{model_file("cally", "cally.csf"), "t.csf"},
+            {model_file("cally", "cally_chest.cmf"), "t.cmf"},
+            {model_file("cally", "cally_wave.caf"), "t.caf"}};
+  }
+  // A .cfg using `file` as the kind its name says (t.csf, t.cmf or t.caf),
+  // with the skeleton `csf` otherwise, and the mesh `mesh` when given.
+  static std::string cfg_using(const std::string& name, const std::string& file, const std::string& csf,
+                               const std::string& mesh = "") {
+    std::string cfg = "skeleton=" + (name == "t.csf" ? file : csf) + "\n";
+    if (name == "t.cmf") {
+      cfg += "mesh=" + file + "\n";
+    } else if (!mesh.empty()) {
+      cfg += "mesh=" + mesh + "\n";
+    }
+    if (name == "t.caf") cfg += "animation=" + file + "\n";
+    return cfg;
+  }
   static std::string read(const std::string& path) {
     std::ifstream in(path, std::ios::binary);
     std::stringstream text;
@@ -360,27 +383,16 @@ TEST_F(Cal3dBadInput, GarbageCfgLines) {
   EXPECT_EQ(ok->mesh.triangle_count(), 0u);
 }
 
-// Truncated copies of each binary file type at several lengths: an error
-// naming the truncated file, never a crash (run under ASan too).
 // Bytes after the end of the data: Cal3D's loaders stop reading there and
 // would ignore them; the import refuses them, naming the file.
 TEST_F(Cal3dBadInput, TrailingBytesAreRefused) {
   const std::string csf = model_file("cally", "cally.csf");
   const std::string cmf = model_file("cally", "cally_chest.cmf");
-  const std::string caf = model_file("cally", "cally_wave.caf");
-  struct Kind {
-    std::string source;
-    std::string name;
-  };
-  for (const Kind& kind : {Kind{csf, "t.csf"}, Kind{cmf, "t.cmf"}, Kind{caf, "t.caf"}}) {
+  for (const BinaryKind& kind : binary_kinds()) {
     const std::string bytes = read(kind.source);
     for (const std::string& tail : {std::string(1, '\0'), std::string("garbage"), bytes.substr(0, 64)}) {
       const std::string file = write(kind.name, bytes + tail);
-      const std::string skel = kind.name == "t.csf" ? file : csf;
-      std::string cfg = "skeleton=" + skel + "\n";
-      if (kind.name == "t.cmf") cfg += "mesh=" + file + "\n";
-      if (kind.name == "t.caf") cfg += "animation=" + file + "\n";
-      auto m = import_cal3d(write("t.cfg", cfg));
+      auto m = import_cal3d(write("t.cfg", cfg_using(kind.name, file, csf)));
       ASSERT_FALSE(m.ok()) << kind.name << " with " << tail.size() << " trailing bytes";
       EXPECT_EQ(m.status().file(), file) << m.status().message();
       EXPECT_NE(m.status().message().find(std::to_string(tail.size()) + " bytes follow the end of the data"),
@@ -389,23 +401,16 @@ TEST_F(Cal3dBadInput, TrailingBytesAreRefused) {
     }
     // The file as it is still loads.
     const std::string file = write(kind.name, bytes);
-    std::string cfg = "skeleton=" + (kind.name == "t.csf" ? file : csf) + "\n";
-    cfg += kind.name == "t.cmf" ? "mesh=" + file + "\n" : "mesh=" + cmf + "\n";
-    if (kind.name == "t.caf") cfg += "animation=" + file + "\n";
-    auto ok = import_cal3d(write("t.cfg", cfg));
+    auto ok = import_cal3d(write("t.cfg", cfg_using(kind.name, file, csf, cmf)));
     EXPECT_TRUE(ok.ok()) << ok.status().message();
   }
 }
 
+// Truncated copies of each binary file type at several lengths: an error
+// naming the truncated file, never a crash (run under ASan too).
 TEST_F(Cal3dBadInput, TruncatedFiles) {
   const std::string csf = model_file("cally", "cally.csf");
-  const std::string cmf = model_file("cally", "cally_chest.cmf");
-  const std::string caf = model_file("cally", "cally_wave.caf");
-  struct Kind {
-    std::string source;
-    std::string name;
-  };
-  for (const Kind& kind : {Kind{csf, "t.csf"}, Kind{cmf, "t.cmf"}, Kind{caf, "t.caf"}}) {
+  for (const BinaryKind& kind : binary_kinds()) {
     const std::string bytes = read(kind.source);
     ASSERT_GT(bytes.size(), 100u);
     const std::vector<std::size_t> lengths = {0,  1,  3,  4,  7,  8,  12, 16, 20, 33, 64,
@@ -413,11 +418,7 @@ TEST_F(Cal3dBadInput, TruncatedFiles) {
                                               bytes.size() - 1};
     for (std::size_t len : lengths) {
       const std::string file = write(kind.name, bytes.substr(0, len));
-      const std::string skel = kind.name == "t.csf" ? file : csf;
-      std::string cfg = "skeleton=" + skel + "\n";
-      if (kind.name == "t.cmf") cfg += "mesh=" + file + "\n";
-      if (kind.name == "t.caf") cfg += "animation=" + file + "\n";
-      auto m = import_cal3d(write("t.cfg", cfg));
+      auto m = import_cal3d(write("t.cfg", cfg_using(kind.name, file, csf)));
       ASSERT_FALSE(m.ok()) << kind.name << " truncated to " << len;
       EXPECT_EQ(m.status().file(), file) << m.status().message();
     }
