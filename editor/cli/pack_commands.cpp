@@ -43,6 +43,7 @@ struct BakeOptions {
   std::string limits_path;
   float padding = 0.0f;
   rt::CandidateBones candidates = rt::CandidateBones::kAll;
+  float sah_intersection_cost = rt::FuzzyBakeOptions{}.kd.intersection_cost;
   int threads = 0;
   std::size_t max_memory_bytes = BakeRequest{}.max_memory_bytes;
   GltfImportOptions gltf;
@@ -68,6 +69,9 @@ std::string bake_usage() {
          "  --limits FILE.json    joint limits (needed by --pose-space limits; stored in the pack)\n"
          "  --pad FRACTION        grow every fuzzy box by this fraction of the model's size (default 0)\n"
          "  --candidates MODE     all (the paper's) | influencing (faster; default all)\n"
+         "  --sah-intersection-cost C  the bone trees' triangle cost against a cell visit's 1\n"
+         "                        (default 0.5, tuned for the default 64-ray packets; 1.5\n"
+         "                        builds deeper trees, which suit --packet-rays 1)\n"
          "  --threads N           worker threads (default all cores)\n"
          "  --max-memory-mib M    refuse a bake whose working set would exceed M MiB\n"
          "                        (default 8192, at least 4; a quarter of it at most goes\n"
@@ -79,7 +83,7 @@ std::string bake_usage() {
 const std::vector<cli::FlagSpec>& bake_flags() {
   static const std::vector<cli::FlagSpec> flags = {
       {"--help", false}, {"-h", false},      {"--out"},     {"--pose-space"}, {"--clips"},
-      {"--samples"},     {"--seed"},         {"--limits"}, {"--pad"},  {"--candidates"}, {"--threads"},
+      {"--samples"},     {"--seed"},         {"--limits"}, {"--pad"},  {"--candidates"}, {"--sah-intersection-cost"}, {"--threads"},
       {"--scene"},       {"--max-memory-mib"}, {"--asset-roots"}, {"--max-triangles"}, {"--max-clips"},
       {"--max-keys"},
   };
@@ -170,6 +174,10 @@ Expected<BakeOptions> parse_bake_options(std::vector<std::string> args) {
   if (auto v = parsed.value("--candidates")) {
     SINEW_ASSIGN_OR_RETURN(const int c, cli::parse_choice("--candidates", *v, {"all", "influencing"}));
     o.candidates = c == 0 ? rt::CandidateBones::kAll : rt::CandidateBones::kInfluencing;
+  }
+  if (auto v = parsed.value("--sah-intersection-cost")) {
+    SINEW_ASSIGN_OR_RETURN(const double cost, cli::parse_double("--sah-intersection-cost", *v, 0.01, 100.0));
+    o.sah_intersection_cost = static_cast<float>(cost);
   }
   if (auto v = parsed.value("--threads")) {
     SINEW_ASSIGN_OR_RETURN(const std::int64_t n, cli::parse_int("--threads", *v, 1, 1024));
@@ -463,6 +471,7 @@ int run_bake(const std::vector<std::string>& args, std::ostream& out, std::ostre
   request.pose_space = o.pose_space;
   request.fuzzy.padding = o.padding;
   request.fuzzy.candidates = o.candidates;
+  request.fuzzy.kd.intersection_cost = o.sah_intersection_cost;
   request.max_memory_bytes = o.max_memory_bytes;
   request.fuzzy.memory_budget_bytes = std::min(request.fuzzy.memory_budget_bytes, o.max_memory_bytes / 4);
   if (!o.limits_path.empty()) {

@@ -132,6 +132,30 @@ TEST_F(PackCommands, AFailedBakeLeavesTheExistingPackAlone) {
   EXPECT_EQ(files, 1);
 }
 
+// The bone trees' SAH triangle cost reaches the build: a dearer triangle
+// splits more (more nodes, fewer triangles per leaf), and both packs hold
+// the same fuzzy boxes and validate.
+TEST_F(PackCommands, SahIntersectionCostShapesTheBoneTrees) {
+  const std::string dir = fresh_dir("sah");
+  const auto bake_and_inspect = [&](const std::string& name, std::vector<std::string> extra) {
+    std::vector<std::string> args = {kCesiumMan, "-o", dir + "/" + name, "--samples", "8", "--threads", "2"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    const CommandRun bake = run(run_bake, args);
+    EXPECT_EQ(bake.code, 0) << bake.err;
+    EXPECT_EQ(run(run_validate, {dir + "/" + name}).code, 0);
+    const CommandRun inspect = run(run_inspect, {dir + "/" + name, "--json"});
+    EXPECT_EQ(inspect.code, 0) << inspect.err;
+    return nlohmann::json::parse(inspect.out)["fuzzy"];
+  };
+  const auto packet = bake_and_inspect("default.pack", {});
+  const auto explicit_default = bake_and_inspect("half.pack", {"--sah-intersection-cost", "0.5"});
+  const auto single_ray = bake_and_inspect("deep.pack", {"--sah-intersection-cost", "1.5"});
+  EXPECT_EQ(packet["nodes"], explicit_default["nodes"]);
+  EXPECT_GT(single_ray["nodes"].get<std::size_t>(), packet["nodes"].get<std::size_t>());
+  EXPECT_LT(single_ray["triangles_per_leaf"].get<double>(), packet["triangles_per_leaf"].get<double>());
+  EXPECT_DOUBLE_EQ(single_ray["fuzzy_area"].get<double>(), packet["fuzzy_area"].get<double>());
+}
+
 TEST_F(PackCommands, RenderingFromThePackEqualsTheInMemoryBake) {
   const std::string dir = fresh_dir("render");
   const std::string pack = dir + "/cesium.pack";
@@ -289,6 +313,8 @@ TEST_F(PackCommands, UsageAndUserErrorsHaveTheirExitCodes) {
       {{kCesiumMan, "-o", dir + "/x.pack", "--pose-space", "limits"}, 2, "--limits"},
       {{kCesiumMan, "-o", dir + "/x.pack", "--pose-space", "arbitrary", "--samples", "0"}, 2, "--samples = 0"},
       {{kCesiumMan, "-o", dir + "/x.pack", "--pad", "-1"}, 2, "--pad = -1"},
+      {{kCesiumMan, "-o", dir + "/x.pack", "--sah-intersection-cost", "0"}, 2, "--sah-intersection-cost = 0"},
+      {{kCesiumMan, "-o", dir + "/x.pack", "--sah-intersection-cost", "nan"}, 2, "--sah-intersection-cost = nan"},
       {{dir + "/missing.glb", "-o", dir + "/x.pack"}, 1, "missing.glb: no such file"},
   };
   for (const Case& c : bake_cases) {
