@@ -189,7 +189,6 @@ void cull_objects(const Scene& scene, const RayBound& bound, std::vector<std::ui
   // scene. A point within an object's slack of the object lies within that
   // much of a cell that lists the object.
   const float grow = bound.world_slack_bound(detail::max_abs(tree.bounds)) + extra_grow;
-  if (!test.may_enter(tree.bounds, grow)) return;
   // Walk the top-level tree over the cells the set may enter; each object
   // is tested once (objects straddle splits and sit in several leaves).
   thread_local std::vector<std::uint32_t> stamp;
@@ -199,34 +198,15 @@ void cull_objects(const Scene& scene, const RayBound& bound, std::vector<std::ui
     std::fill(stamp.begin(), stamp.end(), 0);
     stamp_value = 1;
   }
-  struct Entry {
-    std::uint32_t node;
-    Aabb cell;
-  };
-  std::array<Entry, kMaxTraversalDepth + 2> stack;
-  std::size_t top_index = 0;
-  stack[top_index++] = {0, tree.bounds};
   const std::size_t first_out = out.size();
-  while (top_index > 0) {
-    const Entry e = stack[--top_index];
-    const KdNode node = tree.nodes[e.node];
-    if (node.is_leaf()) {
-      for (std::uint32_t i = 0; i < node.item_count(); ++i) {
-        const std::uint32_t object = tree.items[node.first_item() + i];
-        if (stamp[object] == stamp_value) continue;
-        stamp[object] = stamp_value;
-        if (test.may_enter(objects[object].box, grow)) out.push_back(object);
-      }
-      continue;
+  for_each_reached_leaf(tree, test, grow, [&](std::uint32_t first, std::uint32_t count) {
+    for (std::uint32_t i = 0; i < count; ++i) {
+      const std::uint32_t object = tree.items[first + i];
+      if (stamp[object] == stamp_value) continue;
+      stamp[object] = stamp_value;
+      if (test.may_enter(objects[object].box, grow)) out.push_back(object);
     }
-    const int a = node.axis();
-    Entry below{e.node + 1, e.cell};
-    Entry above{node.above_child(), e.cell};
-    below.cell.upper[a] = std::min(below.cell.upper[a], node.split());
-    above.cell.lower[a] = std::max(above.cell.lower[a], node.split());
-    if (test.may_enter(below.cell, grow)) stack[top_index++] = below;
-    if (test.may_enter(above.cell, grow)) stack[top_index++] = above;
-  }
+  });
   std::sort(out.begin() + static_cast<std::ptrdiff_t>(first_out), out.end());
 }
 

@@ -21,10 +21,13 @@
 // box that a single ray's clip would accept: culling changes no result.
 #pragma once
 
+#include <algorithm>
+#include <array>
 #include <cstdint>
 #include <span>
 #include <vector>
 
+#include "raytrace/kdtree/kd_tree.h"
 #include "raytrace/scene/scene.h"
 #include "runtime/math/aabb.h"
 #include "runtime/math/types.h"
@@ -84,6 +87,35 @@ class RayBound {
   mutable float t_lo_ = 0.0f, t_hi_ = 0.0f;
   mutable float o_mag_ = 0.0f, d_mag_ = 0.0f;
 };
+
+// Calls leaf(first_item, item_count) for every leaf of `tree` whose cell,
+// grown by `grow`, some ray of `test`'s set may enter (empty leaves too).
+template <class LeafFn>
+void for_each_reached_leaf(const KdTreeView& tree, const RayBound::Test& test, float grow, LeafFn&& leaf) {
+  if (tree.empty() || !test.may_enter(tree.bounds, grow)) return;
+  struct Entry {
+    std::uint32_t node;
+    Aabb cell;
+  };
+  std::array<Entry, kMaxTraversalDepth + 2> stack;
+  std::size_t top = 0;
+  stack[top++] = {0, tree.bounds};
+  while (top > 0) {
+    const Entry e = stack[--top];
+    const KdNode node = tree.nodes[e.node];
+    if (node.is_leaf()) {
+      leaf(node.first_item(), node.item_count());
+      continue;
+    }
+    const int a = node.axis();
+    Entry below{e.node + 1, e.cell};
+    Entry above{node.above_child(), e.cell};
+    below.cell.upper[a] = std::min(below.cell.upper[a], node.split());
+    above.cell.lower[a] = std::max(above.cell.lower[a], node.split());
+    if (test.may_enter(below.cell, grow)) stack[top++] = below;
+    if (test.may_enter(above.cell, grow)) stack[top++] = above;
+  }
+}
 
 // The top-level objects (indices into scene.top_level().objects(), in
 // ascending order) that some ray of `bound` may enter, every box grown by

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "raytrace/render/large_packet.h"
-#include "raytrace/render/small_static_tiles.h"
+#include "raytrace/render/static_tiles.h"
 #include "raytrace/render/packet_traversal.h"
 #include "raytrace/render/ray_bound.h"
 #include "raytrace/render/traversal.h"
@@ -523,9 +523,10 @@ void trace_primary(const Scene& scene, const PinholeCamera& camera, TriangleTest
     tile_bound.add_lanes(eye, lane_dirs(b * kBlockLanes).data(), 0.0f, kInf, s.block_pixels[b]);
   }
   cull_objects(scene, tile_bound, lists.tile);
-  if (small_statics_tile(scene, test, lists.tile)) {
+  thread_local StaticTile statics;
+  if (gather_static_tile(scene, test, tile_bound, 0.0f, lists.tile, statics)) {
     for (std::size_t b = 0; b < blocks; ++b) counters.rays += static_cast<std::uint64_t>(std::popcount(s.block_pixels[b]));
-    intersect_small_statics_tile(scene, eye, lists.tile, s, counters);
+    intersect_static_tile(statics, eye, s, counters);
     return;
   }
   if (packet_rays > kPacketSize) {
@@ -770,9 +771,10 @@ std::uint64_t trace_shadow_rays(const Scene& scene, TriangleTest test, int packe
     extra_grow = kFrameRelativeSlack * 4.0f * (extra_grow + scene_magnitude) + 0x1.0p-22f * extra_grow;
   }
   cull_objects(scene, tile_bound, lists.tile, extra_grow);
-  if (small_statics_tile(scene, test, lists.tile)) {
+  thread_local StaticTile statics;
+  if (gather_static_tile(scene, test, tile_bound, extra_grow, lists.tile, statics)) {
     counters.rays += s.shadow_count;
-    return occluded_small_statics_tile(scene, lists.tile, l, s, counters);
+    return occluded_static_tile(statics, l, s, counters);
   }
   if (packet_rays > kPacketSize) return trace_shadow_large(scene, test, lists.tile, l, s, counters);
   RayPacket packet;

@@ -23,7 +23,7 @@
 #include "raytrace/render/packet_traversal.h"
 #include "raytrace/render/ray_bound.h"
 #include "raytrace/render/renderer.h"
-#include "raytrace/render/small_static_tiles.h"
+#include "raytrace/render/static_tiles.h"
 #include "raytrace/render/tile_stages.h"
 #include "raytrace/render/traversal.h"
 #include "raytrace/scene/scene.h"
@@ -406,21 +406,86 @@ std::unique_ptr<rt::Scene> make_static_scene() {
   return scene;
 }
 
+// The tile bound of s's camera rays, as trace_primary builds it.
+rt::RayBound camera_bound(const rt::PinholeCamera& camera, const rt::TileScratch& s) {
+  rt::RayBound bound;
+  for (std::size_t b = 0; b < s.lanes / 8; ++b) {
+    const float* const d[3] = {&s.dir_x[b * 8], &s.dir_y[b * 8], &s.dir_z[b * 8]};
+    bound.add_lanes(camera.eye(), d, 0.0f, kInf, s.block_pixels[b]);
+  }
+  return bound;
+}
+
+// The bound of s's shadow rays (padded to whole groups).
+rt::RayBound shadow_bound(const rt::TileScratch& s) {
+  rt::RayBound bound;
+  static const float zeros[8] = {};
+  for (std::size_t i = 0; i < s.shadow_count; i += 8) {
+    const std::size_t n = std::min<std::size_t>(8, s.shadow_count - i);
+    const float* const o[3] = {&s.so_x[i], &s.so_y[i], &s.so_z[i]};
+    const float* const d[3] = {&s.sd_x[i], &s.sd_y[i], &s.sd_z[i]};
+    bound.add_lanes(o, d, zeros, &s.s_tmax[i], (1u << n) - 1u);
+  }
+  return bound;
+}
+
+// Every camera lane of s equals the single ray's hit (bit for bit) and
+// brute force's; returns the hit count per instance id.
+std::vector<std::size_t> expect_single_ray_hits(const rt::Scene& sc, const rt::PinholeCamera& camera,
+                                                const rt::TileScratch& s) {
+  const std::vector<testing_support::SoupTriangle> soup = testing_support::world_triangles(sc);
+  std::vector<std::size_t> per_instance(8, 0);
+  for (std::size_t k = 0; k < s.lanes; ++k) {
+    Ray ray;
+    ray.origin = camera.eye();
+    ray.direction = Vec3(s.dir_x[k], s.dir_y[k], s.dir_z[k]);
+    const Hit single = s.is_pixel(k) ? rt::intersect(sc, ray, TriangleTest::kFast) : Hit{};
+    EXPECT_EQ(s.triangle[k], single.triangle_id) << k;
+    EXPECT_EQ(s.instance[k], single.instance_id) << k;
+    EXPECT_EQ(s.hit(k), single.valid()) << k;
+    if (!single.valid()) {
+      EXPECT_EQ(s.t[k], kInf) << k;
+      continue;
+    }
+    ++per_instance[single.instance_id];
+    EXPECT_EQ(std::bit_cast<std::uint32_t>(s.t[k]), std::bit_cast<std::uint32_t>(single.t)) << k;
+    EXPECT_EQ(std::bit_cast<std::uint32_t>(s.u[k]), std::bit_cast<std::uint32_t>(single.u)) << k;
+    EXPECT_EQ(std::bit_cast<std::uint32_t>(s.v[k]), std::bit_cast<std::uint32_t>(single.v)) << k;
+    const Hit ref = testing_support::nearest(soup, ray, TriangleTest::kFast);
+    EXPECT_TRUE(testing_support::same_nearest(single, ref, soup, ray, TriangleTest::kFast)) << k;
+    if (::testing::Test::HasFailure()) break;
+  }
+  return per_instance;
+}
+
+// Every shadow ray of s: light 1's bit cleared exactly when the single ray
+// (and brute force) is blocked, light 0's untouched; returns the blocked count.
+std::size_t expect_single_ray_occlusion(const rt::Scene& sc, const rt::TileScratch& s) {
+  const std::vector<testing_support::SoupTriangle> soup = testing_support::world_triangles(sc);
+  std::size_t blocked = 0;
+  for (std::size_t i = 0; i < s.shadow_count; ++i) {
+    Ray ray;
+    ray.origin = Vec3(s.so_x[i], s.so_y[i], s.so_z[i]);
+    ray.direction = Vec3(s.sd_x[i], s.sd_y[i], s.sd_z[i]);
+    ray.t_max = s.s_tmax[i];
+    const bool single = rt::occluded(sc, ray, TriangleTest::kFast);
+    EXPECT_EQ(single, testing_support::any_hit(soup, ray, TriangleTest::kFast)) << i;
+    EXPECT_EQ((s.lit[s.shadow_pixel[i]] & 0b10) == 0, single) << i;
+    EXPECT_EQ(s.lit[s.shadow_pixel[i]] & 0b01, 1) << "other lights untouched";
+    blocked += single ? 1 : 0;
+  }
+  return blocked;
+}
+
 // Tiles that reach only small static meshes: each camera ray's hit and each
 // shadow ray's occlusion are the single ray's (and brute force's), with
 // partial blocks at the image edge, invalid lanes and finite and infinite
-// t ranges; the watertight test keeps the general path.
-TEST(SmallStaticTiles, FindTheSingleRayHits) {
+// t ranges; the watertight test and bone objects keep the general path.
+TEST(StaticTiles, SmallMeshesFindTheSingleRayHits) {
   const std::unique_ptr<rt::Scene> sc = make_static_scene();
-  const std::vector<testing_support::SoupTriangle> soup = testing_support::world_triangles(*sc);
   std::vector<std::uint32_t> objects(sc->top_level().objects().size());
   for (std::uint32_t i = 0; i < objects.size(); ++i) objects[i] = i;
   ASSERT_EQ(objects.size(), 3u);
-  EXPECT_TRUE(rt::small_statics_tile(*sc, TriangleTest::kFast, objects));
-  EXPECT_FALSE(rt::small_statics_tile(*sc, TriangleTest::kWatertight, objects));
-  EXPECT_FALSE(rt::small_statics_tile(*sc, TriangleTest::kFast, {}));
-  EXPECT_FALSE(rt::small_statics_tile(scene(), TriangleTest::kFast, std::vector<std::uint32_t>{0}))
-      << "a bone of the mannequins";
 
   const auto camera =
       rt::PinholeCamera::create({Vec3(0.3f, 1.1f, 3.0f), Vec3(0.0f, 0.5f, 0.0f), Vec3(0, 1, 0), 70.0f}, 13, 11)
@@ -432,40 +497,26 @@ TEST(SmallStaticTiles, FindTheSingleRayHits) {
   s.dir_x[3] = nan;
   s.dir_x[9] = s.dir_y[9] = s.dir_z[9] = 0.0f;
   s.dir_z[17] = -kInf;
+  rt::StaticTile tile;
+  const rt::RayBound bound = camera_bound(camera, s);
+  EXPECT_FALSE(rt::gather_static_tile(*sc, TriangleTest::kWatertight, bound, 0.0f, objects, tile));
+  EXPECT_FALSE(rt::gather_static_tile(*sc, TriangleTest::kFast, bound, 0.0f, {}, tile));
+  EXPECT_FALSE(rt::gather_static_tile(scene(), TriangleTest::kFast, bound, 0.0f, std::vector<std::uint32_t>{0}, tile))
+      << "a bone of the mannequins";
+  ASSERT_TRUE(rt::gather_static_tile(*sc, TriangleTest::kFast, bound, 0.0f, objects, tile));
+  EXPECT_EQ(tile.triangles.size(), 6u) << "small meshes whole";
+  EXPECT_EQ(tile.meshes, 3u);
   rt::TraversalCounters counters;
-  rt::intersect_small_statics_tile(*sc, camera.eye(), objects, s, counters);
+  rt::intersect_static_tile(tile, camera.eye(), s, counters);
   EXPECT_GT(counters.triangle_tests, 0u);
-  std::size_t hits = 0;
-  std::array<std::size_t, 3> per_mesh{};
-  for (std::size_t k = 0; k < s.lanes; ++k) {
-    Ray ray;
-    ray.origin = camera.eye();
-    ray.direction = Vec3(s.dir_x[k], s.dir_y[k], s.dir_z[k]);
-    const Hit single = s.is_pixel(k) ? rt::intersect(*sc, ray, TriangleTest::kFast) : Hit{};
-    ASSERT_EQ(s.triangle[k], single.triangle_id) << k;
-    ASSERT_EQ(s.instance[k], single.instance_id) << k;
-    ASSERT_EQ(s.hit(k), single.valid()) << k;
-    if (!single.valid()) {
-      ASSERT_EQ(s.t[k], kInf) << k;
-      continue;
-    }
-    ++hits;
-    ++per_mesh[single.instance_id];
-    ASSERT_EQ(std::bit_cast<std::uint32_t>(s.t[k]), std::bit_cast<std::uint32_t>(single.t)) << k;
-    ASSERT_EQ(std::bit_cast<std::uint32_t>(s.u[k]), std::bit_cast<std::uint32_t>(single.u)) << k;
-    ASSERT_EQ(std::bit_cast<std::uint32_t>(s.v[k]), std::bit_cast<std::uint32_t>(single.v)) << k;
-    const Hit ref = testing_support::nearest(soup, ray, TriangleTest::kFast);
-    ASSERT_TRUE(testing_support::same_nearest(single, ref, soup, ray, TriangleTest::kFast)) << k;
-  }
-  EXPECT_GT(hits, 60u);
-  for (const std::size_t n : per_mesh) EXPECT_GT(n, 0u) << "every mesh is seen";
+  const std::vector<std::size_t> per_mesh = expect_single_ray_hits(*sc, camera, s);
+  for (std::uint32_t m = 0; m < 3; ++m) EXPECT_GT(per_mesh[m], 0u) << "every mesh is seen";
 
   // Shadow rays: scattered origins, mixed directions, to a point (t_max 1)
   // or unbounded; a count that leaves a partial last group.
   std::mt19937 g(5);
   s.shadow_count = 61;
   std::fill(s.lit.begin(), s.lit.end(), std::uint8_t{0b11});
-  std::size_t blocked = 0;
   for (std::size_t i = 0; i < s.shadow_count; ++i) {
     s.shadow_pixel[i] = static_cast<std::uint32_t>(i);
     const Vec3 o(4.0f * unit(g) - 2.0f, 2.0f * unit(g) + 0.01f, 4.0f * unit(g) - 2.0f);
@@ -478,21 +529,113 @@ TEST(SmallStaticTiles, FindTheSingleRayHits) {
     s.sd_z[i] = d.z;
     s.s_tmax[i] = i % 3 == 0 ? kInf : 1.0f;
   }
-  const std::uint64_t count = rt::occluded_small_statics_tile(*sc, objects, 1, s, counters);
-  for (std::size_t i = 0; i < s.shadow_count; ++i) {
-    Ray ray;
-    ray.origin = Vec3(s.so_x[i], s.so_y[i], s.so_z[i]);
-    ray.direction = Vec3(s.sd_x[i], s.sd_y[i], s.sd_z[i]);
-    ray.t_max = s.s_tmax[i];
-    const bool single = rt::occluded(*sc, ray, TriangleTest::kFast);
-    ASSERT_EQ(single, testing_support::any_hit(soup, ray, TriangleTest::kFast)) << i;
-    ASSERT_EQ((s.lit[i] & 0b10) == 0, single) << i;
-    ASSERT_EQ(s.lit[i] & 0b01, 1) << "other lights untouched";
-    blocked += single ? 1 : 0;
-  }
+  ASSERT_TRUE(rt::gather_static_tile(*sc, TriangleTest::kFast, shadow_bound(s), 0.0f, objects, tile));
+  const std::uint64_t count = rt::occluded_static_tile(tile, 1, s, counters);
+  const std::size_t blocked = expect_single_ray_occlusion(*sc, s);
   EXPECT_EQ(count, blocked);
   EXPECT_GT(blocked, 5u);
   EXPECT_LT(blocked, s.shadow_count - 5);
+}
+
+// A checkered floor of 24 x 24 quads with a box on it (one static mesh of
+// 1,164 triangles, as the demo's arena): a tile that sees a few quads
+// gathers them from the mesh's tree and finds every single-ray hit and
+// occlusion; a tile that sees the whole floor does not qualify.
+TEST(StaticTiles, FloorCellsFindTheSingleRayHits) {
+  rt::StaticMeshDesc floor;
+  constexpr int kQuads = 24;
+  for (int z = 0; z <= kQuads; ++z) {
+    for (int x = 0; x <= kQuads; ++x) floor.positions.push_back(Vec3(x - 12.0f, 0.0f, z - 12.0f));
+  }
+  const auto at = [](int x, int z) { return static_cast<std::uint32_t>(z * (kQuads + 1) + x); };
+  for (int z = 0; z < kQuads; ++z) {
+    for (int x = 0; x < kQuads; ++x) {
+      floor.triangles.push_back({at(x, z), at(x, z + 1), at(x + 1, z)});
+      floor.triangles.push_back({at(x + 1, z), at(x, z + 1), at(x + 1, z + 1)});
+    }
+  }
+  // A box standing on the floor at x, z in [0.25, 0.75], 0.5 high.
+  const std::uint32_t b0 = static_cast<std::uint32_t>(floor.positions.size());
+  for (int i = 0; i < 8; ++i) {
+    floor.positions.push_back(Vec3(i & 1 ? 0.75f : 0.25f, i & 2 ? 0.5f : 0.0f, i & 4 ? 0.75f : 0.25f));
+  }
+  const std::array<std::array<std::uint32_t, 4>, 6> faces = {{{0, 1, 3, 2}, {4, 6, 7, 5}, {0, 4, 5, 1},
+                                                               {2, 3, 7, 6}, {0, 2, 6, 4}, {1, 5, 7, 3}}};
+  for (const auto& f : faces) {
+    floor.triangles.push_back({b0 + f[0], b0 + f[1], b0 + f[2]});
+    floor.triangles.push_back({b0 + f[0], b0 + f[2], b0 + f[3]});
+  }
+  rt::Scene sc;
+  ASSERT_TRUE(sc.add_static_mesh(floor).ok());
+  JobSystem jobs(1);
+  ASSERT_TRUE(sc.prepare_frame(rt::FrameOptions{}, jobs).ok());
+  const std::vector<std::uint32_t> objects = {0};
+
+  // Looking down at the box from above, every direction of one sign per
+  // axis (the tile bound culls along an axis only then): the tile sees the
+  // box and a few quads.
+  const auto camera =
+      rt::PinholeCamera::create({Vec3(1.6f, 2.0f, 1.2f), Vec3(0.5f, 0.0f, 0.5f), Vec3(0, 1, 0), 12.0f}, 29, 21)
+          .value();
+  rt::TileScratch s;
+  s.prepare(Tile{0, 0, 29, 21, 0});
+  rt::generate_camera_rays(camera, s);
+  rt::StaticTile tile;
+  const rt::RayBound bound = camera_bound(camera, s);
+  ASSERT_TRUE(rt::gather_static_tile(sc, TriangleTest::kFast, bound, 0.0f, objects, tile));
+  EXPECT_GE(tile.triangles.size(), 14u) << "the box and the quad under it";
+  EXPECT_LE(tile.triangles.size(), rt::kMaxStaticTileTriangles);
+  EXPECT_TRUE(std::is_sorted(tile.triangles.begin(), tile.triangles.end(),
+                             [](const rt::StaticTriangle& a, const rt::StaticTriangle& b) { return a.triangle < b.triangle; }));
+  rt::TraversalCounters counters;
+  rt::intersect_static_tile(tile, camera.eye(), s, counters);
+  std::size_t box_hits = 0, floor_hits = 0;
+  for (std::size_t k = 0; k < s.lanes; ++k) {
+    if (!s.hit(k)) continue;
+    (s.triangle[k] >= 2u * kQuads * kQuads ? box_hits : floor_hits) += 1;
+  }
+  EXPECT_GT(box_hits, 50u);
+  EXPECT_GT(floor_hits, 50u);
+  expect_single_ray_hits(sc, camera, s);
+
+  // Shadow rays from the floor pixels to a point light: the box shadows
+  // some of them.
+  const Vec3 light(0.5f, 2.0f, -1.5f);  // the box shadows the floor toward +z, not toward +x
+  std::fill(s.lit.begin(), s.lit.end(), std::uint8_t{0b11});
+  s.shadow_count = 0;
+  for (std::size_t k = 0; k < s.lanes; ++k) {
+    if (!s.hit(k) || s.triangle[k] >= 2u * kQuads * kQuads) continue;
+    const Vec3 p = camera.eye() + s.t[k] * Vec3(s.dir_x[k], s.dir_y[k], s.dir_z[k]) + Vec3(0.0f, 1e-4f, 0.0f);
+    const std::size_t i = s.shadow_count++;
+    s.shadow_pixel[i] = static_cast<std::uint32_t>(k);
+    s.so_x[i] = p.x;
+    s.so_y[i] = p.y;
+    s.so_z[i] = p.z;
+    s.sd_x[i] = light.x - p.x;
+    s.sd_y[i] = light.y - p.y;
+    s.sd_z[i] = light.z - p.z;
+    s.s_tmax[i] = 1.0f;
+  }
+  ASSERT_GT(s.shadow_count, 50u);
+  for (std::size_t i = s.shadow_count; i < s.shadow_count + 8; ++i) {  // the spare group the arithmetic reads
+    s.so_x[i] = s.so_y[i] = s.so_z[i] = s.sd_x[i] = s.sd_y[i] = 0.0f;
+    s.sd_z[i] = s.s_tmax[i] = 1.0f;
+  }
+  ASSERT_TRUE(rt::gather_static_tile(sc, TriangleTest::kFast, shadow_bound(s), 0.0f, objects, tile));
+  const std::uint64_t count = rt::occluded_static_tile(tile, 1, s, counters);
+  const std::size_t blocked = expect_single_ray_occlusion(sc, s);
+  EXPECT_EQ(count, blocked);
+  EXPECT_GT(blocked, 10u);
+  EXPECT_LT(blocked, s.shadow_count - 10);
+
+  // The whole floor from afar reaches far more triangles than a tile may hold.
+  const auto wide =
+      rt::PinholeCamera::create({Vec3(0.0f, 20.0f, 20.0f), Vec3(0.0f, 0.0f, 0.0f), Vec3(0, 1, 0), 60.0f}, 16, 16)
+          .value();
+  rt::TileScratch w;
+  w.prepare(Tile{0, 0, 16, 16, 0});
+  rt::generate_camera_rays(wide, w);
+  EXPECT_FALSE(rt::gather_static_tile(sc, TriangleTest::kFast, camera_bound(wide, w), 0.0f, objects, tile));
 }
 
 TEST(TileStages, CameraDirectionsAreTheCameraRays) {

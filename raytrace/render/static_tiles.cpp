@@ -1,4 +1,4 @@
-#include "raytrace/render/small_static_tiles.h"
+#include "raytrace/render/static_tiles.h"
 
 #include <algorithm>
 #include <bit>
@@ -21,36 +21,69 @@ namespace {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
-struct StaticTriangle {
-  Vec3 p0, p1, p2;
-  std::uint32_t triangle;
-  std::uint32_t instance;
-  bool zero_area;  // never hit (the scalar test's last check, once per triangle)
-  bool first;      // its mesh's first triangle: the rays enter a new object
-};
+// Triangle t of `mesh` onto the tile's list.
+void add_triangle(const Scene::StaticMesh& mesh, std::uint32_t t, bool first, StaticTile& tile) {
+  const auto& v = mesh.desc.triangles[t];
+  const Vec3& p0 = mesh.desc.positions[v[0]];
+  const Vec3& p1 = mesh.desc.positions[v[1]];
+  const Vec3& p2 = mesh.desc.positions[v[2]];
+  tile.triangles.push_back({p0, p1, p2, t, mesh.instance_id, detail::zero_area(p1 - p0, p2 - p0), first});
+}
 
-// The objects' triangles in list order, mesh by mesh (per thread, reused).
-const std::vector<StaticTriangle>& gather_triangles(const Scene& scene, std::span<const std::uint32_t> objects) {
-  thread_local std::vector<StaticTriangle> triangles;
-  triangles.clear();
-  const std::span<const TopLevelObject> all = scene.top_level().objects();
-  for (const std::uint32_t object : objects) {
-    const Scene::StaticMesh& mesh = scene.static_meshes()[all[object].index];
-    for (std::uint32_t t = 0; t < mesh.desc.triangles.size(); ++t) {
+// Of a larger mesh, the triangles in the cells of its tree that the bound
+// reaches, whose own box it may enter, ascending; false past `room`.
+bool gather_reached(const Scene::StaticMesh& mesh, const RayBound::Test& test, float grow, std::size_t room,
+                    StaticTile& tile) {
+  thread_local std::vector<std::uint32_t> reached;
+  reached.clear();
+  const KdTreeView tree = mesh.tree.view();
+  bool fits = true;
+  for_each_reached_leaf(tree, test, grow, [&](std::uint32_t first, std::uint32_t count) {
+    for (std::uint32_t i = 0; i < count && fits; ++i) {
+      const std::uint32_t t = tree.items[first + i];
+      if (std::find(reached.begin(), reached.end(), t) != reached.end()) continue;  // listed in an earlier leaf
       const auto& v = mesh.desc.triangles[t];
-      const Vec3& p0 = mesh.desc.positions[v[0]];
-      const Vec3& p1 = mesh.desc.positions[v[1]];
-      const Vec3& p2 = mesh.desc.positions[v[2]];
-      triangles.push_back({p0, p1, p2, t, mesh.instance_id, detail::zero_area(p1 - p0, p2 - p0), t == 0});
+      Aabb box = Aabb::empty();
+      for (const std::uint32_t corner : v) box.extend(mesh.desc.positions[corner]);
+      if (!test.may_enter(box, grow)) continue;
+      reached.push_back(t);
+      fits = reached.size() <= room;
     }
-  }
-  return triangles;
+  });
+  if (!fits) return false;
+  std::sort(reached.begin(), reached.end());
+  for (std::size_t i = 0; i < reached.size(); ++i) add_triangle(mesh, reached[i], i == 0, tile);
+  return true;
 }
 
 }  // namespace
 
-bool small_statics_tile(const Scene& scene, TriangleTest test, std::span<const std::uint32_t> objects) {
-  return !objects.empty() && detail::small_statics_only(scene, test, objects);
+bool gather_static_tile(const Scene& scene, TriangleTest test, const RayBound& bound, float extra_grow,
+                        std::span<const std::uint32_t> objects, StaticTile& tile) {
+  tile.triangles.clear();
+  tile.meshes = 0;
+  if (test != TriangleTest::kFast || objects.empty() || bound.empty()) return false;
+  const std::span<const TopLevelObject> all = scene.top_level().objects();
+  if (!std::all_of(objects.begin(), objects.end(),
+                   [&](std::uint32_t o) { return all[o].kind == TopLevelObject::Kind::kStatic; })) {
+    return false;
+  }
+  const RayBound::Test box_test = bound.test();
+  // The grow cull_objects uses: the largest slack of any box in the scene.
+  const float grow = bound.world_slack_bound(detail::max_abs(scene.top_level().bounds())) + extra_grow;
+  for (const std::uint32_t object : objects) {
+    const Scene::StaticMesh& mesh = scene.static_meshes()[all[object].index];
+    const std::size_t room = kMaxStaticTileTriangles - tile.triangles.size();
+    if (mesh.desc.triangles.size() <= detail::kBruteForceStaticTriangles) {
+      // Whole, as every traversal tests such a mesh.
+      if (mesh.desc.triangles.size() > room) return false;
+      for (std::uint32_t t = 0; t < mesh.desc.triangles.size(); ++t) add_triangle(mesh, t, t == 0, tile);
+    } else if (!gather_reached(mesh, box_test, grow, room, tile)) {
+      return false;
+    }
+    ++tile.meshes;
+  }
+  return true;
 }
 
 namespace {
@@ -230,28 +263,24 @@ std::uint32_t blocked_lanes(const std::vector<StaticTriangle>& triangles, const 
 
 }  // namespace
 
-void intersect_small_statics_tile(const Scene& scene, const Vec3& eye, std::span<const std::uint32_t> objects,
-                                  TileScratch& s, TraversalCounters& counters) {
-  CameraBlocks blocks(gather_triangles(scene, objects), eye);
+void intersect_static_tile(const StaticTile& tile, const Vec3& eye, TileScratch& s, TraversalCounters& counters) {
+  CameraBlocks blocks(tile.triangles, eye);
   for (std::size_t b = 0; b < s.blocks(); ++b) {
-    s.block_hits[b] = static_cast<std::uint8_t>(blocks.trace(s, b, objects.size(), counters));
+    s.block_hits[b] = static_cast<std::uint8_t>(blocks.trace(s, b, tile.meshes, counters));
   }
 }
 
-std::uint64_t occluded_small_statics_tile(const Scene& scene, std::span<const std::uint32_t> objects, int l,
-                                          TileScratch& s, TraversalCounters& counters) {
-  const std::vector<StaticTriangle>& triangles = gather_triangles(scene, objects);
+std::uint64_t occluded_static_tile(const StaticTile& tile, int l, TileScratch& s, TraversalCounters& counters) {
   const std::uint8_t dark = static_cast<std::uint8_t>(~(1u << l));
   std::uint64_t blocked_count = 0;
   for (std::size_t i = 0; i < s.shadow_count; i += kBlockLanes) {
     const std::size_t n = std::min<std::size_t>(kBlockLanes, s.shadow_count - i);
-    for (std::uint32_t m = blocked_lanes(triangles, s, i, n, counters); m != 0; m &= m - 1) {
+    for (std::uint32_t m = blocked_lanes(tile.triangles, s, i, n, counters); m != 0; m &= m - 1) {
       s.lit[s.shadow_pixel[i + static_cast<std::size_t>(std::countr_zero(m))]] &= dark;
       ++blocked_count;
     }
   }
   return blocked_count;
 }
-
 
 }  // namespace sinew::rt
