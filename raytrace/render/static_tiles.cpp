@@ -11,9 +11,9 @@
 #if defined(__AVX2__) && defined(__FMA__)
 #include "raytrace/geometry/triangle_intersect8.h"
 #include "runtime/math/float8.h"
-#define SINEW_SMALL_STATICS_AVX2 1
+#define SINEW_STATIC_TILES_AVX2 1
 #else
-#define SINEW_SMALL_STATICS_AVX2 0
+#define SINEW_STATIC_TILES_AVX2 0
 #endif
 
 namespace sinew::rt {
@@ -88,7 +88,7 @@ bool gather_static_tile(const Scene& scene, TriangleTest test, const RayBound& b
 
 namespace {
 
-#if SINEW_SMALL_STATICS_AVX2
+#if SINEW_STATIC_TILES_AVX2
 
 // One group's rays, aligned for the eight-lane tests.
 struct alignas(32) GroupRays {
@@ -259,7 +259,7 @@ std::uint32_t blocked_lanes(const std::vector<StaticTriangle>& triangles, const 
   return blocked;
 }
 
-#endif  // SINEW_SMALL_STATICS_AVX2
+#endif  // SINEW_STATIC_TILES_AVX2
 
 }  // namespace
 
