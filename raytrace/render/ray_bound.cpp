@@ -206,6 +206,7 @@ void cull_objects(const Scene& scene, const RayBound& bound, std::vector<std::ui
       stamp[object] = stamp_value;
       if (test.may_enter(objects[object].box, grow)) out.push_back(object);
     }
+    return true;
   });
   std::sort(out.begin() + static_cast<std::ptrdiff_t>(first_out), out.end());
 }

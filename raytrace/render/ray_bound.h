@@ -89,7 +89,8 @@ class RayBound {
 };
 
 // Calls leaf(first_item, item_count) for every leaf of `tree` whose cell,
-// grown by `grow`, some ray of `test`'s set may enter (empty leaves too).
+// grown by `grow`, some ray of `test`'s set may enter (empty leaves too),
+// until it returns false.
 template <class LeafFn>
 void for_each_reached_leaf(const KdTreeView& tree, const RayBound::Test& test, float grow, LeafFn&& leaf) {
   if (tree.empty() || !test.may_enter(tree.bounds, grow)) return;
@@ -104,7 +105,7 @@ void for_each_reached_leaf(const KdTreeView& tree, const RayBound::Test& test, f
     const Entry e = stack[--top];
     const KdNode node = tree.nodes[e.node];
     if (node.is_leaf()) {
-      leaf(node.first_item(), node.item_count());
+      if (!leaf(node.first_item(), node.item_count())) return;
       continue;
     }
     const int a = node.axis();

@@ -49,6 +49,7 @@ bool gather_reached(const Scene::StaticMesh& mesh, const RayBound::Test& test, f
       reached.push_back(t);
       fits = reached.size() <= room;
     }
+    return fits;  // past the limit the tile takes the packets: stop walking
   });
   if (!fits) return false;
   std::sort(reached.begin(), reached.end());
