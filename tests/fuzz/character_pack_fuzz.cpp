@@ -20,6 +20,10 @@
 // decoders and validators. The container's own checksum checks are the
 // pack_reader fuzzer's business.
 //
+// Half of the mutations are structural (pack_mutator.h: sections zeroed,
+// swapped, shifted, cut short or copied over each other), the rest are
+// libFuzzer's byte mutations; both are re-sealed.
+//
 // The harness traps (a finding) when a refused pack's error has no code or
 // no message, or when a rendered pixel names a triangle the mesh does not
 // have. Field and value may legitimately be empty ("MESH: section missing"
@@ -41,7 +45,19 @@
 #include "runtime/jobs/job_system.h"
 #include "runtime/pack/checksum.h"
 #include "runtime/pack/pack_format.h"
+#include "tests/fuzz/pack_mutator.h"
 #include "tests/fuzz/reseal_pack.h"
+
+extern "C" std::size_t LLVMFuzzerMutate(std::uint8_t* data, std::size_t size, std::size_t max_size);
+
+extern "C" std::size_t LLVMFuzzerCustomMutator(std::uint8_t* data, std::size_t size, std::size_t max_size,
+                                              unsigned int seed) {
+  if (seed % 2 == 0 &&
+      sinew::fuzz::mutate_pack_structure(std::span(reinterpret_cast<std::byte*>(data), size), seed / 2)) {
+    return size;
+  }
+  return LLVMFuzzerMutate(data, size, max_size);
+}
 
 namespace {
 

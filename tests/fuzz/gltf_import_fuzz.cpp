@@ -10,14 +10,37 @@
 // their buffers (base64 data URIs in .gltf, the BIN chunk in .glb; written by
 // make_gltf_seeds.py). Images are never decoded (the importer skips them).
 //
+// Mutations: half of them are structural (tests/fuzz/gltf_mutator.h: the
+// parsed document's elements duplicated, repeated, deleted, swapped and
+// renumbered, nodes chained and looped, extras nested deeply), the rest are
+// libFuzzer's byte mutations with gltf_import.dict.
+//
 // A finding: any sanitizer report, leak, trap, time-out or OOM; a refusal
 // without an error code or message; or an imported model whose mesh or
 // skeleton breaks the ImportedModel invariants checked below.
 #include <cstddef>
 #include <cstdint>
 
+#include <cstring>
+#include <string>
+
 #include "editor/import/gltf_importer.h"
 #include "tests/fuzz/fuzz_support.h"
+#include "tests/fuzz/gltf_mutator.h"
+
+extern "C" std::size_t LLVMFuzzerMutate(std::uint8_t* data, std::size_t size, std::size_t max_size);
+
+extern "C" std::size_t LLVMFuzzerCustomMutator(std::uint8_t* data, std::size_t size, std::size_t max_size,
+                                              unsigned int seed) {
+  if (seed % 2 == 0) {
+    const std::string mutated = sinew::fuzz::mutate_gltf(data, size, max_size, seed / 2);
+    if (!mutated.empty()) {
+      std::memcpy(data, mutated.data(), mutated.size());
+      return mutated.size();
+    }
+  }
+  return LLVMFuzzerMutate(data, size, max_size);
+}
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace sinew;

@@ -406,6 +406,16 @@ std::unique_ptr<rt::Scene> make_static_scene() {
   return scene;
 }
 
+// A camera from `eye` toward `target` and one tile over its whole w x h
+// image, its rays generated.
+rt::PinholeCamera camera_tile(const Vec3& eye, const Vec3& target, float fov_degrees, int w, int h,
+                              rt::TileScratch& s) {
+  const auto camera = rt::PinholeCamera::create({eye, target, Vec3(0, 1, 0), fov_degrees}, w, h).value();
+  s.prepare(Tile{0, 0, w, h, 0});
+  rt::generate_camera_rays(camera, s);
+  return camera;
+}
+
 // The tile bound of s's camera rays, as trace_primary builds it.
 rt::RayBound camera_bound(const rt::PinholeCamera& camera, const rt::TileScratch& s) {
   rt::RayBound bound;
@@ -487,12 +497,8 @@ TEST(StaticTiles, SmallMeshesFindTheSingleRayHits) {
   for (std::uint32_t i = 0; i < objects.size(); ++i) objects[i] = i;
   ASSERT_EQ(objects.size(), 3u);
 
-  const auto camera =
-      rt::PinholeCamera::create({Vec3(0.3f, 1.1f, 3.0f), Vec3(0.0f, 0.5f, 0.0f), Vec3(0, 1, 0), 70.0f}, 13, 11)
-          .value();
-  rt::TileScratch s;
-  s.prepare(Tile{0, 0, 13, 11, 0});  // partial blocks on the right and bottom
-  rt::generate_camera_rays(camera, s);
+  rt::TileScratch s;  // 13 x 11: partial blocks on the right and bottom
+  const auto camera = camera_tile(Vec3(0.3f, 1.1f, 3.0f), Vec3(0.0f, 0.5f, 0.0f), 70.0f, 13, 11, s);
   const float nan = std::numeric_limits<float>::quiet_NaN();
   s.dir_x[3] = nan;
   s.dir_x[9] = s.dir_y[9] = s.dir_z[9] = 0.0f;
@@ -574,12 +580,8 @@ TEST(StaticTiles, FloorCellsFindTheSingleRayHits) {
   // Looking down at the box from above, every direction of one sign per
   // axis (the tile bound culls along an axis only then): the tile sees the
   // box and a few quads.
-  const auto camera =
-      rt::PinholeCamera::create({Vec3(1.6f, 2.0f, 1.2f), Vec3(0.5f, 0.0f, 0.5f), Vec3(0, 1, 0), 12.0f}, 29, 21)
-          .value();
   rt::TileScratch s;
-  s.prepare(Tile{0, 0, 29, 21, 0});
-  rt::generate_camera_rays(camera, s);
+  const auto camera = camera_tile(Vec3(1.6f, 2.0f, 1.2f), Vec3(0.5f, 0.0f, 0.5f), 12.0f, 29, 21, s);
   rt::StaticTile tile;
   const rt::RayBound bound = camera_bound(camera, s);
   ASSERT_TRUE(rt::gather_static_tile(sc, TriangleTest::kFast, bound, 0.0f, objects, tile));
@@ -629,12 +631,8 @@ TEST(StaticTiles, FloorCellsFindTheSingleRayHits) {
   EXPECT_LT(blocked, s.shadow_count - 10);
 
   // The whole floor from afar reaches far more triangles than a tile may hold.
-  const auto wide =
-      rt::PinholeCamera::create({Vec3(0.0f, 20.0f, 20.0f), Vec3(0.0f, 0.0f, 0.0f), Vec3(0, 1, 0), 60.0f}, 16, 16)
-          .value();
   rt::TileScratch w;
-  w.prepare(Tile{0, 0, 16, 16, 0});
-  rt::generate_camera_rays(wide, w);
+  const auto wide = camera_tile(Vec3(0.0f, 20.0f, 20.0f), Vec3(0.0f), 60.0f, 16, 16, w);
   EXPECT_FALSE(rt::gather_static_tile(sc, TriangleTest::kFast, camera_bound(wide, w), 0.0f, objects, tile));
 }
 
