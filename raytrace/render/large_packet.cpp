@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "raytrace/geometry/triangle_intersect8.h"
+#include "raytrace/render/group_frusta.h"
 #include "raytrace/render/interval_bound.h"
 #include "raytrace/render/traversal_shared.h"
 #include "runtime/math/float8.h"
@@ -124,6 +125,25 @@ class LaneMailbox {
   std::array<std::uint8_t, 256> lanes_{};
 };
 
+// Per object visit, the items already tested by every group whose frustum
+// they reach (with group frusta a triangle's test does not depend on the
+// leaf it is listed in). Direct-mapped; an evicted item is tested again,
+// with the same answers.
+class ItemMailbox {
+ public:
+  void reset() { keys_.fill(kInvalidId); }
+  // True the first time `id` is seen since reset (or since its eviction).
+  bool first_visit(std::uint32_t id) {
+    std::uint32_t& key = keys_[id & (keys_.size() - 1)];
+    if (key == id) return false;
+    key = id;
+    return true;
+  }
+
+ private:
+  std::array<std::uint32_t, 512> keys_{};
+};
+
 // The single-ray traversal's slack for a world-space box of magnitude
 // `box_magnitude` reached up to t_end (render/traversal.cpp world_eps),
 // per lane.
@@ -166,6 +186,15 @@ struct Cell {
   Aabb box() const { return {Vec3(lo[0], lo[1], lo[2]), Vec3(hi[0], hi[1], hi[2])}; }
 };
 
+// A leaf item's triangle in world space.
+struct LeafTriangle {
+  const Vec3* p0;
+  const Vec3* p1;
+  const Vec3* p2;
+  std::uint32_t triangle;
+  std::uint32_t instance;
+};
+
 template <TriangleTest kTest, bool kAnyHit>
 class LargeQuery {
  public:
@@ -179,6 +208,7 @@ class LargeQuery {
     alive_groups_ = 0;
     hits_recorded_ = 0;
     common_origin_ = false;
+    frusta_on_ = false;
     counters_ = {};
     const Ray none{};
     for (int g = 0; g < groups_; ++g) {
@@ -321,6 +351,7 @@ class LargeQuery {
       Group& gr = group_[g];
       for (int a = 0; a < 3; ++a) (Float8(1.0f) / Float8::load(gr.d[a])).store(gr.inv[a]);
     });
+    prepare_frusta();
     for (std::size_t i = 0; i < count; ++i) {
       if (alive_groups_ == 0) return;
       if constexpr (!kAnyHit) {
@@ -335,6 +366,63 @@ class LargeQuery {
   const TraversalCounters& counters() const { return counters_; }
 
  private:
+  // Group frusta (render/group_frusta.h) for closest-hit rays from one
+  // origin, t >= 0, and for any-hit rays bounded from their shared end;
+  // other packets go without (frusta_on_ stays false). Each group's own
+  // frustum is built when a leaf first needs it (ensure_frusta).
+  void prepare_frusta() {
+    frusta_on_ = false;
+    frusta_built_ = 0;
+    if constexpr (!kAnyHit) {
+      if (!common_origin_) return;
+      bool forward = true;
+      for_each_bit(alive_groups_, [&](int g) {
+        forward = forward && (select(Mask8::from_bits(live_[g]), Float8::load(group_[g].t_min), Float8(0.0f)) >=
+                              Float8(0.0f)).bits() == 0xFFu;
+      });
+      if (!forward) return;
+      frusta_.reset(common_origin_at_, 0.0f, groups_);
+    } else {
+      if (!use_reversed()) return;
+      // The apex: one lane's end o + t_max d; the slack: how far every
+      // lane's real end o + t_max d lies from it (its rounding included).
+      const int g0 = std::countr_zero(alive_groups_);
+      const int lane0 = std::countr_zero(live_[g0]);
+      const Group& first = group_[g0];
+      const Vec3 apex(first.o[0][lane0] + first.t_limit[lane0] * first.d[0][lane0],
+                      first.o[1][lane0] + first.t_limit[lane0] * first.d[1][lane0],
+                      first.o[2][lane0] + first.t_limit[lane0] * first.d[2][lane0]);
+      Float8 slack8(0.0f);
+      for_each_bit(alive_groups_, [&](int g) {
+        const Group& gr = group_[g];
+        const Float8 t = Float8::load(gr.t_limit);
+        const Vec3x8 end = gr.origin() + t * gr.direction();
+        const Float8 off =
+            max(max(abs(end.x - Float8(apex.x)), abs(end.y - Float8(apex.y))), abs(end.z - Float8(apex.z)));
+        const Float8 rounding = Float8(0x1.0p-22f) * (Float8::load(gr.o_mag) + t * Float8::load(gr.d_mag));
+        slack8 = max(slack8, select(Mask8::from_bits(live_[g]), off + rounding, Float8(0.0f)));
+      });
+      const float slack = reduce_max(slack8) * (1.0f + 0x1.0p-20f);
+      if (!std::isfinite(slack)) return;
+      frusta_.reset(apex, slack, groups_);
+    }
+    frusta_on_ = true;
+  }
+
+  // The frusta of `groups` that are not built yet.
+  void ensure_frusta(std::uint32_t groups) {
+    for_each_bit(groups & ~frusta_built_, [&](int g) {
+      if constexpr (!kAnyHit) {
+        frusta_.set_group(g, group_[g].d, live_[g]);
+      } else {
+        alignas(32) float back[3][kLanes];
+        for (int a = 0; a < 3; ++a) (Float8(0.0f) - Float8::load(group_[g].d[a])).store(back[a]);
+        frusta_.set_group(g, back, live_[g]);
+      }
+    });
+    frusta_built_ |= groups;
+  }
+
   // Any-hit rays that all end at finite t_max at one shared point.
   bool use_reversed() const {
     if (!kAnyHit || !rays_p_->common_end) return false;
@@ -407,7 +495,11 @@ class LargeQuery {
       }
     });
     if (groups == 0) return;
-    mailbox_.reset();
+    if (frusta_on_) {
+      items_seen_.reset();
+    } else {
+      mailbox_.reset();
+    }
     switch (object.kind) {
       case TopLevelObject::Kind::kBone: {
         const InstanceFrame& frame = scene_ref().instances()[object.index];
@@ -432,8 +524,8 @@ class LargeQuery {
         const auto leaf = [&](std::span<const std::uint32_t> triangles, std::uint32_t groups_here) {
           return test_leaf(triangles, groups_here, [&](std::uint32_t t) {
             const auto& v = mesh.desc.triangles[t];
-            test_groups(need_, mesh.desc.positions[v[0]], mesh.desc.positions[v[1]], mesh.desc.positions[v[2]], t,
-                        mesh.instance_id);
+            return LeafTriangle{&mesh.desc.positions[v[0]], &mesh.desc.positions[v[1]], &mesh.desc.positions[v[2]],
+                                t, mesh.instance_id};
           });
         };
         visit_world_tree(mesh.tree.view(), groups, leaf);
@@ -450,8 +542,8 @@ class LargeQuery {
           return test_leaf(items, groups_here, [&](std::uint32_t item) {
             const std::uint32_t t = frame.escaped_triangles[item];
             const auto& v = mesh.triangles[t];
-            test_groups(need_, frame.positions[v[0]], frame.positions[v[1]], frame.positions[v[2]], t,
-                        frame.instance_id);
+            return LeafTriangle{&frame.positions[v[0]], &frame.positions[v[1]], &frame.positions[v[2]], t,
+                                frame.instance_id};
           });
         };
         visit_world_tree(frame.fallback.view(), groups, leaf);
@@ -501,20 +593,32 @@ class LargeQuery {
     });
   }
 
-  // A leaf's items for the groups reaching it: per item (mailboxed by its
-  // index) the groups with lanes left to test it, handed to `test` in need_.
-  // Returns true when every lane is answered (any hit).
-  template <class TestFn>
-  bool test_leaf(std::span<const std::uint32_t> items, std::uint32_t groups_here, TestFn&& test) {
-    const std::uint32_t groups = groups_here & alive_groups_;
+  // A leaf's items for the groups reaching it. `corners(item)` gives the
+  // item's triangle (LeafTriangle). With group frusta each item is tested
+  // once per object visit, by the groups whose frustum it reaches; without,
+  // per item (mailboxed by its index) by the groups with lanes in the leaf
+  // left to test it. Returns true when every lane is answered (any hit).
+  template <class CornersFn>
+  bool test_leaf(std::span<const std::uint32_t> items, std::uint32_t groups_here, CornersFn&& corners) {
     for (const std::uint32_t item : items) {
-      need_ = 0;
-      for_each_bit(groups & alive_groups_, [&](int g) {
-        visit_[g].leaf_lanes = mailbox_.untested(item, g, leaf_lanes_[g]) & live_[g];
-        if (visit_[g].leaf_lanes != 0) need_ |= 1u << g;
-      });
-      if (need_ == 0) continue;
-      test(item);
+      if (frusta_on_) {
+        if (!items_seen_.first_visit(item)) continue;
+        const LeafTriangle tri = corners(item);
+        ensure_frusta(groups_here & alive_groups_);
+        need_ = frusta_.reached(*tri.p0, *tri.p1, *tri.p2, groups_here & alive_groups_);
+        if (need_ == 0) continue;
+        for_each_bit(need_, [&](int g) { visit_[g].leaf_lanes = visit_[g].lanes & live_[g]; });
+        test_groups(need_, *tri.p0, *tri.p1, *tri.p2, tri.triangle, tri.instance);
+      } else {
+        need_ = 0;
+        for_each_bit(groups_here & alive_groups_, [&](int g) {
+          visit_[g].leaf_lanes = mailbox_.untested(item, g, leaf_lanes_[g]) & live_[g];
+          if (visit_[g].leaf_lanes != 0) need_ |= 1u << g;
+        });
+        if (need_ == 0) continue;
+        const LeafTriangle tri = corners(item);
+        test_groups(need_, *tri.p0, *tri.p1, *tri.p2, tri.triangle, tri.instance);
+      }
       // Done only when every group in the tree is (not just this leaf's).
       if (kAnyHit && (tree_groups_ & alive_groups_) == 0) return true;
     }
@@ -577,8 +681,8 @@ class LargeQuery {
     const auto leaf = [&](std::span<const std::uint32_t> triangles, std::uint32_t groups_here) {
       return test_leaf(triangles, groups_here, [&](std::uint32_t t) {
         const auto& v = mesh.triangles[t];
-        test_groups(need_, frame.positions[v[0]], frame.positions[v[1]], frame.positions[v[2]], t,
-                    frame.instance_id);
+        return LeafTriangle{&frame.positions[v[0]], &frame.positions[v[1]], &frame.positions[v[2]], t,
+                            frame.instance_id};
       });
     };
     walk_tree(tree, entry, leaf);
@@ -720,7 +824,10 @@ class LargeQuery {
           // rays would be (grown by each lane's own slack).
           std::uint32_t reaching = 0;
           const Aabb cell = cur.box();
-          for_each_bit(groups & alive_groups_, [&](int g) {
+          // With group frusta each triangle picks its groups itself, more
+          // tightly than the cell would.
+          if (frusta_on_) reaching = groups & alive_groups_;
+          for_each_bit(frusta_on_ ? 0u : groups & alive_groups_, [&](int g) {
             const VisitGroup& vg = visit_[g];
             Float8 t0 = Float8::load(vg.t0), t1 = Float8::load(vg.t1);
             if constexpr (!kAnyHit) t1 = min(t1, Float8::load(group_[g].t_limit));
@@ -855,6 +962,10 @@ class LargeQuery {
   bool common_origin_ = false;  // every live lane starts at common_origin_at_
   Vec3 common_origin_at_{0.0f};
   LaneMailbox mailbox_;
+  ItemMailbox items_seen_;
+  GroupFrusta<kMaxPacketGroups> frusta_;
+  bool frusta_on_ = false;         // frusta_ holds this packet's apex
+  std::uint32_t frusta_built_ = 0;  // the groups whose frustum frusta_ holds
   TraversalCounters counters_;
 };
 

@@ -5,7 +5,9 @@
 // culling whole cells with a conservative interval bound on the rays
 // (render/interval_bound.h): a cell costs one box test whatever the number
 // of rays, and a leaf's triangles are tested only by the groups whose own
-// bound reaches its cell.
+// bound reaches its cell, or, for rays from one apex (a camera, a point
+// light), by the groups whose frustum reaches the triangle
+// (render/group_frusta.h).
 //
 // The bounds are carried into each bone's frame by bounding the rays after
 // the frame change (the transform is affine, so a ray stays a ray), and

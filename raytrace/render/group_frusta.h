@@ -1,0 +1,140 @@
+// Frusta of a large packet's groups (render/large_packet.h): for rays that
+// leave one apex (a camera's primary rays) or end at one (shadow rays to a
+// point light), each group of eight gets four planes through the apex that
+// hold all of its rays. A triangle whose three corners all lie beyond one of
+// a group's planes is missed by every ray of that group, so a leaf's
+// triangle is tested only by the groups whose frustum it reaches: one test
+// of a triangle against eight frusta costs about what one eight-lane
+// triangle test costs, and most groups of a 64-ray packet miss most of the
+// triangles its cells hold (the fuzzy boxes are loose, the triangles are
+// not).
+//
+// Numerical safety (docs/RAYTRACE.md, "Group frusta"). The planes are grown
+// away from the rays by 2^-16 of their slopes, far above the rounding of
+// their construction (tens of float epsilons), so every ray lies inside
+// each plane. A triangle is culled only when its corners lie beyond a plane
+// by 2^-12 of the coordinate magnitudes involved, plus the rays' own
+// distance from the apex (a reversed shadow ray's end rounds): that margin
+// is hundreds of times the rounding of the corner tests and covers where
+// either triangle test can report a hit off the triangle, except at grazing
+// angles the fast test refuses as rounding noise (kFastDetTolerance).
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+#include "runtime/math/float8.h"
+#include "runtime/math/types.h"
+
+namespace sinew::rt {
+
+template <int kMaxGroups>
+class GroupFrusta {
+  static_assert(kMaxGroups % 8 == 0);
+
+ public:
+  // A packet of `groups` groups whose rays' points are apex + e + s q,
+  // s >= 0, |e| <= slack per coordinate; every group starts with no frustum
+  // (it reaches every triangle).
+  void reset(const Vec3& apex, float slack, int groups) {
+    apex_ = apex;
+    apex_magnitude_ = std::max({std::fabs(apex.x), std::fabs(apex.y), std::fabs(apex.z)});
+    slack_ = slack;
+    groups_ = std::clamp(groups, 0, kMaxGroups);
+    n_ = {};
+    scale_ = {};
+  }
+
+  // Group g's frustum around the directions q of `lanes` (structure of
+  // arrays, eight lanes; other lanes are not read). A group whose rays
+  // spread over more than about 75 degrees from their mean keeps none.
+  void set_group(int g, const float (&q)[3][8], std::uint32_t lanes) {
+    if (lanes == 0 || g < 0 || g >= groups_) return;
+    const Mask8 use = Mask8::from_bits(lanes);
+    const Vec3x8 d{Float8::load(q[0]), Float8::load(q[1]), Float8::load(q[2])};
+    const Float8 length = sqrt(dot(d, d));
+    if ((((length > Float8(0.0f)) & is_finite(length)) | !use).bits() != 0xFFu) return;
+    const Float8 inv = select(use, Float8(1.0f) / length, Float8(0.0f));
+    const Vec3 c = normalized({sum(inv * d.x), sum(inv * d.y), sum(inv * d.z)});
+    if (!(c.x == c.x)) return;
+    // u across the group (first to last lane: a row of a block), v = c x u.
+    const int first = std::countr_zero(lanes), last = 31 - std::countl_zero(lanes);
+    Vec3 across(q[0][last] - q[0][first], q[1][last] - q[1][first], q[2][last] - q[2][first]);
+    across = across - glm::dot(across, c) * c;
+    Vec3 u = normalized(across);
+    if (!(u.x == u.x)) u = normalized(std::fabs(c.x) < 0.5f ? Vec3(0.0f, -c.z, c.y) : Vec3(-c.z, 0.0f, c.x));
+    if (!(u.x == u.x)) return;
+    const Vec3 v = glm::cross(c, u);
+    const auto along = [&](const Vec3& w) { return d.x * Float8(w.x) + d.y * Float8(w.y) + d.z * Float8(w.z); };
+    const Float8 dc = along(c);
+    // Every lane well in front of the centre: slopes stay finite and small.
+    if (((dc > Float8(0.25f) * length) | !use).bits() != 0xFFu) return;
+    const Float8 a = along(u) / dc, b = along(v) / dc;
+    const float big = std::numeric_limits<float>::max();
+    const float a_lo = reduce_min(select(use, a, Float8(big))), a_hi = reduce_max(select(use, a, Float8(-big)));
+    const float b_lo = reduce_min(select(use, b, Float8(big))), b_hi = reduce_max(select(use, b, Float8(-big)));
+    const auto grow = [](float s) { return 0x1.0p-16f * (1.0f + std::fabs(s)); };
+    // Outside: n . (p - apex) > 0. Each plane holds the rays with slopes on
+    // its side: a <= a_hi means (u - a_hi c) . q <= 0.
+    set_plane(0, g, u - (a_hi + grow(a_hi)) * c);
+    set_plane(1, g, (a_lo - grow(a_lo)) * c - u);
+    set_plane(2, g, v - (b_hi + grow(b_hi)) * c);
+    set_plane(3, g, (b_lo - grow(b_lo)) * c - v);
+  }
+
+  // The groups of `groups` whose frustum the triangle may reach.
+  std::uint32_t reached(const Vec3& p0, const Vec3& p1, const Vec3& p2, std::uint32_t groups) const {
+    const Vec3 x0 = p0 - apex_, x1 = p1 - apex_, x2 = p2 - apex_;
+    const float corners = std::max({magnitude(p0), magnitude(p1), magnitude(p2)});
+    const Float8 margin(0x1.0p-12f * (corners + apex_magnitude_) + slack_);
+    std::uint32_t out = 0;
+    for (int base = 0; base < groups_; base += 8) {
+      const std::uint32_t part = (groups >> base) & 0xFFu;
+      if (part == 0) continue;
+      Mask8 culled = Mask8::from_bits(0);
+      for (int i = 0; i < 4; ++i) {
+        const Float8 nx = Float8::load(&n_[i][0][base]), ny = Float8::load(&n_[i][1][base]),
+                     nz = Float8::load(&n_[i][2][base]);
+        const auto side = [&](const Vec3& x) { return (nx * Float8(x.x) + ny * Float8(x.y)) + nz * Float8(x.z); };
+        const Float8 nearest = min(min(side(x0), side(x1)), side(x2));
+        culled = culled | (nearest > Float8::load(&scale_[i][base]) * margin);
+      }
+      out |= (part & ~culled.bits()) << base;
+    }
+    return out;
+  }
+
+ private:
+  static float magnitude(const Vec3& p) { return std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)}); }
+  static Vec3 normalized(const Vec3& w) {
+    const float length = std::sqrt(glm::dot(w, w));
+    return length > 0.0f && std::isfinite(length) ? w / length : Vec3(std::numeric_limits<float>::quiet_NaN());
+  }
+  static float sum(Float8 a) {
+    alignas(32) float lanes[8];
+    a.store(lanes);
+    return ((lanes[0] + lanes[1]) + (lanes[2] + lanes[3])) + ((lanes[4] + lanes[5]) + (lanes[6] + lanes[7]));
+  }
+  void set_plane(int i, int g, const Vec3& n) {
+    n_[i][0][g] = n.x;
+    n_[i][1][g] = n.y;
+    n_[i][2][g] = n.z;
+    // |n|_1 bounds n . e for |e| <= margin per coordinate; slightly more
+    // for the rounding of the products.
+    scale_[i][g] = 1.001f * (std::fabs(n.x) + std::fabs(n.y) + std::fabs(n.z));
+  }
+
+  Vec3 apex_{0.0f};
+  float apex_magnitude_ = 0.0f;
+  float slack_ = 0.0f;
+  int groups_ = 0;
+  // Per plane, axis and group; zero normals (no frustum) cull nothing.
+  alignas(32) std::array<std::array<std::array<float, kMaxGroups>, 3>, 4> n_{};
+  alignas(32) std::array<std::array<float, kMaxGroups>, 4> scale_{};
+};
+
+}  // namespace sinew::rt

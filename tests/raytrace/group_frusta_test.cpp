@@ -1,0 +1,163 @@
+// Group frusta (render/group_frusta.h) never cull a triangle that a ray of
+// the group hits, by either triangle test, for rays from an apex and for
+// rays ending near one, at small and large coordinates; and they do cull
+// most triangles beside a narrow group.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <random>
+
+#include "raytrace/geometry/triangle_intersect.h"
+#include "raytrace/render/group_frusta.h"
+#include "runtime/math/ray.h"
+
+namespace sinew {
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+float unit(std::mt19937& g) { return static_cast<float>(g() >> 8) * 0x1.0p-24f; }
+float signed_unit(std::mt19937& g) { return 2.0f * unit(g) - 1.0f; }
+Vec3 random_vec(std::mt19937& g) { return Vec3(signed_unit(g), signed_unit(g), signed_unit(g)); }
+
+bool hits(const Ray& ray, const Vec3& p0, const Vec3& p1, const Vec3& p2) {
+  rt::TriangleHit h;
+  if (rt::intersect_triangle_fast(ray, ray.t_max, p0, p1, p2, h)) return true;
+  return rt::intersect_triangle_watertight(rt::prepare_watertight(ray), ray, ray.t_max, p0, p1, p2, h);
+}
+
+// A 4x2 block of directions around `centre`, `spread` apart (a pixel's angle).
+void block_directions(const Vec3& centre, float spread, std::mt19937& g, float (&q)[3][8]) {
+  const Vec3 c = glm::normalize(centre);
+  const Vec3 u = glm::normalize(glm::cross(c, std::fabs(c.z) < 0.9f ? Vec3(0, 0, 1) : Vec3(1, 0, 0)));
+  const Vec3 v = glm::cross(c, u);
+  const float scale = 0.5f + 2.0f * unit(g);  // directions need not be unit
+  for (int lane = 0; lane < 8; ++lane) {
+    const float x = static_cast<float>(lane % 4) - 1.5f, y = static_cast<float>(lane / 4) - 0.5f;
+    const Vec3 d = scale * (c + spread * (x * u + y * v));
+    q[0][lane] = d.x;
+    q[1][lane] = d.y;
+    q[2][lane] = d.z;
+  }
+}
+
+struct Tally {
+  int hit_triangles = 0;
+  int culled = 0;
+  int tried = 0;
+};
+
+// Triangles around the group's rays, from far off to straddling them; every
+// one a lane hits must be reached. `end` > 0: the rays run from apex + off +
+// s q to apex + off (|off| <= slack), t in [0, 1); else from the apex, t >= 0.
+void check_group(const Vec3& apex, float slack, const float (&q)[3][8], std::uint32_t lanes, bool reversed,
+                 std::mt19937& g, Tally& tally) {
+  rt::GroupFrusta<8> frusta;
+  frusta.reset(apex, slack, 1);
+  frusta.set_group(0, q, lanes);
+  std::array<Ray, 8> rays;
+  std::array<Vec3, 8> ends;
+  for (int lane = 0; lane < 8; ++lane) {
+    const Vec3 d(q[0][lane], q[1][lane], q[2][lane]);
+    if (reversed) {
+      const Vec3 end = apex + slack * random_vec(g);
+      const float s = 1.0f + 50.0f * unit(g);
+      rays[lane].origin = end + s * d;
+      rays[lane].direction = end - rays[lane].origin;
+      rays[lane].t_min = 0.0f;
+      rays[lane].t_max = 1.0f;
+      ends[lane] = end;
+    } else {
+      rays[lane].origin = apex;
+      rays[lane].direction = d;
+      rays[lane].t_min = 0.0f;
+      rays[lane].t_max = kInf;
+    }
+  }
+  for (int trial = 0; trial < 400; ++trial) {
+    const int lane = static_cast<int>(g() % 8);
+    const Ray& r = rays[lane];
+    // A point along a lane's ray, the triangle around it at a random size,
+    // shifted sideways by up to a few of its sizes.
+    const float t = reversed ? unit(g) : 0.5f + 40.0f * unit(g);
+    const Vec3 at = r.origin + t * r.direction;
+    const float size = glm::length(r.direction) * (0.001f + 0.2f * unit(g) * unit(g)) * (reversed ? 1.0f : t);
+    const Vec3 shift = size * 3.0f * unit(g) * random_vec(g);
+    const Vec3 p0 = at + shift + size * random_vec(g);
+    const Vec3 p1 = at + shift + size * random_vec(g);
+    const Vec3 p2 = at + shift + size * random_vec(g);
+    const bool reached = frusta.reached(p0, p1, p2, 1u) != 0;
+    ++tally.tried;
+    if (!reached) ++tally.culled;
+    for (int l = 0; l < 8; ++l) {
+      if (!(lanes >> l & 1u) || !hits(rays[l], p0, p1, p2)) continue;
+      ++tally.hit_triangles;
+      ASSERT_TRUE(reached) << "lane " << l << " hits a culled triangle; apex (" << apex.x << "," << apex.y << ","
+                           << apex.z << ") slack " << slack << " trial " << trial;
+      break;
+    }
+  }
+}
+
+TEST(GroupFrusta, EveryHitTriangleIsReachedFromTheApex) {
+  std::mt19937 g(3);
+  Tally tally;
+  for (const float offset : {0.0f, 50.0f, 3000.0f}) {
+    for (int group = 0; group < 60; ++group) {
+      const Vec3 apex = offset * random_vec(g) + random_vec(g);
+      float q[3][8];
+      block_directions(random_vec(g), 0.0007f * (1.0f + 4.0f * unit(g)), g, q);
+      const std::uint32_t lanes = group % 5 == 0 ? (g() & 0xFFu) | 1u : 0xFFu;
+      check_group(apex, 0.0f, q, lanes, false, g, tally);
+      if (HasFatalFailure()) return;
+    }
+  }
+  EXPECT_GT(tally.hit_triangles, tally.tried / 10);
+  // Most triangles beside a narrow group are culled: the test has teeth.
+  EXPECT_GT(tally.culled, tally.tried / 3) << tally.culled << " of " << tally.tried;
+}
+
+TEST(GroupFrusta, EveryHitTriangleIsReachedByRaysEndingNearTheApex) {
+  std::mt19937 g(5);
+  Tally tally;
+  for (const float offset : {0.0f, 80.0f, 2000.0f}) {
+    for (int group = 0; group < 60; ++group) {
+      const Vec3 light = offset * random_vec(g) + random_vec(g);
+      const float slack = std::ldexp(1.0f, -22) * (offset + 60.0f) * (1.0f + 3.0f * unit(g));
+      float q[3][8];
+      block_directions(random_vec(g), 0.002f * (1.0f + 4.0f * unit(g)), g, q);
+      check_group(light, slack, q, 0xFFu, true, g, tally);
+      if (HasFatalFailure()) return;
+    }
+  }
+  EXPECT_GT(tally.hit_triangles, tally.tried / 10);
+  EXPECT_GT(tally.culled, tally.tried / 4) << tally.culled << " of " << tally.tried;
+}
+
+TEST(GroupFrusta, GroupsWithoutAFrustumReachEverything) {
+  const Vec3 apex(1.0f, 2.0f, 3.0f);
+  rt::GroupFrusta<16> frusta;
+  frusta.reset(apex, 0.0f, 11);
+  float wide[3][8] = {{1, -1, 0, 0, 1, 0, 0, 1}, {0, 0, 1, -1, 1, 0, 1, 1}, {0, 0, 0, 0, 0, 1, 1, 1}};
+  frusta.set_group(3, wide, 0xFFu);  // spreads over more than 75 degrees
+  float narrow[3][8] = {};
+  for (int lane = 0; lane < 8; ++lane) narrow[2][lane] = 1.0f;
+  frusta.set_group(9, narrow, 0xFFu);
+  frusta.set_group(10, narrow, 0u);  // no lanes: nothing to bound
+  // Beside every group's rays (they run along +z from the apex).
+  const Vec3 p0 = apex + Vec3(5, 5, 1), p1 = apex + Vec3(6, 5, 1), p2 = apex + Vec3(5, 6, 1);
+  const std::uint32_t all = (1u << 11) - 1u;
+  EXPECT_EQ(frusta.reached(p0, p1, p2, all), all & ~(1u << 9));
+  // A triangle around the narrow group's rays is reached by it too.
+  EXPECT_EQ(frusta.reached(apex + Vec3(-1, -1, 2), apex + Vec3(1, -1, 2), apex + Vec3(0, 1, 2), all), all);
+  // Corners that are not finite are never culled.
+  const Vec3 bad(std::numeric_limits<float>::quiet_NaN(), 0.0f, 0.0f);
+  EXPECT_EQ(frusta.reached(bad, p1, p2, 1u << 9), 1u << 9);
+  EXPECT_EQ(frusta.reached(Vec3(kInf, 0, 0), p1, p2, 1u << 9), 1u << 9);
+}
+
+}  // namespace
+}  // namespace sinew
