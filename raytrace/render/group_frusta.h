@@ -55,11 +55,12 @@ class GroupFrusta {
   void set_group(int g, const float (&q)[3][8], std::uint32_t lanes) {
     if (lanes == 0 || g < 0 || g >= groups_) return;
     const Mask8 use = Mask8::from_bits(lanes);
-    const Vec3x8 d{Float8::load(q[0]), Float8::load(q[1]), Float8::load(q[2])};
-    const Float8 length = sqrt(dot(d, d));
-    if ((((length > Float8(0.0f)) & is_finite(length)) | !use).bits() != 0xFFu) return;
-    const Float8 inv = select(use, Float8(1.0f) / length, Float8(0.0f));
-    const Vec3 c = normalized({sum(inv * d.x), sum(inv * d.y), sum(inv * d.z)});
+    const Float8 zero(0.0f);
+    const Vec3x8 d{select(use, Float8::load(q[0]), zero), select(use, Float8::load(q[1]), zero),
+                   select(use, Float8::load(q[2]), zero)};
+    // Any centre in front of every lane will do: the planes come from the
+    // slopes around it, whatever it is. The sum of the directions is one.
+    const Vec3 c = normalized({sum(d.x), sum(d.y), sum(d.z)});
     if (!(c.x == c.x)) return;
     // u across the group (first to last lane: a row of a block), v = c x u.
     const int first = std::countr_zero(lanes), last = 31 - std::countl_zero(lanes);
@@ -71,9 +72,12 @@ class GroupFrusta {
     const Vec3 v = glm::cross(c, u);
     const auto along = [&](const Vec3& w) { return d.x * Float8(w.x) + d.y * Float8(w.y) + d.z * Float8(w.z); };
     const Float8 dc = along(c);
-    // Every lane well in front of the centre: slopes stay finite and small.
-    if (((dc > Float8(0.25f) * length) | !use).bits() != 0xFFu) return;
-    const Float8 a = along(u) / dc, b = along(v) / dc;
+    // Every lane well in front of the centre (within about 75 degrees of
+    // it): slopes stay finite and small. Non-finite lanes fail here too.
+    const Mask8 in_front = (dc > zero) & (dc * dc > Float8(0.0625f) * dot(d, d)) & is_finite(dot(d, d));
+    if ((in_front | !use).bits() != 0xFFu) return;
+    const Float8 inv_dc = Float8(1.0f) / select(use, dc, Float8(1.0f));
+    const Float8 a = along(u) * inv_dc, b = along(v) * inv_dc;
     const float big = std::numeric_limits<float>::max();
     const float a_lo = reduce_min(select(use, a, Float8(big))), a_hi = reduce_max(select(use, a, Float8(-big)));
     const float b_lo = reduce_min(select(use, b, Float8(big))), b_hi = reduce_max(select(use, b, Float8(-big)));
@@ -114,11 +118,7 @@ class GroupFrusta {
     const float length = std::sqrt(glm::dot(w, w));
     return length > 0.0f && std::isfinite(length) ? w / length : Vec3(std::numeric_limits<float>::quiet_NaN());
   }
-  static float sum(Float8 a) {
-    alignas(32) float lanes[8];
-    a.store(lanes);
-    return ((lanes[0] + lanes[1]) + (lanes[2] + lanes[3])) + ((lanes[4] + lanes[5]) + (lanes[6] + lanes[7]));
-  }
+  static float sum(Float8 a) { return reduce_add(a); }
   void set_plane(int i, int g, const Vec3& n) {
     n_[i][0][g] = n.x;
     n_[i][1][g] = n.y;

@@ -85,6 +85,13 @@ inline float reduce_min(Float8 a) {
   m = _mm_min_ss(m, _mm_movehdup_ps(m));
   return _mm_cvtss_f32(m);
 }
+// The sum of the lanes: halves, then pairs.
+inline float reduce_add(Float8 a) {
+  __m128 m = _mm_add_ps(_mm256_castps256_ps128(a.v), _mm256_extractf128_ps(a.v, 1));
+  m = _mm_add_ps(m, _mm_movehl_ps(m, m));
+  m = _mm_add_ss(m, _mm_movehdup_ps(m));
+  return _mm_cvtss_f32(m);
+}
 inline float reduce_max(Float8 a) {
   __m128 m = _mm_max_ps(_mm256_castps256_ps128(a.v), _mm256_extractf128_ps(a.v, 1));
   m = _mm_max_ps(m, _mm_movehl_ps(m, m));
@@ -196,6 +203,11 @@ inline float reduce_min(Float8 a) {
   float m = a.v[0];
   for (int i = 1; i < 8; ++i) m = a.v[i] < m ? a.v[i] : m;
   return m;
+}
+// The AVX2 reduce_add's order: halves, then pairs.
+inline float reduce_add(Float8 a) {
+  const auto& v = a.v;
+  return ((v[0] + v[4]) + (v[2] + v[6])) + ((v[1] + v[5]) + (v[3] + v[7]));
 }
 inline float reduce_max(Float8 a) {
   float m = a.v[0];
