@@ -47,12 +47,17 @@ class GroupFrusta {
     groups_ = std::clamp(groups, 0, kMaxGroups);
     n_ = {};
     scale_ = {};
+    offset_ = {};
+    far_planes_ = false;
   }
 
   // Group g's frustum around the directions q of `lanes` (structure of
   // arrays, eight lanes; other lanes are not read). A group whose rays
   // spread over more than about 75 degrees from their mean keeps none.
-  void set_group(int g, const float (&q)[3][8], std::uint32_t lanes) {
+  // With `reach` (per lane, the largest s of its points apex + e + s q) the
+  // frustum also gets a far plane: a triangle beyond every lane's end point
+  // (a shadow ray's origin, seen from the light) cannot block it.
+  void set_group(int g, const float (&q)[3][8], std::uint32_t lanes, const float* reach = nullptr) {
     if (lanes == 0 || g < 0 || g >= groups_) return;
     const Mask8 use = Mask8::from_bits(lanes);
     const Float8 zero(0.0f);
@@ -88,6 +93,16 @@ class GroupFrusta {
     set_plane(1, g, (a_lo - grow(a_lo)) * c - u);
     set_plane(2, g, v - (b_hi + grow(b_hi)) * c);
     set_plane(3, g, (b_lo - grow(b_lo)) * c - v);
+    if (reach != nullptr) {
+      // c . (p - apex) <= s (c . q) + |c|_1 slack on every lane's points.
+      const Float8 far = select(use, Float8::load(reach) * dc, Float8(0.0f));
+      const float offset = reduce_max(far) * (1.0f + 0x1.0p-16f);
+      if (std::isfinite(offset)) {
+        set_plane(4, g, c);
+        offset_[g] = offset;
+        far_planes_ = true;
+      }
+    }
   }
 
   // The groups of `groups` whose frustum the triangle may reach.
@@ -100,12 +115,14 @@ class GroupFrusta {
       const std::uint32_t part = (groups >> base) & 0xFFu;
       if (part == 0) continue;
       Mask8 culled = Mask8::from_bits(0);
-      for (int i = 0; i < 4; ++i) {
+      for (int i = 0; i < (far_planes_ ? 5 : 4); ++i) {
         const Float8 nx = Float8::load(&n_[i][0][base]), ny = Float8::load(&n_[i][1][base]),
                      nz = Float8::load(&n_[i][2][base]);
         const auto side = [&](const Vec3& x) { return (nx * Float8(x.x) + ny * Float8(x.y)) + nz * Float8(x.z); };
         const Float8 nearest = min(min(side(x0), side(x1)), side(x2));
-        culled = culled | (nearest > Float8::load(&scale_[i][base]) * margin);
+        Float8 limit = Float8::load(&scale_[i][base]) * margin;
+        if (i == 4) limit = limit + Float8::load(&offset_[base]);
+        culled = culled | (nearest > limit);
       }
       out |= (part & ~culled.bits()) << base;
     }
@@ -132,9 +149,12 @@ class GroupFrusta {
   float apex_magnitude_ = 0.0f;
   float slack_ = 0.0f;
   int groups_ = 0;
-  // Per plane, axis and group; zero normals (no frustum) cull nothing.
-  alignas(32) std::array<std::array<std::array<float, kMaxGroups>, 3>, 4> n_{};
-  alignas(32) std::array<std::array<float, kMaxGroups>, 4> scale_{};
+  // Per plane (four sides, then the far plane), axis and group; zero
+  // normals (no frustum) cull nothing.
+  alignas(32) std::array<std::array<std::array<float, kMaxGroups>, 3>, 5> n_{};
+  alignas(32) std::array<std::array<float, kMaxGroups>, 5> scale_{};
+  alignas(32) std::array<float, kMaxGroups> offset_{};  // the far plane's, per group
+  bool far_planes_ = false;
 };
 
 }  // namespace sinew::rt

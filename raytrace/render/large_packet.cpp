@@ -415,9 +415,11 @@ class LargeQuery {
       if constexpr (!kAnyHit) {
         frusta_.set_group(g, group_[g].d, live_[g]);
       } else {
-        alignas(32) float back[3][kLanes];
+        // Lane points o + t d = end - (t_max - t) d, t >= t_min.
+        alignas(32) float back[3][kLanes], reach[kLanes];
         for (int a = 0; a < 3; ++a) (Float8(0.0f) - Float8::load(group_[g].d[a])).store(back[a]);
-        frusta_.set_group(g, back, live_[g]);
+        (Float8::load(group_[g].t_limit) - Float8::load(group_[g].t_min)).store(reach);
+        frusta_.set_group(g, back, live_[g], reach);
       }
     });
     frusta_built_ |= groups;
@@ -600,11 +602,11 @@ class LargeQuery {
   // left to test it. Returns true when every lane is answered (any hit).
   template <class CornersFn>
   bool test_leaf(std::span<const std::uint32_t> items, std::uint32_t groups_here, CornersFn&& corners) {
+    if (frusta_on_) ensure_frusta(groups_here & alive_groups_);
     for (const std::uint32_t item : items) {
       if (frusta_on_) {
         if (!items_seen_.first_visit(item)) continue;
         const LeafTriangle tri = corners(item);
-        ensure_frusta(groups_here & alive_groups_);
         need_ = frusta_.reached(*tri.p0, *tri.p1, *tri.p2, groups_here & alive_groups_);
         if (need_ == 0) continue;
         for_each_bit(need_, [&](int g) { visit_[g].leaf_lanes = visit_[g].lanes & live_[g]; });

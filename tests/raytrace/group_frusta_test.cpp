@@ -55,21 +55,19 @@ struct Tally {
 // s q to apex + off (|off| <= slack), t in [0, 1); else from the apex, t >= 0.
 void check_group(const Vec3& apex, float slack, const float (&q)[3][8], std::uint32_t lanes, bool reversed,
                  std::mt19937& g, Tally& tally) {
-  rt::GroupFrusta<8> frusta;
-  frusta.reset(apex, slack, 1);
-  frusta.set_group(0, q, lanes);
   std::array<Ray, 8> rays;
-  std::array<Vec3, 8> ends;
+  alignas(32) float reach[8] = {};
   for (int lane = 0; lane < 8; ++lane) {
     const Vec3 d(q[0][lane], q[1][lane], q[2][lane]);
     if (reversed) {
+      // From end + s q to end: the points apex + e + (1 - t) s q.
       const Vec3 end = apex + slack * random_vec(g);
       const float s = 1.0f + 50.0f * unit(g);
       rays[lane].origin = end + s * d;
       rays[lane].direction = end - rays[lane].origin;
       rays[lane].t_min = 0.0f;
       rays[lane].t_max = 1.0f;
-      ends[lane] = end;
+      reach[lane] = s;
     } else {
       rays[lane].origin = apex;
       rays[lane].direction = d;
@@ -77,12 +75,16 @@ void check_group(const Vec3& apex, float slack, const float (&q)[3][8], std::uin
       rays[lane].t_max = kInf;
     }
   }
+  rt::GroupFrusta<8> frusta;
+  frusta.reset(apex, slack, 1);
+  frusta.set_group(0, q, lanes, reversed ? reach : nullptr);
   for (int trial = 0; trial < 400; ++trial) {
     const int lane = static_cast<int>(g() % 8);
     const Ray& r = rays[lane];
-    // A point along a lane's ray, the triangle around it at a random size,
-    // shifted sideways by up to a few of its sizes.
-    const float t = reversed ? unit(g) : 0.5f + 40.0f * unit(g);
+    // A point along a lane's ray (for rays ending near the apex, also
+    // behind their origins: the far plane's side), the triangle around it
+    // at a random size, shifted sideways by up to a few of its sizes.
+    const float t = reversed ? 1.2f * unit(g) - 0.2f : 0.5f + 40.0f * unit(g);
     const Vec3 at = r.origin + t * r.direction;
     const float size = glm::length(r.direction) * (0.001f + 0.2f * unit(g) * unit(g)) * (reversed ? 1.0f : t);
     const Vec3 shift = size * 3.0f * unit(g) * random_vec(g);
@@ -135,6 +137,33 @@ TEST(GroupFrusta, EveryHitTriangleIsReachedByRaysEndingNearTheApex) {
   }
   EXPECT_GT(tally.hit_triangles, tally.tried / 10);
   EXPECT_GT(tally.culled, tally.tried / 4) << tally.culled << " of " << tally.tried;
+}
+
+TEST(GroupFrusta, TrianglesBeyondTheRaysEndsAreCulledByTheFarPlane) {
+  // Rays from points 10 to 12 along +z from the light back to it.
+  const Vec3 light(3.0f, -2.0f, 1.0f);
+  float q[3][8] = {};
+  alignas(32) float reach[8];
+  for (int lane = 0; lane < 8; ++lane) {
+    q[0][lane] = 0.001f * static_cast<float>(lane % 4);
+    q[1][lane] = 0.001f * static_cast<float>(lane / 4);
+    q[2][lane] = 1.0f;
+    reach[lane] = 10.0f + 0.25f * static_cast<float>(lane);
+  }
+  rt::GroupFrusta<8> with_far, without;
+  with_far.reset(light, 1e-6f, 1);
+  with_far.set_group(0, q, 0xFFu, reach);
+  without.reset(light, 1e-6f, 1);
+  without.set_group(0, q, 0xFFu);
+  const auto at_depth = [&](float z, int corner) {
+    return light + Vec3(corner == 1 ? 0.05f : -0.05f, corner == 2 ? 0.05f : -0.05f, z);
+  };
+  // Across the rays just behind the farthest end: only the far plane culls it.
+  EXPECT_EQ(with_far.reached(at_depth(12.1f, 0), at_depth(12.1f, 1), at_depth(12.3f, 2), 1u), 0u);
+  EXPECT_EQ(without.reached(at_depth(12.1f, 0), at_depth(12.1f, 1), at_depth(12.3f, 2), 1u), 1u);
+  // Between the light and the ends, or straddling the farthest one: reached.
+  EXPECT_EQ(with_far.reached(at_depth(5.0f, 0), at_depth(5.0f, 1), at_depth(5.0f, 2), 1u), 1u);
+  EXPECT_EQ(with_far.reached(at_depth(11.5f, 0), at_depth(12.5f, 1), at_depth(12.5f, 2), 1u), 1u);
 }
 
 TEST(GroupFrusta, GroupsWithoutAFrustumReachEverything) {
