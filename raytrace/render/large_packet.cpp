@@ -669,7 +669,6 @@ class LargeQuery {
         o_mag = max(o_mag, abs(*oc[a]));
         d_mag = max(d_mag, abs(*dc[a]));
       }
-      const Vec3x8 inv{Float8(1.0f) / d.x, Float8(1.0f) / d.y, Float8(1.0f) / d.z};
       // 2 tolerance + slack * (((carried + |o|) + t1 |d|) + |bounds|), with
       // carried = linear_norm * |world origin| + translation magnitude.
       const Float8 carried =
@@ -677,6 +676,11 @@ class LargeQuery {
       const Float8 eps = Float8(2.0f * frame.tolerance[bone]) +
                          Float8(kFrameRelativeSlack) *
                              (((carried + o_mag) + Float8::load(visit_[g].t1) * d_mag) + Float8(carry.bounds_magnitude));
+      if (frusta_on_) {
+        enter_tree_unclipped(entry, g, o, d, eps, o_mag, d_mag);
+        return;
+      }
+      const Vec3x8 inv{Float8(1.0f) / d.x, Float8(1.0f) / d.y, Float8(1.0f) / d.z};
       enter_tree(entry, tree, g, o, d, inv, eps, o_mag, d_mag);
     });
     const SkinnedMesh& mesh = *character.mesh;
@@ -719,6 +723,30 @@ class LargeQuery {
       ic[a]->store(vg.inv[a]);
     }
     eps.store(vg.lane_eps);
+    const Mask8 kept = Mask8::from_bits(vg.lanes);
+    float group_eps = reduce_max(select(kept, eps, Float8(0.0f)));
+    if (entry.reversed) {
+      const Float8 t_end = Float8::load(group_[g].t_limit);
+      add_reversed(entry.ranges, o, d, t0, t1, t_end, vg.lanes);
+      group_eps += reversed_slack(reduce_max(select(kept, o_mag, Float8(0.0f))),
+                                  reduce_max(select(kept, d_mag, Float8(0.0f))),
+                                  reduce_max(select(kept, t_end, Float8(0.0f))));
+    } else {
+      entry.ranges.add(o, d, t0, t1, vg.lanes);
+    }
+    entry.eps = std::max(entry.eps, group_eps);
+    entry.groups |= 1u << g;
+  }
+
+  // With group frusta no leaf clips a group's lanes (the triangles pick
+  // their groups), so the rays need not be clipped to the root box or kept
+  // in the tree's frame: they join the packet's bound over their passage
+  // through the object, and the walk tests the root box itself.
+  void enter_tree_unclipped(TreeEntry& entry, int g, const Vec3x8& o, const Vec3x8& d, Float8 eps, Float8 o_mag,
+                            Float8 d_mag) {
+    const VisitGroup& vg = visit_[g];
+    if (vg.lanes == 0) return;
+    const Float8 t0 = Float8::load(vg.t0), t1 = Float8::load(vg.t1);
     const Mask8 kept = Mask8::from_bits(vg.lanes);
     float group_eps = reduce_max(select(kept, eps, Float8(0.0f)));
     if (entry.reversed) {
