@@ -723,19 +723,7 @@ class LargeQuery {
       ic[a]->store(vg.inv[a]);
     }
     eps.store(vg.lane_eps);
-    const Mask8 kept = Mask8::from_bits(vg.lanes);
-    float group_eps = reduce_max(select(kept, eps, Float8(0.0f)));
-    if (entry.reversed) {
-      const Float8 t_end = Float8::load(group_[g].t_limit);
-      add_reversed(entry.ranges, o, d, t0, t1, t_end, vg.lanes);
-      group_eps += reversed_slack(reduce_max(select(kept, o_mag, Float8(0.0f))),
-                                  reduce_max(select(kept, d_mag, Float8(0.0f))),
-                                  reduce_max(select(kept, t_end, Float8(0.0f))));
-    } else {
-      entry.ranges.add(o, d, t0, t1, vg.lanes);
-    }
-    entry.eps = std::max(entry.eps, group_eps);
-    entry.groups |= 1u << g;
+    enter_tree_unclipped(entry, g, o, d, eps, o_mag, d_mag);
   }
 
   // With group frusta no leaf clips a group's lanes (the triangles pick
