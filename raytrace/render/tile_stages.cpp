@@ -38,25 +38,25 @@ float encode_srgb(float linear) {
 
 // Linear -> sRGB byte through a table: std::pow per channel per pixel cost
 // more than the shading itself. 16384 entries keep the darkest steps
-// (sRGB byte 1 is linear 3e-4) apart.
+// (sRGB byte 1 is linear 3e-4) apart; as bytes they stay in L1 (a table
+// widened to 32-bit words for the gathers was 64 KiB and missed it).
 class SrgbTable {
  public:
   static constexpr int kSize = 16384;
   SrgbTable() {
-    for (std::size_t i = 0; i < bytes_.size(); ++i) {
+    for (int i = 0; i < kSize; ++i) {
       const float linear = (static_cast<float>(i) + 0.5f) / static_cast<float>(kSize);
-      bytes_[i] = static_cast<std::uint8_t>(std::lround(encode_srgb(linear) * 255.0f));
+      bytes_[static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(std::lround(encode_srgb(linear) * 255.0f));
     }
     bytes_[0] = 0;  // index 0 also stands for "not > 0" (srgb_indices); it encodes to 0 anyway
-    for (std::size_t i = 0; i < bytes_.size(); ++i) words_[i] = bytes_[i];
   }
   std::uint8_t operator[](std::int32_t i) const { return bytes_[static_cast<std::size_t>(i)]; }
-  // The same bytes widened to 32 bits, for eight-lane gathers.
-  const std::int32_t* words() const { return words_.data(); }
+  // For gathers of 32-bit words at byte offsets: entry i is the low byte of
+  // the word at bytes() + i (the padding keeps the last word inside).
+  const std::uint8_t* bytes() const { return bytes_.data(); }
 
  private:
-  std::array<std::uint8_t, kSize> bytes_{};
-  std::array<std::int32_t, kSize> words_{};
+  std::array<std::uint8_t, kSize + 3> bytes_{};
 };
 
 // Built once at start-up, not behind a function-local static's guard.
@@ -82,10 +82,12 @@ void srgb_pixels(const Vec3x8& linear, std::uint32_t* out) {
   srgb_indices(linear.y, g);
   srgb_indices(linear.z, b);
 #if defined(__AVX2__)
-  // Three gathers from the widened table instead of 24 byte loads.
-  const std::int32_t* words = kSrgbTable.words();
+  // Three gathers of words at byte offsets instead of 24 byte loads.
+  const int* words = reinterpret_cast<const int*>(kSrgbTable.bytes());
+  const __m256i low_byte = _mm256_set1_epi32(0xFF);
   const auto gather = [&](const std::int32_t* index) {
-    return _mm256_i32gather_epi32(words, _mm256_load_si256(reinterpret_cast<const __m256i*>(index)), 4);
+    return _mm256_and_si256(
+        _mm256_i32gather_epi32(words, _mm256_load_si256(reinterpret_cast<const __m256i*>(index)), 1), low_byte);
   };
   const __m256i rgba = _mm256_or_si256(
       _mm256_or_si256(gather(r), _mm256_slli_epi32(gather(g), 8)),
@@ -581,18 +583,32 @@ void trace_primary(const Scene& scene, const PinholeCamera& camera, TriangleTest
 
 void reconstruct_surfaces(const Scene& scene, const Vec3& default_albedo, TileScratch& s) {
   const std::size_t blocks = s.lanes / kBlockLanes;
+  // Each lane's corners, corner normals and albedo (lanes without a hit
+  // repeat a harmless unit triangle). A whole block on the triangle of the
+  // last uniform block (a ground's blocks, mostly) keeps them, and the
+  // normal, as they are.
+  alignas(32) float p[3][3][8];  // [corner][axis][lane]
+  alignas(32) float n[3][3][8];
+  alignas(32) float albedo[3][8];
+  std::uint32_t with_normals = 0;
+  std::uint32_t kept_triangle = kInvalidId, kept_instance = kInvalidId;
+  Vec3x8 kept_geometric{};
   for (std::size_t b = 0; b < blocks; ++b) {
     const std::uint32_t hits = s.block_hits[b];
     if (hits == 0) continue;
     const std::size_t k0 = b * kBlockLanes;
-    // Gather each lane's corners, corner normals and albedo (lanes without
-    // a hit repeat a harmless unit triangle).
-    alignas(32) float p[3][3][8];  // [corner][axis][lane]
-    alignas(32) float n[3][3][8];
-    alignas(32) float albedo[3][8];
-    std::uint32_t with_normals = 0;
-    // Lane by lane: AVX2 gathers measured slower here (Zen 4).
-    const bool uniform = gather_lanes(scene, s, k0, hits, default_albedo, p, n, albedo, with_normals);
+    bool kept = hits == 0xFFu && kept_triangle != kInvalidId;
+    for (int lane = 0; lane < kBlockLanes && kept; ++lane) {
+      const std::size_t k = k0 + static_cast<std::size_t>(lane);
+      kept = s.triangle[k] == kept_triangle && s.instance[k] == kept_instance;
+    }
+    bool uniform = kept;
+    if (!kept) {
+      kept_triangle = kInvalidId;  // the arrays are about to change
+      with_normals = 0;
+      // Lane by lane: AVX2 gathers measured slower here (Zen 4).
+      uniform = gather_lanes(scene, s, k0, hits, default_albedo, p, n, albedo, with_normals);
+    }
     // surface_at's arithmetic, eight lanes at once.
     const auto corner = [&](const float (&c)[3][3][8], int i) {
       return Vec3x8{Float8::load(c[i][0]), Float8::load(c[i][1]), Float8::load(c[i][2])};
@@ -607,7 +623,9 @@ void reconstruct_surfaces(const Scene& scene, const Vec3& default_albedo, TileSc
       magnitude = max(magnitude, max(max(abs(c->x), abs(c->y)), abs(c->z)));
     }
     Vec3x8 geometric;
-    if (uniform) {
+    if (kept) {
+      geometric = kept_geometric;
+    } else if (uniform) {
       // One triangle: its normal once, with the lanes' very expressions.
       const Vec3 q0(p[0][0][0], p[0][1][0], p[0][2][0]), q1(p[1][0][0], p[1][1][0], p[1][2][0]),
           q2(p[2][0][0], p[2][1][0], p[2][2][0]);
@@ -617,6 +635,9 @@ void reconstruct_surfaces(const Scene& scene, const Vec3& default_albedo, TileSc
       const bool usable = length > 0.0f && std::isfinite(length);
       const Vec3 g = usable ? Vec3(cross_n.x / length, cross_n.y / length, cross_n.z / length) : Vec3(0, 0, 1);
       geometric = Vec3x8{Float8(g.x), Float8(g.y), Float8(g.z)};
+      kept_triangle = s.triangle[k0];  // gather_lanes is uniform only for whole blocks
+      kept_instance = s.instance[k0];
+      kept_geometric = geometric;
     } else {
       const Vec3x8 cross_n = cross(p1 - p0, p2 - p0);
       const Float8 length = sqrt(dot(cross_n, cross_n));
@@ -697,9 +718,7 @@ void make_shadow_rays(const Light& light, int l, TileScratch& s) {
     compress_store(&s.sd_y[i], direction.y, toward);
     compress_store(&s.sd_z[i], direction.z, toward);
     Float8(point ? 1.0f : kInf).store(&s.s_tmax[i]);
-    alignas(32) std::uint32_t pixel[8];
-    for (int lane = 0; lane < 8; ++lane) pixel[lane] = static_cast<std::uint32_t>(k0) + static_cast<std::uint32_t>(lane);
-    compress_store(&s.shadow_pixel[i], pixel, toward);
+    compress_store_lane_indices(&s.shadow_pixel[i], static_cast<std::uint32_t>(k0), toward);
     s.shadow_count += static_cast<std::size_t>(std::popcount(toward));
   }
   // Close the last run; drop a trailing start that no ray followed.

@@ -122,10 +122,13 @@ inline void compress_store(float* out, Float8 a, std::uint32_t mask) {
   const __m256i perm = _mm256_load_si256(reinterpret_cast<const __m256i*>(detail::kCompressTable.index[mask & 0xFFu]));
   _mm256_storeu_ps(out, _mm256_permutevar8x32_ps(a.v, perm));
 }
-inline void compress_store(std::uint32_t* out, const std::uint32_t* in, std::uint32_t mask) {
-  const __m256i perm = _mm256_load_si256(reinterpret_cast<const __m256i*>(detail::kCompressTable.index[mask & 0xFFu]));
-  const __m256i v = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(in));
-  _mm256_storeu_si256(reinterpret_cast<__m256i*>(out), _mm256_permutevar8x32_epi32(v, perm));
+// compress_store of the eight values base + lane, formed in a register (an
+// array of them written lane by lane and loaded whole stalls on the
+// store-to-load forward).
+inline void compress_store_lane_indices(std::uint32_t* out, std::uint32_t base, std::uint32_t mask) {
+  const __m256i lanes = _mm256_load_si256(reinterpret_cast<const __m256i*>(detail::kCompressTable.index[mask & 0xFFu]));
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(out),
+                      _mm256_add_epi32(lanes, _mm256_set1_epi32(static_cast<int>(base))));
 }
 
 #else  // lane by lane
@@ -220,10 +223,10 @@ inline void compress_store(float* out, Float8 a, std::uint32_t mask) {
     if (mask >> i & 1u) out[n++] = a.v[i];
   }
 }
-inline void compress_store(std::uint32_t* out, const std::uint32_t* in, std::uint32_t mask) {
+inline void compress_store_lane_indices(std::uint32_t* out, std::uint32_t base, std::uint32_t mask) {
   int n = 0;
   for (int i = 0; i < 8; ++i) {
-    if (mask >> i & 1u) out[n++] = in[i];
+    if (mask >> i & 1u) out[n++] = base + static_cast<std::uint32_t>(i);
   }
 }
 
