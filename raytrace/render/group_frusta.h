@@ -45,9 +45,13 @@ class GroupFrusta {
     apex_magnitude_ = std::max({std::fabs(apex.x), std::fabs(apex.y), std::fabs(apex.z)});
     slack_ = slack;
     groups_ = std::clamp(groups, 0, kMaxGroups);
-    n_ = {};
-    scale_ = {};
-    offset_ = {};
+    // Only the eight-group blocks reached() reads.
+    const std::size_t used = static_cast<std::size_t>((groups_ + 7) / 8 * 8);
+    for (int i = 0; i < 5; ++i) {
+      for (auto& axis : n_[i]) std::fill_n(axis.begin(), used, 0.0f);
+      std::fill_n(scale_[i].begin(), used, 0.0f);
+    }
+    std::fill_n(offset_.begin(), used, 0.0f);
     far_planes_ = false;
   }
 
@@ -131,9 +135,12 @@ class GroupFrusta {
 
  private:
   static float magnitude(const Vec3& p) { return std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)}); }
+  // Near unit length is enough: the planes hold the rays for any centre
+  // and any u (set_group), so one reciprocal serves the three axes.
   static Vec3 normalized(const Vec3& w) {
     const float length = std::sqrt(glm::dot(w, w));
-    return length > 0.0f && std::isfinite(length) ? w / length : Vec3(std::numeric_limits<float>::quiet_NaN());
+    return length > 0.0f && std::isfinite(length) ? w * (1.0f / length)
+                                                  : Vec3(std::numeric_limits<float>::quiet_NaN());
   }
   static float sum(Float8 a) { return reduce_add(a); }
   void set_plane(int i, int g, const Vec3& n) {

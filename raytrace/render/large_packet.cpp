@@ -129,19 +129,29 @@ class LaneMailbox {
 // they reach (with group frusta a triangle's test does not depend on the
 // leaf it is listed in). Direct-mapped; an evicted item is tested again,
 // with the same answers.
+// A key holds the visit's epoch above the id, so reset() is a count, not a
+// 2 KiB fill per object visit; the slots are cleared only when the epoch
+// wraps (every 2^32 visits: key 0 never matches a key formed after it).
 class ItemMailbox {
  public:
-  void reset() { keys_.fill(kInvalidId); }
+  void reset() {
+    if (++epoch_ == 0) {
+      keys_.fill(0);
+      epoch_ = 1;
+    }
+  }
   // True the first time `id` is seen since reset (or since its eviction).
   bool first_visit(std::uint32_t id) {
-    std::uint32_t& key = keys_[id & (keys_.size() - 1)];
-    if (key == id) return false;
-    key = id;
+    const std::uint64_t key = std::uint64_t{epoch_} << 32 | id;
+    std::uint64_t& slot = keys_[id & (keys_.size() - 1)];
+    if (slot == key) return false;
+    slot = key;
     return true;
   }
 
  private:
-  std::array<std::uint32_t, 512> keys_{};
+  std::array<std::uint64_t, 512> keys_{};
+  std::uint32_t epoch_ = 0;
 };
 
 // The single-ray traversal's slack for a world-space box of magnitude
