@@ -109,6 +109,32 @@ class GroupFrusta {
     }
   }
 
+  // set_group for every group of `groups`, with group g's directions
+  // sign * q(g) (a float[3][8]), its lanes lanes(g) and, with kFar, its
+  // per-lane reach written by reach(g, out). Groups with all eight lanes in
+  // use are built eight at a time, one group per SIMD lane (set_group's
+  // construction transposed: a packet's frusta cost about what one did);
+  // the others one by one.
+  template <bool kFar, class Q, class Lanes, class Reach>
+  void set_groups(std::uint32_t groups, float sign, Q&& q, Lanes&& lanes, Reach&& reach) {
+    for (int base = 0; base < groups_; base += 8) {
+      std::uint32_t full = 0;
+      for (std::uint32_t m = (groups >> base) & 0xFFu; m != 0; m &= m - 1) {
+        const int g = base + std::countr_zero(m);
+        const std::uint32_t l = lanes(g);
+        if (l == 0xFFu) {
+          full |= 1u << (g - base);
+          continue;
+        }
+        alignas(32) float d[3][8], r[8] = {};
+        for (int a = 0; a < 3; ++a) (Float8(sign) * Float8::load(q(g)[a])).store(d[a]);
+        if constexpr (kFar) reach(g, r);
+        set_group(g, d, l, kFar ? r : nullptr);
+      }
+      if (full != 0) set_block<kFar>(base, full, sign, q, reach);
+    }
+  }
+
   // The groups of `groups` whose frustum the triangle may reach.
   std::uint32_t reached(const Vec3& p0, const Vec3& p1, const Vec3& p2, std::uint32_t groups) const {
     const Vec3 x0 = p0 - apex_, x1 = p1 - apex_, x2 = p2 - apex_;
@@ -134,6 +160,85 @@ class GroupFrusta {
   }
 
  private:
+  // Groups base + k for the bits k of `full` (all eight lanes in use),
+  // lane k of every vector below holding group base + k.
+  template <bool kFar, class Q, class Reach>
+  void set_block(int base, std::uint32_t full, float sign, Q& q, Reach& reach) {
+    alignas(32) float t[3][8][8];  // [axis][ray][group]
+    alignas(32) float r[8][8] = {};  // [ray][group]
+    for (int k = 0; k < 8; ++k) {
+      const bool used = (full >> k & 1u) != 0;
+      for (int a = 0; a < 3; ++a) {
+        for (int j = 0; j < 8; ++j) t[a][j][k] = used ? sign * q(base + k)[a][j] : (a == 2 ? 1.0f : 0.0f);
+      }
+      if constexpr (kFar) {
+        if (used) {
+          alignas(32) float rk[8];
+          reach(base + k, rk);
+          for (int j = 0; j < 8; ++j) r[j][k] = rk[j];
+        }
+      }
+    }
+    const Float8 zero(0.0f), one(1.0f);
+    Vec3x8 d[8];
+    for (int j = 0; j < 8; ++j) d[j] = Vec3x8{Float8::load(t[0][j]), Float8::load(t[1][j]), Float8::load(t[2][j])};
+    const auto unit = [&](const Vec3x8& w, Mask8& ok) {
+      const Float8 length = sqrt(dot(w, w));
+      ok = (length > zero) & is_finite(length);
+      return (one / select(ok, length, one)) * w;
+    };
+    Vec3x8 sum = d[0];
+    for (int j = 1; j < 8; ++j) sum = sum + d[j];
+    Mask8 c_ok, u_ok, alt_ok;
+    const Vec3x8 c = unit(sum, c_ok);
+    Vec3x8 across = d[7] - d[0];
+    across = across - dot(across, c) * c;
+    const Vec3x8 u_across = unit(across, u_ok);
+    const Vec3x8 alt = select(abs(c.x) < Float8(0.5f), Vec3x8{zero, zero - c.z, c.y}, Vec3x8{zero - c.z, zero, c.x});
+    const Vec3x8 u = select(u_ok, u_across, unit(alt, alt_ok));
+    const Vec3x8 v = cross(c, u);
+    Mask8 ok = c_ok & (u_ok | alt_ok) & Mask8::from_bits(full);
+    Float8 dc[8];
+    for (int j = 0; j < 8; ++j) {
+      dc[j] = dot(d[j], c);
+      const Float8 dd = dot(d[j], d[j]);
+      ok = ok & (dc[j] > zero) & (dc[j] * dc[j] > Float8(0.0625f) * dd) & is_finite(dd);
+    }
+    if (ok.bits() == 0) return;
+    const float big = std::numeric_limits<float>::max();
+    Float8 a_lo(big), a_hi(-big), b_lo(big), b_hi(-big), far(0.0f);
+    for (int j = 0; j < 8; ++j) {
+      const Float8 inv_dc = one / select(ok, dc[j], one);
+      const Float8 a = dot(d[j], u) * inv_dc, b = dot(d[j], v) * inv_dc;
+      a_lo = min(a_lo, a);
+      a_hi = max(a_hi, a);
+      b_lo = min(b_lo, b);
+      b_hi = max(b_hi, b);
+      if constexpr (kFar) far = max(far, Float8::load(r[j]) * dc[j]);
+    }
+    const auto grow = [](Float8 x) { return Float8(0x1.0p-16f) * (Float8(1.0f) + abs(x)); };
+    store_planes(0, base, u - (a_hi + grow(a_hi)) * c, ok);
+    store_planes(1, base, (a_lo - grow(a_lo)) * c - u, ok);
+    store_planes(2, base, v - (b_hi + grow(b_hi)) * c, ok);
+    store_planes(3, base, (b_lo - grow(b_lo)) * c - v, ok);
+    if constexpr (kFar) {
+      const Float8 offset = far * Float8(1.0f + 0x1.0p-16f);
+      const Mask8 far_ok = ok & is_finite(offset);
+      if (far_ok.bits() != 0) {
+        store_planes(4, base, c, far_ok);
+        select(far_ok, offset, Float8::load(&offset_[base])).store(&offset_[base]);
+        far_planes_ = true;
+      }
+    }
+  }
+  // set_plane for the groups base + k of the lanes k of `m`.
+  void store_planes(int i, int base, const Vec3x8& n, Mask8 m) {
+    const Float8* const axis[3] = {&n.x, &n.y, &n.z};
+    for (int a = 0; a < 3; ++a) select(m, *axis[a], Float8::load(&n_[i][a][base])).store(&n_[i][a][base]);
+    const Float8 scale = Float8(1.001f) * ((abs(n.x) + abs(n.y)) + abs(n.z));
+    select(m, scale, Float8::load(&scale_[i][base])).store(&scale_[i][base]);
+  }
+
   static float magnitude(const Vec3& p) { return std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)}); }
   // Near unit length is enough: the planes hold the rays for any centre
   // and any u (set_group), so one reciprocal serves the three axes.

@@ -419,20 +419,22 @@ class LargeQuery {
     frusta_on_ = true;
   }
 
-  // The frusta of `groups` that are not built yet.
+  // The frusta of `groups` and of every other live group not built yet:
+  // built together, eight at a time, they cost about what one did.
   void ensure_frusta(std::uint32_t groups) {
-    for_each_bit(groups & ~frusta_built_, [&](int g) {
-      if constexpr (!kAnyHit) {
-        frusta_.set_group(g, group_[g].d, live_[g]);
-      } else {
-        // Lane points o + t d = end - (t_max - t) d, t >= t_min.
-        alignas(32) float back[3][kLanes], reach[kLanes];
-        for (int a = 0; a < 3; ++a) (Float8(0.0f) - Float8::load(group_[g].d[a])).store(back[a]);
+    if ((groups & ~frusta_built_) == 0) return;
+    const std::uint32_t todo = alive_groups_ & ~frusta_built_;
+    const auto directions = [&](int g) -> const float (&)[3][kLanes] { return group_[g].d; };
+    const auto lanes = [&](int g) { return live_[g]; };
+    if constexpr (!kAnyHit) {
+      frusta_.template set_groups<false>(todo, 1.0f, directions, lanes, [](int, float*) {});
+    } else {
+      // Lane points o + t d = end - (t_max - t) d, t >= t_min.
+      frusta_.template set_groups<true>(todo, -1.0f, directions, lanes, [&](int g, float* reach) {
         (Float8::load(group_[g].t_limit) - Float8::load(group_[g].t_min)).store(reach);
-        frusta_.set_group(g, back, live_[g], reach);
-      }
-    });
-    frusta_built_ |= groups;
+      });
+    }
+    frusta_built_ |= todo;
   }
 
   // Any-hit rays that all end at finite t_max at one shared point.

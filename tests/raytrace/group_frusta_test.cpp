@@ -4,6 +4,7 @@
 // most triangles beside a narrow group.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -53,8 +54,10 @@ struct Tally {
 // Triangles around the group's rays, from far off to straddling them; every
 // one a lane hits must be reached. `end` > 0: the rays run from apex + off +
 // s q to apex + off (|off| <= slack), t in [0, 1); else from the apex, t >= 0.
+// `batched`: the frustum is built by set_groups, as lane 5 of a block of
+// eight groups whose other lanes hold other directions (or no lanes).
 void check_group(const Vec3& apex, float slack, const float (&q)[3][8], std::uint32_t lanes, bool reversed,
-                 std::mt19937& g, Tally& tally) {
+                 bool batched, std::mt19937& g, Tally& tally) {
   std::array<Ray, 8> rays;
   alignas(32) float reach[8] = {};
   for (int lane = 0; lane < 8; ++lane) {
@@ -75,9 +78,36 @@ void check_group(const Vec3& apex, float slack, const float (&q)[3][8], std::uin
       rays[lane].t_max = kInf;
     }
   }
-  rt::GroupFrusta<8> frusta;
-  frusta.reset(apex, slack, 1);
-  frusta.set_group(0, q, lanes, reversed ? reach : nullptr);
+  rt::GroupFrusta<16> frusta;
+  std::uint32_t tested = 1u;
+  if (!batched) {
+    frusta.reset(apex, slack, 1);
+    frusta.set_group(0, q, lanes, reversed ? reach : nullptr);
+  } else {
+    // Groups 0-7 and 8-15: the tested one is group 5 and group 13 (its
+    // directions negated and given with sign -1), among others.
+    constexpr int kTested = 5;
+    float others[16][3][8], negated[3][8];
+    for (auto& other : others) block_directions(random_vec(g), 0.01f * unit(g), g, other);
+    for (int a = 0; a < 3; ++a) {
+      for (int lane = 0; lane < 8; ++lane) negated[a][lane] = -q[a][lane];
+    }
+    frusta.reset(apex, slack, 16);
+    const auto lanes_of = [&](int group) { return group == 2 ? 0u : group % kTested == 1 ? 0x7Fu : lanes; };
+    const auto directions = [&](int group) -> const float (&)[3][8] {
+      return group == kTested ? q : group == 8 + kTested ? negated : others[group];
+    };
+    if (reversed) {
+      const auto reach_of = [&](int, float* out) { std::copy(reach, reach + 8, out); };
+      frusta.set_groups<true>(0xFFu, 1.0f, directions, lanes_of, reach_of);
+      frusta.set_groups<true>(0xFF00u, -1.0f, directions, lanes_of, reach_of);
+    } else {
+      const auto no_reach = [](int, float*) {};
+      frusta.set_groups<false>(0xFFu, 1.0f, directions, lanes_of, no_reach);
+      frusta.set_groups<false>(0xFF00u, -1.0f, directions, lanes_of, no_reach);
+    }
+    tested = 1u << kTested | 1u << (8 + kTested);
+  }
   for (int trial = 0; trial < 400; ++trial) {
     const int lane = static_cast<int>(g() % 8);
     const Ray& r = rays[lane];
@@ -91,7 +121,10 @@ void check_group(const Vec3& apex, float slack, const float (&q)[3][8], std::uin
     const Vec3 p0 = at + shift + size * random_vec(g);
     const Vec3 p1 = at + shift + size * random_vec(g);
     const Vec3 p2 = at + shift + size * random_vec(g);
-    const bool reached = frusta.reached(p0, p1, p2, 1u) != 0;
+    const std::uint32_t reached_groups = frusta.reached(p0, p1, p2, tested);
+    // Built one way or the other, with either sign, the same rays.
+    ASSERT_TRUE(reached_groups == 0 || reached_groups == tested) << reached_groups;
+    const bool reached = reached_groups != 0;
     ++tally.tried;
     if (!reached) ++tally.culled;
     for (int l = 0; l < 8; ++l) {
@@ -113,8 +146,10 @@ TEST(GroupFrusta, EveryHitTriangleIsReachedFromTheApex) {
       float q[3][8];
       block_directions(random_vec(g), 0.0007f * (1.0f + 4.0f * unit(g)), g, q);
       const std::uint32_t lanes = group % 5 == 0 ? (g() & 0xFFu) | 1u : 0xFFu;
-      check_group(apex, 0.0f, q, lanes, false, g, tally);
-      if (HasFatalFailure()) return;
+      for (const bool batched : {false, true}) {
+        check_group(apex, 0.0f, q, lanes, false, batched, g, tally);
+        if (HasFatalFailure()) return;
+      }
     }
   }
   EXPECT_GT(tally.hit_triangles, tally.tried / 10);
@@ -131,8 +166,10 @@ TEST(GroupFrusta, EveryHitTriangleIsReachedByRaysEndingNearTheApex) {
       const float slack = std::ldexp(1.0f, -22) * (offset + 60.0f) * (1.0f + 3.0f * unit(g));
       float q[3][8];
       block_directions(random_vec(g), 0.002f * (1.0f + 4.0f * unit(g)), g, q);
-      check_group(light, slack, q, 0xFFu, true, g, tally);
-      if (HasFatalFailure()) return;
+      for (const bool batched : {false, true}) {
+        check_group(light, slack, q, 0xFFu, true, batched, g, tally);
+        if (HasFatalFailure()) return;
+      }
     }
   }
   EXPECT_GT(tally.hit_triangles, tally.tried / 10);
