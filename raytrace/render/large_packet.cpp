@@ -423,18 +423,18 @@ class LargeQuery {
   // built together, eight at a time, they cost about what one did.
   void ensure_frusta(std::uint32_t groups) {
     if ((groups & ~frusta_built_) == 0) return;
-    const std::uint32_t todo = alive_groups_ & ~frusta_built_;
+    const std::uint32_t unbuilt = alive_groups_ & ~frusta_built_;
     const auto directions = [&](int g) -> const float (&)[3][kLanes] { return group_[g].d; };
     const auto lanes = [&](int g) { return live_[g]; };
     if constexpr (!kAnyHit) {
-      frusta_.template set_groups<false>(todo, 1.0f, directions, lanes, [](int, float*) {});
+      frusta_.template set_groups<false>(unbuilt, 1.0f, directions, lanes, [](int, float*) {});
     } else {
       // Lane points o + t d = end - (t_max - t) d, t >= t_min.
-      frusta_.template set_groups<true>(todo, -1.0f, directions, lanes, [&](int g, float* reach) {
+      frusta_.template set_groups<true>(unbuilt, -1.0f, directions, lanes, [&](int g, float* reach) {
         (Float8::load(group_[g].t_limit) - Float8::load(group_[g].t_min)).store(reach);
       });
     }
-    frusta_built_ |= todo;
+    frusta_built_ |= unbuilt;
   }
 
   // Any-hit rays that all end at finite t_max at one shared point.
