@@ -55,10 +55,18 @@ inline bool mutate_pack_structure(std::span<std::byte> all, unsigned int seed) {
       std::swap(ea.size, eb.size);
       break;
     case 3: {  // shifted by whole alignment steps, either way
-      const std::int64_t steps = static_cast<std::int64_t>(g() % 9) - 4;
-      const std::int64_t moved = static_cast<std::int64_t>(ea.offset) + steps * kSectionAlignment;
-      if (moved < 0 || steps == 0) return false;
-      ea.offset = static_cast<std::uint64_t>(moved);
+      // Unsigned and range-checked: a mutated table may hold any offset,
+      // up to 2^64 - 1, so signed arithmetic here could overflow.
+      const unsigned int pick = g() % 9;
+      if (pick == 4) return false;
+      const std::uint64_t step = std::uint64_t{pick < 4 ? 4u - pick : pick - 4u} * kSectionAlignment;
+      if (pick < 4) {
+        if (ea.offset < step) return false;
+        ea.offset -= step;
+      } else {
+        if (ea.offset > UINT64_MAX - step) return false;
+        ea.offset += step;
+      }
       break;
     }
     case 4:  // cut short
