@@ -27,6 +27,7 @@
 #include "raytrace/scene/scene.h"
 #include "runtime/core/expected.h"
 #include "runtime/jobs/job_system.h"
+#include "runtime/memory/line_aligned.h"
 #include "runtime/timing/phase_timers.h"
 
 namespace sinew::demo {
@@ -110,7 +111,7 @@ class DemoSession {
   rt::Renderer renderer_;
   rt::RenderSettings settings_;
   std::optional<rt::PinholeCamera> camera_;  // set by the first frame
-  std::vector<std::uint8_t> rgba_;
+  LineAlignedVector<std::uint8_t> rgba_;  // line-aligned, as the renderer stores it fastest
   PhaseTimers timers_;
   BakeInfo bake_info_;
 };

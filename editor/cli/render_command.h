@@ -49,6 +49,7 @@
 #include "raytrace/scene/scene.h"
 #include "runtime/core/expected.h"
 #include "runtime/math/aabb.h"
+#include "runtime/memory/line_aligned.h"
 #include "runtime/timing/phase_timers.h"
 
 namespace sinew::editor {
@@ -104,10 +105,11 @@ struct RenderStatsSummary {
 struct RenderOutputs {
   int width = 0;
   int height = 0;
-  std::vector<std::uint8_t> color_rgba8;
-  std::vector<float> depth;
-  std::vector<std::uint32_t> triangle_id;
-  std::vector<std::uint32_t> instance_id;
+  // Line-aligned, as the renderer stores them fastest.
+  LineAlignedVector<std::uint8_t> color_rgba8;
+  LineAlignedVector<float> depth;
+  LineAlignedVector<std::uint32_t> triangle_id;
+  LineAlignedVector<std::uint32_t> instance_id;
   rt::CameraDesc camera;   // the camera used (given or framed)
   rt::Light light;         // the light used
   std::string clip_name;   // empty: rest pose

@@ -106,7 +106,8 @@ struct PassInputs {
 // A host buffer: `data` holds `height` rows, `row_pitch` bytes apart (0:
 // packed, width x pixel size). The pitch must hold a row and be a multiple
 // of 4 bytes for every output but colour RGBA8. Bytes between rows are never
-// written.
+// written. Rows on 64-byte lines (data and pitch multiples of 64) are
+// stored fastest, as whole lines.
 struct OutputBuffer {
   void* data = nullptr;
   std::size_t row_pitch = 0;

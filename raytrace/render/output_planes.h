@@ -20,10 +20,14 @@ struct OutputPlane {
   std::byte* base = nullptr;  // null: not requested
   std::size_t pitch = 0;
   std::size_t channels = 1;
+  // The pixel at `base`: (0, 0) for a whole image, a tile's corner for
+  // its staging plane (render/output_staging.h).
+  int x0 = 0, y0 = 0;
 
   bool wanted() const { return base != nullptr; }
   T* at(int x, int y) const {
-    return reinterpret_cast<T*>(base + static_cast<std::size_t>(y) * pitch) + static_cast<std::size_t>(x) * channels;
+    return reinterpret_cast<T*>(base + static_cast<std::size_t>(y - y0) * pitch) +
+           static_cast<std::size_t>(x - x0) * channels;
   }
 };
 

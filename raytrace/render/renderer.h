@@ -79,7 +79,8 @@ struct FrameBuffers {
   // holds at least a row and is a multiple of the element's alignment (4
   // bytes for every output but color_rgba8). With a pitch, the span reaches
   // at least to the end of the last row's last pixel; the padding between
-  // rows is never written.
+  // rows is never written. Rows on 64-byte lines (span start and pitch
+  // multiples of 64) are stored fastest (render/output_staging.h).
   struct RowPitches {
     std::size_t color_rgba8 = 0;
     std::size_t color_rgba32f = 0;

@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "raytrace/render/output_staging.h"
 #include "runtime/jobs/job_system.h"
 #include "runtime/math/ray.h"
 
@@ -55,6 +56,8 @@ struct TileScratch {
   // come from one region's pixels (regions without a ray have no entry).
   std::vector<std::uint32_t> shadow_region_begin;
   bool shadow_common_end = false;  // every ray ends at the light (a point light)
+  // The tile's outputs until shade_and_write stores them (render/output_staging.h).
+  OutputStaging staging;
 
   // Lays out `area`'s pixels in regions of region_blocks_x by
   // region_blocks_y blocks (clipped at the tile's edges) and sizes every

@@ -825,8 +825,10 @@ std::uint64_t trace_shadow_rays(const Scene& scene, TriangleTest test, int packe
   return blocked_count;
 }
 
-void shade_and_write(const RenderSettings& settings, std::span<const Light> lights, const OutputPlanes& out,
+void shade_and_write(const RenderSettings& settings, std::span<const Light> lights, const OutputPlanes& host,
                      TileScratch& s) {
+  // Written to the tile's staging planes, stored to the host's at the end.
+  const OutputPlanes& out = s.staging.stage(host, s.tile);
   const std::size_t blocks = s.lanes / kBlockLanes;
   const bool want_color = out.want_color();
   const std::array<std::uint8_t, 4> background_bytes = {srgb_byte(settings.background.x),
@@ -942,6 +944,7 @@ void shade_and_write(const RenderSettings& settings, std::span<const Light> ligh
       if (out.rgba8.wanted()) std::memcpy(out.rgba8.at(x, y), &pixels_rgba8[lane], 4);
     }
   }
+  s.staging.flush(host);
 }
 
 }  // namespace sinew::rt

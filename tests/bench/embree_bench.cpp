@@ -25,6 +25,7 @@
 #include "tests/bench/brute_force_gate.h"
 // Always included for EmbreeMode and EmbreeWidth, which the options name;
 // the tracer itself is only linked (and called) when Embree was found.
+#include "runtime/memory/line_aligned.h"
 #include "tests/bench/embree_tracer.h"
 
 namespace sinew::bench {
@@ -438,7 +439,8 @@ Expected<ConfigResult> run_configuration(const editor::ImportedModel& model, con
   }
 #endif
 
-  std::vector<std::uint8_t> color(4 * static_cast<std::size_t>(o.width) * static_cast<std::size_t>(o.height));
+  // Line-aligned, as a host would give it: both contenders' shading streams its rows.
+  LineAlignedVector<std::uint8_t> color(4 * static_cast<std::size_t>(o.width) * static_cast<std::size_t>(o.height));
   FrameContext ctx;
   ctx.model = &model;
   ctx.stage = &stage;

@@ -42,6 +42,7 @@
 #include "raytrace/render/renderer.h"
 #include "raytrace/scene/scene.h"
 #include "runtime/jobs/job_system.h"
+#include "runtime/memory/line_aligned.h"
 #include "runtime/timing/phase_timers.h"
 #include "tests/bench/bench_support.h"
 #include "tests/bench/brute_force_gate.h"
@@ -243,7 +244,7 @@ Expected<FpsPair> measure_fps(BenchStage& stage, const FirstFrame& view, const P
                               int threads) {
   JobSystem jobs(threads);
   const int w = view.camera.width(), h = view.camera.height();
-  std::vector<std::uint8_t> color(4 * static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
+  LineAlignedVector<std::uint8_t> color(4 * static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
   rt::FrameBuffers buffers;
   buffers.width = w;
   buffers.height = h;

@@ -25,6 +25,7 @@
 #include "raytrace/scene/scene.h"
 #include "runtime/cpu/cpu_features.h"
 #include "runtime/jobs/job_system.h"
+#include "runtime/memory/line_aligned.h"
 #include "runtime/timing/phase_timers.h"
 
 namespace sinew::bench {
@@ -223,7 +224,7 @@ Expected<RunResult> run_configuration(const BenchModel& m, const BenchOptions& o
 
   // Colour only: shading runs and writes it, and no other AOV adds work the
   // table does not measure.
-  std::vector<std::uint8_t> color(4 * static_cast<std::size_t>(o.width) * static_cast<std::size_t>(o.height));
+  LineAlignedVector<std::uint8_t> color(4 * static_cast<std::size_t>(o.width) * static_cast<std::size_t>(o.height));
   rt::FrameBuffers buffers;
   buffers.width = o.width;
   buffers.height = o.height;

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <array>
 #include <bit>
+#include <cstddef>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -29,6 +30,7 @@
 #include "raytrace/scene/scene.h"
 #include "runtime/jobs/job_system.h"
 #include "runtime/math/float8.h"
+#include "runtime/memory/line_aligned.h"
 #include "tests/support/brute_force.h"
 #include "tests/support/idle_mannequin.h"
 
@@ -782,6 +784,107 @@ TEST(Renderer, PacketsMatchSingleRaysAndBruteForceAtEdgesAndInsideCharacters) {
     }
   }
   EXPECT_GT(character, checked / 10);
+}
+
+
+// One host plane: `rows` rows `pitch` bytes apart, starting `offset` bytes
+// into line-aligned storage filled with a sentinel byte (and a little more,
+// so that the span's whole elements reach the last row's end).
+struct HostPlane {
+  LineAlignedVector<std::byte> bytes;
+  std::size_t offset = 0, pitch = 0;
+  HostPlane(std::size_t offset_bytes, std::size_t pitch_bytes, int rows)
+      : bytes(offset_bytes + pitch_bytes * static_cast<std::size_t>(rows) + 16, std::byte{0xA5}),
+        offset(offset_bytes),
+        pitch(pitch_bytes) {}
+  template <class T>
+  std::span<T> span() {
+    return {reinterpret_cast<T*>(bytes.data() + offset), (bytes.size() - offset) / sizeof(T)};
+  }
+};
+
+// Every output, laid out with each row `row_bytes(output)` rounded up to a
+// multiple of `align` plus `pad` bytes, starting `offset` bytes past a line.
+struct HostFrame {
+  std::vector<HostPlane> planes;
+  rt::FrameBuffers buffers;
+  HostFrame(int w, int h, std::size_t align, std::size_t pad, std::size_t offset) {
+    const std::size_t sizes[] = {4, 16, 4, sizeof(Vec3), 4, 4};
+    for (const std::size_t bytes_per_pixel : sizes) {
+      const std::size_t row = bytes_per_pixel * static_cast<std::size_t>(w);
+      planes.emplace_back(offset, (row + align - 1) / align * align + pad, h);
+    }
+    buffers.width = w;
+    buffers.height = h;
+    buffers.color_rgba8 = planes[0].span<std::uint8_t>();
+    buffers.color_rgba32f = planes[1].span<float>();
+    buffers.depth = planes[2].span<float>();
+    buffers.normal = planes[3].span<Vec3>();
+    buffers.triangle_id = planes[4].span<std::uint32_t>();
+    buffers.instance_id = planes[5].span<std::uint32_t>();
+    buffers.row_pitch = {planes[0].pitch, planes[1].pitch, planes[2].pitch,
+                         planes[3].pitch, planes[4].pitch, planes[5].pitch};
+  }
+  // Plane p's row y: its pixels, and the padding after them.
+  std::span<const std::byte> row(std::size_t p, int y, std::size_t row_bytes) const {
+    return {planes[p].bytes.data() + planes[p].offset + static_cast<std::size_t>(y) * planes[p].pitch, row_bytes};
+  }
+  std::span<const std::byte> padding(std::size_t p, int y, std::size_t row_bytes) const {
+    return {planes[p].bytes.data() + planes[p].offset + static_cast<std::size_t>(y) * planes[p].pitch + row_bytes,
+            planes[p].pitch - row_bytes};
+  }
+};
+
+// Rows that start on a line are staged and stored by streaming whole lines
+// (render/output_staging.h); the others are written in place. Both must
+// give every output the same bytes, and neither may touch the padding
+// between rows, whatever the tile and image edges do to the lines.
+TEST(Renderer, StagedAndInPlaceOutputsHoldTheSameBytes) {
+  const rt::Scene& sc = scene();
+  JobSystem jobs(2);
+  const rt::CameraDesc desc{Vec3(0.5f, 1.4f, 3.0f), Vec3(0.0f, 0.9f, 0.0f), Vec3(0, 1, 0), 45.0f};
+  const std::size_t bytes_per_pixel[] = {4, 16, 4, sizeof(Vec3), 4, 4};
+  for (const auto& [w, h] : {std::pair{37, 23}, std::pair{64, 40}}) {
+    const auto camera = rt::PinholeCamera::create(desc, w, h).value();
+    for (const int tile : {5, 16, 32}) {
+      rt::RenderSettings settings;
+      settings.tile_size = tile;
+      // In place: rows 4 bytes past a line. Staged: rows on lines, packed
+      // where the row is whole lines, else padded to them, or padded further.
+      HostFrame in_place(w, h, 4, 0, 4);
+      HostFrame staged(w, h, 64, 0, 0);
+      HostFrame staged_padded(w, h, 64, 128, 0);
+      rt::Renderer renderer;
+      ASSERT_TRUE(renderer.render(sc, camera, settings, in_place.buffers, jobs).ok());
+      ASSERT_TRUE(renderer.render(sc, camera, settings, staged.buffers, jobs).ok());
+      ASSERT_TRUE(renderer.render(sc, camera, settings, staged_padded.buffers, jobs).ok());
+      for (std::size_t p = 0; p < 6; ++p) {
+        const std::size_t row_bytes = bytes_per_pixel[p] * static_cast<std::size_t>(w);
+        for (int y = 0; y < h; ++y) {
+          const auto reference = in_place.row(p, y, row_bytes);
+          for (const HostFrame* frame : {&staged, &staged_padded}) {
+            const auto row = frame->row(p, y, row_bytes);
+            ASSERT_TRUE(std::equal(row.begin(), row.end(), reference.begin()))
+                << "plane " << p << " row " << y << " tile " << tile << " " << w << "x" << h;
+            for (const std::byte b : frame->padding(p, y, row_bytes)) ASSERT_EQ(b, std::byte{0xA5}) << "plane " << p;
+          }
+          for (const std::byte b : in_place.padding(p, y, row_bytes)) ASSERT_EQ(b, std::byte{0xA5}) << "plane " << p;
+        }
+      }
+      // The reference is the packed render of the test above, pixel for
+      // pixel, and sees the characters.
+      const Frame packed = render(sc, camera, tile, 64, TriangleTest::kFast, jobs);
+      EXPECT_GT(std::count_if(packed.instance.begin(), packed.instance.end(),
+                              [](std::uint32_t id) { return id < 2; }),
+                w * h / 20);
+      for (int y = 0; y < h; ++y) {
+        const auto row = in_place.row(4, y, 4 * static_cast<std::size_t>(w));
+        ASSERT_TRUE(std::equal(row.begin(), row.end(),
+                               reinterpret_cast<const std::byte*>(packed.triangle.data() + y * w)))
+            << "row " << y;
+      }
+    }
+  }
 }
 
 }  // namespace

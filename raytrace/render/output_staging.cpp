@@ -1,0 +1,114 @@
+#include "raytrace/render/output_staging.h"
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+#include <algorithm>
+#include <cstdint>
+#include <cstring>
+
+namespace sinew::rt {
+namespace {
+
+constexpr std::size_t kLineBytes = 64;
+
+// Bytes of one tile row of `plane`.
+template <class T>
+std::size_t row_bytes(const OutputPlane<T>& plane, const Tile& tile) {
+  return static_cast<std::size_t>(tile.x1 - tile.x0) * plane.channels * sizeof(T);
+}
+
+// `n` bytes from `src` to `dst`: the whole 64-byte lines of dst by
+// streaming stores, the ragged ends by ordinary ones (a streaming store to
+// part of a line costs memory far more than the ordinary store does).
+void stream_row(std::byte* dst, const std::byte* src, std::size_t n) {
+#if defined(__SSE2__)
+  const std::size_t misalign = reinterpret_cast<std::uintptr_t>(dst) % kLineBytes;
+  const std::size_t head = std::min(n, misalign == 0 ? 0 : kLineBytes - misalign);
+  std::memcpy(dst, src, head);
+  std::size_t i = head;
+  for (; i + kLineBytes <= n; i += kLineBytes) {
+    for (std::size_t k = 0; k < kLineBytes; k += 16) {
+      const __m128i chunk = _mm_loadu_si128(reinterpret_cast<const __m128i*>(src + i + k));
+      _mm_stream_si128(reinterpret_cast<__m128i*>(dst + i + k), chunk);
+    }
+  }
+  std::memcpy(dst + i, src + i, n - i);
+#else
+  std::memcpy(dst, src, n);
+#endif
+}
+
+// Rows that start on a line: only they leave whole lines to stream.
+template <class T>
+bool line_aligned(const OutputPlane<T>& plane) {
+  return plane.wanted() && reinterpret_cast<std::uintptr_t>(plane.base) % kLineBytes == 0 &&
+         plane.pitch % kLineBytes == 0;
+}
+
+template <class T>
+void flush_plane(const OutputPlane<T>& staged, const OutputPlane<T>& out, const Tile& tile) {
+  if (!staged.wanted() || staged.base == out.base) return;
+  const std::size_t n = row_bytes(out, tile);
+  for (int y = tile.y0; y < tile.y1; ++y) {
+    stream_row(reinterpret_cast<std::byte*>(out.at(tile.x0, y)),
+               reinterpret_cast<const std::byte*>(staged.at(tile.x0, y)), n);
+  }
+}
+
+}  // namespace
+
+const OutputPlanes& OutputStaging::stage(const OutputPlanes& out, const Tile& tile) {
+  tile_ = tile;
+  const std::size_t rows = static_cast<std::size_t>(std::max(0, tile.y1 - tile.y0));
+  // Each wanted plane's rows, rounded up to whole lines.
+  std::size_t lines = 0;
+  const auto size_plane = [&](const auto& plane) {
+    if (line_aligned(plane)) lines += (row_bytes(plane, tile) + kLineBytes - 1) / kLineBytes * rows;
+  };
+  size_plane(out.rgba8);
+  size_plane(out.rgba32f);
+  size_plane(out.depth);
+  size_plane(out.normal);
+  size_plane(out.triangle);
+  size_plane(out.instance);
+  if (storage_.size() < lines) storage_.resize(lines);
+  std::size_t next = 0;
+  const auto place = [&](const auto& plane, auto& staged) {
+    staged = {};
+    if (!plane.wanted()) return;
+    if (!line_aligned(plane)) {
+      staged = plane;  // written in place
+      return;
+    }
+    const std::size_t pitch_lines = (row_bytes(plane, tile) + kLineBytes - 1) / kLineBytes;
+    staged.base = storage_[next].bytes;
+    staged.pitch = pitch_lines * kLineBytes;
+    staged.channels = plane.channels;
+    staged.x0 = tile.x0;
+    staged.y0 = tile.y0;
+    next += pitch_lines * rows;
+  };
+  place(out.rgba8, staged_.rgba8);
+  place(out.rgba32f, staged_.rgba32f);
+  place(out.depth, staged_.depth);
+  place(out.normal, staged_.normal);
+  place(out.triangle, staged_.triangle);
+  place(out.instance, staged_.instance);
+  return staged_;
+}
+
+void OutputStaging::flush(const OutputPlanes& out) const {
+  flush_plane(staged_.rgba8, out.rgba8, tile_);
+  flush_plane(staged_.rgba32f, out.rgba32f, tile_);
+  flush_plane(staged_.depth, out.depth, tile_);
+  flush_plane(staged_.normal, out.normal, tile_);
+  flush_plane(staged_.triangle, out.triangle, tile_);
+  flush_plane(staged_.instance, out.instance, tile_);
+#if defined(__SSE2__)
+  _mm_sfence();
+#endif
+}
+
+}  // namespace sinew::rt
