@@ -45,13 +45,10 @@ class GroupFrusta {
     apex_magnitude_ = std::max({std::fabs(apex.x), std::fabs(apex.y), std::fabs(apex.z)});
     slack_ = slack;
     groups_ = std::clamp(groups, 0, kMaxGroups);
-    // Only the eight-group blocks reached() reads.
-    const std::size_t used = static_cast<std::size_t>((groups_ + 7) / 8 * 8);
-    for (int i = 0; i < 5; ++i) {
-      for (auto& axis : n_[i]) std::fill_n(axis.begin(), used, 0.0f);
-      std::fill_n(scale_[i].begin(), used, 0.0f);
-    }
-    std::fill_n(offset_.begin(), used, 0.0f);
+    // The planes themselves are left as they are: reached() reads only
+    // those of groups marked built.
+    sides_.fill(0);
+    far_.fill(0);
     far_planes_ = false;
   }
 
@@ -97,6 +94,7 @@ class GroupFrusta {
     set_plane(1, g, (a_lo - grow(a_lo)) * c - u);
     set_plane(2, g, v - (b_hi + grow(b_hi)) * c);
     set_plane(3, g, (b_lo - grow(b_lo)) * c - v);
+    sides_[g / 8] = static_cast<std::uint8_t>(sides_[g / 8] | 1u << (g % 8));
     if (reach != nullptr) {
       // c . (p - apex) <= s (c . q) + |c|_1 slack on every lane's points.
       const Float8 far = select(use, Float8::load(reach) * dc, Float8(0.0f));
@@ -104,6 +102,7 @@ class GroupFrusta {
       if (std::isfinite(offset)) {
         set_plane(4, g, c);
         offset_[g] = offset;
+        far_[g / 8] = static_cast<std::uint8_t>(far_[g / 8] | 1u << (g % 8));
         far_planes_ = true;
       }
     }
@@ -144,17 +143,27 @@ class GroupFrusta {
     for (int base = 0; base < groups_; base += 8) {
       const std::uint32_t part = (groups >> base) & 0xFFu;
       if (part == 0) continue;
-      Mask8 culled = Mask8::from_bits(0);
-      for (int i = 0; i < (far_planes_ ? 5 : 4); ++i) {
+      const std::uint32_t block = static_cast<std::uint32_t>(base / 8);
+      const std::uint32_t sides = sides_[block], far = far_planes_ ? far_[block] : 0u;
+      if ((part & (sides | far)) == 0) {
+        out |= part << base;  // no group here has a frustum
+        continue;
+      }
+      Mask8 culled_by_sides = Mask8::from_bits(0), culled_by_far = Mask8::from_bits(0);
+      for (int i = 0; i < (far != 0 ? 5 : 4); ++i) {
         const Float8 nx = Float8::load(&n_[i][0][base]), ny = Float8::load(&n_[i][1][base]),
                      nz = Float8::load(&n_[i][2][base]);
         const auto side = [&](const Vec3& x) { return (nx * Float8(x.x) + ny * Float8(x.y)) + nz * Float8(x.z); };
         const Float8 nearest = min(min(side(x0), side(x1)), side(x2));
         Float8 limit = Float8::load(&scale_[i][base]) * margin;
-        if (i == 4) limit = limit + Float8::load(&offset_[base]);
-        culled = culled | (nearest > limit);
+        if (i == 4) {
+          culled_by_far = nearest > limit + Float8::load(&offset_[base]);
+        } else {
+          culled_by_sides = culled_by_sides | (nearest > limit);
+        }
       }
-      out |= (part & ~culled.bits()) << base;
+      const std::uint32_t culled = (culled_by_sides.bits() & sides) | (culled_by_far.bits() & far);
+      out |= (part & ~culled) << base;
     }
     return out;
   }
@@ -221,12 +230,14 @@ class GroupFrusta {
     store_planes(1, base, (a_lo - grow(a_lo)) * c - u, ok);
     store_planes(2, base, v - (b_hi + grow(b_hi)) * c, ok);
     store_planes(3, base, (b_lo - grow(b_lo)) * c - v, ok);
+    sides_[static_cast<std::size_t>(base / 8)] |= static_cast<std::uint8_t>(ok.bits());
     if constexpr (kFar) {
       const Float8 offset = far * Float8(1.0f + 0x1.0p-16f);
       const Mask8 far_ok = ok & is_finite(offset);
       if (far_ok.bits() != 0) {
         store_planes(4, base, c, far_ok);
         select(far_ok, offset, Float8::load(&offset_[base])).store(&offset_[base]);
+        far_[static_cast<std::size_t>(base / 8)] |= static_cast<std::uint8_t>(far_ok.bits());
         far_planes_ = true;
       }
     }
@@ -261,9 +272,11 @@ class GroupFrusta {
   float apex_magnitude_ = 0.0f;
   float slack_ = 0.0f;
   int groups_ = 0;
-  // Per plane (four sides, then the far plane), axis and group; zero
-  // normals (no frustum) cull nothing.
+  // Per plane (four sides, then the far plane), axis and group; read only
+  // for the groups whose bit is set in sides_ (the four sides) or far_ (the
+  // far plane), per block of eight groups.
   alignas(32) std::array<std::array<std::array<float, kMaxGroups>, 3>, 5> n_{};
+  std::array<std::uint8_t, kMaxGroups / 8> sides_{}, far_{};
   alignas(32) std::array<std::array<float, kMaxGroups>, 5> scale_{};
   alignas(32) std::array<float, kMaxGroups> offset_{};  // the far plane's, per group
   bool far_planes_ = false;
