@@ -82,4 +82,16 @@ struct OutputPlanes {
   bool want_surface() const { return want_color() || normal.wanted(); }
 };
 
+// fn(a.p, b.p) for every plane p, the planes of `a` and `b` paired by kind
+// (either may be const).
+template <class A, class B, class Fn>
+void for_each_plane_pair(A& a, B& b, Fn&& fn) {
+  fn(a.rgba8, b.rgba8);
+  fn(a.rgba32f, b.rgba32f);
+  fn(a.depth, b.depth);
+  fn(a.normal, b.normal);
+  fn(a.triangle, b.triangle);
+  fn(a.instance, b.instance);
+}
+
 }  // namespace sinew::rt

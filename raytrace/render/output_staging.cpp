@@ -62,50 +62,33 @@ void flush_plane(const OutputPlane<T>& staged, const OutputPlane<T>& out, const 
 const OutputPlanes& OutputStaging::stage(const OutputPlanes& out, const Tile& tile) {
   tile_ = tile;
   const std::size_t rows = static_cast<std::size_t>(std::max(0, tile.y1 - tile.y0));
-  // Each wanted plane's rows, rounded up to whole lines.
+  const auto pitch_lines = [&](const auto& plane) { return (row_bytes(plane, tile) + kLineBytes - 1) / kLineBytes; };
+  // Each staged plane's rows, rounded up to whole lines.
   std::size_t lines = 0;
-  const auto size_plane = [&](const auto& plane) {
-    if (line_aligned(plane)) lines += (row_bytes(plane, tile) + kLineBytes - 1) / kLineBytes * rows;
-  };
-  size_plane(out.rgba8);
-  size_plane(out.rgba32f);
-  size_plane(out.depth);
-  size_plane(out.normal);
-  size_plane(out.triangle);
-  size_plane(out.instance);
+  for_each_plane_pair(out, out, [&](const auto& plane, const auto&) {
+    if (line_aligned(plane)) lines += pitch_lines(plane) * rows;
+  });
   if (storage_.size() < lines) storage_.resize(lines);
   std::size_t next = 0;
-  const auto place = [&](const auto& plane, auto& staged) {
+  for_each_plane_pair(out, staged_, [&](const auto& plane, auto& staged) {
     staged = {};
     if (!plane.wanted()) return;
     if (!line_aligned(plane)) {
       staged = plane;  // written in place
       return;
     }
-    const std::size_t pitch_lines = (row_bytes(plane, tile) + kLineBytes - 1) / kLineBytes;
     staged.base = storage_[next].bytes;
-    staged.pitch = pitch_lines * kLineBytes;
+    staged.pitch = pitch_lines(plane) * kLineBytes;
     staged.channels = plane.channels;
     staged.x0 = tile.x0;
     staged.y0 = tile.y0;
-    next += pitch_lines * rows;
-  };
-  place(out.rgba8, staged_.rgba8);
-  place(out.rgba32f, staged_.rgba32f);
-  place(out.depth, staged_.depth);
-  place(out.normal, staged_.normal);
-  place(out.triangle, staged_.triangle);
-  place(out.instance, staged_.instance);
+    next += pitch_lines(plane) * rows;
+  });
   return staged_;
 }
 
 void OutputStaging::flush(const OutputPlanes& out) const {
-  flush_plane(staged_.rgba8, out.rgba8, tile_);
-  flush_plane(staged_.rgba32f, out.rgba32f, tile_);
-  flush_plane(staged_.depth, out.depth, tile_);
-  flush_plane(staged_.normal, out.normal, tile_);
-  flush_plane(staged_.triangle, out.triangle, tile_);
-  flush_plane(staged_.instance, out.instance, tile_);
+  for_each_plane_pair(staged_, out, [&](const auto& staged, const auto& plane) { flush_plane(staged, plane, tile_); });
 #if defined(__SSE2__)
   _mm_sfence();
 #endif

@@ -56,7 +56,8 @@ std::uint64_t trace_shadow_rays(const Scene& scene, TriangleTest test, int packe
                                 TraversalCounters& counters);
 
 // Diffuse shading (ambient + each unblocked light's N.L) and the requested
-// outputs of the tile's pixels.
+// outputs of the tile's pixels, through s.staging: line-aligned planes get
+// whole lines by streaming stores, the others are written in place.
 void shade_and_write(const RenderSettings& settings, std::span<const Light> lights, const OutputPlanes& out,
                      TileScratch& s);
 
