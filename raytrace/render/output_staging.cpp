@@ -77,7 +77,7 @@ const OutputPlanes& OutputStaging::stage(const OutputPlanes& out, const Tile& ti
       staged = plane;  // written in place
       return;
     }
-    staged.base = storage_[next].bytes;
+    staged.base = reinterpret_cast<std::byte*>(storage_.data() + next);
     staged.pitch = pitch_lines(plane) * kLineBytes;
     staged.channels = plane.channels;
     staged.x0 = tile.x0;
