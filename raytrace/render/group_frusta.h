@@ -49,7 +49,6 @@ class GroupFrusta {
     // those of groups marked built.
     sides_.fill(0);
     far_.fill(0);
-    far_planes_ = false;
   }
 
   // Group g's frustum around the directions q of `lanes` (structure of
@@ -103,7 +102,6 @@ class GroupFrusta {
         set_plane(4, g, c);
         offset_[g] = offset;
         far_[g / 8] = static_cast<std::uint8_t>(far_[g / 8] | 1u << (g % 8));
-        far_planes_ = true;
       }
     }
   }
@@ -144,7 +142,7 @@ class GroupFrusta {
       const std::uint32_t part = (groups >> base) & 0xFFu;
       if (part == 0) continue;
       const std::uint32_t block = static_cast<std::uint32_t>(base / 8);
-      const std::uint32_t sides = sides_[block], far = far_planes_ ? far_[block] : 0u;
+      const std::uint32_t sides = sides_[block], far = far_[block];
       if ((part & (sides | far)) == 0) {
         out |= part << base;  // no group here has a frustum
         continue;
@@ -238,7 +236,6 @@ class GroupFrusta {
         store_planes(4, base, c, far_ok);
         select(far_ok, offset, Float8::load(&offset_[base])).store(&offset_[base]);
         far_[static_cast<std::size_t>(base / 8)] |= static_cast<std::uint8_t>(far_ok.bits());
-        far_planes_ = true;
       }
     }
   }
@@ -279,7 +276,6 @@ class GroupFrusta {
   std::array<std::uint8_t, kMaxGroups / 8> sides_{}, far_{};
   alignas(32) std::array<std::array<float, kMaxGroups>, 5> scale_{};
   alignas(32) std::array<float, kMaxGroups> offset_{};  // the far plane's, per group
-  bool far_planes_ = false;
 };
 
 }  // namespace sinew::rt

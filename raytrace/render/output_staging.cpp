@@ -11,8 +11,6 @@
 namespace sinew::rt {
 namespace {
 
-constexpr std::size_t kLineBytes = 64;
-
 // Bytes of one tile row of `plane`.
 template <class T>
 std::size_t row_bytes(const OutputPlane<T>& plane, const Tile& tile) {
@@ -24,12 +22,12 @@ std::size_t row_bytes(const OutputPlane<T>& plane, const Tile& tile) {
 // part of a line costs memory far more than the ordinary store does).
 void stream_row(std::byte* dst, const std::byte* src, std::size_t n) {
 #if defined(__SSE2__)
-  const std::size_t misalign = reinterpret_cast<std::uintptr_t>(dst) % kLineBytes;
-  const std::size_t head = std::min(n, misalign == 0 ? 0 : kLineBytes - misalign);
+  const std::size_t misalign = reinterpret_cast<std::uintptr_t>(dst) % kCacheLineBytes;
+  const std::size_t head = std::min(n, misalign == 0 ? 0 : kCacheLineBytes - misalign);
   std::memcpy(dst, src, head);
   std::size_t i = head;
-  for (; i + kLineBytes <= n; i += kLineBytes) {
-    for (std::size_t k = 0; k < kLineBytes; k += 16) {
+  for (; i + kCacheLineBytes <= n; i += kCacheLineBytes) {
+    for (std::size_t k = 0; k < kCacheLineBytes; k += 16) {
       const __m128i chunk = _mm_loadu_si128(reinterpret_cast<const __m128i*>(src + i + k));
       _mm_stream_si128(reinterpret_cast<__m128i*>(dst + i + k), chunk);
     }
@@ -43,8 +41,8 @@ void stream_row(std::byte* dst, const std::byte* src, std::size_t n) {
 // Rows that start on a line: only they leave whole lines to stream.
 template <class T>
 bool line_aligned(const OutputPlane<T>& plane) {
-  return plane.wanted() && reinterpret_cast<std::uintptr_t>(plane.base) % kLineBytes == 0 &&
-         plane.pitch % kLineBytes == 0;
+  return plane.wanted() && reinterpret_cast<std::uintptr_t>(plane.base) % kCacheLineBytes == 0 &&
+         plane.pitch % kCacheLineBytes == 0;
 }
 
 template <class T>
@@ -62,13 +60,13 @@ void flush_plane(const OutputPlane<T>& staged, const OutputPlane<T>& out, const 
 const OutputPlanes& OutputStaging::stage(const OutputPlanes& out, const Tile& tile) {
   tile_ = tile;
   const std::size_t rows = static_cast<std::size_t>(std::max(0, tile.y1 - tile.y0));
-  const auto pitch_lines = [&](const auto& plane) { return (row_bytes(plane, tile) + kLineBytes - 1) / kLineBytes; };
+  const auto pitch_lines = [&](const auto& plane) { return (row_bytes(plane, tile) + kCacheLineBytes - 1) / kCacheLineBytes; };
   // Each staged plane's rows, rounded up to whole lines.
   std::size_t lines = 0;
   for_each_plane_pair(out, out, [&](const auto& plane, const auto&) {
     if (line_aligned(plane)) lines += pitch_lines(plane) * rows;
   });
-  if (storage_.size() < lines) storage_.resize(lines);
+  if (storage_.size() < lines * kCacheLineBytes) storage_.resize(lines * kCacheLineBytes);
   std::size_t next = 0;
   for_each_plane_pair(out, staged_, [&](const auto& plane, auto& staged) {
     staged = {};
@@ -77,8 +75,8 @@ const OutputPlanes& OutputStaging::stage(const OutputPlanes& out, const Tile& ti
       staged = plane;  // written in place
       return;
     }
-    staged.base = reinterpret_cast<std::byte*>(storage_.data() + next);
-    staged.pitch = pitch_lines(plane) * kLineBytes;
+    staged.base = storage_.data() + next * kCacheLineBytes;
+    staged.pitch = pitch_lines(plane) * kCacheLineBytes;
     staged.channels = plane.channels;
     staged.x0 = tile.x0;
     staged.y0 = tile.y0;

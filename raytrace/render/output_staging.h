@@ -13,10 +13,10 @@
 #pragma once
 
 #include <cstddef>
-#include <vector>
 
 #include "raytrace/render/output_planes.h"
 #include "runtime/jobs/job_system.h"
+#include "runtime/memory/line_aligned.h"
 
 namespace sinew::rt {
 
@@ -33,10 +33,7 @@ class OutputStaging {
   void flush(const OutputPlanes& out) const;
 
  private:
-  struct alignas(64) Line {
-    std::byte bytes[64];
-  };
-  std::vector<Line> storage_;
+  LineAlignedVector<std::byte> storage_;  // the staging planes, each starting on a line
   OutputPlanes staged_;
   Tile tile_;
 };

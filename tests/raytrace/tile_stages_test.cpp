@@ -10,8 +10,8 @@
 #include <algorithm>
 #include <array>
 #include <bit>
-#include <cstddef>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <limits>
 #include <memory>
@@ -786,6 +786,9 @@ TEST(Renderer, PacketsMatchSingleRaysAndBruteForceAtEdgesAndInsideCharacters) {
   EXPECT_GT(character, checked / 10);
 }
 
+// Bytes per pixel of each output, in FrameBuffers order: RGBA8, RGBA32F,
+// depth, normal, triangle id, instance id.
+constexpr std::size_t kOutputPixelBytes[] = {4, 16, 4, sizeof(Vec3), 4, 4};
 
 // One host plane: `rows` rows `pitch` bytes apart, starting `offset` bytes
 // into line-aligned storage filled with a sentinel byte (and a little more,
@@ -809,8 +812,7 @@ struct HostFrame {
   std::vector<HostPlane> planes;
   rt::FrameBuffers buffers;
   HostFrame(int w, int h, std::size_t align, std::size_t pad, std::size_t offset) {
-    const std::size_t sizes[] = {4, 16, 4, sizeof(Vec3), 4, 4};
-    for (const std::size_t bytes_per_pixel : sizes) {
+    for (const std::size_t bytes_per_pixel : kOutputPixelBytes) {
       const std::size_t row = bytes_per_pixel * static_cast<std::size_t>(w);
       planes.emplace_back(offset, (row + align - 1) / align * align + pad, h);
     }
@@ -843,7 +845,6 @@ TEST(Renderer, StagedAndInPlaceOutputsHoldTheSameBytes) {
   const rt::Scene& sc = scene();
   JobSystem jobs(2);
   const rt::CameraDesc desc{Vec3(0.5f, 1.4f, 3.0f), Vec3(0.0f, 0.9f, 0.0f), Vec3(0, 1, 0), 45.0f};
-  const std::size_t bytes_per_pixel[] = {4, 16, 4, sizeof(Vec3), 4, 4};
   for (const auto& [w, h] : {std::pair{37, 23}, std::pair{64, 40}}) {
     const auto camera = rt::PinholeCamera::create(desc, w, h).value();
     for (const int tile : {5, 16, 32}) {
@@ -859,7 +860,7 @@ TEST(Renderer, StagedAndInPlaceOutputsHoldTheSameBytes) {
       ASSERT_TRUE(renderer.render(sc, camera, settings, staged.buffers, jobs).ok());
       ASSERT_TRUE(renderer.render(sc, camera, settings, staged_padded.buffers, jobs).ok());
       for (std::size_t p = 0; p < 6; ++p) {
-        const std::size_t row_bytes = bytes_per_pixel[p] * static_cast<std::size_t>(w);
+        const std::size_t row_bytes = kOutputPixelBytes[p] * static_cast<std::size_t>(w);
         for (int y = 0; y < h; ++y) {
           const auto reference = in_place.row(p, y, row_bytes);
           for (const HostFrame* frame : {&staged, &staged_padded}) {
