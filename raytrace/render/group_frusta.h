@@ -1,7 +1,7 @@
 // Frusta of a large packet's groups (render/large_packet.h): for rays that
-// leave one apex (a camera's primary rays) or end at one (shadow rays to a
-// point light), each group of eight gets four planes through the apex that
-// hold all of its rays. A triangle whose three corners all lie beyond one of
+// leave one apex (a camera's primary rays, a point light's shadow rays),
+// each group of eight gets four planes through the apex that hold all of
+// its rays, and rays of finite reach (shadow rays) a far plane. A triangle whose three corners all lie beyond one of
 // a group's planes is missed by every ray of that group, so a leaf's
 // triangle is tested only by the groups whose frustum it reaches: one test
 // of a triangle against eight frusta costs about what one eight-lane
@@ -13,9 +13,7 @@
 // away from the rays by 2^-16 of their slopes, far above the rounding of
 // their construction (tens of float epsilons), so every ray lies inside
 // each plane. A triangle is culled only when its corners lie beyond a plane
-// by 2^-12 of the coordinate magnitudes involved, plus the rays' own
-// distance from the apex (a reversed shadow ray's end rounds): that margin
-// is hundreds of times the rounding of the corner tests and covers where
+// by 2^-12 of the coordinate magnitudes involved: that margin is hundreds of times the rounding of the corner tests and covers where
 // either triangle test can report a hit off the triangle, except at grazing
 // angles the fast test refuses as rounding noise (kFastDetTolerance).
 #pragma once
@@ -37,13 +35,11 @@ class GroupFrusta {
   static_assert(kMaxGroups % 8 == 0);
 
  public:
-  // A packet of `groups` groups whose rays' points are apex + e + s q,
-  // s >= 0, |e| <= slack per coordinate; every group starts with no frustum
-  // (it reaches every triangle).
-  void reset(const Vec3& apex, float slack, int groups) {
+  // A packet of `groups` groups whose rays' points are apex + s q, s >= 0;
+  // every group starts with no frustum (it reaches every triangle).
+  void reset(const Vec3& apex, int groups) {
     apex_ = apex;
     apex_magnitude_ = std::max({std::fabs(apex.x), std::fabs(apex.y), std::fabs(apex.z)});
-    slack_ = slack;
     groups_ = std::clamp(groups, 0, kMaxGroups);
     // The planes themselves are left as they are: reached() reads only
     // those of groups marked built.
@@ -54,9 +50,9 @@ class GroupFrusta {
   // Group g's frustum around the directions q of `lanes` (structure of
   // arrays, eight lanes; other lanes are not read). A group whose rays
   // spread over more than about 75 degrees from their mean keeps none.
-  // With `reach` (per lane, the largest s of its points apex + e + s q) the
+  // With `reach` (per lane, the largest s of its points apex + s q) the
   // frustum also gets a far plane: a triangle beyond every lane's end point
-  // (a shadow ray's origin, seen from the light) cannot block it.
+  // (a shadow ray's shadowed point) cannot block it.
   void set_group(int g, const float (&q)[3][8], std::uint32_t lanes, const float* reach = nullptr) {
     if (lanes == 0 || g < 0 || g >= groups_) return;
     const Mask8 use = Mask8::from_bits(lanes);
@@ -95,7 +91,7 @@ class GroupFrusta {
     set_plane(3, g, (b_lo - grow(b_lo)) * c - v);
     sides_[g / 8] = static_cast<std::uint8_t>(sides_[g / 8] | 1u << (g % 8));
     if (reach != nullptr) {
-      // c . (p - apex) <= s (c . q) + |c|_1 slack on every lane's points.
+      // c . (p - apex) <= s (c . q) on every lane's points.
       const Float8 far = select(use, Float8::load(reach) * dc, Float8(0.0f));
       const float offset = reduce_max(far) * (1.0f + 0x1.0p-16f);
       if (std::isfinite(offset)) {
@@ -136,7 +132,7 @@ class GroupFrusta {
   std::uint32_t reached(const Vec3& p0, const Vec3& p1, const Vec3& p2, std::uint32_t groups) const {
     const Vec3 x0 = p0 - apex_, x1 = p1 - apex_, x2 = p2 - apex_;
     const float corners = std::max({magnitude(p0), magnitude(p1), magnitude(p2)});
-    const Float8 margin(0x1.0p-12f * (corners + apex_magnitude_) + slack_);
+    const Float8 margin(0x1.0p-12f * (corners + apex_magnitude_));
     std::uint32_t out = 0;
     for (int base = 0; base < groups_; base += 8) {
       const std::uint32_t part = (groups >> base) & 0xFFu;
@@ -267,7 +263,6 @@ class GroupFrusta {
 
   Vec3 apex_{0.0f};
   float apex_magnitude_ = 0.0f;
-  float slack_ = 0.0f;
   int groups_ = 0;
   // Per plane (four sides, then the far plane), axis and group; read only
   // for the groups whose bit is set in sides_ (the four sides) or far_ (the

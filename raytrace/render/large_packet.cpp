@@ -212,7 +212,6 @@ class LargeQuery {
   // reused, start() resetting what one packet reads.
   void start(const Scene& scene, const LargePacketRays& rays, PacketHits out) {
     scene_p_ = &scene;
-    rays_p_ = &rays;
     out_ = out;
     groups_ = std::clamp(rays.groups, 0, kMaxPacketGroups);
     alive_groups_ = 0;
@@ -285,16 +284,11 @@ class LargeQuery {
     // finite reach ends inside the scene).
     RangeAccumulator acc;
     Float8 o_mag8(0.0f), d_mag8(0.0f), t_hi8(0.0f);
-    const bool reversed = use_reversed();
     for_each_bit(alive_groups_, [&](int g) {
       const Group& gr = group_[g];
       const Mask8 use = Mask8::from_bits(live_[g]);
       const Float8 t_max = Float8::load(gr.t_limit);
-      if (reversed) {
-        add_reversed(acc, gr.origin(), gr.direction(), Float8::load(gr.t_min), t_max, t_max, live_[g]);
-      } else {
-        acc.add(gr.origin(), gr.direction(), Float8::load(gr.t_min), t_max, live_[g]);
-      }
+      acc.add(gr.origin(), gr.direction(), Float8::load(gr.t_min), t_max, live_[g]);
       o_mag8 = max(o_mag8, select(use, Float8::load(gr.o_mag), Float8(0.0f)));
       d_mag8 = max(d_mag8, select(use, Float8::load(gr.d_mag), Float8(0.0f)));
       t_hi8 = max(t_hi8, select(use, t_max, Float8(0.0f)));
@@ -305,8 +299,7 @@ class LargeQuery {
     const float scene_magnitude = max_abs(scene_ref().top_level().bounds());
     float reach = 1.01f * (o_mag + scene_magnitude);
     if (std::isfinite(t_hi)) reach = std::max(reach, t_hi * d_mag * 1.01f);
-    float slack = kFrameRelativeSlack * 1.01f * (o_mag + reach + scene_magnitude);
-    if (reversed) slack += reversed_slack(o_mag, d_mag, t_hi);
+    const float slack = kFrameRelativeSlack * 1.01f * (o_mag + reach + scene_magnitude);
     const float grow = bound.grow_for(scene_ref().top_level().bounds(), slack);
     struct Candidate {
       float entry;
@@ -330,10 +323,10 @@ class LargeQuery {
     }
     Candidate* const begin = heap_candidates.empty() ? stack_candidates.data() : heap_candidates.data();
     // Closest hit: front to back, so an object entered after every lane's
-    // best hit is skipped. Rays bounded from their end (shadow rays to a
+    // best hit is skipped. Any hit from one origin (shadow rays from a
     // point light): from the light, so a lane blocked on the way retires
-    // before it walks the tree it starts in, which costs most.
-    if (!kAnyHit || reversed) {
+    // before it walks the tree it ends in, which costs most.
+    if (!kAnyHit || common_origin_) {
       std::sort(begin, begin + count, [](const Candidate& a, const Candidate& b) {
         return a.entry < b.entry || (a.entry == b.entry && a.object < b.object);
       });
@@ -376,46 +369,22 @@ class LargeQuery {
   const TraversalCounters& counters() const { return counters_; }
 
  private:
-  // Group frusta (render/group_frusta.h) for closest-hit rays from one
-  // origin, t >= 0, and for any-hit rays bounded from their shared end;
-  // other packets go without (frusta_on_ stays false). Each group's own
-  // frustum is built when a leaf first needs it (ensure_frusta).
+  // Group frusta (render/group_frusta.h) for rays from one origin, t >= 0:
+  // camera rays and shadow rays from a point light, whose frusta also get a
+  // far plane at their ends; other packets go without (frusta_on_ stays
+  // false). Each group's own frustum is built when a leaf first needs it
+  // (ensure_frusta).
   void prepare_frusta() {
     frusta_on_ = false;
     frusta_built_ = 0;
-    if constexpr (!kAnyHit) {
-      if (!common_origin_) return;
-      bool forward = true;
-      for_each_bit(alive_groups_, [&](int g) {
-        forward = forward && (select(Mask8::from_bits(live_[g]), Float8::load(group_[g].t_min), Float8(0.0f)) >=
-                              Float8(0.0f)).bits() == 0xFFu;
-      });
-      if (!forward) return;
-      frusta_.reset(common_origin_at_, 0.0f, groups_);
-    } else {
-      if (!use_reversed()) return;
-      // The apex: one lane's end o + t_max d; the slack: how far every
-      // lane's real end o + t_max d lies from it (its rounding included).
-      const int g0 = std::countr_zero(alive_groups_);
-      const int lane0 = std::countr_zero(live_[g0]);
-      const Group& first = group_[g0];
-      const Vec3 apex(first.o[0][lane0] + first.t_limit[lane0] * first.d[0][lane0],
-                      first.o[1][lane0] + first.t_limit[lane0] * first.d[1][lane0],
-                      first.o[2][lane0] + first.t_limit[lane0] * first.d[2][lane0]);
-      Float8 slack8(0.0f);
-      for_each_bit(alive_groups_, [&](int g) {
-        const Group& gr = group_[g];
-        const Float8 t = Float8::load(gr.t_limit);
-        const Vec3x8 end = gr.origin() + t * gr.direction();
-        const Float8 off =
-            max(max(abs(end.x - Float8(apex.x)), abs(end.y - Float8(apex.y))), abs(end.z - Float8(apex.z)));
-        const Float8 rounding = Float8(0x1.0p-22f) * (Float8::load(gr.o_mag) + t * Float8::load(gr.d_mag));
-        slack8 = max(slack8, select(Mask8::from_bits(live_[g]), off + rounding, Float8(0.0f)));
-      });
-      const float slack = reduce_max(slack8) * (1.0f + 0x1.0p-20f);
-      if (!std::isfinite(slack)) return;
-      frusta_.reset(apex, slack, groups_);
-    }
+    if (!common_origin_) return;
+    bool forward = true;
+    for_each_bit(alive_groups_, [&](int g) {
+      forward = forward && (select(Mask8::from_bits(live_[g]), Float8::load(group_[g].t_min), Float8(0.0f)) >=
+                            Float8(0.0f)).bits() == 0xFFu;
+    });
+    if (!forward) return;
+    frusta_.reset(common_origin_at_, groups_);
     frusta_on_ = true;
   }
 
@@ -429,38 +398,12 @@ class LargeQuery {
     if constexpr (!kAnyHit) {
       frusta_.template set_groups<false>(unbuilt, 1.0f, directions, lanes, [](int, float*) {});
     } else {
-      // Lane points o + t d = end - (t_max - t) d, t >= t_min.
-      frusta_.template set_groups<true>(unbuilt, -1.0f, directions, lanes, [&](int g, float* reach) {
-        (Float8::load(group_[g].t_limit) - Float8::load(group_[g].t_min)).store(reach);
-      });
+      // A lane's points end at t_max (infinite for a directional light's
+      // rays: no far plane).
+      frusta_.template set_groups<true>(unbuilt, 1.0f, directions, lanes,
+                                        [&](int g, float* reach) { std::copy_n(group_[g].t_limit, kLanes, reach); });
     }
     frusta_built_ |= unbuilt;
-  }
-
-  // Any-hit rays that all end at finite t_max at one shared point.
-  bool use_reversed() const {
-    if (!kAnyHit || !rays_p_->common_end) return false;
-    bool finite = true;
-    for_each_bit(alive_groups_, [&](int g) {
-      const Float8 t = select(Mask8::from_bits(live_[g]), Float8::load(group_[g].t_limit), Float8(0.0f));
-      finite = finite && (is_finite(t).bits() == 0xFFu);
-    });
-    return finite;
-  }
-
-  // The ranges of rays o + t d, t in [t0, t1], written backwards from
-  // their end o + t_end d: base - s d with s in [t_end - t1, t_end - t0],
-  // widened for the rounding of t_end - t (t0 >= 0, so |t_end - t| <= t_end).
-  static void add_reversed(RangeAccumulator& acc, const Vec3x8& o, const Vec3x8& d, Float8 t0, Float8 t1,
-                           Float8 t_end, std::uint32_t mask) {
-    const Vec3x8 base = o + t_end * d;
-    const Vec3x8 back{Float8(0.0f) - d.x, Float8(0.0f) - d.y, Float8(0.0f) - d.z};
-    const Float8 widen = Float8(0x1.0p-22f) * abs(t_end);
-    acc.add(base, back, (t_end - t1) - widen, (t_end - t0) + widen, mask);
-  }
-  // The rounding of base = o + t_end d, as a growth of every box.
-  static float reversed_slack(float o_mag, float d_mag, float t_end_max) {
-    return 0x1.0p-22f * (o_mag + t_end_max * d_mag);
   }
 
   // The largest t any lane of `groups` still looks for: its best hit (or
@@ -645,12 +588,12 @@ class LargeQuery {
   void visit_world_tree(const KdTreeView& tree, std::uint32_t groups, LeafFn& leaf) {
     if (tree.empty()) return;
     const float box_magnitude = max_abs(tree.bounds);
-    TreeEntry entry(use_reversed());
+    TreeEntry entry;
     for_each_bit(groups, [&](int g) {
       const Group& gr = group_[g];
       const Vec3x8 inv{Float8::load(gr.inv[0]), Float8::load(gr.inv[1]), Float8::load(gr.inv[2])};
       const Float8 eps = world_eps(gr, box_magnitude, Float8::load(visit_[g].t1));
-      enter_tree(entry, tree, g, gr.origin(), gr.direction(), inv, eps, Float8::load(gr.o_mag), Float8::load(gr.d_mag));
+      enter_tree(entry, tree, g, gr.origin(), gr.direction(), inv, eps);
     });
     walk_tree(tree, entry, leaf);
   }
@@ -664,7 +607,7 @@ class LargeQuery {
     // Each group's rays in the bone frame (Affine3::transform_point /
     // transform_vector term by term, as the single ray), with each lane's
     // slack there.
-    TreeEntry entry(use_reversed());
+    TreeEntry entry;
     for_each_bit(groups, [&](int g) {
       const Group& gr = group_[g];
       const Vec3x8 wo = gr.origin(), wd = gr.direction();
@@ -689,11 +632,11 @@ class LargeQuery {
                          Float8(kFrameRelativeSlack) *
                              (((carried + o_mag) + Float8::load(visit_[g].t1) * d_mag) + Float8(carry.bounds_magnitude));
       if (frusta_on_) {
-        enter_tree_unclipped(entry, g, o, d, eps, o_mag, d_mag);
+        enter_tree_unclipped(entry, g, o, d, eps);
         return;
       }
       const Vec3x8 inv{Float8(1.0f) / d.x, Float8(1.0f) / d.y, Float8(1.0f) / d.z};
-      enter_tree(entry, tree, g, o, d, inv, eps, o_mag, d_mag);
+      enter_tree(entry, tree, g, o, d, inv, eps);
     });
     const SkinnedMesh& mesh = *character.mesh;
     const auto leaf = [&](std::span<const std::uint32_t> triangles, std::uint32_t groups_here) {
@@ -709,17 +652,15 @@ class LargeQuery {
   // Entering a tree: the groups' lanes clipped to its root box, their rays
   // in the tree's frame kept for the leaf clips, and the packet's bound.
   struct TreeEntry {
-    explicit TreeEntry(bool reversed_rays) : reversed(reversed_rays) {}
-    bool reversed;
     RangeAccumulator ranges;
     float eps = 0.0f;  // the largest lane slack
     std::uint32_t groups = 0;
   };
 
   // Group g's rays o + t d in the tree's frame (reciprocals inv, lane
-  // slack eps, coordinate magnitudes o_mag and d_mag).
+  // slack eps).
   void enter_tree(TreeEntry& entry, const KdTreeView& tree, int g, const Vec3x8& o, const Vec3x8& d,
-                  const Vec3x8& inv, Float8 eps, Float8 o_mag, Float8 d_mag) {
+                  const Vec3x8& inv, Float8 eps) {
     VisitGroup& vg = visit_[g];
     Float8 t0 = Float8::load(vg.t0), t1 = Float8::load(vg.t1);
     vg.lanes = clip_lanes(tree.bounds, eps, o, d, inv, vg.lanes, t0, t1);
@@ -735,30 +676,19 @@ class LargeQuery {
       ic[a]->store(vg.inv[a]);
     }
     eps.store(vg.lane_eps);
-    enter_tree_unclipped(entry, g, o, d, eps, o_mag, d_mag);
+    enter_tree_unclipped(entry, g, o, d, eps);
   }
 
   // With group frusta no leaf clips a group's lanes (the triangles pick
   // their groups), so the rays need not be clipped to the root box or kept
   // in the tree's frame: they join the packet's bound over their passage
   // through the object, and the walk tests the root box itself.
-  void enter_tree_unclipped(TreeEntry& entry, int g, const Vec3x8& o, const Vec3x8& d, Float8 eps, Float8 o_mag,
-                            Float8 d_mag) {
+  void enter_tree_unclipped(TreeEntry& entry, int g, const Vec3x8& o, const Vec3x8& d, Float8 eps) {
     const VisitGroup& vg = visit_[g];
     if (vg.lanes == 0) return;
     const Float8 t0 = Float8::load(vg.t0), t1 = Float8::load(vg.t1);
-    const Mask8 kept = Mask8::from_bits(vg.lanes);
-    float group_eps = reduce_max(select(kept, eps, Float8(0.0f)));
-    if (entry.reversed) {
-      const Float8 t_end = Float8::load(group_[g].t_limit);
-      add_reversed(entry.ranges, o, d, t0, t1, t_end, vg.lanes);
-      group_eps += reversed_slack(reduce_max(select(kept, o_mag, Float8(0.0f))),
-                                  reduce_max(select(kept, d_mag, Float8(0.0f))),
-                                  reduce_max(select(kept, t_end, Float8(0.0f))));
-    } else {
-      entry.ranges.add(o, d, t0, t1, vg.lanes);
-    }
-    entry.eps = std::max(entry.eps, group_eps);
+    entry.ranges.add(o, d, t0, t1, vg.lanes);
+    entry.eps = std::max(entry.eps, reduce_max(select(Mask8::from_bits(vg.lanes), eps, Float8(0.0f))));
     entry.groups |= 1u << g;
   }
 
@@ -973,7 +903,6 @@ class LargeQuery {
   }
 
   const Scene* scene_p_ = nullptr;
-  const LargePacketRays* rays_p_ = nullptr;
   const Scene& scene_ref() const { return *scene_p_; }
   PacketHits out_{};
   int groups_ = 0;

@@ -17,9 +17,8 @@
 // each lane's nearest hit has the single ray's t, u and v; the triangle can
 // differ only where two triangles give exactly the same t.
 //
-// Shadow rays to a point light all end at the light: their culling bounds
-// start there (the rays reversed), which is as tight as a camera's frustum
-// however far apart the shadowed points are.
+// A point light's shadow rays run from the light (render/tile_stages.h):
+// one apex, as a camera's rays, and their frusta end at the shadowed points.
 #pragma once
 
 #include <cstdint>
@@ -44,10 +43,6 @@ struct LargePacketRays {
   const float* t_min = nullptr;
   const float* t_max = nullptr;
   const std::uint8_t* active = nullptr;  // per group, bit i: lane i
-  // Every ray ends at one point, o + t_max d (shadow rays to a point
-  // light, t_max = 1 and d = light - o, up to rounding): culling bounds
-  // start there. Only an any-hit query reads it.
-  bool common_end = false;
 };
 
 // The nearest hits of every active lane, written to 8 * groups entries of

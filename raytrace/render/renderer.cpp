@@ -104,6 +104,18 @@ Vec3 offset_origin(const SurfacePoint& surface, const Vec3& toward) {
   return origin;
 }
 
+Ray shadow_ray_from_light(const SurfacePoint& surface, const Vec3& toward, const Vec3& light) {
+  SurfacePoint widened = surface;
+  const float reach = max_abs_coordinate(light) + 2.0f * max_abs_coordinate(light - surface.position);
+  widened.error = surface.error + Vec3(gamma(7) * reach);
+  Ray ray;
+  ray.origin = light;
+  ray.direction = offset_origin(widened, toward) - light;
+  ray.t_min = 0.0f;
+  ray.t_max = 1.0f;
+  return ray;
+}
+
 namespace {
 
 using Clock = std::chrono::steady_clock;

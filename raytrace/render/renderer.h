@@ -125,10 +125,19 @@ struct SurfacePoint {
 };
 SurfacePoint surface_at(const Scene& scene, const Hit& hit, const Vec3& default_albedo);
 
-// The shadow ray's origin: `p` pushed off the surface along the geometric
-// normal, to the side `toward` points to, by its rounding error bound
-// (pbrt-v4's OffsetRayOrigin idea), so neither acne far from the origin nor
-// a visible gap at tiny scales.
+// A directional light's shadow ray origin: `p` pushed off the surface along
+// the geometric normal, to the side `toward` points to, by its rounding
+// error bound (pbrt-v4's OffsetRayOrigin idea), so neither acne far from
+// the origin nor a visible gap at tiny scales.
 Vec3 offset_origin(const SurfacePoint& surface, const Vec3& toward);
+
+// A point light's shadow ray: from the light to the surface point pushed
+// off toward `toward` (offset_origin), t in [0, 1). Traced from the light,
+// a tile's shadow rays share one origin, as its camera rays do
+// (docs/RAYTRACE.md, "Shadow rays"). The push covers the point's rounding
+// and also a triangle test's along a ray from the light, which grows with
+// the light's magnitude and distance: gamma(7) (|light| + 2 |light - p|)
+// more per axis, so the ray stops short of the surface it ends on.
+Ray shadow_ray_from_light(const SurfacePoint& surface, const Vec3& toward, const Vec3& light);
 
 }  // namespace sinew::rt

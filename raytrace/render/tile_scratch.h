@@ -55,7 +55,6 @@ struct TileScratch {
   // Shadow ray r's region: rays [shadow_region_begin[r], shadow_region_begin[r + 1])
   // come from one region's pixels (regions without a ray have no entry).
   std::vector<std::uint32_t> shadow_region_begin;
-  bool shadow_common_end = false;  // every ray ends at the light (a point light)
   // The tile's outputs until shade_and_write stores them (render/output_staging.h).
   OutputStaging staging;
 

@@ -147,11 +147,6 @@ void store3(const Vec3x8& v, std::vector<float>& x, std::vector<float>& y, std::
   v.y.store(&y[k]);
   v.z.store(&z[k]);
 }
-void store_lanes(const Vec3x8& v, float (&out)[3][8]) {
-  v.x.store(out[0]);
-  v.y.store(out[1]);
-  v.z.store(out[2]);
-}
 
 // Per-thread lists of the objects a tile's and a packet's rays may enter.
 struct CullLists {
@@ -451,7 +446,6 @@ std::uint64_t trace_shadow_large(const Scene& scene, TriangleTest test, const st
     rays.t_min = zeros.data();
     rays.t_max = &s.s_tmax[i0];
     rays.active = active.data();
-    rays.common_end = s.shadow_common_end;
     TraversalCounters work;
     occluded_large_packet(scene, rays, test, objects, blocked.data(), &work);
     add_work(counters, work);
@@ -678,9 +672,10 @@ void make_shadow_rays(const Light& light, int l, TileScratch& s) {
   const bool point = light.kind == Light::Kind::kPoint;
   const Vec3x8 light_at{Float8(light.position.x), Float8(light.position.y), Float8(light.position.z)};
   const Vec3x8 light_dir{Float8(light.direction.x), Float8(light.direction.y), Float8(light.direction.z)};
+  const float light_magnitude =
+      std::max({std::fabs(light.position.x), std::fabs(light.position.y), std::fabs(light.position.z)});
   s.shadow_count = 0;
   s.shadow_region_begin.clear();
-  s.shadow_common_end = point;
   std::size_t region = 0;
   for (std::size_t b = 0; b < blocks; ++b) {
     if (b == s.region_begin[region]) {
@@ -702,13 +697,21 @@ void make_shadow_rays(const Light& light, int l, TileScratch& s) {
     }
     if (toward == 0) continue;
     // offset_origin: pushed off along the camera-facing normal by the
-    // rounding bound, then one float further on every axis it moved.
-    const Float8 e = Float8::load(&s.error[k0]);
+    // rounding bound (for a point light, shadow_ray_from_light's wider
+    // one), then one float further on every axis it moved.
+    Float8 e = Float8::load(&s.error[k0]);
+    if (point) {
+      const Float8 reach = Float8(light_magnitude) +
+                           Float8(2.0f) * max(max(abs(to_light.x), abs(to_light.y)), abs(to_light.z));
+      e = e + Float8(gamma(7)) * reach;
+    }
     const Float8 distance = abs(facing.x) * e + abs(facing.y) * e + abs(facing.z) * e;
     const Vec3x8 offset = distance * facing;
     const Vec3x8 moved = position + offset;
-    const Vec3x8 origin{step_away(moved.x, offset.x), step_away(moved.y, offset.y), step_away(moved.z, offset.z)};
-    const Vec3x8 direction = point ? light_at - origin : light_dir;
+    const Vec3x8 end{step_away(moved.x, offset.x), step_away(moved.y, offset.y), step_away(moved.z, offset.z)};
+    // A point light's rays run from the light to the offset points.
+    const Vec3x8 origin = point ? light_at : end;
+    const Vec3x8 direction = point ? end - light_at : light_dir;
     // Compacted eight lanes at a time (the arrays have a spare group).
     const std::size_t i = s.shadow_count;
     compress_store(&s.so_x[i], origin.x, toward);
@@ -756,42 +759,15 @@ std::uint64_t trace_shadow_rays(const Scene& scene, TriangleTest test, int packe
   CullLists& lists = cull_lists();
   lists.tile.clear();
   RayBound tile_bound;
-  float extra_grow = 0.0f;
   for (std::size_t i = 0; i < padded; i += kPacketSize) {
     const std::size_t n = std::min<std::size_t>(kPacketSize, s.shadow_count - i);
-    const std::uint32_t lanes = (1u << n) - 1u;
-    if (s.shadow_common_end) {
-      // Rays to a point light, bounded from the light: o + d - s d, s in
-      // [0, 1]. Far tighter than the origins' spread times the directions'.
-      alignas(32) float end[3][8], back[3][8];
-      const Vec3x8 o = load3(s.so_x, s.so_y, s.so_z, i);
-      const Vec3x8 d = load3(s.sd_x, s.sd_y, s.sd_z, i);
-      store_lanes(o + d, end);
-      store_lanes(Vec3x8{-d.x, -d.y, -d.z}, back);
-      const float* const oe[3] = {end[0], end[1], end[2]};
-      const float* const db[3] = {back[0], back[1], back[2]};
-      static const float kOnes[kPacketSize] = {1, 1, 1, 1, 1, 1, 1, 1};
-      tile_bound.add_lanes(oe, db, kZeros, kOnes, lanes);
-      const Mask8 use = Mask8::from_bits(lanes);
-      const auto mag = [&](const Vec3x8& v) {
-        return reduce_max(select(use, max(max(abs(v.x), abs(v.y)), abs(v.z)), Float8(0.0f)));
-      };
-      extra_grow = std::max(extra_grow, mag(o) + mag(d));
-    } else {
-      const float* const o[3] = {&s.so_x[i], &s.so_y[i], &s.so_z[i]};
-      const float* const d[3] = {&s.sd_x[i], &s.sd_y[i], &s.sd_z[i]};
-      tile_bound.add_lanes(o, d, kZeros, &s.s_tmax[i], lanes);
-    }
+    const float* const o[3] = {&s.so_x[i], &s.so_y[i], &s.so_z[i]};
+    const float* const d[3] = {&s.sd_x[i], &s.sd_y[i], &s.sd_z[i]};
+    tile_bound.add_lanes(o, d, kZeros, &s.s_tmax[i], (1u << n) - 1u);
   }
-  if (s.shadow_common_end) {
-    // The traversal's slack is relative to the rays' own origins and
-    // reach, which the reversed bound does not see; and o + d rounds.
-    const float scene_magnitude = detail::max_abs(scene.top_level().bounds());
-    extra_grow = kFrameRelativeSlack * 4.0f * (extra_grow + scene_magnitude) + 0x1.0p-22f * extra_grow;
-  }
-  cull_objects(scene, tile_bound, lists.tile, extra_grow);
+  cull_objects(scene, tile_bound, lists.tile);
   thread_local StaticTile statics;
-  if (gather_static_tile(scene, test, tile_bound, extra_grow, lists.tile, statics)) {
+  if (gather_static_tile(scene, test, tile_bound, 0.0f, lists.tile, statics)) {
     counters.rays += s.shadow_count;
     return occluded_static_tile(statics, l, s, counters);
   }

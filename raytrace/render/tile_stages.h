@@ -44,14 +44,13 @@ void reconstruct_surfaces(const Scene& scene, const Vec3& default_albedo, TileSc
 
 // Light `l`'s shadow rays for the hits whose surface faces it, compacted in
 // block order into s.shadow_*; hits facing away lose bit l of s.lit here.
-// Origins are offset_origin's, directions run to the light (t_max 1) or
-// along a directional light (t_max inf).
+// A point light's rays are shadow_ray_from_light's (from the light, t_max
+// 1); a directional light's leave offset_origin along the light (t_max inf).
 void make_shadow_rays(const Light& light, int l, TileScratch& s);
 
 // Traces s.shadow_* one by one, as packets of eight, or as one large
-// packet per region (culled like the primary rays; rays to a point light
-// culled from the light); blocked rays clear bit l of s.lit. Returns how
-// many were blocked.
+// packet per region (culled like the primary rays); blocked rays clear
+// bit l of s.lit. Returns how many were blocked.
 std::uint64_t trace_shadow_rays(const Scene& scene, TriangleTest test, int packet_rays, int l, TileScratch& s,
                                 TraversalCounters& counters);
 

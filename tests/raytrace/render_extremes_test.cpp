@@ -434,9 +434,11 @@ namespace sinew {
 namespace {
 
 // A floor at exactly y = 0 under a light, nothing in between: no pixel may
-// be shadowed (a shadow ray must not hit the floor it starts on). Before the
+// be shadowed (a shadow ray must not hit the floor it ends on). Before the
 // shadow offset accounted for the triangle test's own rounding, a floor at
-// y = 0 had a zero error bound and shadowed itself everywhere.
+// y = 0 had a zero error bound and shadowed itself everywhere. Lights near
+// the floor (grazing rays) and thousands of floor sizes away (rays from the
+// light round at its magnitude) too.
 TEST(RenderStatic, AFloorAtExactlyZeroDoesNotShadowItself) {
   rt::StaticMeshDesc floor;
   for (int j = 0; j < 4; ++j) {
@@ -458,19 +460,77 @@ TEST(RenderStatic, AFloorAtExactlyZeroDoesNotShadowItself) {
   desc.target = Vec3(0.0f, 0.0f, 0.0f);
   auto camera = rt::PinholeCamera::create(desc, 64, 64);
   ASSERT_TRUE(camera.ok());
-  for (const int packet_rays : {1, 8, 64, 256}) {
-    rt::RenderSettings settings;
-    settings.light.position = Vec3(6.0f, 12.0f, 4.0f);
-    settings.packet_rays = packet_rays;
-    std::vector<std::uint8_t> color(64 * 64 * 4);
-    rt::FrameBuffers buffers;
-    buffers.width = buffers.height = 64;
-    buffers.color_rgba8 = color;
-    rt::Renderer renderer;
-    auto stats = renderer.render(scene, *camera, settings, buffers, jobs);
-    ASSERT_TRUE(stats.ok());
-    EXPECT_GT(stats->shadow_rays, 1000u);
-    EXPECT_EQ(stats->shadowed, 0u) << packet_rays << " rays per packet";
+  for (const Vec3& light : {Vec3(6.0f, 12.0f, 4.0f), Vec3(0.5f, 0.25f, 0.5f), Vec3(3e4f, 6e4f, -2e4f)}) {
+    for (const int packet_rays : {1, 8, 64, 256}) {
+      rt::RenderSettings settings;
+      settings.light.position = light;
+      settings.packet_rays = packet_rays;
+      std::vector<std::uint8_t> color(64 * 64 * 4);
+      rt::FrameBuffers buffers;
+      buffers.width = buffers.height = 64;
+      buffers.color_rgba8 = color;
+      rt::Renderer renderer;
+      auto stats = renderer.render(scene, *camera, settings, buffers, jobs);
+      ASSERT_TRUE(stats.ok());
+      EXPECT_GT(stats->shadow_rays, 1000u);
+      EXPECT_EQ(stats->shadowed, 0u) << packet_rays << " rays per packet, light y " << light.y;
+    }
+  }
+}
+
+// The same on a tilted floor away from the origin, where no coordinate is
+// exact: rays from the light round at its magnitude and length, and the
+// shadow ray's end must clear the floor by that much (shadow_ray_from_light).
+TEST(RenderStatic, ATiltedFloorDoesNotShadowItselfUnderNearAndFarLights) {
+  const Vec3 centre(310.7f, -42.3f, 127.9f);
+  const Vec3 u = glm::normalize(Vec3(0.83f, 0.31f, -0.12f));
+  const Vec3 v = glm::normalize(glm::cross(Vec3(0.2f, 0.1f, 1.0f), u));
+  const Vec3 up = glm::cross(u, v);
+  rt::StaticMeshDesc floor;
+  constexpr int kQuads = 6;
+  for (int j = 0; j <= kQuads; ++j) {
+    for (int i = 0; i <= kQuads; ++i) {
+      floor.positions.push_back(centre + (3.1f * static_cast<float>(i - kQuads / 2)) * u +
+                                (3.1f * static_cast<float>(j - kQuads / 2)) * v);
+    }
+  }
+  for (std::uint32_t j = 0; j < kQuads; ++j) {
+    for (std::uint32_t i = 0; i < kQuads; ++i) {
+      const std::uint32_t a = j * (kQuads + 1) + i;
+      floor.triangles.push_back({a, a + 1, a + kQuads + 2});
+      floor.triangles.push_back({a, a + kQuads + 2, a + kQuads + 1});
+    }
+  }
+  rt::Scene scene;
+  ASSERT_TRUE(scene.add_static_mesh(floor).ok());
+  JobSystem jobs(1);
+  ASSERT_TRUE(scene.prepare_frame(rt::FrameOptions{}, jobs).ok());
+  rt::CameraDesc desc;
+  desc.eye = centre + 14.0f * up - 9.0f * v;
+  desc.target = centre;
+  desc.up = up;
+  auto camera = rt::PinholeCamera::create(desc, 96, 96);
+  ASSERT_TRUE(camera.ok());
+  for (const Vec3& light : {centre + 20.0f * up + 3.0f * u, centre + 0.4f * up + 1.0f * v,
+                            centre + 5e4f * up - 2e4f * u, centre + 3.0f * up + 4e3f * v}) {
+    for (const int packet_rays : {1, 8, 64, 256}) {
+      for (const TriangleTest test : {TriangleTest::kFast, TriangleTest::kWatertight}) {
+        rt::RenderSettings settings;
+        settings.light.position = light;
+        settings.packet_rays = packet_rays;
+        settings.triangle_test = test;
+        std::vector<std::uint8_t> color(96 * 96 * 4);
+        rt::FrameBuffers buffers;
+        buffers.width = buffers.height = 96;
+        buffers.color_rgba8 = color;
+        rt::Renderer renderer;
+        auto stats = renderer.render(scene, *camera, settings, buffers, jobs);
+        ASSERT_TRUE(stats.ok());
+        EXPECT_GT(stats->shadow_rays, 2000u);
+        EXPECT_EQ(stats->shadowed, 0u) << packet_rays << " rays per packet, light " << light.x << ","
+                                      << light.y << "," << light.z;
+      }
+    }
   }
 }
 

@@ -337,9 +337,9 @@ TEST(LargePackets, FindTheSingleRayHits) {
   EXPECT_GT(hits, checked / 6);
 }
 
-// Shadow rays from surface points to a point light (common_end: culled
-// from the light), the light outside, inside a character's bone box and
-// on the ground; the occlusion of every ray is the single ray's.
+// Shadow rays from a point light to surface points (one origin: group
+// frusta with far planes), the light outside, inside a character's bone box
+// and on the ground; the occlusion of every ray is the single ray's.
 TEST(LargePackets, ShadowRaysToAPointLightMatchSingleRays) {
   const rt::Scene& s = scene();
   std::mt19937 g(5);
@@ -365,12 +365,11 @@ TEST(LargePackets, ShadowRaysToAPointLightMatchSingleRays) {
         const Hit hit = rt::intersect(s, ray, TriangleTest::kFast);
         const Vec3 at = hit.valid() ? ray.at(hit.t * 0.9999f) : Vec3(unit(g), 0.001f, unit(g));
         for (int a = 0; a < 3; ++a) {
-          o[a][k] = at[a];
-          d[a][k] = light[a] - at[a];
+          o[a][k] = light[a];
+          d[a][k] = at[a] - light[a];
         }
       }
-      rt::LargePacketRays rays = arrays.view();
-      rays.common_end = true;
+      const rt::LargePacketRays rays = arrays.view();
       std::vector<std::uint32_t> every(objects.size());
       for (std::uint32_t i = 0; i < every.size(); ++i) every[i] = i;
       for (const TriangleTest test : kTests) {
@@ -697,9 +696,10 @@ TEST(TileStages, SurfacesAndShadowOriginsAreTheScalarOnes) {
         }
         ASSERT_LT(next_ray, s.shadow_count);
         ASSERT_EQ(s.shadow_pixel[next_ray], k);
-        const Vec3 origin = rt::offset_origin(p, facing);
-        ASSERT_EQ(Vec3(s.so_x[next_ray], s.so_y[next_ray], s.so_z[next_ray]), origin) << k;
-        ASSERT_EQ(Vec3(s.sd_x[next_ray], s.sd_y[next_ray], s.sd_z[next_ray]), light.position - origin) << k;
+        const Ray ray = rt::shadow_ray_from_light(p, facing, light.position);
+        ASSERT_EQ(s.shadow_ray(next_ray).origin, light.position) << k;
+        ASSERT_EQ(s.shadow_ray(next_ray).direction, ray.direction) << k;
+        ASSERT_EQ(s.shadow_ray(next_ray).t_max, 1.0f) << k;
         ++next_ray;
         ++rays;
       }
