@@ -107,7 +107,7 @@ Vec3 offset_origin(const SurfacePoint& surface, const Vec3& toward) {
 Ray shadow_ray_from_light(const SurfacePoint& surface, const Vec3& toward, const Vec3& light) {
   SurfacePoint widened = surface;
   const float reach = max_abs_coordinate(light) + 2.0f * max_abs_coordinate(light - surface.position);
-  widened.error = surface.error + Vec3(gamma(7) * reach);
+  widened.error = surface.error + Vec3(gamma(32) * reach);
   Ray ray;
   ray.origin = light;
   ray.direction = offset_origin(widened, toward) - light;

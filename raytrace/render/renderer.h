@@ -136,8 +136,9 @@ Vec3 offset_origin(const SurfacePoint& surface, const Vec3& toward);
 // a tile's shadow rays share one origin, as its camera rays do
 // (docs/RAYTRACE.md, "Shadow rays"). The push covers the point's rounding
 // and also a triangle test's along a ray from the light, which grows with
-// the light's magnitude and distance: gamma(7) (|light| + 2 |light - p|)
-// more per axis, so the ray stops short of the surface it ends on.
+// the light's magnitude and distance: gamma(32) (|light| + 2 |light - p|)
+// more per axis, so the ray stops short of the surface it ends on (an
+// eighth of it was not enough in tests/raytrace/render_extremes_test.cpp).
 Ray shadow_ray_from_light(const SurfacePoint& surface, const Vec3& toward, const Vec3& light);
 
 }  // namespace sinew::rt

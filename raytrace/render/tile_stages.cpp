@@ -703,7 +703,7 @@ void make_shadow_rays(const Light& light, int l, TileScratch& s) {
     if (point) {
       const Float8 reach = Float8(light_magnitude) +
                            Float8(2.0f) * max(max(abs(to_light.x), abs(to_light.y)), abs(to_light.z));
-      e = e + Float8(gamma(7)) * reach;
+      e = e + Float8(gamma(32)) * reach;
     }
     const Float8 distance = abs(facing.x) * e + abs(facing.y) * e + abs(facing.z) * e;
     const Vec3x8 offset = distance * facing;
