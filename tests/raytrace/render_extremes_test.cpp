@@ -433,6 +433,25 @@ TEST(RenderStatic, AStaticMeshShadowsItself) {
 namespace sinew {
 namespace {
 
+// Renders a colour image of `camera` lit by a point light at `light`; the
+// render's stats.
+rt::RenderStats render_lit(const rt::Scene& scene, const rt::PinholeCamera& camera, const Vec3& light,
+                           int packet_rays, TriangleTest test, JobSystem& jobs) {
+  rt::RenderSettings settings;
+  settings.light.position = light;
+  settings.packet_rays = packet_rays;
+  settings.triangle_test = test;
+  std::vector<std::uint8_t> color(static_cast<std::size_t>(camera.width()) * camera.height() * 4);
+  rt::FrameBuffers buffers;
+  buffers.width = camera.width();
+  buffers.height = camera.height();
+  buffers.color_rgba8 = color;
+  rt::Renderer renderer;
+  auto stats = renderer.render(scene, camera, settings, buffers, jobs);
+  EXPECT_TRUE(stats.ok());
+  return stats.ok() ? *stats : rt::RenderStats{};
+}
+
 // A floor at exactly y = 0 under a light, nothing in between: no pixel may
 // be shadowed (a shadow ray must not hit the floor it ends on). Before the
 // shadow offset accounted for the triangle test's own rounding, a floor at
@@ -462,18 +481,9 @@ TEST(RenderStatic, AFloorAtExactlyZeroDoesNotShadowItself) {
   ASSERT_TRUE(camera.ok());
   for (const Vec3& light : {Vec3(6.0f, 12.0f, 4.0f), Vec3(0.5f, 0.25f, 0.5f), Vec3(3e4f, 6e4f, -2e4f)}) {
     for (const int packet_rays : {1, 8, 64, 256}) {
-      rt::RenderSettings settings;
-      settings.light.position = light;
-      settings.packet_rays = packet_rays;
-      std::vector<std::uint8_t> color(64 * 64 * 4);
-      rt::FrameBuffers buffers;
-      buffers.width = buffers.height = 64;
-      buffers.color_rgba8 = color;
-      rt::Renderer renderer;
-      auto stats = renderer.render(scene, *camera, settings, buffers, jobs);
-      ASSERT_TRUE(stats.ok());
-      EXPECT_GT(stats->shadow_rays, 1000u);
-      EXPECT_EQ(stats->shadowed, 0u) << packet_rays << " rays per packet, light y " << light.y;
+      const rt::RenderStats stats = render_lit(scene, *camera, light, packet_rays, TriangleTest::kFast, jobs);
+      EXPECT_GT(stats.shadow_rays, 1000u);
+      EXPECT_EQ(stats.shadowed, 0u) << packet_rays << " rays per packet, light y " << light.y;
     }
   }
 }
@@ -514,20 +524,10 @@ TEST(RenderStatic, ATiltedFloorDoesNotShadowItselfUnderNearAndFarLights) {
   for (const Vec3& light : {centre + 20.0f * up + 3.0f * u, centre + 0.4f * up + 1.0f * v,
                             centre + 5e4f * up - 2e4f * u, centre + 3.0f * up + 4e3f * v}) {
     for (const int packet_rays : {1, 8, 64, 256}) {
-      for (const TriangleTest test : {TriangleTest::kFast, TriangleTest::kWatertight}) {
-        rt::RenderSettings settings;
-        settings.light.position = light;
-        settings.packet_rays = packet_rays;
-        settings.triangle_test = test;
-        std::vector<std::uint8_t> color(96 * 96 * 4);
-        rt::FrameBuffers buffers;
-        buffers.width = buffers.height = 96;
-        buffers.color_rgba8 = color;
-        rt::Renderer renderer;
-        auto stats = renderer.render(scene, *camera, settings, buffers, jobs);
-        ASSERT_TRUE(stats.ok());
-        EXPECT_GT(stats->shadow_rays, 2000u);
-        EXPECT_EQ(stats->shadowed, 0u) << packet_rays << " rays per packet, light " << light.x << ","
+      for (const TriangleTest test : kTests) {
+        const rt::RenderStats stats = render_lit(scene, *camera, light, packet_rays, test, jobs);
+        EXPECT_GT(stats.shadow_rays, 2000u);
+        EXPECT_EQ(stats.shadowed, 0u) << packet_rays << " rays per packet, light " << light.x << ","
                                       << light.y << "," << light.z;
       }
     }
