@@ -398,8 +398,7 @@ class LargeQuery {
     if constexpr (!kAnyHit) {
       frusta_.template set_groups<false>(unbuilt, 1.0f, directions, lanes, [](int, float*) {});
     } else {
-      // A lane's points end at t_max (infinite for a directional light's
-      // rays: no far plane).
+      // A lane's points end at t_max (an infinite one: no far plane).
       frusta_.template set_groups<true>(unbuilt, 1.0f, directions, lanes,
                                         [&](int g, float* reach) { std::copy_n(group_[g].t_limit, kLanes, reach); });
     }
