@@ -1,20 +1,21 @@
 // Frusta of a large packet's groups (render/large_packet.h): for rays that
 // leave one apex (a camera's primary rays, a point light's shadow rays),
 // each group of eight gets four planes through the apex that hold all of
-// its rays, and rays of finite reach (shadow rays) a far plane. A triangle whose three corners all lie beyond one of
-// a group's planes is missed by every ray of that group, so a leaf's
-// triangle is tested only by the groups whose frustum it reaches: one test
-// of a triangle against eight frusta costs about what one eight-lane
-// triangle test costs, and most groups of a 64-ray packet miss most of the
-// triangles its cells hold (the fuzzy boxes are loose, the triangles are
-// not).
+// its rays, and rays of finite reach (shadow rays) a far plane. A triangle
+// whose three corners all lie beyond one of a group's planes is missed by
+// every ray of that group, so a leaf's triangle is tested only by the
+// groups whose frustum it reaches: one test of a triangle against eight
+// frusta costs about what one eight-lane triangle test costs, and most
+// groups of a 64-ray packet miss most of the triangles its cells hold (the
+// fuzzy boxes are loose, the triangles are not).
 //
 // Numerical safety (docs/RAYTRACE.md, "Group frusta"). The planes are grown
 // away from the rays by 2^-16 of their slopes, far above the rounding of
 // their construction (tens of float epsilons), so every ray lies inside
 // each plane. A triangle is culled only when its corners lie beyond a plane
-// by 2^-12 of the coordinate magnitudes involved: that margin is hundreds of times the rounding of the corner tests and covers where
-// either triangle test can report a hit off the triangle, except at grazing
+// by 2^-12 of the coordinate magnitudes involved: that margin is hundreds
+// of times the rounding of the corner tests and covers where either
+// triangle test can report a hit off the triangle, except at grazing
 // angles the fast test refuses as rounding noise (kFastDetTolerance).
 #pragma once
 

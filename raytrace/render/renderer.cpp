@@ -11,6 +11,7 @@
 #include "raytrace/render/output_planes.h"
 #include "raytrace/render/tile_scratch.h"
 #include "raytrace/render/tile_stages.h"
+#include "raytrace/render/traversal_shared.h"
 #include "runtime/jobs/job_system.h"
 #include "runtime/timing/phase_timers.h"
 
@@ -31,8 +32,6 @@ float next_float(float x, bool up) {
   bits = (x > 0.0f) == up ? bits + 1 : bits - 1;
   return std::bit_cast<float>(bits);
 }
-
-float max_abs_coordinate(const Vec3& v) { return std::max({std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)}); }
 
 // Sums per-tile counters in tile order so the totals are deterministic.
 void add(TraversalCounters& into, const TraversalCounters& from) {
@@ -79,7 +78,7 @@ SurfacePoint surface_at(const Scene& scene, const Hit& hit, const Vec3& default_
   // so its error is relative to the largest vertex coordinate in any axis.
   // A per-axis bound is 0 across a floor at exactly y = 0, and a shadow ray
   // started one float above it hit the floor itself at t = -0.
-  const float magnitude = std::max({max_abs_coordinate(p[0]), max_abs_coordinate(p[1]), max_abs_coordinate(p[2])});
+  const float magnitude = std::max({detail::max_abs(p[0]), detail::max_abs(p[1]), detail::max_abs(p[2])});
   s.error = Vec3(gamma(7) * magnitude);
   const Vec3 n = glm::cross(p[1] - p[0], p[2] - p[0]);
   const float length = glm::length(n);
@@ -106,7 +105,7 @@ Vec3 offset_origin(const SurfacePoint& surface, const Vec3& toward) {
 
 Ray shadow_ray_from_light(const SurfacePoint& surface, const Vec3& toward, const Vec3& light) {
   SurfacePoint widened = surface;
-  const float reach = max_abs_coordinate(light) + 2.0f * max_abs_coordinate(light - surface.position);
+  const float reach = detail::max_abs(light) + 2.0f * detail::max_abs(light - surface.position);
   widened.error = surface.error + Vec3(gamma(32) * reach);
   Ray ray;
   ray.origin = light;

@@ -672,8 +672,7 @@ void make_shadow_rays(const Light& light, int l, TileScratch& s) {
   const bool point = light.kind == Light::Kind::kPoint;
   const Vec3x8 light_at{Float8(light.position.x), Float8(light.position.y), Float8(light.position.z)};
   const Vec3x8 light_dir{Float8(light.direction.x), Float8(light.direction.y), Float8(light.direction.z)};
-  const float light_magnitude =
-      std::max({std::fabs(light.position.x), std::fabs(light.position.y), std::fabs(light.position.z)});
+  const float light_magnitude = detail::max_abs(light.position);
   s.shadow_count = 0;
   s.shadow_region_begin.clear();
   std::size_t region = 0;
