@@ -24,71 +24,99 @@ constexpr float kRelativeMargin = 0x1.0p-20f;
 
 }  // namespace
 
+namespace {
+
+// Lanes not in `lanes` repeat an active lane's values, so they widen nothing.
+Float8 pick(const float* p, Mask8 use, int first) { return select(use, Float8::load(p), Float8(p[first])); }
+
+void fold_in(bool empty, float* lo, float* hi, Float8 x) {
+  if (empty) {
+    x.store(lo);
+    x.store(hi);
+  } else {
+    min(Float8::load(lo), x).store(lo);
+    max(Float8::load(hi), x).store(hi);
+  }
+}
+
+}  // namespace
+
+bool RayBound::add_directions(const float* const d[3], std::uint32_t lanes) {
+  const Mask8 use = Mask8::from_bits(lanes);
+  const int first = std::countr_zero(lanes);
+  Mask8 finite = Mask8::from_bits(0xFFu);
+  for (int a = 0; a < 3; ++a) {
+    const Float8 da = pick(d[a], use, first);
+    finite = finite & is_finite(da);
+    fold_in(empty_, lanes_.d_min[a], lanes_.d_max[a], da);
+  }
+  empty_ = false;
+  folded_ = false;
+  return finite.bits() == 0xFFu;
+}
+
 void RayBound::add_lanes(const float* const o[3], const float* const d[3], const float* t_min, const float* t_max,
                          std::uint32_t lanes) {
   lanes &= 0xFFu;
   if (lanes == 0) return;
   const Mask8 use = Mask8::from_bits(lanes);
-  const Float8 t0 = Float8::load(t_min), t1 = Float8::load(t_max);
-  Mask8 finite = is_finite(t0) & (t0 < t1);
-  // Lanes not in `lanes` repeat an active lane's values, so they widen nothing.
   const int first = std::countr_zero(lanes);
-  const auto pick = [&](const float* p) { return select(use, Float8::load(p), Float8(p[first])); };
-  const auto fold_in = [&](float* lo, float* hi, Float8 x) {
-    if (empty_) {
-      x.store(lo);
-      x.store(hi);
-    } else {
-      min(Float8::load(lo), x).store(lo);
-      max(Float8::load(hi), x).store(hi);
-    }
-  };
+  const Float8 t0p = pick(t_min, use, first), t1p = pick(t_max, use, first);
+  Mask8 finite = is_finite(t0p) & (t0p < t1p);
   for (int a = 0; a < 3; ++a) {
-    const Float8 oa = pick(o[a]);
-    const Float8 da = pick(d[a]);
-    finite = finite & is_finite(oa) & is_finite(da);
-    fold_in(lanes_.o_min[a], lanes_.o_max[a], oa);
-    fold_in(lanes_.d_min[a], lanes_.d_max[a], da);
+    const Float8 oa = pick(o[a], use, first);
+    finite = finite & is_finite(oa);
+    fold_in(lane_origins_empty_, lanes_.o_min[a], lanes_.o_max[a], oa);
   }
-  if ((finite.bits() & lanes) != lanes) unbounded_ = true;
-  const Float8 t0p = pick(t_min), t1p = pick(t_max);
-  if (empty_) {
+  if (lane_origins_empty_) {
     t0p.store(lanes_.t_min);
     t1p.store(lanes_.t_max);
   } else {
     min(Float8::load(lanes_.t_min), t0p).store(lanes_.t_min);
     max(Float8::load(lanes_.t_max), t1p).store(lanes_.t_max);
   }
-  empty_ = false;
-  folded_ = false;
+  lane_origins_empty_ = false;
+  if (!add_directions(d, lanes) || finite.bits() != 0xFFu) unbounded_ = true;
 }
 
 void RayBound::add_lanes(const Vec3& origin, const float* const d[3], float t_min, float t_max,
                          std::uint32_t lanes) {
-  if ((lanes & 0xFFu) == 0) return;
-  alignas(32) float ox[8], oy[8], oz[8], t0[8], t1[8];
-  Float8(origin.x).store(ox);
-  Float8(origin.y).store(oy);
-  Float8(origin.z).store(oz);
-  Float8(t_min).store(t0);
-  Float8(t_max).store(t1);
-  const float* const o[3] = {ox, oy, oz};
-  add_lanes(o, d, t0, t1, lanes);
+  lanes &= 0xFFu;
+  if (lanes == 0) return;
+  bool finite = std::isfinite(t_min) && t_min < t_max;
+  for (int a = 0; a < 3; ++a) {
+    finite = finite && std::isfinite(origin[a]);
+    shared_o_lo_[a] = shared_empty_ ? origin[a] : std::min(shared_o_lo_[a], origin[a]);
+    shared_o_hi_[a] = shared_empty_ ? origin[a] : std::max(shared_o_hi_[a], origin[a]);
+  }
+  shared_t_lo_ = shared_empty_ ? t_min : std::min(shared_t_lo_, t_min);
+  shared_t_hi_ = shared_empty_ ? t_max : std::max(shared_t_hi_, t_max);
+  shared_empty_ = false;
+  if (!add_directions(d, lanes) || !finite) unbounded_ = true;
 }
 
 void RayBound::fold() const {
   if (folded_ || empty_) return;
   o_mag_ = d_mag_ = 0.0f;
+  const float big = std::numeric_limits<float>::max();
   for (int a = 0; a < 3; ++a) {
-    o_lo_[a] = reduce_min(Float8::load(lanes_.o_min[a]));
-    o_hi_[a] = reduce_max(Float8::load(lanes_.o_max[a]));
+    o_lo_[a] = shared_empty_ ? big : shared_o_lo_[a];
+    o_hi_[a] = shared_empty_ ? -big : shared_o_hi_[a];
+    if (!lane_origins_empty_) {
+      o_lo_[a] = std::min(o_lo_[a], reduce_min(Float8::load(lanes_.o_min[a])));
+      o_hi_[a] = std::max(o_hi_[a], reduce_max(Float8::load(lanes_.o_max[a])));
+    }
     d_lo_[a] = reduce_min(Float8::load(lanes_.d_min[a]));
     d_hi_[a] = reduce_max(Float8::load(lanes_.d_max[a]));
     o_mag_ = std::max({o_mag_, std::fabs(o_lo_[a]), std::fabs(o_hi_[a])});
     d_mag_ = std::max({d_mag_, std::fabs(d_lo_[a]), std::fabs(d_hi_[a])});
   }
-  t_lo_ = reduce_min(Float8::load(lanes_.t_min));
-  t_hi_ = reduce_max(Float8::load(lanes_.t_max));
+  t_lo_ = shared_empty_ ? kInf : shared_t_lo_;
+  t_hi_ = shared_empty_ ? -kInf : shared_t_hi_;
+  if (!lane_origins_empty_) {
+    t_lo_ = std::min(t_lo_, reduce_min(Float8::load(lanes_.t_min)));
+    t_hi_ = std::max(t_hi_, reduce_max(Float8::load(lanes_.t_max)));
+  }
   folded_ = true;
 }
 

@@ -41,7 +41,9 @@ class RayBound {
   // only when the bound is used.
   void add_lanes(const float* const o[3], const float* const d[3], const float* t_min, const float* t_max,
                  std::uint32_t lanes);
-  // Adds eight rays from one shared origin.
+  // Adds eight rays from one shared origin with one [t_min, t_max]: only
+  // the directions are folded lane by lane (a tile's camera rays, a point
+  // light's shadow rays).
   void add_lanes(const Vec3& origin, const float* const d[3], float t_min, float t_max, std::uint32_t lanes);
 
   bool empty() const { return empty_; }
@@ -70,15 +72,24 @@ class RayBound {
   Test test() const;
 
  private:
+  // Folds the directions of `lanes` (not 0) in; false when one is not finite.
+  bool add_directions(const float* const d[3], std::uint32_t lanes);
   void fold() const;
 
-  // Per lane, the running minimum and maximum of each quantity.
+  // Per lane, the running minimum and maximum of each quantity: the
+  // directions of every ray added, the origins and parameters of the rays
+  // added with their own (per-lane origin_empty_ says whether any were).
   struct Lanes {
     float o_min[3][8], o_max[3][8], d_min[3][8], d_max[3][8];
     float t_min[8], t_max[8];
   };
   Lanes lanes_{};
-  bool empty_ = true;
+  // The shared origins and parameter ranges of the rays added with one.
+  float shared_o_lo_[3] = {0, 0, 0}, shared_o_hi_[3] = {0, 0, 0};
+  float shared_t_lo_ = 0.0f, shared_t_hi_ = 0.0f;
+  bool empty_ = true;               // no ray at all (so no direction)
+  bool lane_origins_empty_ = true;  // no ray with its own origin
+  bool shared_empty_ = true;        // no ray with a shared origin
   bool unbounded_ = false;  // a non-finite ray was added
   // Folded (by fold(), on first use).
   mutable bool folded_ = false;

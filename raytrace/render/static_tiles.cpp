@@ -174,34 +174,57 @@ class CameraBlocks {
   GroupRays r_;
 };
 
-// The blocked lanes of the `n` shadow rays from i (the arrays hold a spare
-// group past the last ray: tile_scratch.h).
-std::uint32_t blocked_lanes(const std::vector<StaticTriangle>& triangles, const TileScratch& s, std::size_t i,
-                            std::size_t n, TraversalCounters& counters) {
-  GroupRays r;
-  Float8(0.0f).store(r.t_min);
-  Float8::load(&s.so_x[i]).store(r.o[0]);
-  Float8::load(&s.so_y[i]).store(r.o[1]);
-  Float8::load(&s.so_z[i]).store(r.o[2]);
-  Float8::load(&s.sd_x[i]).store(r.d[0]);
-  Float8::load(&s.sd_y[i]).store(r.d[1]);
-  Float8::load(&s.sd_z[i]).store(r.d[2]);
-  Float8::load(&s.s_tmax[i]).store(r.t_limit);
-  std::uint32_t live = valid_lanes(r) & ((1u << n) - 1u);
-  std::uint32_t blocked = 0;
-  for (std::size_t t = 0; t < triangles.size() && live != 0; ++t) {
-    const std::uint64_t lanes = static_cast<std::uint64_t>(std::popcount(live));
-    const StaticTriangle& tri = triangles[t];
-    if (tri.first) counters.object_visits += lanes;
-    counters.triangle_tests += lanes;
-    alignas(32) float th[kBlockLanes], u[kBlockLanes], v[kBlockLanes];
-    const std::uint32_t hit = intersect_triangle_fast8(r.lanes(), live, tri.p0, tri.p1, tri.p2, th, u, v);
-    if (hit == 0 || tri.zero_area) continue;
-    blocked |= hit;
-    live &= ~hit;
+// The shadow rays of one tile. Rays from one point (a point light's:
+// s.shadows_from_point) test the triangles with their origin terms
+// computed once for the whole tile.
+class ShadowBlocks {
+ public:
+  ShadowBlocks(const std::vector<StaticTriangle>& triangles, const TileScratch& s) : triangles_(triangles) {
+    thread_local std::vector<CommonOriginTriangle> prepared;
+    prepared.clear();
+    if (s.shadows_from_point) {
+      for (const StaticTriangle& tri : triangles) {
+        prepared.push_back(prepare_common_origin(s.shadow_origin, tri.p0, tri.p1, tri.p2));
+      }
+    }
+    prepared_ = &prepared;
   }
-  return blocked;
-}
+
+  // The blocked lanes of the `n` shadow rays from i (the arrays hold a
+  // spare group past the last ray: tile_scratch.h).
+  std::uint32_t blocked(const TileScratch& s, std::size_t i, std::size_t n, TraversalCounters& counters) const {
+    GroupRays r;
+    Float8(0.0f).store(r.t_min);
+    Float8::load(&s.so_x[i]).store(r.o[0]);
+    Float8::load(&s.so_y[i]).store(r.o[1]);
+    Float8::load(&s.so_z[i]).store(r.o[2]);
+    Float8::load(&s.sd_x[i]).store(r.d[0]);
+    Float8::load(&s.sd_y[i]).store(r.d[1]);
+    Float8::load(&s.sd_z[i]).store(r.d[2]);
+    Float8::load(&s.s_tmax[i]).store(r.t_limit);
+    std::uint32_t live = valid_lanes(r) & ((1u << n) - 1u);
+    std::uint32_t blocked = 0;
+    const bool common = !prepared_->empty();
+    for (std::size_t t = 0; t < triangles_.size() && live != 0; ++t) {
+      const std::uint64_t lanes = static_cast<std::uint64_t>(std::popcount(live));
+      const StaticTriangle& tri = triangles_[t];
+      if (tri.first) counters.object_visits += lanes;
+      counters.triangle_tests += lanes;
+      alignas(32) float th[kBlockLanes], u[kBlockLanes], v[kBlockLanes];
+      const std::uint32_t hit =
+          common ? intersect_triangle_fast8_common_origin(r.lanes(), live, (*prepared_)[t], th, u, v)
+                 : intersect_triangle_fast8(r.lanes(), live, tri.p0, tri.p1, tri.p2, th, u, v);
+      if (hit == 0 || tri.zero_area) continue;
+      blocked |= hit;
+      live &= ~hit;
+    }
+    return blocked;
+  }
+
+ private:
+  const std::vector<StaticTriangle>& triangles_;
+  const std::vector<CommonOriginTriangle>* prepared_ = nullptr;
+};
 
 #else  // lane by lane with the scalar test, which the eight-lane tests equal bit for bit
 
@@ -241,24 +264,31 @@ class CameraBlocks {
   Vec3 eye_;
 };
 
-std::uint32_t blocked_lanes(const std::vector<StaticTriangle>& triangles, const TileScratch& s, std::size_t i,
-                            std::size_t n, TraversalCounters& counters) {
-  std::uint32_t blocked = 0;
-  for (std::size_t lane = 0; lane < n; ++lane) {
-    const Ray ray = s.shadow_ray(i + lane);
-    if (!detail::valid_ray(ray)) continue;
-    for (const StaticTriangle& tri : triangles) {
-      if (tri.first) ++counters.object_visits;
-      ++counters.triangle_tests;
-      TriangleHit h;
-      if (intersect_triangle_fast(ray, ray.t_max, tri.p0, tri.p1, tri.p2, h)) {
-        blocked |= 1u << lane;
-        break;
+class ShadowBlocks {
+ public:
+  ShadowBlocks(const std::vector<StaticTriangle>& triangles, const TileScratch& /*s*/) : triangles_(triangles) {}
+
+  std::uint32_t blocked(const TileScratch& s, std::size_t i, std::size_t n, TraversalCounters& counters) const {
+    std::uint32_t blocked = 0;
+    for (std::size_t lane = 0; lane < n; ++lane) {
+      const Ray ray = s.shadow_ray(i + lane);
+      if (!detail::valid_ray(ray)) continue;
+      for (const StaticTriangle& tri : triangles_) {
+        if (tri.first) ++counters.object_visits;
+        ++counters.triangle_tests;
+        TriangleHit h;
+        if (intersect_triangle_fast(ray, ray.t_max, tri.p0, tri.p1, tri.p2, h)) {
+          blocked |= 1u << lane;
+          break;
+        }
       }
     }
+    return blocked;
   }
-  return blocked;
-}
+
+ private:
+  const std::vector<StaticTriangle>& triangles_;
+};
 
 #endif  // SINEW_STATIC_TILES_AVX2
 
@@ -274,9 +304,10 @@ void intersect_static_tile(const StaticTile& tile, const Vec3& eye, TileScratch&
 std::uint64_t occluded_static_tile(const StaticTile& tile, int l, TileScratch& s, TraversalCounters& counters) {
   const std::uint8_t dark = static_cast<std::uint8_t>(~(1u << l));
   std::uint64_t blocked_count = 0;
+  const ShadowBlocks blocks(tile.triangles, s);
   for (std::size_t i = 0; i < s.shadow_count; i += kBlockLanes) {
     const std::size_t n = std::min<std::size_t>(kBlockLanes, s.shadow_count - i);
-    for (std::uint32_t m = blocked_lanes(tile.triangles, s, i, n, counters); m != 0; m &= m - 1) {
+    for (std::uint32_t m = blocks.blocked(s, i, n, counters); m != 0; m &= m - 1) {
       s.lit[s.shadow_pixel[i + static_cast<std::size_t>(std::countr_zero(m))]] &= dark;
       ++blocked_count;
     }

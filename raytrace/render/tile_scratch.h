@@ -52,6 +52,10 @@ struct TileScratch {
   std::size_t shadow_count = 0;
   std::vector<std::uint32_t> shadow_pixel;  // the lane index k each ray belongs to
   std::vector<float> so_x, so_y, so_z, sd_x, sd_y, sd_z, s_tmax;
+  // Whether every shadow ray starts at shadow_origin with t in [0, 1) (a
+  // point light's: render/renderer.h shadow_ray_from_light).
+  bool shadows_from_point = false;
+  Vec3 shadow_origin{0.0f};
   // Shadow ray r's region: rays [shadow_region_begin[r], shadow_region_begin[r + 1])
   // come from one region's pixels (regions without a ray have no entry).
   std::vector<std::uint32_t> shadow_region_begin;

@@ -348,6 +348,7 @@ void TileScratch::prepare(const Tile& area, int region_blocks_x, int region_bloc
   region_begin.push_back(static_cast<std::uint32_t>(b));
   shadow_count = 0;
   shadow_region_begin.clear();
+  shadows_from_point = false;
 }
 
 void generate_camera_rays(const PinholeCamera& camera, TileScratch& s) {
@@ -675,6 +676,8 @@ void make_shadow_rays(const Light& light, int l, TileScratch& s) {
   const float light_magnitude = detail::max_abs(light.position);
   s.shadow_count = 0;
   s.shadow_region_begin.clear();
+  s.shadows_from_point = point;
+  s.shadow_origin = light.position;
   std::size_t region = 0;
   for (std::size_t b = 0; b < blocks; ++b) {
     if (b == s.region_begin[region]) {
@@ -762,7 +765,11 @@ std::uint64_t trace_shadow_rays(const Scene& scene, TriangleTest test, int packe
     const std::size_t n = std::min<std::size_t>(kPacketSize, s.shadow_count - i);
     const float* const o[3] = {&s.so_x[i], &s.so_y[i], &s.so_z[i]};
     const float* const d[3] = {&s.sd_x[i], &s.sd_y[i], &s.sd_z[i]};
-    tile_bound.add_lanes(o, d, kZeros, &s.s_tmax[i], (1u << n) - 1u);
+    if (s.shadows_from_point) {
+      tile_bound.add_lanes(s.shadow_origin, d, 0.0f, 1.0f, (1u << n) - 1u);
+    } else {
+      tile_bound.add_lanes(o, d, kZeros, &s.s_tmax[i], (1u << n) - 1u);
+    }
   }
   cull_objects(scene, tile_bound, lists.tile);
   thread_local StaticTile statics;

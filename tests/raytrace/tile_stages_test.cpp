@@ -153,6 +153,59 @@ TEST(RayBound, NonFiniteRaysCullNothing) {
   EXPECT_TRUE(bound.test().may_enter(Aabb{Vec3(100.0f), Vec3(101.0f)}, 0.0f));
 }
 
+// Groups added with one shared origin and parameter range bound exactly
+// what the same rays added lane by lane bound (min and max are exact), in
+// any mix with groups of their own origins.
+TEST(RayBound, SharedOriginGroupsBoundAsTheirLanesDo) {
+  std::mt19937 g(23);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  for (int trial = 0; trial < 2000; ++trial) {
+    rt::RayBound mixed, by_lane;
+    const int groups = 1 + trial % 5;
+    for (int k = 0; k < groups; ++k) {
+      alignas(32) float o[3][8], d[3][8], t0[8], t1[8];
+      const bool shared = (trial + k) % 3 != 0;
+      const Vec3 apex(unit(g) * 8 - 4, unit(g) * 8 - 4, unit(g) * 8 - 4);
+      const float shared_t0 = trial % 4 == 0 ? unit(g) : 0.0f;
+      const float shared_t1 = trial % 5 == 0 ? kInf : 1.0f + unit(g);
+      for (int lane = 0; lane < 8; ++lane) {
+        for (int a = 0; a < 3; ++a) {
+          o[a][lane] = shared ? apex[a] : apex[a] + unit(g) - 0.5f;
+          d[a][lane] = unit(g) - 0.5f;
+        }
+        t0[lane] = shared ? shared_t0 : 0.5f * unit(g);
+        t1[lane] = shared ? shared_t1 : 1.0f + unit(g);
+      }
+      const std::uint32_t lanes = trial % 7 == 0 ? (g() & 0xFFu) | 0x10u : 0xFFu;
+      const float* const op[3] = {o[0], o[1], o[2]};
+      const float* const dp[3] = {d[0], d[1], d[2]};
+      if (shared) {
+        mixed.add_lanes(apex, dp, shared_t0, shared_t1, lanes);
+      } else {
+        mixed.add_lanes(op, dp, t0, t1, lanes);
+      }
+      by_lane.add_lanes(op, dp, t0, t1, lanes);
+    }
+    ASSERT_EQ(mixed.world_slack_bound(10.0f), by_lane.world_slack_bound(10.0f)) << "trial " << trial;
+    const rt::RayBound::Test a = mixed.test(), b = by_lane.test();
+    for (int box = 0; box < 16; ++box) {
+      const Vec3 c(unit(g) * 10 - 5, unit(g) * 10 - 5, unit(g) * 10 - 5);
+      const Vec3 e(unit(g), unit(g), unit(g));
+      const Aabb cell{c - e, c + e};
+      ASSERT_EQ(a.may_enter(cell, 0.01f), b.may_enter(cell, 0.01f)) << "trial " << trial << " box " << box;
+    }
+  }
+  // A non-finite shared origin or parameter range culls nothing.
+  alignas(32) float d[3][8] = {};
+  for (float& z : d[2]) z = 1.0f;
+  const float* const dp[3] = {d[0], d[1], d[2]};
+  rt::RayBound nan_origin, nan_t;
+  nan_origin.add_lanes(Vec3(std::numeric_limits<float>::quiet_NaN(), 0.0f, 0.0f), dp, 0.0f, 1.0f, 0xFFu);
+  nan_t.add_lanes(Vec3(0.0f), dp, 0.0f, std::numeric_limits<float>::quiet_NaN(), 0xFFu);
+  EXPECT_TRUE(nan_origin.test().may_enter(Aabb{Vec3(100.0f), Vec3(101.0f)}, 0.0f));
+  EXPECT_TRUE(nan_t.test().may_enter(Aabb{Vec3(100.0f), Vec3(101.0f)}, 0.0f));
+}
+
 // Random packets around the characters: culled (tile bound, then packet
 // cull, as the renderer does) and unculled traversal agree with single rays.
 TEST(PacketCulling, CulledPacketsFindTheSingleRayHits) {
@@ -630,6 +683,28 @@ TEST(StaticTiles, FloorCellsFindTheSingleRayHits) {
   EXPECT_EQ(count, blocked);
   EXPECT_GT(blocked, 10u);
   EXPECT_LT(blocked, s.shadow_count - 10);
+
+  // The same points seen from the light, as the renderer traces a point
+  // light's rays: one origin, so the tile takes the common-origin test,
+  // which must block exactly the single rays that are blocked.
+  std::fill(s.lit.begin(), s.lit.end(), std::uint8_t{0b11});
+  for (std::size_t i = 0; i < s.shadow_count; ++i) {
+    const Vec3 p(s.so_x[i], s.so_y[i], s.so_z[i]);
+    s.so_x[i] = light.x;
+    s.so_y[i] = light.y;
+    s.so_z[i] = light.z;
+    s.sd_x[i] = p.x - light.x;
+    s.sd_y[i] = p.y - light.y;
+    s.sd_z[i] = p.z - light.z;
+  }
+  s.shadows_from_point = true;
+  s.shadow_origin = light;
+  ASSERT_TRUE(rt::gather_static_tile(sc, TriangleTest::kFast, shadow_bound(s), 0.0f, objects, tile));
+  const std::uint64_t from_light = rt::occluded_static_tile(tile, 1, s, counters);
+  const std::size_t blocked_from_light = expect_single_ray_occlusion(sc, s);
+  EXPECT_EQ(from_light, blocked_from_light);
+  EXPECT_GT(blocked_from_light, 10u);
+  EXPECT_LT(blocked_from_light, s.shadow_count - 10);
 
   // The whole floor from afar reaches far more triangles than a tile may hold.
   rt::TileScratch w;
