@@ -70,7 +70,7 @@ std::string bake_usage() {
          "  --pad FRACTION        grow every fuzzy box by this fraction of the model's size (default 0)\n"
          "  --candidates MODE     all (the paper's) | influencing (faster; default all)\n"
          "  --sah-intersection-cost C  the bone trees' triangle cost against a cell visit's 1\n"
-         "                        (default 0.5, tuned for the default 64-ray packets; 1.5\n"
+         "                        (default 0.5, tuned for 64-ray packets; 1.5\n"
          "                        builds deeper trees, which suit --packet-rays 1)\n"
          "  --threads N           worker threads (default all cores)\n"
          "  --max-memory-mib M    refuse a bake whose working set would exceed M MiB\n"

@@ -393,7 +393,7 @@ std::string render_usage() {
          "  --instances N             copies side by side along +X, each 0.37 s later (default 1)\n"
          "  --frames N                frames rendered at 30 fps from --time; the last is written (default 1)\n"
          "  --triangle-test fast|watertight   ray-triangle test (default fast)\n"
-         "  --packet-rays 1|8|64|256  rays traced together: single rays, 4x2, 8x8 or 16x16 pixels (default 64)\n"
+         "  --packet-rays 1|8|64|256  rays traced together: single rays, 4x2, 8x8 or 16x16 pixels (default 256)\n"
          "  --asset-roots A:B         more folders a glTF file's buffers may be read from (by default\n"
          "                            only its own folder and below)\n"
          "  --bone-boxes exact|cheap  per-frame bone boxes (default exact)\n"

@@ -57,7 +57,7 @@ struct RenderSettings {
   // culled cell by cell, render/large_packet.h). Shadow rays are packed
   // from the same pixels. The hits agree (large packets may pick another
   // triangle only at an exact tie in t); other values are refused.
-  int packet_rays = 64;
+  int packet_rays = 256;
 };
 
 // Host-owned outputs; an empty span means "not requested" and is neither
