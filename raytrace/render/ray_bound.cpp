@@ -79,10 +79,7 @@ void RayBound::add_lanes(const float* const o[3], const float* const d[3], const
   if (!add_directions(d, lanes) || finite.bits() != 0xFFu) unbounded_ = true;
 }
 
-void RayBound::add_lanes(const Vec3& origin, const float* const d[3], float t_min, float t_max,
-                         std::uint32_t lanes) {
-  lanes &= 0xFFu;
-  if (lanes == 0) return;
+bool RayBound::add_shared(const Vec3& origin, float t_min, float t_max) {
   bool finite = std::isfinite(t_min) && t_min < t_max;
   for (int a = 0; a < 3; ++a) {
     finite = finite && std::isfinite(origin[a]);
@@ -92,7 +89,63 @@ void RayBound::add_lanes(const Vec3& origin, const float* const d[3], float t_mi
   shared_t_lo_ = shared_empty_ ? t_min : std::min(shared_t_lo_, t_min);
   shared_t_hi_ = shared_empty_ ? t_max : std::max(shared_t_hi_, t_max);
   shared_empty_ = false;
+  return finite;
+}
+
+void RayBound::add_lanes(const Vec3& origin, const float* const d[3], float t_min, float t_max,
+                         std::uint32_t lanes) {
+  lanes &= 0xFFu;
+  if (lanes == 0) return;
+  const bool finite = add_shared(origin, t_min, t_max);
   if (!add_directions(d, lanes) || !finite) unbounded_ = true;
+}
+
+template <class LanesOf>
+void RayBound::add_shared_groups(const Vec3& origin, const float* const d[3], float t_min, float t_max,
+                                 std::size_t groups, LanesOf&& lanes_of) {
+  // The running extremes stay in registers; lanes never in use keep +-inf,
+  // which no fold picks.
+  const Float8 plus(kInf), minus(-kInf);
+  Float8 lo[3] = {plus, plus, plus}, hi[3] = {minus, minus, minus};
+  Mask8 finite = Mask8::from_bits(0xFFu);
+  std::uint32_t any = 0;
+  for (std::size_t k = 0; k < groups; ++k) {
+    const std::uint32_t lanes = lanes_of(k) & 0xFFu;
+    if (lanes == 0) continue;
+    any |= lanes;
+    const Mask8 use = Mask8::from_bits(lanes);
+    for (int a = 0; a < 3; ++a) {
+      const Float8 x = Float8::load(d[a] + 8 * k);
+      finite = finite & (is_finite(x) | !use);
+      lo[a] = min(lo[a], select(use, x, plus));
+      hi[a] = max(hi[a], select(use, x, minus));
+    }
+  }
+  if (any == 0) return;
+  for (int a = 0; a < 3; ++a) {
+    if (empty_) {
+      lo[a].store(lanes_.d_min[a]);
+      hi[a].store(lanes_.d_max[a]);
+    } else {
+      min(Float8::load(lanes_.d_min[a]), lo[a]).store(lanes_.d_min[a]);
+      max(Float8::load(lanes_.d_max[a]), hi[a]).store(lanes_.d_max[a]);
+    }
+  }
+  empty_ = false;
+  folded_ = false;
+  if (!add_shared(origin, t_min, t_max) || finite.bits() != 0xFFu) unbounded_ = true;
+}
+
+void RayBound::add_groups(const Vec3& origin, const float* const d[3], float t_min, float t_max,
+                          std::span<const std::uint8_t> lanes) {
+  add_shared_groups(origin, d, t_min, t_max, lanes.size(), [&](std::size_t k) { return std::uint32_t{lanes[k]}; });
+}
+
+void RayBound::add_run(const Vec3& origin, const float* const d[3], float t_min, float t_max, std::size_t rays) {
+  add_shared_groups(origin, d, t_min, t_max, (rays + 7) / 8, [&](std::size_t k) {
+    const std::size_t left = rays - 8 * k;
+    return left >= 8 ? 0xFFu : (1u << left) - 1u;
+  });
 }
 
 void RayBound::fold() const {

@@ -513,12 +513,8 @@ void trace_primary(const Scene& scene, const PinholeCamera& camera, TriangleTest
   CullLists& lists = cull_lists();
   lists.tile.clear();
   RayBound tile_bound;
-  const auto lane_dirs = [&](std::size_t k) {
-    return std::array<const float*, 3>{&s.dir_x[k], &s.dir_y[k], &s.dir_z[k]};
-  };
-  for (std::size_t b = 0; b < blocks; ++b) {
-    tile_bound.add_lanes(eye, lane_dirs(b * kBlockLanes).data(), 0.0f, kInf, s.block_pixels[b]);
-  }
+  const float* const dirs[3] = {s.dir_x.data(), s.dir_y.data(), s.dir_z.data()};
+  tile_bound.add_groups(eye, dirs, 0.0f, kInf, std::span<const std::uint8_t>(s.block_pixels.data(), blocks));
   cull_objects(scene, tile_bound, lists.tile);
   thread_local StaticTile statics;
   if (gather_static_tile(scene, test, tile_bound, 0.0f, lists.tile, statics)) {
@@ -761,13 +757,14 @@ std::uint64_t trace_shadow_rays(const Scene& scene, TriangleTest test, int packe
   CullLists& lists = cull_lists();
   lists.tile.clear();
   RayBound tile_bound;
-  for (std::size_t i = 0; i < padded; i += kPacketSize) {
-    const std::size_t n = std::min<std::size_t>(kPacketSize, s.shadow_count - i);
-    const float* const o[3] = {&s.so_x[i], &s.so_y[i], &s.so_z[i]};
-    const float* const d[3] = {&s.sd_x[i], &s.sd_y[i], &s.sd_z[i]};
-    if (s.shadows_from_point) {
-      tile_bound.add_lanes(s.shadow_origin, d, 0.0f, 1.0f, (1u << n) - 1u);
-    } else {
+  if (s.shadows_from_point) {
+    const float* const d[3] = {s.sd_x.data(), s.sd_y.data(), s.sd_z.data()};
+    tile_bound.add_run(s.shadow_origin, d, 0.0f, 1.0f, s.shadow_count);
+  } else {
+    for (std::size_t i = 0; i < padded; i += kPacketSize) {
+      const std::size_t n = std::min<std::size_t>(kPacketSize, s.shadow_count - i);
+      const float* const o[3] = {&s.so_x[i], &s.so_y[i], &s.so_z[i]};
+      const float* const d[3] = {&s.sd_x[i], &s.sd_y[i], &s.sd_z[i]};
       tile_bound.add_lanes(o, d, kZeros, &s.s_tmax[i], (1u << n) - 1u);
     }
   }

@@ -195,6 +195,47 @@ TEST(RayBound, SharedOriginGroupsBoundAsTheirLanesDo) {
       ASSERT_EQ(a.may_enter(cell, 0.01f), b.may_enter(cell, 0.01f)) << "trial " << trial << " box " << box;
     }
   }
+  // Many groups from one origin at once (a tile's camera rays, a point
+  // light's run of shadow rays) bound what they bound one by one.
+  for (int trial = 0; trial < 500; ++trial) {
+    const int groups = 1 + trial % 9;
+    const Vec3 apex(unit(g) * 8 - 4, unit(g) * 8 - 4, unit(g) * 8 - 4);
+    const float t0 = trial % 3 == 0 ? unit(g) : 0.0f, t1 = trial % 4 == 0 ? kInf : 1.0f + unit(g);
+    std::vector<float> dx(8 * groups), dy(8 * groups), dz(8 * groups);
+    std::vector<std::uint8_t> lanes(groups);
+    for (int k = 0; k < groups; ++k) {
+      lanes[k] = static_cast<std::uint8_t>(trial % 5 == 0 ? g() & 0xFFu : 0xFFu);  // some groups empty
+      for (int lane = 0; lane < 8; ++lane) {
+        dx[8 * k + lane] = unit(g) - 0.5f;
+        dy[8 * k + lane] = unit(g) - 0.5f;
+        dz[8 * k + lane] = trial % 7 == 0 ? 0.0f : unit(g) - 0.5f;
+      }
+    }
+    const float* const d[3] = {dx.data(), dy.data(), dz.data()};
+    rt::RayBound grouped, one_by_one, run, run_by_lane;
+    grouped.add_groups(apex, d, t0, t1, lanes);
+    const int rays = 8 * groups - trial % 8;
+    run.add_run(apex, d, t0, t1, static_cast<std::size_t>(rays));
+    for (int k = 0; k < groups; ++k) {
+      const float* const dk[3] = {dx.data() + 8 * k, dy.data() + 8 * k, dz.data() + 8 * k};
+      one_by_one.add_lanes(apex, dk, t0, t1, lanes[k]);
+      const int left = rays - 8 * k;
+      run_by_lane.add_lanes(apex, dk, t0, t1, left >= 8 ? 0xFFu : (1u << left) - 1u);
+    }
+    ASSERT_EQ(grouped.empty(), one_by_one.empty()) << "trial " << trial;
+    if (grouped.empty()) continue;
+    ASSERT_EQ(grouped.world_slack_bound(10.0f), one_by_one.world_slack_bound(10.0f)) << "trial " << trial;
+    ASSERT_EQ(run.world_slack_bound(10.0f), run_by_lane.world_slack_bound(10.0f)) << "trial " << trial;
+    const rt::RayBound::Test a = grouped.test(), b = one_by_one.test(), c = run.test(), e = run_by_lane.test();
+    for (int box = 0; box < 16; ++box) {
+      const Vec3 centre(unit(g) * 10 - 5, unit(g) * 10 - 5, unit(g) * 10 - 5);
+      const Vec3 half(unit(g), unit(g), unit(g));
+      const Aabb cell{centre - half, centre + half};
+      ASSERT_EQ(a.may_enter(cell, 0.01f), b.may_enter(cell, 0.01f)) << "trial " << trial << " box " << box;
+      ASSERT_EQ(c.may_enter(cell, 0.01f), e.may_enter(cell, 0.01f)) << "trial " << trial << " box " << box;
+    }
+  }
+
   // A non-finite shared origin or parameter range culls nothing.
   alignas(32) float d[3][8] = {};
   for (float& z : d[2]) z = 1.0f;
@@ -204,6 +245,13 @@ TEST(RayBound, SharedOriginGroupsBoundAsTheirLanesDo) {
   nan_t.add_lanes(Vec3(0.0f), dp, 0.0f, std::numeric_limits<float>::quiet_NaN(), 0xFFu);
   EXPECT_TRUE(nan_origin.test().may_enter(Aabb{Vec3(100.0f), Vec3(101.0f)}, 0.0f));
   EXPECT_TRUE(nan_t.test().may_enter(Aabb{Vec3(100.0f), Vec3(101.0f)}, 0.0f));
+  // So does a non-finite direction in one of many groups.
+  std::vector<float> many_x(32, 0.0f), many_y(32, 0.0f), many_z(32, 1.0f);
+  many_x[19] = std::numeric_limits<float>::infinity();
+  const float* const many[3] = {many_x.data(), many_y.data(), many_z.data()};
+  rt::RayBound inf_direction;
+  inf_direction.add_run(Vec3(0.0f), many, 0.0f, 1.0f, 32);
+  EXPECT_TRUE(inf_direction.test().may_enter(Aabb{Vec3(100.0f), Vec3(101.0f)}, 0.0f));
 }
 
 // Random packets around the characters: culled (tile bound, then packet
