@@ -176,7 +176,8 @@ Expected<bool> parse_on_off(std::string_view flag, const std::string& text) {
 
 Status parse_import_limits(const ParsedArgs& args, ImportLimits& limits) {
   const std::pair<const char*, std::size_t*> options[] = {
-      {"--max-triangles", &limits.max_triangles}, {"--max-clips", &limits.max_clips}, {"--max-keys", &limits.max_keys}};
+      {"--max-triangles", &limits.max_triangles}, {"--max-clips", &limits.max_clips}, {"--max-keys", &limits.max_keys},
+      {"--max-nodes", &limits.max_nodes},         {"--max-bytes", &limits.max_bytes}};
   for (const auto& [flag, value] : options) {
     if (const auto text = args.value(flag)) {
       SINEW_ASSIGN_OR_RETURN(const std::int64_t n, parse_int(flag, *text, 1, std::int64_t{1} << 40));
@@ -192,7 +193,10 @@ std::string import_limits_usage() {
          std::to_string(d.max_triangles) + ")\n" +
          "  --max-clips N         glTF import limit on animations (default " + std::to_string(d.max_clips) + ")\n" +
          "  --max-keys N          glTF import limit on animation keys over all channels (default " +
-         std::to_string(d.max_keys) + ")\n";
+         std::to_string(d.max_keys) + ")\n" +
+         "  --max-nodes N         glTF import limit on nodes (default " + std::to_string(d.max_nodes) + ")\n" +
+         "  --max-bytes N         glTF import limit on the bytes read, the file and its external buffers (default " +
+         std::to_string(d.max_bytes) + ")\n";
 }
 
 Expected<std::vector<std::string>> parse_folder_list(std::string_view flag, const std::string& text) {

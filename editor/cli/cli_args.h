@@ -65,7 +65,8 @@ Expected<int> parse_choice(std::string_view flag, const std::string& text,
                            std::initializer_list<std::string_view> choices);
 // "on" or "off".
 Expected<bool> parse_on_off(std::string_view flag, const std::string& text);
-// --max-triangles, --max-clips and --max-keys into `limits` (each at least 1).
+// --max-triangles, --max-clips, --max-keys, --max-nodes and --max-bytes into
+// `limits` (each at least 1).
 Status parse_import_limits(const ParsedArgs& args, ImportLimits& limits);
 // Their help lines.
 std::string import_limits_usage();

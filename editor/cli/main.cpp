@@ -46,7 +46,8 @@ int main(int argc, char** argv) {
   } catch (const std::bad_alloc&) {
     std::cerr << "sinew-editor " << command
               << ": out of memory: the input needs more than this machine has (the glTF import limits "
-                 "--max-triangles, --max-clips and --max-keys, and bake's --max-memory-mib, bound it lower)\n";
+                 "--max-triangles, --max-clips, --max-keys, --max-nodes and --max-bytes, and bake's --max-memory-mib, "
+                 "bound it lower)\n";
   } catch (const std::exception& e) {
     std::cerr << "sinew-editor " << command << ": internal error: " << sinew::printable(e.what()) << "\n";
   }

@@ -85,7 +85,7 @@ const std::vector<cli::FlagSpec>& bake_flags() {
       {"--help", false}, {"-h", false},      {"--out"},     {"--pose-space"}, {"--clips"},
       {"--samples"},     {"--seed"},         {"--limits"}, {"--pad"},  {"--candidates"}, {"--sah-intersection-cost"}, {"--threads"},
       {"--scene"},       {"--max-memory-mib"}, {"--asset-roots"}, {"--max-triangles"}, {"--max-clips"},
-      {"--max-keys"},
+      {"--max-keys"},    {"--max-nodes"},    {"--max-bytes"},
   };
   return flags;
 }

@@ -43,7 +43,7 @@ const std::vector<cli::FlagSpec>& render_flags() {
       {"--seed"},        {"--shadows"},          {"--light"},      {"--threads"},      {"--instances"},
       {"--frames"},      {"--triangle-test"},    {"--bone-boxes"}, {"--fallback"},     {"--limits"},
       {"--ground"},      {"--packet-rays"},      {"--asset-roots"},   {"--max-triangles"}, {"--max-clips"},
-      {"--max-keys"},
+      {"--max-keys"},    {"--max-nodes"},        {"--max-bytes"},
   };
   return flags;
 }

@@ -29,7 +29,6 @@ namespace {
 // Far beyond any character; keeps a corrupt count from allocating gigabytes
 // before the bounds checks against the (much smaller) buffers run.
 constexpr std::size_t kMaxElements = std::size_t{1} << 25;  // values per accessor
-constexpr std::size_t kMaxNodes = std::size_t{1} << 20;
 constexpr const char* kStaticRootName = "<static>";
 constexpr const char* kDefaultMaterialName = "<default>";
 
@@ -452,9 +451,7 @@ struct NodeGraph {
 Expected<NodeGraph> build_graph(const Ctx& c) {
   const auto& nodes = c.model.nodes;
   const std::size_t n = nodes.size();
-  if (n > kMaxNodes) {
-    return c.error(ErrorCode::kLimitExceeded, "nodes", std::to_string(n), "too many nodes");
-  }
+  if (n > c.limits.max_nodes) return c.limit("nodes", n, "nodes", c.limits.max_nodes, "--max-nodes");
   NodeGraph g;
   g.parent.assign(n, -1);
   g.local.assign(n, DMat4(1.0));
@@ -1202,10 +1199,14 @@ bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, in
 }
 
 // tinygltf's file reads, kept inside the asset roots (it also looks in the
-// current directory) and to regular files.
+// current directory), to regular files, and to the import's byte limit
+// (the document's own bytes count first).
 struct GuardedFs {
   const AssetRoots* roots = nullptr;
+  std::size_t bytes_left = 0;
+  std::size_t max_bytes = 0;
   std::string refused, why;  // the first path refused, and why
+  bool over_limit = false;
 };
 
 bool guarded_read(std::vector<unsigned char>* out, std::string* err, const std::string& filepath, void* user) {
@@ -1216,7 +1217,24 @@ bool guarded_read(std::vector<unsigned char>* out, std::string* err, const std::
   } else if (Status s = check_regular_file(filepath); !s.ok()) {
     why = s.message();
   } else {
-    return tinygltf::ReadWholeFile(out, err, filepath, nullptr);
+    // The size first, so that a huge file is not read at all; then what
+    // was read (the file may have grown in between).
+    std::error_code ec;
+    const std::uintmax_t size = std::filesystem::file_size(filepath, ec);
+    const bool fits = !ec && size <= fs.bytes_left;
+    if (fits && !tinygltf::ReadWholeFile(out, err, filepath, nullptr)) return false;
+    if (fits && out->size() <= fs.bytes_left) {
+      fs.bytes_left -= out->size();
+      return true;
+    }
+    if (ec) {
+      why = "cannot read its size: " + ec.message();
+    } else {
+      fs.over_limit = true;
+      why = std::to_string(fits ? out->size() : size) + " bytes, past the import limit of " +
+            std::to_string(fs.max_bytes) + " bytes for the file and its buffers (raise it with --max-bytes)";
+      out->clear();
+    }
   }
   if (fs.refused.empty()) {
     fs.refused = filepath;
@@ -1229,7 +1247,18 @@ bool guarded_read(std::vector<unsigned char>* out, std::string* err, const std::
 }  // namespace
 
 Expected<ImportedModel> import_gltf(const std::string& path, const GltfImportOptions& options) {
+  const std::size_t max_bytes = options.limits.max_bytes;
+  const auto too_big = [&](std::uintmax_t size) {
+    return make_error(ErrorCode::kLimitExceeded, path, "", std::to_string(size) + " bytes",
+                      "more bytes than the import limit of " + std::to_string(max_bytes) +
+                          " (raise it with --max-bytes)");
+  };
+  SINEW_RETURN_IF_ERROR(check_regular_file(path));
+  std::error_code size_error;
+  const std::uintmax_t size = std::filesystem::file_size(path, size_error);
+  if (!size_error && size > max_bytes) return too_big(size);
   SINEW_ASSIGN_OR_RETURN(const std::string bytes, read_file_text(path));
+  if (bytes.size() > max_bytes) return too_big(bytes.size());
   // tinygltf takes 32-bit lengths.
   if (bytes.size() > std::numeric_limits<unsigned int>::max()) {
     return make_error(ErrorCode::kLimitExceeded, path, "", std::to_string(bytes.size()) + " bytes",
@@ -1253,7 +1282,7 @@ Expected<ImportedModel> import_gltf(const std::string& path, const GltfImportOpt
   tinygltf::Model model;
   tinygltf::TinyGLTF loader;
   loader.SetImageLoader(skip_image, nullptr);
-  GuardedFs guarded{&roots, {}, {}};
+  GuardedFs guarded{&roots, max_bytes - bytes.size(), max_bytes, {}, {}, false};
   loader.SetFsCallbacks(tinygltf::FsCallbacks{&tinygltf::FileExists, &tinygltf::ExpandFilePath, &guarded_read,
                                               &tinygltf::WriteWholeFile, &guarded});
   std::string err, warn;
@@ -1276,7 +1305,8 @@ Expected<ImportedModel> import_gltf(const std::string& path, const GltfImportOpt
     loaded = false;
   }
   if (!loaded && !guarded.refused.empty()) {
-    return make_error(ErrorCode::kInvalidData, path, "uri", guarded.refused, "not read: " + guarded.why);
+    return make_error(guarded.over_limit ? ErrorCode::kLimitExceeded : ErrorCode::kInvalidData, path, "uri",
+                      guarded.refused, "not read: " + guarded.why);
   }
   if (!loaded) {
     while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();

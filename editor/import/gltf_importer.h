@@ -63,10 +63,14 @@ namespace sinew::editor {
 // of "../../etc/passwd" or "/etc/passwd" is refused before anything is read.
 // Resource limits, each named (with the option that raises it) when hit:
 // a 290 KB file instancing one mesh from 5,000 nodes is 23 M triangles.
+// (Joints have no import limit of their own: a skeleton holds at most
+// anim::kMaxJoints, and more are refused as beyond its capacity.)
 struct ImportLimits {
   std::size_t max_triangles = std::size_t{1} << 22;  // 4,194,304, over all mesh instances
   std::size_t max_clips = 1024;                      // animations
   std::size_t max_keys = std::size_t{1} << 24;       // keys over all channels (16,777,216)
+  std::size_t max_nodes = std::size_t{1} << 20;      // 1,048,576 nodes
+  std::size_t max_bytes = std::size_t{1} << 30;      // 1 GiB read: the file and its external buffers
 };
 struct GltfImportOptions {
   std::vector<std::string> asset_roots;  // more folders external files may come from

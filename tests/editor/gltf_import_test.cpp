@@ -1122,6 +1122,45 @@ TEST_F(GltfSynthetic, ResourceLimitsAreNamedAndCanBeRaised) {
   const auto keys = import_gltf(write(synthetic()), few_keys);
   ASSERT_FALSE(keys.ok());
   EXPECT_NE(keys.status().message().find("--max-keys"), std::string::npos) << keys.status().message();
+
+  // Nodes: the file above has 5,003.
+  GltfImportOptions few_nodes;
+  few_nodes.limits.max_nodes = 5002;
+  const auto nodes_refused = import_gltf(write(many), few_nodes);
+  ASSERT_FALSE(nodes_refused.ok());
+  EXPECT_EQ(nodes_refused.status().code(), ErrorCode::kLimitExceeded);
+  EXPECT_NE(nodes_refused.status().message().find(
+                "nodes = 5003: more nodes than the import limit of 5002 (raise it with --max-nodes)"),
+            std::string::npos)
+      << nodes_refused.status().message();
+  few_nodes.limits.max_nodes = 5003;
+  EXPECT_TRUE(import_gltf(write(many), few_nodes).ok());
+
+  // Bytes: the document's own, then those of its external buffer on top
+  // (neither file is read past the limit).
+  const Synthetic plain = synthetic();
+  const std::string path = write(plain);
+  const std::size_t document = plain.json.size(), total = document + plain.bin.size();
+  GltfImportOptions bytes;
+  bytes.limits.max_bytes = document - 1;
+  const auto document_refused = import_gltf(path, bytes);
+  ASSERT_FALSE(document_refused.ok());
+  EXPECT_EQ(document_refused.status().code(), ErrorCode::kLimitExceeded);
+  EXPECT_NE(document_refused.status().message().find(std::to_string(document) +
+                                                     " bytes: more bytes than the import limit of " +
+                                                     std::to_string(document - 1) + " (raise it with --max-bytes)"),
+            std::string::npos)
+      << document_refused.status().message();
+  bytes.limits.max_bytes = total - 1;
+  const auto buffer_refused = import_gltf(path, bytes);
+  ASSERT_FALSE(buffer_refused.ok());
+  EXPECT_EQ(buffer_refused.status().code(), ErrorCode::kLimitExceeded);
+  EXPECT_NE(buffer_refused.status().message().find("synthetic.bin"), std::string::npos)
+      << buffer_refused.status().message();
+  EXPECT_NE(buffer_refused.status().message().find("(raise it with --max-bytes)"), std::string::npos)
+      << buffer_refused.status().message();
+  bytes.limits.max_bytes = total;
+  EXPECT_TRUE(import_gltf(path, bytes).ok());
 }
 
 TEST_F(GltfSynthetic, MissingFile) {

@@ -456,6 +456,21 @@ TEST(RenderCommand, OptionsMapToTheirSettings) {
   EXPECT_EQ(r->pose_space.mode, anim::PoseSpaceMode::kArbitrary);
   EXPECT_EQ(r->pose_space.samples, 50);
   EXPECT_EQ(r->pose_space.seed, 18446744073709551615ull);
+
+  // The glTF import limits, each from its option; 0 is refused naming it.
+  const auto limits = parse_render_options({"m.glb", "--out", "o", "--max-triangles", "7", "--max-clips", "8",
+                                            "--max-keys", "9", "--max-nodes", "10", "--max-bytes", "11"});
+  ASSERT_TRUE(limits.ok()) << limits.status().message();
+  EXPECT_EQ(limits->gltf.limits.max_triangles, 7u);
+  EXPECT_EQ(limits->gltf.limits.max_clips, 8u);
+  EXPECT_EQ(limits->gltf.limits.max_keys, 9u);
+  EXPECT_EQ(limits->gltf.limits.max_nodes, 10u);
+  EXPECT_EQ(limits->gltf.limits.max_bytes, 11u);
+  EXPECT_EQ(d->gltf.limits.max_nodes, ImportLimits{}.max_nodes);
+  EXPECT_EQ(d->gltf.limits.max_bytes, ImportLimits{}.max_bytes);
+  const auto zero = parse_render_options({"m.glb", "--out", "o", "--max-bytes", "0"});
+  ASSERT_FALSE(zero.ok());
+  EXPECT_NE(zero.status().message().find("--max-bytes = 0"), std::string::npos) << zero.status().message();
 }
 
 TEST(CliArgs, ParsesTypedValuesAndRejectsBadOnes) {
