@@ -20,6 +20,7 @@
 #include "editor/cli/render_command.h"
 #include "editor/import/cal3d_importer.h"
 #include "editor/import/model_loader.h"
+#include "raytrace/render/renderer.h"
 #include "raytrace/scene/scene.h"
 #include "runtime/core/expected.h"
 #include "runtime/cpu/cpu_features.h"
@@ -28,6 +29,17 @@
 namespace sinew::bench {
 
 // The CPU's model name from /proc/cpuinfo, "unknown" elsewhere.
+// The renderer's default packets in words, e.g. "16×16-pixel packets of
+// 256 rays" (a packet is a square region; 8 rays are one 4×2 block).
+inline std::string packet_words() {
+  const int rays = rt::RenderSettings{}.packet_rays;
+  int side = 1;
+  while (side * side < rays) ++side;
+  if (side * side != rays) return std::to_string(rays) + "-ray packets";
+  const std::string s = std::to_string(side);
+  return s + "×" + s + "-pixel packets of " + std::to_string(rays) + " rays";
+}
+
 inline std::string cpu_model() {
   std::ifstream in("/proc/cpuinfo");
   std::string line;

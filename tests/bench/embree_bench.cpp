@@ -799,11 +799,12 @@ int run_embree_bench(const std::vector<std::string>& args, const std::string& co
   std::printf("\n  build = Sinew: boxes + fallback + top level of prepare_frame; Embree: vertex upload +\n"
               "  rtcCommitScene (rebuild or refit); exact: merge + SAH kd build + top level. trace = primary +\n"
               "  shadow rays; total = skinning (shared) + build + trace + shade; medians over the frames.\n"
-              "  sinew/this < 1: Sinew is faster. Sinew traces 8x8-pixel packets of 64 rays culled cell by cell\n"
+              "  sinew/this < 1: Sinew is faster. Sinew traces %s culled cell by cell\n"
               "  (render/large_packet.h) after a tile cull of the top level (render/tile_stages.h). Embree is\n"
               "  shown at every width run: 1 = rtcIntersect1/rtcOccluded1,\n"
               "  4/8/16 = rtcIntersectN/rtcOccludedN packets with RTC_INTERSECT_CONTEXT_FLAG_COHERENT; the best\n"
-              "  Embree row (lowest median total) is marked, and Sinew/best compares Sinew with it.\n");
+              "  Embree row (lowest median total) is marked, and Sinew/best compares Sinew with it.\n",
+              packet_words().c_str());
   for (const std::string& row : best_rows) std::printf("  best Embree, %s\n", row.c_str());
   const std::string load_end = load_average();
   std::printf("  load at the end: %s (1, 5, 15 min)\n", load_end.c_str());

@@ -337,8 +337,8 @@ std::string embree_markdown(const Run& r) {
   }
   md += "\n*build*: Sinew = bone boxes + fallback + top level; Embree = vertex upload + `rtcCommitScene`; exact = "
         "merge + SAH kd build + top level. *trace* = primary + shadow rays; *total* = skinning (shared) + build + "
-        "trace + shade; medians over the frames. Ratios below 1: Sinew is faster. Sinew traces 8×8-pixel "
-        "packets of 64 rays that walk each tree once, after a tile cull of the top level; tiles that reach only a "
+        "trace + shade; medians over the frames. Ratios below 1: Sinew is faster. Sinew traces " +
+        packet_words() + " that walk each tree once, after a tile cull of the top level; tiles that reach only a "
         "few static triangles test them directly. ";
   md += widths ? "Embree ran every mode at every width — single rays (`rtcIntersect1`/`rtcOccluded1`) and 4-, 8- "
                  "and 16-wide packets (`rtcIntersectN`/`rtcOccludedN` with `RTC_INTERSECT_CONTEXT_FLAG_COHERENT`); "
