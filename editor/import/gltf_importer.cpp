@@ -1249,7 +1249,7 @@ bool guarded_read(std::vector<unsigned char>* out, std::string* err, const std::
 Expected<ImportedModel> import_gltf(const std::string& path, const GltfImportOptions& options) {
   const std::size_t max_bytes = options.limits.max_bytes;
   const auto too_big = [&](std::uintmax_t size) {
-    return make_error(ErrorCode::kLimitExceeded, path, "", std::to_string(size) + " bytes",
+    return make_error(ErrorCode::kLimitExceeded, path, "size", std::to_string(size) + " bytes",
                       "more bytes than the import limit of " + std::to_string(max_bytes) +
                           " (raise it with --max-bytes)");
   };
