@@ -92,14 +92,6 @@ bool RayBound::add_shared(const Vec3& origin, float t_min, float t_max) {
   return finite;
 }
 
-void RayBound::add_lanes(const Vec3& origin, const float* const d[3], float t_min, float t_max,
-                         std::uint32_t lanes) {
-  lanes &= 0xFFu;
-  if (lanes == 0) return;
-  const bool finite = add_shared(origin, t_min, t_max);
-  if (!add_directions(d, lanes) || !finite) unbounded_ = true;
-}
-
 template <class LanesOf>
 void RayBound::add_shared_groups(const Vec3& origin, const float* const d[3], float t_min, float t_max,
                                  std::size_t groups, LanesOf&& lanes_of) {
@@ -134,6 +126,11 @@ void RayBound::add_shared_groups(const Vec3& origin, const float* const d[3], fl
   empty_ = false;
   folded_ = false;
   if (!add_shared(origin, t_min, t_max) || finite.bits() != 0xFFu) unbounded_ = true;
+}
+
+void RayBound::add_lanes(const Vec3& origin, const float* const d[3], float t_min, float t_max,
+                         std::uint32_t lanes) {
+  add_shared_groups(origin, d, t_min, t_max, 1, [&](std::size_t) { return lanes; });
 }
 
 void RayBound::add_groups(const Vec3& origin, const float* const d[3], float t_min, float t_max,

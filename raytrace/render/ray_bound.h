@@ -79,7 +79,8 @@ class RayBound {
   Test test() const;
 
  private:
-  // Folds the directions of `lanes` (not 0) in; false when one is not finite.
+  // Folds the directions of `lanes` (not 0) of rays with their own origins
+  // in; false when one is not finite.
   bool add_directions(const float* const d[3], std::uint32_t lanes);
   // Folds in one shared origin and parameter range; false when not finite.
   bool add_shared(const Vec3& origin, float t_min, float t_max);
@@ -91,7 +92,7 @@ class RayBound {
 
   // Per lane, the running minimum and maximum of each quantity: the
   // directions of every ray added, the origins and parameters of the rays
-  // added with their own (per-lane origin_empty_ says whether any were).
+  // added with their own (lane_origins_empty_ says whether any were).
   struct Lanes {
     float o_min[3][8], o_max[3][8], d_min[3][8], d_max[3][8];
     float t_min[8], t_max[8];
