@@ -26,6 +26,7 @@
 #include <cstdint>
 #include <limits>
 
+#include "runtime/math/aabb.h"
 #include "runtime/math/float8.h"
 #include "runtime/math/types.h"
 
@@ -127,6 +128,46 @@ class GroupFrusta {
       }
       if (full != 0) set_block<kFar>(base, full, sign, q, reach);
     }
+  }
+
+  // The groups of `groups` whose frustum may reach `box` (an object's box,
+  // before its lanes are clipped to it). A box lies wholly beyond a plane
+  // when its corner nearest the plane does; the same margin as reached()
+  // covers the rounding of that corner's distance. A box that is empty or
+  // not finite is reached by every group (its distances are NaN or inf).
+  std::uint32_t box_reached(const Aabb& box, std::uint32_t groups) const {
+    const Vec3 c = 0.5f * (box.lower + box.upper) - apex_;
+    const Vec3 h = 0.5f * (box.upper - box.lower);
+    const float corners = std::max(magnitude(box.lower), magnitude(box.upper));
+    const Float8 margin(0x1.0p-12f * (corners + apex_magnitude_));
+    std::uint32_t out = 0;
+    for (int base = 0; base < groups_; base += 8) {
+      const std::uint32_t part = (groups >> base) & 0xFFu;
+      if (part == 0) continue;
+      const std::uint32_t block = static_cast<std::uint32_t>(base / 8);
+      const std::uint32_t sides = sides_[block], far = far_[block];
+      if ((part & (sides | far)) == 0) {
+        out |= part << base;
+        continue;
+      }
+      Mask8 culled_by_sides = Mask8::from_bits(0), culled_by_far = Mask8::from_bits(0);
+      for (int i = 0; i < (far != 0 ? 5 : 4); ++i) {
+        const Float8 nx = Float8::load(&n_[i][0][base]), ny = Float8::load(&n_[i][1][base]),
+                     nz = Float8::load(&n_[i][2][base]);
+        const Float8 centre = (nx * Float8(c.x) + ny * Float8(c.y)) + nz * Float8(c.z);
+        const Float8 reach = (abs(nx) * Float8(h.x) + abs(ny) * Float8(h.y)) + abs(nz) * Float8(h.z);
+        const Float8 nearest = centre - reach;
+        const Float8 limit = Float8::load(&scale_[i][base]) * margin;
+        if (i == 4) {
+          culled_by_far = nearest > limit + Float8::load(&offset_[base]);
+        } else {
+          culled_by_sides = culled_by_sides | (nearest > limit);
+        }
+      }
+      const std::uint32_t culled = (culled_by_sides.bits() & sides) | (culled_by_far.bits() & far);
+      out |= (part & ~culled) << base;
+    }
+    return out;
   }
 
   // The groups of `groups` whose frustum the triangle may reach.

@@ -301,6 +301,7 @@ class LargeQuery {
     if (std::isfinite(t_hi)) reach = std::max(reach, t_hi * d_mag * 1.01f);
     const float slack = kFrameRelativeSlack * 1.01f * (o_mag + reach + scene_magnitude);
     const float grow = bound.grow_for(scene_ref().top_level().bounds(), slack);
+    visit_slack_ = slack;
     struct Candidate {
       float entry;
       std::uint32_t object;
@@ -435,7 +436,18 @@ class LargeQuery {
   void visit(const TopLevelObject& object, std::uint32_t object_index) {
     std::uint32_t groups = 0;
     const float box_magnitude = max_abs(object.box);
-    for_each_bit(alive_groups_, [&](int g) {
+    // With group frusta, only the groups whose frustum reaches the box
+    // grown by every lane's slack clip their lanes to it: most groups of a
+    // packet miss most of the objects its bound reaches (a shadow packet's
+    // groups enter about one object in three). The others enter nothing.
+    std::uint32_t clipped = alive_groups_;
+    if (frusta_on_) {
+      ensure_frusta(alive_groups_);
+      const Vec3 s(visit_slack_);
+      clipped = frusta_.box_reached({object.box.lower - s, object.box.upper + s}, alive_groups_);
+      for_each_bit(alive_groups_ & ~clipped, [&](int g) { visit_[g].lanes = visit_[g].leaf_lanes = 0; });
+    }
+    for_each_bit(clipped, [&](int g) {
       const Group& gr = group_[g];
       VisitGroup& vg = visit_[g];
       Float8 t0 = Float8::load(gr.t_min), t1 = Float8::load(gr.t_limit);
@@ -922,6 +934,7 @@ class LargeQuery {
   LaneMailbox mailbox_;
   ItemMailbox items_seen_;
   GroupFrusta<kMaxPacketGroups> frusta_;
+  float visit_slack_ = 0.0f;       // run(): a bound on every lane's slack in an object's box clip
   bool frusta_on_ = false;         // frusta_ holds this packet's apex
   std::uint32_t frusta_built_ = 0;  // the groups whose frustum frusta_ holds
   TraversalCounters counters_;

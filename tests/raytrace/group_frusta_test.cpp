@@ -13,6 +13,7 @@
 
 #include "raytrace/geometry/triangle_intersect.h"
 #include "raytrace/render/group_frusta.h"
+#include "runtime/math/aabb.h"
 #include "runtime/math/ray.h"
 
 namespace sinew {
@@ -45,10 +46,28 @@ void block_directions(const Vec3& centre, float spread, std::mt19937& g, float (
   }
 }
 
+// Whether the ray's points at t in [t_min, t_max] meet the box, in double.
+bool enters(const Ray& ray, const Aabb& box) {
+  double t0 = ray.t_min, t1 = ray.t_max;
+  for (int a = 0; a < 3; ++a) {
+    const double o = ray.origin[a], d = ray.direction[a], lo = box.lower[a], hi = box.upper[a];
+    if (d == 0.0) {
+      if (o < lo || o > hi) return false;
+      continue;
+    }
+    const double n = (lo - o) / d, f = (hi - o) / d;
+    t0 = std::max(t0, std::min(n, f));
+    t1 = std::min(t1, std::max(n, f));
+  }
+  return t0 <= t1;
+}
+
 struct Tally {
   int hit_triangles = 0;
   int culled = 0;
   int tried = 0;
+  int boxes_entered = 0;
+  int boxes_culled = 0;
 };
 
 // Triangles around the group's rays, from far off to straddling them; every
@@ -120,6 +139,20 @@ void check_group(const Vec3& apex, const float (&along)[3][8], std::uint32_t lan
     const bool reached = reached_groups != 0;
     ++tally.tried;
     if (!reached) ++tally.culled;
+    // A box about the same place (an object's box): never culled when a
+    // lane's ray enters it.
+    const Vec3 half = size * Vec3(unit(g), unit(g), unit(g));
+    const Aabb box{at + shift - half, at + shift + half};
+    const std::uint32_t box_groups = frusta.box_reached(box, tested);
+    ASSERT_TRUE(box_groups == 0 || box_groups == tested) << box_groups;
+    if (box_groups == 0) ++tally.boxes_culled;
+    for (int l = 0; l < 8; ++l) {
+      if (!(lanes >> l & 1u) || !enters(rays[l], box)) continue;
+      ++tally.boxes_entered;
+      ASSERT_NE(box_groups, 0u) << "lane " << l << " enters a culled box; apex (" << apex.x << "," << apex.y << ","
+                                << apex.z << ") trial " << trial;
+      break;
+    }
     for (int l = 0; l < 8; ++l) {
       if (!(lanes >> l & 1u) || !hits(rays[l], p0, p1, p2)) continue;
       ++tally.hit_triangles;
@@ -148,6 +181,8 @@ TEST(GroupFrusta, EveryHitTriangleIsReachedFromTheApex) {
   EXPECT_GT(tally.hit_triangles, tally.tried / 10);
   // Most triangles beside a narrow group are culled: the test has teeth.
   EXPECT_GT(tally.culled, tally.tried / 3) << tally.culled << " of " << tally.tried;
+  EXPECT_GT(tally.boxes_entered, tally.tried / 10);
+  EXPECT_GT(tally.boxes_culled, tally.tried / 4) << tally.boxes_culled << " of " << tally.tried;
 }
 
 TEST(GroupFrusta, EveryHitTriangleIsReachedBySegmentsFromTheApex) {
@@ -166,6 +201,8 @@ TEST(GroupFrusta, EveryHitTriangleIsReachedBySegmentsFromTheApex) {
   }
   EXPECT_GT(tally.hit_triangles, tally.tried / 10);
   EXPECT_GT(tally.culled, tally.tried / 4) << tally.culled << " of " << tally.tried;
+  EXPECT_GT(tally.boxes_entered, tally.tried / 10);
+  EXPECT_GT(tally.boxes_culled, tally.tried / 5) << tally.boxes_culled << " of " << tally.tried;
 }
 
 TEST(GroupFrusta, TrianglesBeyondTheRaysEndsAreCulledByTheFarPlane) {
@@ -193,6 +230,15 @@ TEST(GroupFrusta, TrianglesBeyondTheRaysEndsAreCulledByTheFarPlane) {
   // Between the light and the ends, or straddling the farthest one: reached.
   EXPECT_EQ(with_far.reached(at_depth(5.0f, 0), at_depth(5.0f, 1), at_depth(5.0f, 2), 1u), 1u);
   EXPECT_EQ(with_far.reached(at_depth(11.5f, 0), at_depth(12.5f, 1), at_depth(12.5f, 2), 1u), 1u);
+  // Boxes the same: one just behind the farthest end is culled by the far
+  // plane only; one straddling the ends (10 to 11.75) is reached.
+  const auto across = [&](float z0, float z1) {
+    return Aabb{light + Vec3(-0.05f, -0.05f, z0), light + Vec3(0.05f, 0.05f, z1)};
+  };
+  EXPECT_EQ(with_far.box_reached(across(12.1f, 12.4f), 1u), 0u);
+  EXPECT_EQ(without.box_reached(across(12.1f, 12.4f), 1u), 1u);
+  EXPECT_EQ(with_far.box_reached(across(11.5f, 12.4f), 1u), 1u);
+  EXPECT_EQ(with_far.box_reached(across(2.0f, 3.0f), 1u), 1u);
 }
 
 TEST(GroupFrusta, GroupsWithoutAFrustumReachEverything) {
@@ -215,6 +261,12 @@ TEST(GroupFrusta, GroupsWithoutAFrustumReachEverything) {
   const Vec3 bad(std::numeric_limits<float>::quiet_NaN(), 0.0f, 0.0f);
   EXPECT_EQ(frusta.reached(bad, p1, p2, 1u << 9), 1u << 9);
   EXPECT_EQ(frusta.reached(Vec3(kInf, 0, 0), p1, p2, 1u << 9), 1u << 9);
+  // Boxes likewise: beside the rays only the narrow group culls one; a box
+  // that is empty or not finite is reached by every group.
+  EXPECT_EQ(frusta.box_reached({apex + Vec3(5, 5, 1), apex + Vec3(6, 6, 2)}, all), all & ~(1u << 9));
+  EXPECT_EQ(frusta.box_reached(Aabb{}, 1u << 9), 1u << 9);
+  EXPECT_EQ(frusta.box_reached({bad, p1}, 1u << 9), 1u << 9);
+  EXPECT_EQ(frusta.box_reached({Vec3(-kInf), Vec3(kInf)}, 1u << 9), 1u << 9);
 }
 
 }  // namespace
