@@ -36,6 +36,9 @@ struct TileScratch {
   std::vector<int> block_x0, block_y0;     // per block: its top-left pixel
   std::vector<std::uint8_t> block_pixels;  // per block: bit i set when lane i is a pixel of the image
   std::vector<std::uint8_t> block_hits;    // per block: bit i set when lane i hit
+  // Per block: bit i set when lane i hit a character (not a static mesh);
+  // set with the surfaces (reconstruct_surfaces).
+  std::vector<std::uint8_t> block_on_character;
   // Primary rays: unit directions (the origin is the camera's eye).
   std::vector<float> dir_x, dir_y, dir_z;
   // Nearest hits (triangle kInvalidId on a miss).
@@ -56,8 +59,9 @@ struct TileScratch {
   // point light's: render/renderer.h shadow_ray_from_light).
   bool shadows_from_point = false;
   Vec3 shadow_origin{0.0f};
-  // Shadow ray r's region: rays [shadow_region_begin[r], shadow_region_begin[r + 1])
-  // come from one region's pixels (regions without a ray have no entry).
+  // Shadow run r: rays [shadow_region_begin[r], shadow_region_begin[r + 1])
+  // come from one region's pixels, those on characters or those on static
+  // meshes (runs without a ray have no entry).
   std::vector<std::uint32_t> shadow_region_begin;
   // The tile's outputs until shade_and_write stores them (render/output_staging.h).
   OutputStaging staging;

@@ -39,11 +39,14 @@ void trace_primary(const Scene& scene, const PinholeCamera& camera, TriangleTest
                    TileScratch& s, TraversalCounters& counters);
 
 // The surfaces at the hits (positions, camera-facing geometric and
-// shading normals, albedo, rounding bound), as surface_at computes them.
+// shading normals, albedo, rounding bound), as surface_at computes them,
+// and which hits are on characters (s.block_on_character).
 void reconstruct_surfaces(const Scene& scene, const Vec3& default_albedo, TileScratch& s);
 
-// Light `l`'s shadow rays for the hits whose surface faces it, compacted in
-// block order into s.shadow_*; hits facing away lose bit l of s.lit here.
+// Light `l`'s shadow rays for the hits whose surface faces it, compacted
+// into s.shadow_* in runs (s.shadow_region_begin): per region, the rays of
+// its hits on characters, then those on static meshes, each in block order;
+// hits facing away lose bit l of s.lit here.
 // A point light's rays are shadow_ray_from_light's (from the light, t_max
 // 1); a directional light's leave offset_origin along the light (t_max inf).
 void make_shadow_rays(const Light& light, int l, TileScratch& s);

@@ -782,51 +782,101 @@ TEST(TileStages, SurfacesAndShadowOriginsAreTheScalarOnes) {
           .value();
   rt::Light light;
   light.position = Vec3(2.0f, 4.0f, 3.0f);
-  std::size_t hits = 0, rays = 0;
-  for (int ty = 0; ty < 64; ty += 16) {
-    for (int tx = 0; tx < 64; tx += 16) {
-      rt::TileScratch s;
-      s.prepare(Tile{tx, ty, tx + 16, ty + 16, 0});
-      rt::generate_camera_rays(camera, s);
-      rt::TraversalCounters counters;
-      rt::trace_primary(sc, camera, TriangleTest::kFast, 8, s, counters);
-      std::fill(s.lit.begin(), s.lit.end(), std::uint8_t{1});
-      rt::reconstruct_surfaces(sc, Vec3(0.7f), s);
-      rt::make_shadow_rays(light, 0, s);
-      std::size_t next_ray = 0;
-      for (std::size_t k = 0; k < s.lanes; ++k) {
-        if (!s.hit(k)) continue;
-        ++hits;
-        const Hit hit{s.t[k], s.u[k], s.v[k], s.triangle[k], s.instance[k]};
-        const rt::SurfacePoint p = rt::surface_at(sc, hit, Vec3(0.7f));
-        const Vec3 dir(s.dir_x[k], s.dir_y[k], s.dir_z[k]);
-        Vec3 facing = p.geometric_normal;
-        if (glm::dot(facing, dir) > 0.0f) facing = -facing;
-        Vec3 n = p.shading_normal;
-        if (glm::dot(n, facing) < 0.0f) n = -n;
-        ASSERT_EQ(Vec3(s.px[k], s.py[k], s.pz[k]), p.position) << k;
-        ASSERT_EQ(Vec3(s.gx[k], s.gy[k], s.gz[k]), facing) << k;
-        ASSERT_EQ(Vec3(s.nx[k], s.ny[k], s.nz[k]), n) << k;
-        ASSERT_EQ(Vec3(s.ar[k], s.ag[k], s.ab[k]), p.albedo) << k;
-        ASSERT_EQ(s.error[k], p.error.x) << k;
-        if (glm::dot(facing, light.position - p.position) <= 0.0f) {
-          ASSERT_EQ(s.lit[k], 0u) << "facing away from the light: dark without a ray";
+  std::size_t hits = 0, rays = 0, split_regions = 0;
+  // Regions of one block (8-ray packets) and of 4x8 blocks (256 rays).
+  for (const int region_x : {1, 4}) {
+    for (int ty = 0; ty < 64; ty += 16) {
+      for (int tx = 0; tx < 64; tx += 16) {
+        rt::TileScratch s;
+        s.prepare(Tile{tx, ty, tx + 16, ty + 16, 0}, region_x, 2 * region_x);
+        rt::generate_camera_rays(camera, s);
+        rt::TraversalCounters counters;
+        rt::trace_primary(sc, camera, TriangleTest::kFast, 8, s, counters);
+        std::fill(s.lit.begin(), s.lit.end(), std::uint8_t{1});
+        rt::reconstruct_surfaces(sc, Vec3(0.7f), s);
+        rt::make_shadow_rays(light, 0, s);
+        const auto on_character = [&](std::size_t k) {
+          return sc.object_slots()[s.instance[k]].kind == rt::Scene::ObjectKind::kCharacter;
+        };
+        const auto region_of = [&](std::size_t k) {
+          const std::size_t b = k / rt::kBlockLanes;
+          return static_cast<std::size_t>(std::upper_bound(s.region_begin.begin(), s.region_begin.end(), b) -
+                                          s.region_begin.begin());
+        };
+        // Which ray each lane got.
+        std::vector<std::size_t> ray_of(s.lanes, s.lanes);
+        for (std::size_t i = 0; i < s.shadow_count; ++i) {
+          ASSERT_EQ(ray_of[s.shadow_pixel[i]], s.lanes) << "one ray per lane";
+          ray_of[s.shadow_pixel[i]] = i;
+        }
+        std::size_t lane_rays = 0;
+        for (std::size_t k = 0; k < s.lanes; ++k) {
+          if (!s.hit(k)) continue;
+          ++hits;
+          const Hit hit{s.t[k], s.u[k], s.v[k], s.triangle[k], s.instance[k]};
+          const rt::SurfacePoint p = rt::surface_at(sc, hit, Vec3(0.7f));
+          const Vec3 dir(s.dir_x[k], s.dir_y[k], s.dir_z[k]);
+          Vec3 facing = p.geometric_normal;
+          if (glm::dot(facing, dir) > 0.0f) facing = -facing;
+          Vec3 n = p.shading_normal;
+          if (glm::dot(n, facing) < 0.0f) n = -n;
+          ASSERT_EQ(Vec3(s.px[k], s.py[k], s.pz[k]), p.position) << k;
+          ASSERT_EQ(Vec3(s.gx[k], s.gy[k], s.gz[k]), facing) << k;
+          ASSERT_EQ(Vec3(s.nx[k], s.ny[k], s.nz[k]), n) << k;
+          ASSERT_EQ(Vec3(s.ar[k], s.ag[k], s.ab[k]), p.albedo) << k;
+          ASSERT_EQ(s.error[k], p.error.x) << k;
+          const bool lane_on_character = (s.block_on_character[k / rt::kBlockLanes] >> (k % rt::kBlockLanes) & 1u) != 0;
+          ASSERT_EQ(lane_on_character, on_character(k)) << k;
+          if (glm::dot(facing, light.position - p.position) <= 0.0f) {
+            ASSERT_EQ(s.lit[k], 0u) << "facing away from the light: dark without a ray";
+            ASSERT_EQ(ray_of[k], s.lanes) << "no ray facing away from the light";
+            continue;
+          }
+          const std::size_t i = ray_of[k];
+          ASSERT_LT(i, s.shadow_count) << k;
+          const Ray ray = rt::shadow_ray_from_light(p, facing, light.position);
+          ASSERT_EQ(s.shadow_ray(i).origin, light.position) << k;
+          ASSERT_EQ(s.shadow_ray(i).direction, ray.direction) << k;
+          ASSERT_EQ(s.shadow_ray(i).t_max, 1.0f) << k;
+          ++lane_rays;
+          ++rays;
+        }
+        EXPECT_EQ(lane_rays, s.shadow_count);
+        // Runs: region by region, a region's rays on characters, then its
+        // rays on static meshes, each in lane order.
+        if (s.shadow_count == 0) {
+          EXPECT_TRUE(s.shadow_region_begin.empty());
           continue;
         }
-        ASSERT_LT(next_ray, s.shadow_count);
-        ASSERT_EQ(s.shadow_pixel[next_ray], k);
-        const Ray ray = rt::shadow_ray_from_light(p, facing, light.position);
-        ASSERT_EQ(s.shadow_ray(next_ray).origin, light.position) << k;
-        ASSERT_EQ(s.shadow_ray(next_ray).direction, ray.direction) << k;
-        ASSERT_EQ(s.shadow_ray(next_ray).t_max, 1.0f) << k;
-        ++next_ray;
-        ++rays;
+        ASSERT_GE(s.shadow_region_begin.size(), 2u);
+        EXPECT_EQ(s.shadow_region_begin.front(), 0u);
+        EXPECT_EQ(s.shadow_region_begin.back(), s.shadow_count);
+        std::size_t last_region = 0, last_kind = 0;
+        for (std::size_t r = 0; r + 1 < s.shadow_region_begin.size(); ++r) {
+          const std::size_t i0 = s.shadow_region_begin[r], i1 = s.shadow_region_begin[r + 1];
+          ASSERT_LT(i0, i1) << "no empty run";
+          const std::size_t region = region_of(s.shadow_pixel[i0]);
+          const std::size_t kind = on_character(s.shadow_pixel[i0]) ? 0 : 1;
+          for (std::size_t i = i0; i < i1; ++i) {
+            ASSERT_EQ(region_of(s.shadow_pixel[i]), region) << i;
+            ASSERT_EQ(on_character(s.shadow_pixel[i]) ? 0u : 1u, kind) << i;
+            if (i > i0) {
+              ASSERT_LT(s.shadow_pixel[i - 1], s.shadow_pixel[i]);
+            }
+          }
+          if (r > 0) {
+            ASSERT_TRUE(region > last_region || (region == last_region && kind > last_kind)) << r;
+            if (region == last_region) ++split_regions;
+          }
+          last_region = region;
+          last_kind = kind;
+        }
       }
-      EXPECT_EQ(next_ray, s.shadow_count);
     }
   }
-  EXPECT_GT(hits, 1000u);
-  EXPECT_GT(rays, 500u);
+  EXPECT_GT(hits, 2000u);
+  EXPECT_GT(rays, 1000u);
+  EXPECT_GT(split_regions, 4u) << "regions with rays on both kinds of mesh";
 }
 
 struct Frame {
