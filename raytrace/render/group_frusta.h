@@ -139,41 +139,31 @@ class GroupFrusta {
     const Vec3 c = 0.5f * (box.lower + box.upper) - apex_;
     const Vec3 h = 0.5f * (box.upper - box.lower);
     const float corners = std::max(magnitude(box.lower), magnitude(box.upper));
-    const Float8 margin(0x1.0p-12f * (corners + apex_magnitude_));
-    std::uint32_t out = 0;
-    for (int base = 0; base < groups_; base += 8) {
-      const std::uint32_t part = (groups >> base) & 0xFFu;
-      if (part == 0) continue;
-      const std::uint32_t block = static_cast<std::uint32_t>(base / 8);
-      const std::uint32_t sides = sides_[block], far = far_[block];
-      if ((part & (sides | far)) == 0) {
-        out |= part << base;
-        continue;
-      }
-      Mask8 culled_by_sides = Mask8::from_bits(0), culled_by_far = Mask8::from_bits(0);
-      for (int i = 0; i < (far != 0 ? 5 : 4); ++i) {
-        const Float8 nx = Float8::load(&n_[i][0][base]), ny = Float8::load(&n_[i][1][base]),
-                     nz = Float8::load(&n_[i][2][base]);
-        const Float8 centre = (nx * Float8(c.x) + ny * Float8(c.y)) + nz * Float8(c.z);
-        const Float8 reach = (abs(nx) * Float8(h.x) + abs(ny) * Float8(h.y)) + abs(nz) * Float8(h.z);
-        const Float8 nearest = centre - reach;
-        const Float8 limit = Float8::load(&scale_[i][base]) * margin;
-        if (i == 4) {
-          culled_by_far = nearest > limit + Float8::load(&offset_[base]);
-        } else {
-          culled_by_sides = culled_by_sides | (nearest > limit);
-        }
-      }
-      const std::uint32_t culled = (culled_by_sides.bits() & sides) | (culled_by_far.bits() & far);
-      out |= (part & ~culled) << base;
-    }
-    return out;
+    return uncut(groups, corners, [&](Float8 nx, Float8 ny, Float8 nz) {
+      const Float8 centre = (nx * Float8(c.x) + ny * Float8(c.y)) + nz * Float8(c.z);
+      const Float8 reach = (abs(nx) * Float8(h.x) + abs(ny) * Float8(h.y)) + abs(nz) * Float8(h.z);
+      return centre - reach;
+    });
   }
 
   // The groups of `groups` whose frustum the triangle may reach.
   std::uint32_t reached(const Vec3& p0, const Vec3& p1, const Vec3& p2, std::uint32_t groups) const {
     const Vec3 x0 = p0 - apex_, x1 = p1 - apex_, x2 = p2 - apex_;
     const float corners = std::max({magnitude(p0), magnitude(p1), magnitude(p2)});
+    return uncut(groups, corners, [&](Float8 nx, Float8 ny, Float8 nz) {
+      const auto side = [&](const Vec3& x) { return (nx * Float8(x.x) + ny * Float8(x.y)) + nz * Float8(x.z); };
+      return min(min(side(x0), side(x1)), side(x2));
+    });
+  }
+
+ private:
+  // The groups of `groups` that no plane of theirs cuts off, eight at a
+  // time: nearest(nx, ny, nz) is the shape's least signed distance
+  // n . (p - apex) to each group's plane n, and a plane cuts the shape off
+  // when that exceeds the margin for coordinates up to `corners` (for the
+  // far plane, beyond its offset). Groups without a frustum are never cut.
+  template <class Nearest>
+  std::uint32_t uncut(std::uint32_t groups, float corners, Nearest&& nearest) const {
     const Float8 margin(0x1.0p-12f * (corners + apex_magnitude_));
     std::uint32_t out = 0;
     for (int base = 0; base < groups_; base += 8) {
@@ -187,15 +177,13 @@ class GroupFrusta {
       }
       Mask8 culled_by_sides = Mask8::from_bits(0), culled_by_far = Mask8::from_bits(0);
       for (int i = 0; i < (far != 0 ? 5 : 4); ++i) {
-        const Float8 nx = Float8::load(&n_[i][0][base]), ny = Float8::load(&n_[i][1][base]),
-                     nz = Float8::load(&n_[i][2][base]);
-        const auto side = [&](const Vec3& x) { return (nx * Float8(x.x) + ny * Float8(x.y)) + nz * Float8(x.z); };
-        const Float8 nearest = min(min(side(x0), side(x1)), side(x2));
-        Float8 limit = Float8::load(&scale_[i][base]) * margin;
+        const Float8 d = nearest(Float8::load(&n_[i][0][base]), Float8::load(&n_[i][1][base]),
+                                 Float8::load(&n_[i][2][base]));
+        const Float8 limit = Float8::load(&scale_[i][base]) * margin;
         if (i == 4) {
-          culled_by_far = nearest > limit + Float8::load(&offset_[base]);
+          culled_by_far = d > limit + Float8::load(&offset_[base]);
         } else {
-          culled_by_sides = culled_by_sides | (nearest > limit);
+          culled_by_sides = culled_by_sides | (d > limit);
         }
       }
       const std::uint32_t culled = (culled_by_sides.bits() & sides) | (culled_by_far.bits() & far);
@@ -204,7 +192,6 @@ class GroupFrusta {
     return out;
   }
 
- private:
   // Groups base + k for the bits k of `full` (all eight lanes in use),
   // lane k of every vector below holding group base + k.
   template <bool kFar, class Q, class Reach>
