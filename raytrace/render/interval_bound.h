@@ -12,8 +12,9 @@
 //
 // Numerical safety: every product is widened by a relative 2^-20 (far above
 // its 2^-24 rounding), reciprocal bounds likewise, and callers grow boxes by
-// grow_for(): their own slack plus 2^-20 of the larger of the box's and the
-// origins' magnitudes, for the rounding of (plane - origin). A set holding
+// grow_for(): their own slack plus, per axis, 2^-20 of the larger of the
+// box's and the origins' magnitudes on that axis, for the rounding of
+// (plane - origin). A set holding
 // a non-finite ray bounds nothing: every box may be entered.
 #pragma once
 
@@ -113,7 +114,6 @@ class IntervalBound {
     unbounded_ = !r.finite;
     t_lo_ = r.t_lo;
     t_hi_ = r.t_hi;
-    o_mag_ = r.origin_magnitude();
     const float ones = std::bit_cast<float>(0xFFFFFFFFu);
     alignas(16) float olo[4], ohi[4], rlo[4], rhi[4], pos[4], neg[4], nr[4], nf[4];
     for (int a = 0; a < 4; ++a) {
@@ -149,13 +149,28 @@ class IntervalBound {
     not_falling_ = _mm_load_ps(nf);
   }
 
+  // How much to grow boxes by, per axis.
+  struct Growth {
+    __m128 v;         // x, y, z, 0
+    float axis[3];
+  };
+
   // The growth for boxes inside `enclosing` that absorbs this bound's own
-  // rounding, on top of the caller's `slack`.
-  float grow_for(const Aabb& enclosing, float slack) const {
-    const float box = std::max({std::fabs(enclosing.lower.x), std::fabs(enclosing.lower.y),
-                                std::fabs(enclosing.lower.z), std::fabs(enclosing.upper.x),
-                                std::fabs(enclosing.upper.y), std::fabs(enclosing.upper.z)});
-    return slack + kRelativeMargin * std::max(box, o_mag_);
+  // rounding, on top of the caller's `slack`: the rounding of
+  // (plane - origin) on an axis is relative to that axis's coordinates
+  // alone, so a flat ground is not grown at the scale of its width.
+  Growth grow_for(const Aabb& enclosing, float slack) const {
+    Growth g;
+    alignas(16) float v[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+    for (int a = 0; a < 3; ++a) {
+      const float box = std::max(std::fabs(enclosing.lower[a]), std::fabs(enclosing.upper[a]));
+      const float origin = std::max(std::fabs(axis_[a].o_lo), std::fabs(axis_[a].o_hi));
+      // NaN coordinates make the growth NaN, and so every box test pass.
+      const float m = box != box || origin != origin ? box + origin : std::max(box, origin);
+      v[a] = g.axis[a] = slack + kRelativeMargin * m;
+    }
+    g.v = _mm_load_ps(v);
+    return g;
   }
 
   float t_lo() const { return t_lo_; }
@@ -163,10 +178,10 @@ class IntervalBound {
 
   // A lower bound on the parameter, within [t_lo, t_hi], at which some ray
   // enters `box` grown by `grow` on every side; +inf when no ray does.
-  float entry(const Aabb& box, float grow, float t_hi) const {
+  float entry(const Aabb& box, const Growth& grow, float t_hi) const {
     constexpr float kInf = std::numeric_limits<float>::infinity();
     if (unbounded_) return -kInf;
-    const __m128 g = _mm_set1_ps(grow);
+    const __m128 g = grow.v;
     const __m128 lo = _mm_sub_ps(_mm_setr_ps(box.lower.x, box.lower.y, box.lower.z, 0.0f), g);
     const __m128 hi = _mm_add_ps(_mm_setr_ps(box.upper.x, box.upper.y, box.upper.z, 0.0f), g);
     // Every origin on one side of a slab, no direction turning towards it.
@@ -204,7 +219,7 @@ class IntervalBound {
     const float t_leave = std::min(t_hi, _mm_cvtss_f32(l));
     return t_enter <= t_leave ? t_enter : kInf;
   }
-  float entry(const Aabb& box, float grow) const { return entry(box, grow, t_hi_); }
+  float entry(const Aabb& box, const Growth& grow) const { return entry(box, grow, t_hi_); }
 
   // The direction sign of every ray of the set on axis a: +1, -1, or 0
   // (mixed, zero or too small to bound).
@@ -234,7 +249,7 @@ class IntervalBound {
     int sign = 0;
   };
   Axis axis_[3];
-  float t_lo_ = 0.0f, t_hi_ = 0.0f, o_mag_ = 0.0f;
+  float t_lo_ = 0.0f, t_hi_ = 0.0f;
   bool unbounded_ = false;
 };
 

@@ -10,6 +10,7 @@
 #include "raytrace/geometry/triangle_intersect8.h"
 #include "raytrace/render/group_frusta.h"
 #include "raytrace/render/interval_bound.h"
+#include "raytrace/render/ray_bound.h"
 #include "raytrace/render/traversal_shared.h"
 #include "runtime/math/float8.h"
 
@@ -280,8 +281,7 @@ class LargeQuery {
     if (alive_groups_ == 0 || objects.empty()) return;
     const std::span<const TopLevelObject> all = scene_ref().top_level().objects();
     // The packet's bound in world space and a bound on the slack of every
-    // single-ray box clip (RayBound::world_slack_bound's reasoning: a
-    // finite reach ends inside the scene).
+    // single-ray box clip (traversal_slack_bound, render/ray_bound.h).
     RangeAccumulator acc;
     Float8 o_mag8(0.0f), d_mag8(0.0f), t_hi8(0.0f);
     for_each_bit(alive_groups_, [&](int g) {
@@ -297,10 +297,8 @@ class LargeQuery {
     const float o_mag = reduce_max(o_mag8), d_mag = reduce_max(d_mag8), t_hi = reduce_max(t_hi8);
     const IntervalBound bound(ranges);
     const float scene_magnitude = max_abs(scene_ref().top_level().bounds());
-    float reach = 1.01f * (o_mag + scene_magnitude);
-    if (std::isfinite(t_hi)) reach = std::max(reach, t_hi * d_mag * 1.01f);
-    const float slack = kFrameRelativeSlack * 1.01f * (o_mag + reach + scene_magnitude);
-    const float grow = bound.grow_for(scene_ref().top_level().bounds(), slack);
+    const float slack = traversal_slack_bound(o_mag, d_mag, t_hi, scene_magnitude);
+    const IntervalBound::Growth grow = bound.grow_for(scene_ref().top_level().bounds(), slack);
     visit_slack_ = slack;
     struct Candidate {
       float entry;
@@ -719,7 +717,7 @@ class LargeQuery {
   // leaf, the groups whose own bound reaches its cell test its triangles.
   // `leaf` returns true to stop (every lane answered).
   template <class LeafFn>
-  void traverse(const KdTreeView& tree, const IntervalBound& bound, float grow, std::uint32_t groups,
+  void traverse(const KdTreeView& tree, const IntervalBound& bound, const IntervalBound::Growth& grow, std::uint32_t groups,
                 LeafFn& leaf) {
     // The packet's limit changes only when a lane records a hit.
     std::uint64_t seen = ~std::uint64_t{0};
@@ -760,11 +758,11 @@ class LargeQuery {
           bool below_first = true;
           if (sign > 0) {
             // Rising rays: below until they cross split + grow, above from split - grow.
-            below.t1 = std::min(cur.t1, bound.crossing_hi(a, split + grow));
-            above.t0 = std::max(cur.t0, bound.crossing_lo(a, split - grow));
+            below.t1 = std::min(cur.t1, bound.crossing_hi(a, split + grow.axis[a]));
+            above.t0 = std::max(cur.t0, bound.crossing_lo(a, split - grow.axis[a]));
           } else if (sign < 0) {
-            above.t1 = std::min(cur.t1, bound.crossing_hi(a, split - grow));
-            below.t0 = std::max(cur.t0, bound.crossing_lo(a, split + grow));
+            above.t1 = std::min(cur.t1, bound.crossing_hi(a, split - grow.axis[a]));
+            below.t0 = std::max(cur.t0, bound.crossing_lo(a, split + grow.axis[a]));
             below_first = false;
           } else {
             const float eb = bound.entry(below.box(), grow, cur.t1);

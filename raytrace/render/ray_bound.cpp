@@ -172,13 +172,7 @@ void RayBound::fold() const {
 
 float RayBound::world_slack_bound(float scene_magnitude) const {
   fold();
-  // The traversal's slack is kFrameRelativeSlack * (|o| + t_end |d| +
-  // |box|), t_end being the ray's t_max or its best hit so far. A finite hit
-  // lies inside the scene, so t_end |d| <= |o| + |scene| there; boxes are
-  // inside the scene, so |box| <= |scene|.
-  float reach = 1.01f * (o_mag_ + scene_magnitude);
-  if (std::isfinite(t_hi_)) reach = std::max(reach, t_hi_ * d_mag_ * 1.01f);
-  return kFrameRelativeSlack * 1.01f * (o_mag_ + reach + scene_magnitude);
+  return traversal_slack_bound(o_mag_, d_mag_, t_hi_, scene_magnitude);
 }
 
 RayBound::Test RayBound::test() const {
@@ -187,7 +181,6 @@ RayBound::Test RayBound::test() const {
   t.unbounded = unbounded_;
   t.t_lo = t_lo_;
   t.t_hi = t_hi_;
-  t.o_mag = o_mag_;
   const float ones = std::bit_cast<float>(0xFFFFFFFFu);
   for (int a = 0; a < 4; ++a) {
     const bool axis = a < 3;
@@ -215,13 +208,16 @@ bool RayBound::Test::may_enter(const Aabb& box, float grow) const {
   const __m128 sign = _mm_set1_ps(-0.0f);
   const __m128 lower = _mm_setr_ps(box.lower.x, box.lower.y, box.lower.z, 0.0f);
   const __m128 upper = _mm_setr_ps(box.upper.x, box.upper.y, box.upper.z, 0.0f);
-  __m128 mag = _mm_max_ps(_mm_andnot_ps(sign, lower), _mm_andnot_ps(sign, upper));
-  mag = _mm_max_ps(mag, _mm_movehl_ps(mag, mag));
-  mag = _mm_max_ss(mag, _mm_movehdup_ps(mag));
-  const float margin = grow + kRelativeMargin * std::max(_mm_cvtss_f32(mag), o_mag);
-  const __m128 lo = _mm_sub_ps(lower, _mm_set1_ps(margin));
-  const __m128 hi = _mm_add_ps(upper, _mm_set1_ps(margin));
+  if (_mm_movemask_ps(_mm_cmpunord_ps(lower, upper)) != 0) return true;  // a NaN box: never culled
   const __m128 olo = _mm_loadu_ps(o_lo), ohi = _mm_loadu_ps(o_hi);
+  // The rounding of (plane - origin) on an axis is relative to that axis's
+  // coordinates alone: a flat ground's height is not rounded at the scale
+  // of its width.
+  const __m128 mag = _mm_max_ps(_mm_max_ps(_mm_andnot_ps(sign, lower), _mm_andnot_ps(sign, upper)),
+                                _mm_max_ps(_mm_andnot_ps(sign, olo), _mm_andnot_ps(sign, ohi)));
+  const __m128 margin = _mm_add_ps(_mm_set1_ps(grow), _mm_mul_ps(_mm_set1_ps(kRelativeMargin), mag));
+  const __m128 lo = _mm_sub_ps(lower, margin);
+  const __m128 hi = _mm_add_ps(upper, margin);
   // Every origin on one side of a slab, no direction turning towards it.
   const __m128 below = _mm_and_ps(_mm_cmplt_ps(ohi, lo), _mm_loadu_ps(not_rising));
   const __m128 above = _mm_and_ps(_mm_cmpgt_ps(olo, hi), _mm_loadu_ps(not_falling));

@@ -23,6 +23,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -33,6 +34,19 @@
 #include "runtime/math/types.h"
 
 namespace sinew::rt {
+
+// An upper bound on the slack the traversal grows a world-space box by
+// (kFrameRelativeSlack * (|o| + t_end |d| + |box|), render/traversal.h)
+// over rays whose origin and direction coordinates are at most o_mag and
+// d_mag in magnitude and whose t_max is at most t_hi, for boxes inside a
+// scene of magnitude scene_magnitude. The reach t_end |d| is at most
+// t_hi d_mag when t_hi is finite (t_end never passes t_max); otherwise it is
+// a finite hit's, inside the scene, so at most o_mag + scene_magnitude.
+// Shadow rays (t_hi = 1) reach only their own length, not the scene's.
+inline float traversal_slack_bound(float o_mag, float d_mag, float t_hi, float scene_magnitude) {
+  const float reach = std::isfinite(t_hi) ? 1.01f * t_hi * d_mag : 1.01f * (o_mag + scene_magnitude);
+  return kFrameRelativeSlack * 1.01f * (o_mag + reach + scene_magnitude);
+}
 
 class RayBound {
  public:
@@ -73,7 +87,7 @@ class RayBound {
     float r_lo[4], r_hi[4];  // reciprocal direction range where the sign is fixed
     float positive[4], negative[4];         // all-ones where every direction is > 0 (< 0)
     float not_rising[4], not_falling[4];    // all-ones where no direction is > 0 (< 0)
-    float t_lo = 0.0f, t_hi = 0.0f, o_mag = 0.0f;
+    float t_lo = 0.0f, t_hi = 0.0f;
     bool unbounded = false;  // a non-finite ray: every box may be entered
   };
   Test test() const;
