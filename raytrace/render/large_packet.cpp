@@ -445,6 +445,19 @@ class LargeQuery {
       clipped = frusta_.box_reached({object.box.lower - s, object.box.upper + s}, alive_groups_);
       for_each_bit(alive_groups_ & ~clipped, [&](int g) { visit_[g].lanes = visit_[g].leaf_lanes = 0; });
     }
+    if (kTest == TriangleTest::kFast && detail::is_small_static(scene_ref(), object)) {
+      // A ground quad and the like: its triangles are tested directly, and
+      // a lane's clip to their box would only repeat what the triangle
+      // tests decide (run()'s short cut for packets of such meshes).
+      std::uint32_t groups = 0;
+      for_each_bit(clipped, [&](int g) {
+        visit_[g].lanes = visit_[g].leaf_lanes = live_[g];
+        if (live_[g] != 0) groups |= 1u << g;
+        counters_.object_visits += static_cast<std::uint64_t>(std::popcount(live_[g]));
+      });
+      if (groups != 0) visit_small_static(scene_ref().static_meshes()[object.index], groups);
+      return;
+    }
     for_each_bit(clipped, [&](int g) {
       const Group& gr = group_[g];
       VisitGroup& vg = visit_[g];
