@@ -137,6 +137,10 @@ class CameraBlocks {
     alignas(32) float best_u[kBlockLanes] = {}, best_v[kBlockLanes] = {};
     std::uint32_t best[kBlockLanes];  // index into triangles
     std::uint32_t hits = 0;
+    // The last triangle hit, and its lanes: when those are all of the hit
+    // lanes, every hit lane ended on it (a ground block, mostly).
+    std::size_t last = 0;
+    std::uint32_t last_lanes = 0;
     if (live != 0) {
       const std::uint64_t lanes = static_cast<std::uint64_t>(std::popcount(live));
       counters.object_visits += objects * lanes;
@@ -153,12 +157,23 @@ class CameraBlocks {
         for (std::uint32_t bits = hit; bits != 0; bits &= bits - 1) {
           best[std::countr_zero(bits)] = static_cast<std::uint32_t>(i);
         }
+        last = i;
+        last_lanes = hit;
         hits |= hit;
       }
     }
     Float8::load(r_.t_limit).store(&s.t[k0]);
     Float8::load(best_u).store(&s.u[k0]);
     Float8::load(best_v).store(&s.v[k0]);
+    if (hits != 0 && last_lanes == hits) {
+      const std::uint32_t triangle = triangles_[last].triangle, instance = triangles_[last].instance;
+      for (int lane = 0; lane < kBlockLanes; ++lane) {
+        const bool hit = (hits >> lane & 1u) != 0;
+        s.triangle[k0 + static_cast<std::size_t>(lane)] = hit ? triangle : kInvalidId;
+        s.instance[k0 + static_cast<std::size_t>(lane)] = hit ? instance : kInvalidId;
+      }
+      return hits;
+    }
     for (int lane = 0; lane < kBlockLanes; ++lane) {
       const std::size_t k = k0 + static_cast<std::size_t>(lane);
       const bool hit = (hits >> lane & 1u) != 0;
