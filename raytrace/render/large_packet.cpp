@@ -449,7 +449,6 @@ class LargeQuery {
       // A ground quad and the like: its triangles are tested directly, and
       // a lane's clip to their box would only repeat what the triangle
       // tests decide (run()'s short cut for packets of such meshes).
-      std::uint32_t groups = 0;
       for_each_bit(clipped, [&](int g) {
         visit_[g].lanes = visit_[g].leaf_lanes = live_[g];
         if (live_[g] != 0) groups |= 1u << g;
