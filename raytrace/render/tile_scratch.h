@@ -51,7 +51,17 @@ struct TileScratch {
   std::vector<float> ar, ag, ab;     // albedo
   std::vector<float> error;          // rounding bound of the position, every axis
   std::vector<std::uint8_t> lit;     // bit l: light l reaches the hit
-  // This light's shadow rays, compacted in block order (render/tile_stages.h).
+  // This light's shadow rays as placed, lane by lane (render/tile_stages.h
+  // place_shadow_rays): per block the lanes with a ray, and per lane the
+  // ray's direction (a point light's, from shadow_origin) or its origin (a
+  // directional light's, along shadow_direction).
+  std::size_t shadow_placed = 0;
+  std::vector<std::uint8_t> shadow_lanes;
+  std::vector<float> shadow_lane_x, shadow_lane_y, shadow_lane_z;
+  Vec3 shadow_direction{0.0f};
+  bool shadows_compacted = true;  // shadow_* below hold the placed rays
+  // This light's shadow rays, compacted in block order (render/tile_stages.h
+  // compact_shadow_rays).
   std::size_t shadow_count = 0;
   std::vector<std::uint32_t> shadow_pixel;  // the lane index k each ray belongs to
   std::vector<float> so_x, so_y, so_z, sd_x, sd_y, sd_z, s_tmax;

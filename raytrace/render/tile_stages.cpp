@@ -310,6 +310,7 @@ void TileScratch::prepare(const Tile& area, int region_blocks_x, int region_bloc
     block_pixels.resize(blocks);
     block_hits.resize(blocks);
     block_on_character.resize(blocks);
+    shadow_lanes.resize(blocks);
     block_x0.resize(blocks);
     block_y0.resize(blocks);
   }
@@ -318,7 +319,8 @@ void TileScratch::prepare(const Tile& area, int region_blocks_x, int region_bloc
   const std::size_t arrays = lanes + kBlockLanes;
   if (capacity_ < arrays) {
     for (std::vector<float>* a : {&dir_x, &dir_y, &dir_z, &t, &u, &v, &px, &py, &pz, &gx, &gy, &gz, &nx, &ny,
-                                  &nz, &ar, &ag, &ab, &error, &so_x, &so_y, &so_z, &sd_x, &sd_y, &sd_z, &s_tmax}) {
+                                  &nz, &ar, &ag, &ab, &error, &so_x, &so_y, &so_z, &sd_x, &sd_y, &sd_z, &s_tmax,
+                                  &shadow_lane_x, &shadow_lane_y, &shadow_lane_z}) {
       a->resize(arrays);
     }
     triangle.resize(arrays);
@@ -350,6 +352,8 @@ void TileScratch::prepare(const Tile& area, int region_blocks_x, int region_bloc
     }
   }
   region_begin.push_back(static_cast<std::uint32_t>(b));
+  shadow_placed = 0;
+  shadows_compacted = true;
   shadow_count = 0;
   shadow_region_begin.clear();
   shadows_from_point = false;
@@ -669,19 +673,23 @@ void reconstruct_surfaces(const Scene& scene, const Vec3& default_albedo, TileSc
   }
 }
 
-void make_shadow_rays(const Light& light, int l, TileScratch& s) {
+void place_shadow_rays(const Light& light, int l, TileScratch& s) {
   const std::uint8_t dark = static_cast<std::uint8_t>(~(1u << l));
   const bool point = light.kind == Light::Kind::kPoint;
   const Vec3x8 light_at{Float8(light.position.x), Float8(light.position.y), Float8(light.position.z)};
   const Vec3x8 light_dir{Float8(light.direction.x), Float8(light.direction.y), Float8(light.direction.z)};
   const float light_magnitude = detail::max_abs(light.position);
+  s.shadow_placed = 0;
+  s.shadows_compacted = false;
   s.shadow_count = 0;
   s.shadow_region_begin.clear();
   s.shadows_from_point = point;
   s.shadow_origin = light.position;
-  // The rays of block b's lanes of `lanes` (hits), compacted; the lanes
-  // facing away from the light lose bit l of s.lit instead.
-  const auto add_block = [&](std::size_t b, std::uint32_t lanes) {
+  s.shadow_direction = light.direction;
+  for (std::size_t b = 0; b < s.blocks(); ++b) {
+    s.shadow_lanes[b] = 0;
+    const std::uint32_t lanes = s.block_hits[b];
+    if (lanes == 0) continue;
     const std::size_t k0 = b * kBlockLanes;
     const Vec3x8 position = load3(s.px, s.py, s.pz, k0);
     const Vec3x8 facing = load3(s.gx, s.gy, s.gz, k0);
@@ -690,7 +698,7 @@ void make_shadow_rays(const Light& light, int l, TileScratch& s) {
     for (std::uint32_t away = lanes & ~toward; away != 0; away &= away - 1) {
       s.lit[k0 + static_cast<std::size_t>(std::countr_zero(away))] &= dark;  // no ray needed
     }
-    if (toward == 0) return;
+    if (toward == 0) continue;
     // offset_origin: pushed off along the camera-facing normal by the
     // rounding bound (for a point light, shadow_ray_from_light's wider
     // one), then one float further on every axis it moved.
@@ -705,19 +713,37 @@ void make_shadow_rays(const Light& light, int l, TileScratch& s) {
     const Vec3x8 moved = position + offset;
     const Vec3x8 end{step_away(moved.x, offset.x), step_away(moved.y, offset.y), step_away(moved.z, offset.z)};
     // A point light's rays run from the light to the offset points.
-    const Vec3x8 origin = point ? light_at : end;
-    const Vec3x8 direction = point ? end - light_at : light_dir;
-    // Compacted eight lanes at a time (the arrays have a spare group).
+    store3(point ? end - light_at : end, s.shadow_lane_x, s.shadow_lane_y, s.shadow_lane_z, k0);
+    s.shadow_lanes[b] = static_cast<std::uint8_t>(toward);
+    s.shadow_placed += static_cast<std::size_t>(std::popcount(toward));
+  }
+}
+
+void compact_shadow_rays(TileScratch& s) {
+  if (s.shadows_compacted) return;
+  s.shadows_compacted = true;
+  const bool point = s.shadows_from_point;
+  const Vec3x8 light_at{Float8(s.shadow_origin.x), Float8(s.shadow_origin.y), Float8(s.shadow_origin.z)};
+  const Vec3x8 light_dir{Float8(s.shadow_direction.x), Float8(s.shadow_direction.y), Float8(s.shadow_direction.z)};
+  s.shadow_count = 0;
+  s.shadow_region_begin.clear();
+  // The rays of block b's lanes of `lanes`, compacted eight lanes at a time
+  // (the arrays have a spare group).
+  const auto add_block = [&](std::size_t b, std::uint32_t lanes) {
+    const std::size_t k0 = b * kBlockLanes;
+    const Vec3x8 placed = load3(s.shadow_lane_x, s.shadow_lane_y, s.shadow_lane_z, k0);
+    const Vec3x8 origin = point ? light_at : placed;
+    const Vec3x8 direction = point ? placed : light_dir;
     const std::size_t i = s.shadow_count;
-    compress_store(&s.so_x[i], origin.x, toward);
-    compress_store(&s.so_y[i], origin.y, toward);
-    compress_store(&s.so_z[i], origin.z, toward);
-    compress_store(&s.sd_x[i], direction.x, toward);
-    compress_store(&s.sd_y[i], direction.y, toward);
-    compress_store(&s.sd_z[i], direction.z, toward);
+    compress_store(&s.so_x[i], origin.x, lanes);
+    compress_store(&s.so_y[i], origin.y, lanes);
+    compress_store(&s.so_z[i], origin.z, lanes);
+    compress_store(&s.sd_x[i], direction.x, lanes);
+    compress_store(&s.sd_y[i], direction.y, lanes);
+    compress_store(&s.sd_z[i], direction.z, lanes);
     Float8(point ? 1.0f : kInf).store(&s.s_tmax[i]);
-    compress_store_lane_indices(&s.shadow_pixel[i], static_cast<std::uint32_t>(k0), toward);
-    s.shadow_count += static_cast<std::size_t>(std::popcount(toward));
+    compress_store_lane_indices(&s.shadow_pixel[i], static_cast<std::uint32_t>(k0), lanes);
+    s.shadow_count += static_cast<std::size_t>(std::popcount(lanes));
   };
   // Per region, the rays from characters and those from static meshes make
   // two runs (two packets): a silhouette region's rays end at two depths,
@@ -732,20 +758,25 @@ void make_shadow_rays(const Light& light, int l, TileScratch& s) {
     const std::size_t b0 = s.region_begin[r], b1 = s.region_begin[r + 1];
     std::uint32_t statics = 0;
     for (std::size_t b = b0; b < b1; ++b) {
-      const std::uint32_t on_character = s.block_on_character[b] & s.block_hits[b];
-      statics |= s.block_hits[b] & ~on_character;
+      const std::uint32_t on_character = s.block_on_character[b] & s.shadow_lanes[b];
+      statics |= s.shadow_lanes[b] & ~on_character;
       if (on_character != 0) add_block(b, on_character);
     }
     close_run();
     if (statics == 0) continue;
     for (std::size_t b = b0; b < b1; ++b) {
-      const std::uint32_t on_static = s.block_hits[b] & ~s.block_on_character[b];
+      const std::uint32_t on_static = s.shadow_lanes[b] & ~s.block_on_character[b];
       if (on_static != 0) add_block(b, on_static);
     }
     close_run();
   }
   // No ray at all: no run.
   if (s.shadow_count == 0) s.shadow_region_begin.clear();
+}
+
+void make_shadow_rays(const Light& light, int l, TileScratch& s) {
+  place_shadow_rays(light, l, s);
+  compact_shadow_rays(s);
 }
 
 std::uint64_t trace_shadow_rays(const Scene& scene, TriangleTest test, int packet_rays, int l, TileScratch& s,
@@ -757,12 +788,43 @@ std::uint64_t trace_shadow_rays(const Scene& scene, TriangleTest test, int packe
     ++blocked_count;
   };
   if (packet_rays <= 1) {
+    compact_shadow_rays(s);
     for (std::size_t i = 0; i < s.shadow_count; ++i) {
       if (occluded(scene, s.shadow_ray(i), test, &counters)) block(i);
     }
     return blocked_count;
   }
-  if (s.shadow_count == 0) return 0;
+  if (s.shadow_placed == 0) return 0;
+  static const float kZeros[kPacketSize] = {};
+  // The tile's rays bounded and culled as placed, lane by lane (the same
+  // rays, so the same bound as over the compacted ones): a tile whose rays
+  // can reach nothing (a ground in the open, mostly) compacts none.
+  CullLists& lists = cull_lists();
+  lists.tile.clear();
+  RayBound tile_bound;
+  const float* const placed[3] = {s.shadow_lane_x.data(), s.shadow_lane_y.data(), s.shadow_lane_z.data()};
+  if (s.shadows_from_point) {
+    tile_bound.add_groups(s.shadow_origin, placed, 0.0f, 1.0f, std::span(s.shadow_lanes.data(), s.blocks()));
+  } else {
+    alignas(32) float d[3][kPacketSize], t_max[kPacketSize];
+    for (int lane = 0; lane < kPacketSize; ++lane) {
+      for (int a = 0; a < 3; ++a) d[a][lane] = s.shadow_direction[a];
+      t_max[lane] = kInf;
+    }
+    const float* const directions[3] = {d[0], d[1], d[2]};
+    for (std::size_t b = 0; b < s.blocks(); ++b) {
+      if (s.shadow_lanes[b] == 0) continue;
+      const std::size_t k0 = b * kBlockLanes;
+      const float* const o[3] = {placed[0] + k0, placed[1] + k0, placed[2] + k0};
+      tile_bound.add_lanes(o, directions, kZeros, t_max, s.shadow_lanes[b]);
+    }
+  }
+  cull_objects(scene, tile_bound, lists.tile);
+  if (lists.tile.empty()) {
+    counters.rays += s.shadow_placed;
+    return 0;
+  }
+  compact_shadow_rays(s);
   // Pad a group past the last ray (inactive lanes, but the arithmetic
   // reads them; a large packet's groups start anywhere).
   const std::size_t padded = (s.shadow_count + kPacketSize - 1) / kPacketSize * kPacketSize;
@@ -772,22 +834,6 @@ std::uint64_t trace_shadow_rays(const Scene& scene, TriangleTest test, int packe
     s.sd_z[i] = 1.0f;
     s.s_tmax[i] = 1.0f;
   }
-  static const float kZeros[kPacketSize] = {};
-  CullLists& lists = cull_lists();
-  lists.tile.clear();
-  RayBound tile_bound;
-  if (s.shadows_from_point) {
-    const float* const d[3] = {s.sd_x.data(), s.sd_y.data(), s.sd_z.data()};
-    tile_bound.add_run(s.shadow_origin, d, 0.0f, 1.0f, s.shadow_count);
-  } else {
-    for (std::size_t i = 0; i < padded; i += kPacketSize) {
-      const std::size_t n = std::min<std::size_t>(kPacketSize, s.shadow_count - i);
-      const float* const o[3] = {&s.so_x[i], &s.so_y[i], &s.so_z[i]};
-      const float* const d[3] = {&s.sd_x[i], &s.sd_y[i], &s.sd_z[i]};
-      tile_bound.add_lanes(o, d, kZeros, &s.s_tmax[i], (1u << n) - 1u);
-    }
-  }
-  cull_objects(scene, tile_bound, lists.tile);
   thread_local StaticTile statics;
   if (gather_static_tile(scene, test, tile_bound, 0.0f, lists.tile, statics)) {
     counters.rays += s.shadow_count;

@@ -2,7 +2,7 @@
 // structure-of-arrays form (render/tile_scratch.h), eight lanes at a time:
 //
 //   generate_camera_rays -> trace_primary -> reconstruct_surfaces
-//   -> per light: make_shadow_rays -> trace_shadow_rays -> shade_and_write
+//   -> per light: place_shadow_rays -> trace_shadow_rays -> shade_and_write
 //
 // Renderer::render runs them per tile; the Embree peer of the benchmarks
 // runs the same stages with its own two trace stages, so camera rays,
@@ -43,17 +43,27 @@ void trace_primary(const Scene& scene, const PinholeCamera& camera, TriangleTest
 // and which hits are on characters (s.block_on_character).
 void reconstruct_surfaces(const Scene& scene, const Vec3& default_albedo, TileScratch& s);
 
-// Light `l`'s shadow rays for the hits whose surface faces it, compacted
-// into s.shadow_* in runs (s.shadow_region_begin): per region, the rays of
-// its hits on characters, then those on static meshes, each in block order;
-// hits facing away lose bit l of s.lit here.
-// A point light's rays are shadow_ray_from_light's (from the light, t_max
-// 1); a directional light's leave offset_origin along the light (t_max inf).
+// Light `l`'s shadow rays for the hits whose surface faces it, placed lane
+// by lane (s.shadow_lanes, s.shadow_lane_*); hits facing away lose bit l of
+// s.lit here. A point light's rays are shadow_ray_from_light's (from the
+// light, t_max 1); a directional light's leave offset_origin along the
+// light (t_max inf).
+void place_shadow_rays(const Light& light, int l, TileScratch& s);
+
+// The placed rays compacted into s.shadow_* in runs (s.shadow_region_begin):
+// per region, the rays of its hits on characters, then those on static
+// meshes, each in block order. Does nothing when they already are.
+void compact_shadow_rays(TileScratch& s);
+
+// place_shadow_rays, then compact_shadow_rays (tracers that take every ray,
+// as the Embree peer of the benchmarks does).
 void make_shadow_rays(const Light& light, int l, TileScratch& s);
 
-// Traces s.shadow_* one by one, as packets of eight, or as one large
-// packet per region (culled like the primary rays); blocked rays clear
-// bit l of s.lit. Returns how many were blocked.
+// Traces the placed shadow rays one by one, as packets of eight, or as one
+// large packet per region; blocked rays clear bit l of s.lit. Returns how
+// many were blocked. Packets are culled like the primary rays, first the
+// tile's placed rays as one bound: when that reaches no object, nothing is
+// compacted or traced. Single rays (packet_rays 1) are all traced.
 std::uint64_t trace_shadow_rays(const Scene& scene, TriangleTest test, int packet_rays, int l, TileScratch& s,
                                 TraversalCounters& counters);
 
