@@ -6,6 +6,7 @@
 // the traversal's hits, and images are identical for 1 and 2 threads.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <random>
@@ -458,7 +459,8 @@ rt::RenderStats render_lit(const rt::Scene& scene, const rt::PinholeCamera& came
 // y = 0 had a zero error bound and shadowed itself everywhere. Lights near
 // the floor (grazing rays) and thousands of floor sizes away (rays from the
 // light round at its magnitude) too.
-TEST(RenderStatic, AFloorAtExactlyZeroDoesNotShadowItself) {
+// A 32 x 32 floor of sixteen quads at exactly y = 0, centred on the origin.
+rt::StaticMeshDesc floor_at_zero() {
   rt::StaticMeshDesc floor;
   for (int j = 0; j < 4; ++j) {
     for (int i = 0; i < 4; ++i) {
@@ -470,8 +472,12 @@ TEST(RenderStatic, AFloorAtExactlyZeroDoesNotShadowItself) {
       floor.triangles.push_back({base, base + 2, base + 3});
     }
   }
+  return floor;
+}
+
+TEST(RenderStatic, AFloorAtExactlyZeroDoesNotShadowItself) {
   rt::Scene scene;
-  ASSERT_TRUE(scene.add_static_mesh(floor).ok());
+  ASSERT_TRUE(scene.add_static_mesh(floor_at_zero()).ok());
   JobSystem jobs(1);
   ASSERT_TRUE(scene.prepare_frame(rt::FrameOptions{}, jobs).ok());
   rt::CameraDesc desc;
@@ -486,6 +492,89 @@ TEST(RenderStatic, AFloorAtExactlyZeroDoesNotShadowItself) {
       EXPECT_EQ(stats.shadowed, 0u) << packet_rays << " rays per packet, light y " << light.y;
     }
   }
+}
+
+// The colour outputs against the shading model computed here in double:
+// ambient plus the light's colour times N.L (the floor faces +y), times the
+// albedo, and for RGBA8 the sRGB curve of IEC 61966-2-1 rounded to a byte;
+// misses get the background. Dim and overbright settings cover the curve's
+// linear toe and the clamp at 1.
+TEST(RenderStatic, ColoursFollowTheShadingModelAndTheSrgbCurve) {
+  rt::Scene scene;
+  ASSERT_TRUE(scene.add_static_mesh(floor_at_zero()).ok());
+  JobSystem jobs(2);
+  ASSERT_TRUE(scene.prepare_frame(rt::FrameOptions{}, jobs).ok());
+  rt::CameraDesc desc;
+  desc.eye = Vec3(0.0f, 6.0f, -12.0f);
+  desc.target = Vec3(0.0f, 0.0f, 4.0f);
+  constexpr int kSize = 80;
+  auto camera = rt::PinholeCamera::create(desc, kSize, kSize);
+  ASSERT_TRUE(camera.ok());
+  const auto srgb = [](double linear) {
+    const double c = std::clamp(linear, 0.0, 1.0);
+    return c <= 0.0031308 ? 12.92 * c : 1.055 * std::pow(c, 1.0 / 2.4) - 0.055;
+  };
+  struct Case {
+    Vec3 ambient, light_color, albedo, light;
+  };
+  const Case cases[] = {
+      {Vec3(0.18f), Vec3(1.0f), Vec3(0.7f), Vec3(6.0f, 12.0f, 4.0f)},
+      {Vec3(0.0f), Vec3(0.004f, 0.02f, 0.09f), Vec3(0.5f, 0.9f, 0.2f), Vec3(-3.0f, 2.0f, 9.0f)},
+      {Vec3(0.3f, 0.1f, 0.0f), Vec3(3.0f, 1.2f, 0.6f), Vec3(0.9f), Vec3(0.5f, 0.25f, 0.5f)},
+      {Vec3(0.05f), Vec3(1.0f), Vec3(0.7f), Vec3(2.0f, -5.0f, 1.0f)},  // below: ambient only
+  };
+  const auto pixels = static_cast<std::size_t>(kSize) * kSize;
+  std::size_t lit = 0, toe = 0, clamped = 0;
+  for (const Case& c : cases) {
+    for (const int packet_rays : {1, 256}) {
+      rt::RenderSettings settings;
+      settings.light.position = c.light;
+      settings.light.color = c.light_color;
+      settings.ambient = c.ambient;
+      settings.default_albedo = c.albedo;
+      settings.packet_rays = packet_rays;
+      std::vector<std::uint8_t> rgba8(4 * pixels);
+      std::vector<float> rgba32f(4 * pixels), depth(pixels);
+      rt::FrameBuffers buffers;
+      buffers.width = buffers.height = kSize;
+      buffers.color_rgba8 = rgba8;
+      buffers.color_rgba32f = rgba32f;
+      buffers.depth = depth;
+      rt::Renderer renderer;
+      ASSERT_TRUE(renderer.render(scene, *camera, settings, buffers, jobs).ok());
+      for (int y = 0; y < kSize; ++y) {
+        for (int x = 0; x < kSize; ++x) {
+          const std::size_t i = static_cast<std::size_t>(y) * kSize + static_cast<std::size_t>(x);
+          double expected[3];
+          if (std::isinf(depth[i])) {
+            for (int a = 0; a < 3; ++a) expected[a] = settings.background[a];
+          } else {
+            const Ray ray = camera->ray(x, y);
+            const glm::dvec3 dir = glm::normalize(glm::dvec3(ray.direction));
+            const glm::dvec3 p = glm::dvec3(ray.origin) + static_cast<double>(depth[i]) * dir;
+            const glm::dvec3 to_light = glm::dvec3(c.light) - p;
+            const double cosine = std::max(0.0, to_light.y / glm::length(to_light));
+            if (cosine > 0.0) ++lit;
+            for (int a = 0; a < 3; ++a) {
+              expected[a] = static_cast<double>(c.albedo[a]) *
+                            (static_cast<double>(c.ambient[a]) + static_cast<double>(c.light_color[a]) * cosine);
+              if (expected[a] > 0.0 && expected[a] <= 0.0031308) ++toe;
+              if (expected[a] > 1.0) ++clamped;
+            }
+          }
+          for (int a = 0; a < 3; ++a) {
+            EXPECT_NEAR(rgba32f[4 * i + a], expected[a], 1e-5 + 1e-5 * expected[a]) << x << "," << y << " channel " << a;
+            EXPECT_NEAR(rgba8[4 * i + a], std::lround(255.0 * srgb(expected[a])), 1) << x << "," << y << " channel " << a;
+          }
+          EXPECT_EQ(rgba8[4 * i + 3], 255);
+          EXPECT_EQ(rgba32f[4 * i + 3], 1.0f);
+        }
+      }
+    }
+  }
+  EXPECT_GT(lit, pixels);  // the cases reach every part of the curve
+  EXPECT_GT(toe, 100u);
+  EXPECT_GT(clamped, 100u);
 }
 
 // The same on a tilted floor away from the origin, where no coordinate is
