@@ -31,72 +31,49 @@ constexpr float gamma(int n) {
   return (static_cast<float>(n) * u) / (1.0f - static_cast<float>(n) * u);
 }
 
-float encode_srgb(float linear) {
-  const float c = std::clamp(linear, 0.0f, 1.0f);
-  return c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
-}
-
-// Linear -> sRGB byte through a table: std::pow per channel per pixel cost
-// more than the shading itself. 16384 entries keep the darkest steps
-// (sRGB byte 1 is linear 3e-4) apart; as bytes they stay in L1 (a table
-// widened to 32-bit words for the gathers was 64 KiB and missed it).
-class SrgbTable {
- public:
-  static constexpr int kSize = 16384;
-  SrgbTable() {
-    for (int i = 0; i < kSize; ++i) {
-      const float linear = (static_cast<float>(i) + 0.5f) / static_cast<float>(kSize);
-      bytes_[static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(std::lround(encode_srgb(linear) * 255.0f));
-    }
-    bytes_[0] = 0;  // index 0 also stands for "not > 0" (srgb_indices); it encodes to 0 anyway
+// Linear -> sRGB bytes, eight lanes at a time, by arithmetic: std::pow per
+// channel cost more than the shading itself, and a byte table's three
+// gathers per eight pixels were a quarter of shade_and_write. Above the
+// curve's linear toe, 255 * (1.055 c^(1/2.4) - 0.055) is a degree-4
+// polynomial in c^(1/4), fitted minimax over [0.0031308, 1]: 0.009 of a
+// byte step at most in real arithmetic, so a byte is off the correctly
+// rounded one by at most one step, and only where the exact value lies
+// within 0.01 of a half step (about one value in 200;
+// RenderStatic.ColoursFollowTheShadingModelAndTheSrgbCurve checks against
+// the curve in double). The 0.5 added to the last coefficient rounds by
+// truncation. Lanes not > 0 (NaN too) give 0; lanes above 1 give 255.
+Float8 srgb_steps(Float8 linear) {
+  const Float8 c = min(select(linear > Float8(0.0f), linear, Float8(0.0f)), Float8(1.0f));
+  const Float8 q = sqrt(sqrt(c));
+  Float8 curve(2.073888969e+01f);
+  for (const float k : {-8.555185699e+01f, 2.862825012e+02f, 5.001527405e+01f, -1.647604179e+01f + 0.5f}) {
+    curve = curve * q + Float8(k);
   }
-  std::uint8_t operator[](std::int32_t i) const { return bytes_[static_cast<std::size_t>(i)]; }
-  // For gathers of 32-bit words at byte offsets: entry i is the low byte of
-  // the word at bytes() + i (the padding keeps the last word inside).
-  const std::uint8_t* bytes() const { return bytes_.data(); }
-
- private:
-  std::array<std::uint8_t, kSize + 3> bytes_{};
-};
-
-// Built once at start-up, not behind a function-local static's guard.
-const SrgbTable kSrgbTable;
-
-// Table indices of eight linear values; lanes that are not > 0 (NaN too)
-// give index 0, whose byte is 0 (the table's first entry encodes linear
-// 3e-5, below half an sRGB step).
-void srgb_indices(Float8 linear, std::int32_t* out) {
-  const Float8 scaled = min(linear, Float8(1.0f)) * Float8(static_cast<float>(SrgbTable::kSize - 1));
-  store_truncated(select(linear > Float8(0.0f), scaled, Float8(0.0f)), out);
+  const Float8 toe = c * Float8(12.92f * 255.0f) + Float8(0.5f);
+  return min(select(c <= Float8(0.0031308f), toe, curve), Float8(255.5f));
 }
 std::uint8_t srgb_byte(float linear) {
-  alignas(32) std::int32_t index[8];
-  srgb_indices(Float8(linear), index);
-  return kSrgbTable[index[0]];
+  alignas(32) std::int32_t steps[8];
+  store_truncated(srgb_steps(Float8(linear)), steps);
+  return static_cast<std::uint8_t>(steps[0]);
 }
 
 // Eight RGBA8 pixels, R in the low byte, alpha 255.
 void srgb_pixels(const Vec3x8& linear, std::uint32_t* out) {
-  alignas(32) std::int32_t r[8], g[8], b[8];
-  srgb_indices(linear.x, r);
-  srgb_indices(linear.y, g);
-  srgb_indices(linear.z, b);
-#if defined(__AVX2__)
-  // Three gathers of words at byte offsets instead of 24 byte loads.
-  const int* words = reinterpret_cast<const int*>(kSrgbTable.bytes());
-  const __m256i low_byte = _mm256_set1_epi32(0xFF);
-  const auto gather = [&](const std::int32_t* index) {
-    return _mm256_and_si256(
-        _mm256_i32gather_epi32(words, _mm256_load_si256(reinterpret_cast<const __m256i*>(index)), 1), low_byte);
-  };
+#if SINEW_FLOAT8_AVX2
+  const auto bytes = [](Float8 x) { return _mm256_cvttps_epi32(srgb_steps(x).v); };
   const __m256i rgba = _mm256_or_si256(
-      _mm256_or_si256(gather(r), _mm256_slli_epi32(gather(g), 8)),
-      _mm256_or_si256(_mm256_slli_epi32(gather(b), 16), _mm256_set1_epi32(static_cast<int>(0xFF000000u))));
+      _mm256_or_si256(bytes(linear.x), _mm256_slli_epi32(bytes(linear.y), 8)),
+      _mm256_or_si256(_mm256_slli_epi32(bytes(linear.z), 16), _mm256_set1_epi32(static_cast<int>(0xFF000000u))));
   _mm256_storeu_si256(reinterpret_cast<__m256i*>(out), rgba);
 #else
+  alignas(32) std::int32_t r[8], g[8], b[8];
+  store_truncated(srgb_steps(linear.x), r);
+  store_truncated(srgb_steps(linear.y), g);
+  store_truncated(srgb_steps(linear.z), b);
   for (int i = 0; i < 8; ++i) {
-    out[i] = std::uint32_t{kSrgbTable[r[i]]} | std::uint32_t{kSrgbTable[g[i]]} << 8 |
-             std::uint32_t{kSrgbTable[b[i]]} << 16 | 0xFF000000u;
+    out[i] = static_cast<std::uint32_t>(r[i]) | static_cast<std::uint32_t>(g[i]) << 8 |
+             static_cast<std::uint32_t>(b[i]) << 16 | 0xFF000000u;
   }
 #endif
 }
