@@ -135,7 +135,9 @@ class CameraBlocks {
     Float8(kInf).store(r_.t_limit);
     const std::uint32_t live = valid_lanes(r_) & s.block_pixels[b];
     alignas(32) float best_u[kBlockLanes] = {}, best_v[kBlockLanes] = {};
-    std::uint32_t best[kBlockLanes];  // index into triangles
+    // Per lane the index of its nearest triangle so far, as a float (exact:
+    // far fewer than 2^24 triangles), chosen by the hit mask like t, u, v.
+    Float8 best_index(0.0f);
     std::uint32_t hits = 0;
     // The last triangle hit, and its lanes: when those are all of the hit
     // lanes, every hit lane ended on it (a ground block, mostly).
@@ -154,9 +156,7 @@ class CameraBlocks {
         select(m, Float8::load(t), Float8::load(r_.t_limit)).store(r_.t_limit);
         select(m, Float8::load(u), Float8::load(best_u)).store(best_u);
         select(m, Float8::load(v), Float8::load(best_v)).store(best_v);
-        for (std::uint32_t bits = hit; bits != 0; bits &= bits - 1) {
-          best[std::countr_zero(bits)] = static_cast<std::uint32_t>(i);
-        }
+        best_index = select(m, Float8(static_cast<float>(i)), best_index);
         last = i;
         last_lanes = hit;
         hits |= hit;
@@ -174,11 +174,13 @@ class CameraBlocks {
       }
       return hits;
     }
+    alignas(32) std::int32_t best[kBlockLanes];
+    store_truncated(best_index, best);
     for (int lane = 0; lane < kBlockLanes; ++lane) {
       const std::size_t k = k0 + static_cast<std::size_t>(lane);
       const bool hit = (hits >> lane & 1u) != 0;
-      s.triangle[k] = hit ? triangles_[best[lane]].triangle : kInvalidId;
-      s.instance[k] = hit ? triangles_[best[lane]].instance : kInvalidId;
+      s.triangle[k] = hit ? triangles_[static_cast<std::size_t>(best[lane])].triangle : kInvalidId;
+      s.instance[k] = hit ? triangles_[static_cast<std::size_t>(best[lane])].instance : kInvalidId;
     }
     return hits;
   }
