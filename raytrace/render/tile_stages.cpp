@@ -569,6 +569,7 @@ void reconstruct_surfaces(const Scene& scene, const Vec3& default_albedo, TileSc
   std::uint32_t with_normals = 0, on_character = 0;
   std::uint32_t kept_triangle = kInvalidId, kept_instance = kInvalidId;
   Vec3x8 kept_geometric{};
+  Float8 kept_magnitude(0.0f);  // the corners' largest coordinate, with them
   for (std::size_t b = 0; b < blocks; ++b) {
     const std::uint32_t hits = s.block_hits[b];
     s.block_on_character[b] = 0;
@@ -596,9 +597,12 @@ void reconstruct_surfaces(const Scene& scene, const Vec3& default_albedo, TileSc
     const Float8 v = Float8::load(&s.v[k0]);
     const Float8 w = Float8(1.0f) - u - v;
     const Vec3x8 position = (w * p0 + u * p1) + v * p2;
-    Float8 magnitude = abs(p0.x);
-    for (const Vec3x8* c : {&p0, &p1, &p2}) {
-      magnitude = max(magnitude, max(max(abs(c->x), abs(c->y)), abs(c->z)));
+    Float8 magnitude = kept_magnitude;
+    if (!kept) {
+      magnitude = abs(p0.x);
+      for (const Vec3x8* c : {&p0, &p1, &p2}) {
+        magnitude = max(magnitude, max(max(abs(c->x), abs(c->y)), abs(c->z)));
+      }
     }
     Vec3x8 geometric;
     if (kept) {
@@ -616,6 +620,7 @@ void reconstruct_surfaces(const Scene& scene, const Vec3& default_albedo, TileSc
       kept_triangle = s.triangle[k0];  // gather_lanes is uniform only for whole blocks
       kept_instance = s.instance[k0];
       kept_geometric = geometric;
+      kept_magnitude = magnitude;
     } else {
       const Vec3x8 cross_n = cross(p1 - p0, p2 - p0);
       const Float8 length = sqrt(dot(cross_n, cross_n));
@@ -884,9 +889,9 @@ void shade_and_write(const RenderSettings& settings, std::span<const Light> ligh
               light.kind == Light::Kind::kPoint
                   ? Vec3x8{Float8(light.position.x), Float8(light.position.y), Float8(light.position.z)} - position
                   : Vec3x8{Float8(light.direction.x), Float8(light.direction.y), Float8(light.direction.z)};
-          const Float8 inv_length = Float8(1.0f) / sqrt(dot(to_light, to_light));
-          const Float8 cosine = select(Mask8::from_bits(lit_bits), max(dot(n, inv_length * to_light), Float8(0.0f)),
-                                       Float8(0.0f));
+          const Float8 cosine =
+              select(Mask8::from_bits(lit_bits), max(dot(n, to_light) / sqrt(dot(to_light, to_light)), Float8(0.0f)),
+                     Float8(0.0f));
           radiance = radiance + Vec3x8{Float8(light.color.x) * cosine, Float8(light.color.y) * cosine,
                                        Float8(light.color.z) * cosine};
         }
