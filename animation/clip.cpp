@@ -57,13 +57,7 @@ Status validate_track(Track<T>& track, std::string_view source, const std::strin
         return make_error(ErrorCode::kInvalidData, source, field + ".values[" + std::to_string(v) + "]",
                           "0", "zero-length rotation quaternion");
       }
-      // Already unit (within rounding): kept as is, so that building a clip
-      // from stored, normalised keys (a content pack) keeps their bits.
-      constexpr double kUnitTolerance = 4.0 * static_cast<double>(std::numeric_limits<float>::epsilon());
-      if (is_value && std::fabs(len - 1.0) > kUnitTolerance) {
-        track.values[v] = Quat(static_cast<float>(w / len), static_cast<float>(x / len), static_cast<float>(y / len),
-                               static_cast<float>(z / len));
-      }
+      if (is_value) track.values[v] = unit_rotation(q);
     }
   }
   return {};

@@ -3,10 +3,27 @@
 // these, one per joint, in the skeleton's joint order.
 #pragma once
 
+#include <cmath>
+#include <limits>
+
 #include "runtime/math/affine.h"
 #include "runtime/math/types.h"
 
 namespace sinew::anim {
+
+// `q` at unit length, scaled in double (the squares of finite float
+// components neither overflow nor underflow there). A q already unit within
+// rounding is returned as it is: normalising stored, normalised rotations
+// (a content pack's rest pose and keys) again keeps their bits, where
+// glm::normalize may move the last one. q must not be zero.
+inline Quat unit_rotation(const Quat& q) {
+  const double x = q.x, y = q.y, z = q.z, w = q.w;
+  const double len = std::sqrt(x * x + y * y + z * z + w * w);
+  constexpr double kUnitTolerance = 4.0 * static_cast<double>(std::numeric_limits<float>::epsilon());
+  if (std::fabs(len - 1.0) <= kUnitTolerance) return q;
+  return Quat(static_cast<float>(w / len), static_cast<float>(x / len), static_cast<float>(y / len),
+              static_cast<float>(z / len));
+}
 
 struct JointTransform {
   Vec3 translation{0.0f};

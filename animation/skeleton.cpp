@@ -106,7 +106,7 @@ Expected<Skeleton> Skeleton::build(const RawSkeleton& raw, std::string_view sour
     const RawJoint& j = raw.joints[static_cast<std::size_t>(order[k])];
     s.parents_[k] = j.parent == kNoParent ? kNoParent : remap[static_cast<std::size_t>(j.parent)];
     s.rest_[k] = j.rest;
-    s.rest_[k].rotation = glm::normalize(j.rest.rotation);
+    s.rest_[k].rotation = unit_rotation(j.rest.rotation);
     s.inverse_bind_[k] = j.inverse_bind;
     s.names_[k] = j.name;
   }
