@@ -65,8 +65,13 @@ class GroupFrusta {
     // slopes around it, whatever it is. The sum of the directions is one.
     const Vec3 c = normalized({sum(d.x), sum(d.y), sum(d.z)});
     if (!(c.x == c.x)) return;
-    // u across the group (first to last lane: a row of a block), v = c x u.
-    const int first = std::countr_zero(lanes), last = 31 - std::countl_zero(lanes);
+    // u along a row of the group: from its first lane to the one three on
+    // (a camera block's lanes are two rows of four pixels), or to its last.
+    // Any u bounds the rays; one along the pixel rows bounds a block's
+    // rectangle of rays, where a diagonal one (lane 0 to lane 7) bounded a
+    // rectangle turned by 18 degrees, 1.7 times the area.
+    const int first = std::countr_zero(lanes);
+    const int last = first + 3 < 8 && (lanes >> (first + 3) & 1u) ? first + 3 : 31 - std::countl_zero(lanes);
     Vec3 across(q[0][last] - q[0][first], q[1][last] - q[1][first], q[2][last] - q[2][first]);
     across = across - glm::dot(across, c) * c;
     Vec3 u = normalized(across);
@@ -223,7 +228,7 @@ class GroupFrusta {
     for (int j = 1; j < 8; ++j) sum = sum + d[j];
     Mask8 c_ok, u_ok, alt_ok;
     const Vec3x8 c = unit(sum, c_ok);
-    Vec3x8 across = d[7] - d[0];
+    Vec3x8 across = d[3] - d[0];  // along a row, as set_group
     across = across - dot(across, c) * c;
     const Vec3x8 u_across = unit(across, u_ok);
     const Vec3x8 alt = select(abs(c.x) < Float8(0.5f), Vec3x8{zero, zero - c.z, c.y}, Vec3x8{zero - c.z, zero, c.x});
