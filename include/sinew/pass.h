@@ -57,7 +57,7 @@ class OutputMask {
 constexpr OutputMask operator|(Output a, Output b) { return OutputMask(a) | OutputMask(b); }
 
 enum class TriangleTest : std::uint8_t {
-  kFast,        // projection test (Wald 2004): fastest
+  kFast,        // Möller–Trumbore, no per-triangle precomputation: fastest
   kWatertight,  // Woop, Benthin and Wald 2013: no ray leaks between adjacent triangles
 };
 
