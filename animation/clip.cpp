@@ -51,7 +51,8 @@ Status validate_track(Track<T>& track, std::string_view source, const std::strin
       // In double: the squares of finite float components (up to 3.4e38)
       // overflow float, not double, and tiny ones do not underflow.
       const Quat& q = track.values[v];
-      const double x = q.x, y = q.y, z = q.z, w = q.w;
+      const double x = static_cast<double>(q.x), y = static_cast<double>(q.y), z = static_cast<double>(q.z),
+                   w = static_cast<double>(q.w);
       const double len = std::sqrt(x * x + y * y + z * z + w * w);
       if (is_value && len < 1e-6) {
         return make_error(ErrorCode::kInvalidData, source, field + ".values[" + std::to_string(v) + "]",

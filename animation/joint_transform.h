@@ -17,7 +17,8 @@ namespace sinew::anim {
 // (a content pack's rest pose and keys) again keeps their bits, where
 // glm::normalize may move the last one. q must not be zero.
 inline Quat unit_rotation(const Quat& q) {
-  const double x = q.x, y = q.y, z = q.z, w = q.w;
+  const double x = static_cast<double>(q.x), y = static_cast<double>(q.y), z = static_cast<double>(q.z),
+               w = static_cast<double>(q.w);
   const double len = std::sqrt(x * x + y * y + z * z + w * w);
   constexpr double kUnitTolerance = 4.0 * static_cast<double>(std::numeric_limits<float>::epsilon());
   if (std::fabs(len - 1.0) <= kUnitTolerance) return q;
