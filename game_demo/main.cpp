@@ -10,11 +10,13 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "game_demo/demo_options.h"
 #include "game_demo/demo_session.h"
 #include "game_demo/input_script.h"
+#include "game_demo/timings_json.h"
 #include "runtime/cpu/cpu_features.h"
 #include "runtime/image/image_io.h"
 #include "runtime/io/atomic_file.h"
@@ -26,38 +28,6 @@
 
 namespace sinew::demo {
 namespace {
-
-std::string json_number(double v) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.4f", std::isfinite(v) ? v : 0.0);
-  return text;
-}
-
-// Per-frame phase times, then the summary (per-phase medians and fps).
-std::string timings_json(const std::vector<std::vector<std::pair<std::string, double>>>& rows,
-                         const PhaseTimers& timers, const DemoSession& session, int threads,
-                         std::uint64_t escaped_triangles) {
-  std::string out = "{\n  \"frames\": [\n";
-  for (std::size_t f = 0; f < rows.size(); ++f) {
-    out += "    {\"frame\": " + std::to_string(f);
-    for (const auto& [phase, ms] : rows[f]) out += ", \"" + phase + "\": " + json_number(ms);
-    out += f + 1 < rows.size() ? "},\n" : "}\n";
-  }
-  const double total = timers.median_total_ms();
-  const BakeInfo& bake = session.bake_info();
-  out += "  ],\n  \"summary\": {\n";
-  out += "    \"fps\": " + json_number(total > 0.0 ? 1000.0 / total : 0.0) + ",\n";
-  out += "    \"frame_median_ms\": " + json_number(total) + ",\n";
-  out += "    \"threads\": " + std::to_string(threads) + ",\n";
-  out += "    \"characters\": " + std::to_string(session.world().character_count()) + ",\n";
-  out += "    \"size\": [" + std::to_string(session.width()) + ", " + std::to_string(session.height()) + "],\n";
-  out += "    \"model\": \"" + bake.model + "\",\n";
-  out += "    \"triangles\": " + std::to_string(bake.triangles) + ",\n";
-  out += "    \"pose_samples\": " + std::to_string(bake.pose_samples) + ",\n";
-  out += "    \"escaped_triangles\": " + std::to_string(escaped_triangles) + ",\n";
-  out += "    \"phases\": " + timers.json() + "  }\n}\n";
-  return out;
-}
 
 int fail(const Status& s) {
   std::fprintf(stderr, "sinew-demo: %s\n", s.message().c_str());
@@ -108,12 +78,20 @@ int run_headless(const DemoOptions& opt, const InputScript* script, DemoSession&
   if (frames_run > 1 && frames_run - 1 != opt.frames / 2) {
     if (Status s = write_frame(frames_run - 1); !s.ok()) return fail(s);
   }
-  const std::string timings_path = opt.out_dir + "/timings.json";
-  if (Status s = write_file_atomic(timings_path, timings_json(rows, session.timers(), session, jobs.thread_count(), escaped));
-      !s.ok()) {
-    return fail(s);
-  }
   const BakeInfo& bake = session.bake_info();
+  TimingsRun run;
+  run.frames = std::move(rows);
+  run.timers = &session.timers();
+  run.model = bake.model;
+  run.triangles = bake.triangles;
+  run.pose_samples = bake.pose_samples;
+  run.characters = session.world().character_count();
+  run.width = session.width();
+  run.height = session.height();
+  run.threads = jobs.thread_count();
+  run.escaped_triangles = escaped;
+  const std::string timings_path = opt.out_dir + "/timings.json";
+  if (Status s = write_file_atomic(timings_path, timings_json(run)); !s.ok()) return fail(s);
   std::printf("sinew-demo: %d characters (%s, %zu triangles, %u pose samples baked in %.0f ms), %d frames at %dx%d "
               "on %d threads (headless)\n",
               session.world().character_count(), bake.model.c_str(), bake.triangles, bake.pose_samples, bake.bake_ms,
