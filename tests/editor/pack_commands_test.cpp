@@ -7,6 +7,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cstdlib>
 #include <cstring>
@@ -157,17 +158,27 @@ TEST_F(PackCommands, SahIntersectionCostShapesTheBoneTrees) {
   EXPECT_DOUBLE_EQ(single_ray["fuzzy_area"].get<double>(), packet["fuzzy_area"].get<double>());
 }
 
-// Every output of two renders, bit for bit (depth as bytes: +inf misses too).
-void expect_same_frame(const RenderOutputs& a, const RenderOutputs& b) {
-  EXPECT_TRUE(a.color_rgba8 == b.color_rgba8);
-  EXPECT_TRUE(a.triangle_id == b.triangle_id);
-  EXPECT_TRUE(a.instance_id == b.instance_id);
-  ASSERT_EQ(a.depth.size(), b.depth.size());
+// Renders `o` from the source model and from the pack baked from it: every
+// output the same bit for bit (depth as bytes: +inf misses too). Returns the
+// pack's pose-sample count (0 when a render failed).
+std::uint32_t expect_pack_renders_like_source(RenderOptions o, const std::string& source, const std::string& pack) {
+  o.model_path = source;
+  const auto a = render_model(o);
+  o.model_path = pack;
+  const auto b = render_model(o);
+  EXPECT_TRUE(a.ok()) << a.status().message();
+  EXPECT_TRUE(b.ok()) << b.status().message();
+  if (!a.ok() || !b.ok()) return 0;
+  EXPECT_TRUE(a->color_rgba8 == b->color_rgba8);
+  EXPECT_TRUE(a->triangle_id == b->triangle_id);
+  EXPECT_TRUE(a->instance_id == b->instance_id);
+  EXPECT_EQ(a->depth.size(), b->depth.size());
   std::size_t differ = 0;
-  for (std::size_t i = 0; i < a.depth.size(); ++i) {
-    if (std::memcmp(&a.depth[i], &b.depth[i], sizeof(float)) != 0) ++differ;
+  for (std::size_t i = 0; i < std::min(a->depth.size(), b->depth.size()); ++i) {
+    if (std::memcmp(&a->depth[i], &b->depth[i], sizeof(float)) != 0) ++differ;
   }
-  EXPECT_EQ(differ, 0u) << "of " << a.depth.size() << " depths";
+  EXPECT_EQ(differ, 0u) << "of " << a->depth.size() << " depths";
+  return b->stats.pose_samples;
 }
 
 TEST_F(PackCommands, RenderingFromThePackEqualsTheInMemoryBake) {
@@ -182,14 +193,7 @@ TEST_F(PackCommands, RenderingFromThePackEqualsTheInMemoryBake) {
   o.pose_space.mode = anim::PoseSpaceMode::kArbitrary;
   o.pose_space.samples = 16;
   o.pose_space.every_frame_30hz = false;
-  o.model_path = kCesiumMan;
-  const auto in_memory = render_model(o);
-  ASSERT_TRUE(in_memory.ok()) << in_memory.status().message();
-  o.model_path = pack;
-  const auto from_pack = render_model(o);
-  ASSERT_TRUE(from_pack.ok()) << from_pack.status().message();
-  expect_same_frame(*in_memory, *from_pack);
-  EXPECT_EQ(from_pack->stats.pose_samples, 16u);
+  EXPECT_EQ(expect_pack_renders_like_source(o, kCesiumMan, pack), 16u);
 }
 
 // Cally in the default pose space, from the issue that found it: the pack's
@@ -213,13 +217,7 @@ TEST_F(PackCommands, RenderingCallyFromThePackEqualsTheInMemoryBakeBitForBit) {
   camera.up = Vec3(0.0f, 0.0f, 1.0f);
   camera.fovy_degrees = 40.0f;
   o.camera = camera;
-  o.model_path = cally;
-  const auto in_memory = render_model(o);
-  ASSERT_TRUE(in_memory.ok()) << in_memory.status().message();
-  o.model_path = pack;
-  const auto from_pack = render_model(o);
-  ASSERT_TRUE(from_pack.ok()) << from_pack.status().message();
-  expect_same_frame(*in_memory, *from_pack);
+  EXPECT_GT(expect_pack_renders_like_source(o, cally, pack), 0u);
 }
 
 TEST_F(PackCommands, SubdivideWritesAModelOnlyPackThatBakes) {
