@@ -2,8 +2,9 @@
 // CalCoreAnimation, glTF's animation). Immutable and shared by instances;
 // the per-instance playback state is a SamplingCache.
 //
-// Time is seconds on the file's own timeline (DESIGN.md section 8): before a
-// track's first key it holds the first value, after its last key the last.
+// Time is seconds on the file's own timeline (docs/ANIMATION.md, "Skeleton
+// and clips"): before a track's first key it holds the first value, after
+// its last key the last.
 // A looping clip of duration D (its last key time) plays t mod D.
 //
 // Key times (the one rule for every source): a track's times must be finite,

@@ -1,6 +1,6 @@
 // Mixer: one character instance's animation scheduling with Cal3D's
 // semantics (CalMixer, CalAnimationCycle, CalAnimationAction of Cal3D
-// 0.11.0), the "Mixer.update(dt)" step of DESIGN.md section 3.
+// 0.11.0), the Mixer::update(dt) step of docs/DESIGN.md section 3.
 //
 // Ownership: the mixer holds per-instance state only (active cycles and
 // actions, their weights, fades and times, the global sync time). It keeps

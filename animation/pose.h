@@ -1,5 +1,5 @@
 // Pose -> matrices: the last step of animation and the whole interface to
-// raytrace/ (DESIGN.md section 3). Jobs take spans in and out, allocate
+// raytrace/ (docs/DESIGN.md section 3). Jobs take spans in and out, allocate
 // nothing and never own their buffers.
 #pragma once
 

@@ -1,6 +1,6 @@
 // The bridge from an imported model to the ray tracer: pose-space samples as
 // skinning matrices, a clip's pose at a time, and the in-memory bake
-// (DESIGN.md section 3, offline half, without the pack).
+// (docs/DESIGN.md section 3, offline half, without the pack).
 //
 // raytrace/ never sees animation types: it gets spans of Affine3 skinning
 // matrices, produced here.

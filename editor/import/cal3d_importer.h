@@ -2,7 +2,7 @@
 // XML variants .xsf/.xmf/.xaf/.xrf) through the Cal3D library itself, so the
 // file parsing is Cal3D's and only the conversion to Sinew's types is ours.
 //
-// Conventions (DESIGN.md section 8), pinned by tests/editor/cal3d_import_test:
+// Conventions (docs/ANIMATION.md, "Importers"), pinned by tests/editor/cal3d_import_test:
 // * Units: the .cfg `scale=` is applied with CalCoreModel::scale() after
 //   everything is loaded, so positions, bone translations and keyframe
 //   translations are in the file's units times that scale — exactly what the

@@ -1,4 +1,4 @@
-// ImportedModel: what every importer produces (DESIGN.md section 9), in
+// ImportedModel: what every importer produces (docs/ANIMATION.md, "Importers"), in
 // Sinew's own types. Importers are the only code that knows file formats
 // other than the content pack.
 //

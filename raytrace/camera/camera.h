@@ -1,5 +1,5 @@
 // PinholeCamera: the camera convention every tool and test relies on
-// (issue 4, pinned by a test):
+// (pinned by tests/raytrace/camera_test.cpp):
 //   forward = normalize(target - eye); right = normalize(cross(forward, up));
 //   up' = cross(right, forward); pixel (x, y), y = 0 the top row, shoots along
 //   normalize(forward + sx*tan(fovy/2)*aspect*right + sy*tan(fovy/2)*up')

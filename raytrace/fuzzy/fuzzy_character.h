@@ -1,5 +1,5 @@
 // The baked, immutable ray-tracing data of one character (paper section 3),
-// shared by all its instances (DESIGN.md section 4, "instances share").
+// shared by all its instances (docs/DESIGN.md section 4, "instances share").
 //
 // Bone frame. A bone's frame is the frame its skinning matrix S_b maps from
 // (bind-pose model space relative to that bone): a point p in world space is

@@ -1,6 +1,6 @@
 // Ray-triangle tests against skinned (world-space, per-frame) triangles.
 //
-// Two tests, selectable per render (DESIGN.md section 5):
+// Two tests, selectable per render (docs/DESIGN.md section 5):
 //  - kFast: Moller-Trumbore. Skinned triangles move every frame, so tests
 //    that need per-triangle precomputation (Wald 2004's projection test)
 //    would pay it every frame; Moller-Trumbore needs none.

@@ -30,7 +30,7 @@ class PhaseTimers;
 
 namespace sinew::rt {
 
-// How a bone's world box is found each frame (issue 4, point 4).
+// How a bone's world box is found each frame (docs/RAYTRACE.md, "Per frame", step 3).
 enum class BoneBoxMode : std::uint8_t {
   kExact,  // the union of the bone's skinned triangles: tight, costs a pass over them
   kCheap,  // the fuzzy root box carried by the bone matrix: free, looser
@@ -39,7 +39,7 @@ enum class BoneBoxMode : std::uint8_t {
 struct FrameOptions {
   BoneBoxMode bone_boxes = BoneBoxMode::kExact;
   // Route triangles that left their fuzzy boxes through a per-frame
-  // world-space kd-tree so the image stays exact (DESIGN.md section 4). Off:
+  // world-space kd-tree so the image stays exact (docs/DESIGN.md section 4). Off:
   // escapes are still counted in FrameStats::escaped_checks (escaped_triangles
   // stays 0: nothing is routed), and may show as holes.
   bool fallback = true;

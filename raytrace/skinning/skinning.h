@@ -1,5 +1,5 @@
 // Per-frame linear blend skinning into world space, with the escape check
-// fused in (paper section 3; DESIGN.md section 4, "outside the pose space").
+// fused in (paper section 3; docs/DESIGN.md section 4, "Escaped triangles go to the fallback").
 //
 // The kernel reads the rest mesh once and writes world positions (and,
 // when asked, normals: blended with the same matrices and not renormalised,

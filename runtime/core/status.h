@@ -1,5 +1,5 @@
 // Status: the error value every Sinew library function returns instead of
-// throwing, aborting or asserting on input data (DESIGN.md section 7).
+// throwing, aborting or asserting on input data (docs/DESIGN.md section 7).
 //
 // An error carries a machine-readable code plus the three facts a user needs
 // to fix bad input: the file (or source) it came from, the field inside it,

@@ -1,7 +1,7 @@
 // MappedFile: a read-only memory mapping of a whole file.
 //
 // Content packs are used in place: loaders hand out spans into the mapping
-// instead of copying (DESIGN.md section 2). The mapping lives as long as the
+// instead of copying (docs/DESIGN.md section 2). The mapping lives as long as the
 // MappedFile; spans taken from bytes() must not outlive it. Move-only.
 // An empty file maps to an empty span (mmap itself refuses length 0).
 #pragma once

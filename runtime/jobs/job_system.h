@@ -8,7 +8,7 @@
 // (the ThreadSanitizer preset); or a host's own scheduler. Work is split
 // into chunks whose boundaries depend only on the range and the grain, never
 // on timing or the executor, so per-chunk results are reproducible
-// (DESIGN.md section 4, determinism).
+// (docs/DESIGN.md section 4, determinism).
 #pragma once
 
 #include <cstddef>

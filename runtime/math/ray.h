@@ -1,6 +1,6 @@
 // Ray types. Directions are NOT required to be unit length: rays transformed
 // into a bone's frame keep t meaning the same distance parameter in both
-// frames (paper section 4; DESIGN.md section 1, point 5).
+// frames (paper section 4; docs/DESIGN.md section 1).
 #pragma once
 
 #include <cstdint>

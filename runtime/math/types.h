@@ -1,5 +1,5 @@
 // Math vocabulary types on GLM. Sinew works in single precision: positions in
-// the file's own units (DESIGN.md section 8), right-handed, column vectors.
+// the file's own units (docs/ANIMATION.md, "Importers"), right-handed, column vectors.
 #pragma once
 
 #include <glm/glm.hpp>

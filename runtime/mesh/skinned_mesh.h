@@ -6,7 +6,7 @@
 // Layout is structure-of-arrays; influences are fixed at kMaxInfluences per
 // vertex (unused slots have weight 0 and joint 0) so SIMD skinning needs no
 // per-vertex branching. Triangle ids are the index into `triangles`, in the
-// importer's documented order (DESIGN.md section 8).
+// importer's documented order (docs/ANIMATION.md, "Importers").
 #pragma once
 
 #include <array>

@@ -1,5 +1,5 @@
 // PhaseTimers: per-phase wall-clock samples so every program can print
-// medians (DESIGN.md section 6: animation, skinning, boxes, top-level build,
+// medians (docs/DESIGN.md section 6: animation, skinning, boxes, top-level build,
 // trace, shade, display). One sample per phase per frame; a phase's name is
 // registered on first use and keeps its first-use order in reports.
 //

@@ -1,4 +1,4 @@
-// Issue 7's rule for peer benchmarks: a configuration whose output fails the
+// The rule for peer benchmarks (docs/BENCHMARKS.md): a configuration whose output fails the
 // brute-force check on its first frame is not reported. This compares a
 // contender's primary hits with brute force (tests/support/brute_force.h)
 // on every `stride`-th pixel of the image.

@@ -12,9 +12,10 @@
 // paper's sample counts; fuzzy area, triangles per leaf and the fps of the
 // rest pose from one viewpoint per model.
 //
-// Issue 7's rule holds throughout: a configuration whose first frame fails
-// the brute-force check (brute_force_gate.h) is printed as FAILED with no
-// numbers, and the exit code is 1.
+// The benchmarks' rule holds throughout (docs/BENCHMARKS.md): a
+// configuration whose first frame fails the brute-force check
+// (brute_force_gate.h) is printed as FAILED with no numbers, and the exit
+// code is 1.
 #include "tests/bench/paper_bench.h"
 
 #include <algorithm>

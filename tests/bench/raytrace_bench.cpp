@@ -277,7 +277,7 @@ Expected<RunResult> run_configuration(const BenchModel& m, const BenchOptions& o
     run.max_escaped_triangles = std::max(run.max_escaped_triangles, prepared.escaped_triangles);
 
     if (f == 0) {
-      // Issue 7's rule: a configuration whose first frame disagrees with
+      // The benchmarks' rule (docs/BENCHMARKS.md): a configuration whose first frame disagrees with
       // brute force is not reported (every 7th pixel, untimed).
       const BruteForceGate gate(scene, *camera, kGateStride);
       SINEW_ASSIGN_OR_RETURN(const std::vector<Hit> hits, render_primary_hits(scene, *camera, settings, jobs));

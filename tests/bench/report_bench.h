@@ -1,4 +1,4 @@
-// sinew-bench report: one command that measures everything issue 7 asks
+// sinew-bench report: one command that measures everything docs/BENCHMARKS.md reports
 // for and writes it down. It runs, in one process and one after another,
 // the paper tables (`paper`), the peer comparison (`embree`, on Cally and
 // on Cally's largest subdivision), the speed/accuracy trade (`tradeoff`) and

@@ -1,5 +1,5 @@
 // sinew-bench tradeoff: the speed/accuracy trade of the bake's options
-// measured side by side (DESIGN.md section 5): pose-space mode, sample count
+// measured side by side (docs/DESIGN.md section 5): pose-space mode, sample count
 // and padding against bake time, pack size, fuzzy area, fps, escapes and
 // holes on held-out poses; plus the fast vs watertight triangle test (fps
 // and leaked rays on a crack test) and exact vs cheap bone boxes.

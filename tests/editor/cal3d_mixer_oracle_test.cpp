@@ -1,7 +1,8 @@
 // The mixer against the Cal3D library: two blended cycles with fades plus an
 // action with fade-in and fade-out, driven by the same update steps on both
-// sides, compared bone by bone and vertex by vertex on Cally (issue 3's
-// oracle for blending), and the same on Paladin at its .cfg scale of 0.5.
+// sides, compared bone by bone and vertex by vertex on Cally (the blending
+// oracle of docs/ANIMATION.md, "Tests"), and the same on Paladin at its .cfg
+// scale of 0.5.
 // Complements the single-clip oracle in cal3d_import_test.cpp.
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-# The numerical-extremes suite (issue 8, point 4) and resource limits (point 5).
+# The numerical-extremes suite (docs/ROBUSTNESS.md) and resource limits.
 # Included from tests/CMakeLists.txt; CMAKE_CURRENT_LIST_DIR is tests/extremes.
 sinew_add_test_binary(sinew_extremes_tests
   SOURCES ${CMAKE_CURRENT_LIST_DIR}/extremes_scene_test.cpp

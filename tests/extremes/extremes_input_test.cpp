@@ -1,4 +1,4 @@
-// Extreme inputs end to end (issue 8, point 4): clips with duplicate,
+// Extreme inputs end to end (docs/ROBUSTNESS.md): clips with duplicate,
 // out-of-order or single keys, and skin weights that do not sum to 1. Each
 // either gives the brute-force image after bake and render, or a clear error
 // naming the field.

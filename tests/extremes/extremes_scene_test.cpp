@@ -1,4 +1,4 @@
-// Numerical extremes end to end (issue 8, point 4): model -> bake -> pose ->
+// Numerical extremes end to end (docs/ROBUSTNESS.md): model -> bake -> pose ->
 // render every AOV -> every pixel against brute force over the skinned
 // triangles, no NaN anywhere. tests/raytrace/render_extremes_test.cpp checks
 // single rays for scaled/distant characters, zero-scale skinning matrices

@@ -1,4 +1,4 @@
-// Shared by the numerical-extremes suite (issue 8, point 4): a baked model
+// Shared by the numerical-extremes suite (docs/ROBUSTNESS.md): a baked model
 // posed into a scene, rendered with every AOV, and every pixel compared with
 // brute force over the skinned triangles (tests/support/brute_force.h).
 #pragma once

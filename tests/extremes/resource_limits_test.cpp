@@ -1,4 +1,4 @@
-// Resource limits (issue 8, point 5): inputs beyond what the format or
+// Resource limits (docs/ROBUSTNESS.md): inputs beyond what the format or
 // memory allows are refused with a clear message before any allocation in
 // proportion to the claim, and the bake's memory is bounded and reported.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// Beyond the sampled pose space and at numerical extremes (DESIGN.md
+// Beyond the sampled pose space and at numerical extremes (docs/DESIGN.md
 // sections 4 and 5): escapes are detected and the fallback keeps every ray
 // exact; scales 1e-3 and 1e4, a character 1e5 units from the origin,
 // axis-parallel rays, origins on split planes, zero-area triangles and

@@ -1,9 +1,9 @@
-// The ray tracer against brute force (DESIGN.md section 4): for real models
+// The ray tracer against brute force (docs/DESIGN.md section 4): for real models
 // posed inside their sampled pose space, every ray's nearest hit (triangle,
 // instance, t within 1e-5 relative) and every shadow ray's occlusion agree
 // with intersecting every skinned triangle one by one; poses outside the
 // pose space are detected and, through the fallback, still exact; and the
-// numerical extremes of DESIGN.md section 5 hold.
+// numerical extremes of docs/DESIGN.md section 5 hold.
 #include <gtest/gtest.h>
 
 #include <algorithm>

@@ -1,4 +1,4 @@
-# The soak test (issue 8, point 3): label "soak", left out of `./sinew test`.
+# The soak test (docs/ROBUSTNESS.md, "The soak test"): label "soak", left out of `./sinew test`.
 # Included from tests/CMakeLists.txt; CMAKE_CURRENT_LIST_DIR is tests/soak.
 
 # One GoogleTest case, registered directly (not with sinew_add_test_binary)

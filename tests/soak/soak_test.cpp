@@ -1,4 +1,4 @@
-// The soak test (issue 8, point 3): the demo's world run for a long time
+// The soak test (docs/ROBUSTNESS.md, "The soak test"): the demo's world run for a long time
 // (20,000 frames by default; SINEW_SOAK_FRAMES overrides, SINEW_SOAK_SEED
 // picks the seed) with random player input, random camera moves and random
 // clip switches, rendered with every AOV at a small size. It checks that
