@@ -33,7 +33,7 @@ struct TileScratch {
 
   // Region r holds blocks [region_begin[r], region_begin[r + 1]).
   std::vector<std::uint32_t> region_begin;
-  std::vector<int> block_x0, block_y0;     // per block: its top-left pixel
+  std::vector<int> block_dx, block_dy;     // per block: its top-left pixel, from the tile's
   std::vector<std::uint8_t> block_pixels;  // per block: bit i set when lane i is a pixel of the image
   std::vector<std::uint8_t> block_hits;    // per block: bit i set when lane i hit
   // Per block: bit i set when lane i hit a character (not a static mesh);
@@ -84,11 +84,11 @@ struct TileScratch {
 
   std::size_t blocks() const { return lanes / kBlockLanes; }
   std::size_t regions() const { return region_begin.empty() ? 0 : region_begin.size() - 1; }
-  int pixel_x(std::size_t k) const {
-    return block_x0[k / kBlockLanes] + static_cast<int>(k % kBlockWidth);
-  }
+  int block_x0(std::size_t b) const { return tile.x0 + block_dx[b]; }
+  int block_y0(std::size_t b) const { return tile.y0 + block_dy[b]; }
+  int pixel_x(std::size_t k) const { return block_x0(k / kBlockLanes) + static_cast<int>(k % kBlockWidth); }
   int pixel_y(std::size_t k) const {
-    return block_y0[k / kBlockLanes] + static_cast<int>((k % kBlockLanes) / kBlockWidth);
+    return block_y0(k / kBlockLanes) + static_cast<int>((k % kBlockLanes) / kBlockWidth);
   }
   bool is_pixel(std::size_t k) const { return (block_pixels[k / kBlockLanes] >> (k % kBlockLanes) & 1u) != 0; }
   bool hit(std::size_t k) const { return (block_hits[k / kBlockLanes] >> (k % kBlockLanes) & 1u) != 0; }
@@ -104,6 +104,9 @@ struct TileScratch {
 
  private:
   std::size_t capacity_ = 0;  // lanes every array holds
+  // The layout last made: a tile of the same size and regions (most tiles
+  // of a frame) reuses it wherever it lies.
+  int layout_width_ = -1, layout_height_ = -1, layout_region_x_ = -1, layout_region_y_ = -1;
 };
 
 // The calling thread's scratch. One tile at a time per thread: a tile's

@@ -279,8 +279,24 @@ void set_miss(TileScratch& s, std::size_t k) {
 
 void TileScratch::prepare(const Tile& area, int region_blocks_x, int region_blocks_y) {
   tile = area;
-  blocks_x = (area.x1 - area.x0 + kBlockWidth - 1) / kBlockWidth;
-  blocks_y = (area.y1 - area.y0 + kBlockHeight - 1) / kBlockHeight;
+  shadow_placed = 0;
+  shadows_compacted = true;
+  shadow_count = 0;
+  shadow_region_begin.clear();
+  shadows_from_point = false;
+  const int width = area.x1 - area.x0, height = area.y1 - area.y0;
+  const int rx = std::max(1, region_blocks_x), ry = std::max(1, region_blocks_y);
+  if (width == layout_width_ && height == layout_height_ && rx == layout_region_x_ && ry == layout_region_y_) {
+    std::fill_n(block_hits.begin(), blocks(), std::uint8_t{0});
+    std::fill_n(block_on_character.begin(), blocks(), std::uint8_t{0});
+    return;
+  }
+  layout_width_ = width;
+  layout_height_ = height;
+  layout_region_x_ = rx;
+  layout_region_y_ = ry;
+  blocks_x = (width + kBlockWidth - 1) / kBlockWidth;
+  blocks_y = (height + kBlockHeight - 1) / kBlockHeight;
   const std::size_t blocks = static_cast<std::size_t>(blocks_x) * static_cast<std::size_t>(blocks_y);
   lanes = blocks * kBlockLanes;
   if (block_pixels.size() < blocks) {
@@ -288,8 +304,8 @@ void TileScratch::prepare(const Tile& area, int region_blocks_x, int region_bloc
     block_hits.resize(blocks);
     block_on_character.resize(blocks);
     shadow_lanes.resize(blocks);
-    block_x0.resize(blocks);
-    block_y0.resize(blocks);
+    block_dx.resize(blocks);
+    block_dy.resize(blocks);
   }
   // One spare group: a region's shadow rays start anywhere in the compacted
   // arrays and are read a whole group at a time.
@@ -306,7 +322,6 @@ void TileScratch::prepare(const Tile& area, int region_blocks_x, int region_bloc
     shadow_pixel.resize(arrays);
     capacity_ = arrays;
   }
-  const int rx = std::max(1, region_blocks_x), ry = std::max(1, region_blocks_y);
   region_begin.clear();
   std::size_t b = 0;
   for (int y0 = 0; y0 < blocks_y; y0 += ry) {
@@ -314,12 +329,12 @@ void TileScratch::prepare(const Tile& area, int region_blocks_x, int region_bloc
       region_begin.push_back(static_cast<std::uint32_t>(b));
       for (int y = y0; y < std::min(blocks_y, y0 + ry); ++y) {
         for (int x = x0; x < std::min(blocks_x, x0 + rx); ++x, ++b) {
-          const int px0 = area.x0 + x * kBlockWidth;
-          const int py0 = area.y0 + y * kBlockHeight;
-          block_x0[b] = px0;
-          block_y0[b] = py0;
-          const int w = std::min(kBlockWidth, area.x1 - px0);
-          const int h = std::min(kBlockHeight, area.y1 - py0);
+          const int dx = x * kBlockWidth;
+          const int dy = y * kBlockHeight;
+          block_dx[b] = dx;
+          block_dy[b] = dy;
+          const int w = std::min(kBlockWidth, width - dx);
+          const int h = std::min(kBlockHeight, height - dy);
           const std::uint32_t row = (1u << w) - 1u;
           block_pixels[b] = static_cast<std::uint8_t>(h == 2 ? row | (row << kBlockWidth) : row);
           block_hits[b] = 0;
@@ -329,11 +344,6 @@ void TileScratch::prepare(const Tile& area, int region_blocks_x, int region_bloc
     }
   }
   region_begin.push_back(static_cast<std::uint32_t>(b));
-  shadow_placed = 0;
-  shadows_compacted = true;
-  shadow_count = 0;
-  shadow_region_begin.clear();
-  shadows_from_point = false;
 }
 
 void generate_camera_rays(const PinholeCamera& camera, TileScratch& s) {
@@ -903,8 +913,8 @@ void shade_and_write(const RenderSettings& settings, std::span<const Light> ligh
         if (out.rgba8.wanted()) srgb_pixels(color, pixels_rgba8);
       }
     }
-    const int bx = s.block_x0[b];
-    const int by = s.block_y0[b];
+    const int bx = s.block_x0(b);
+    const int by = s.block_y0(b);
     if (pixels == 0xFFu && (hits == 0xFFu || hits == 0u)) {
       // A whole block of one kind: each output's two rows of four pixels
       // are contiguous.
