@@ -74,6 +74,21 @@ inline Float8 select(Mask8 mask, Float8 yes, Float8 no) { return {_mm256_blendv_
 inline Mask8 is_finite(Float8 a) {
   return {_mm256_cmp_ps(abs(a).v, _mm256_set1_ps(3.402823466e38f), _CMP_LE_OQ)};
 }
+// a * b + c rounded once, per lane, as std::fma: not the separate product
+// and sum every other operation reproduces, so only for code that need not
+// match scalar arithmetic bit for bit (a polynomial approximation).
+inline Float8 fused_multiply_add(Float8 a, Float8 b, Float8 c) {
+#if defined(__FMA__)
+  return {_mm256_fmadd_ps(a.v, b.v, c.v)};
+#else
+  alignas(32) float x[8], y[8], z[8];
+  _mm256_store_ps(x, a.v);
+  _mm256_store_ps(y, b.v);
+  _mm256_store_ps(z, c.v);
+  for (int i = 0; i < 8; ++i) x[i] = std::fma(x[i], y[i], z[i]);
+  return {_mm256_load_ps(x)};
+#endif
+}
 // Truncation towards zero to int32, stored.
 inline void store_truncated(Float8 a, std::int32_t* out) {
   _mm256_storeu_si256(reinterpret_cast<__m256i*>(out), _mm256_cvttps_epi32(a.v));
@@ -199,6 +214,9 @@ inline Float8 select(Mask8 mask, Float8 yes, Float8 no) {
   return Float8::map([&](int i) { return (mask.b >> i & 1u) ? yes.v[i] : no.v[i]; });
 }
 inline Mask8 is_finite(Float8 a) { return Float8::test([&](int i) { return std::isfinite(a.v[i]); }); }
+inline Float8 fused_multiply_add(Float8 a, Float8 b, Float8 c) {
+  return Float8::map([&](int i) { return std::fma(a.v[i], b.v[i], c.v[i]); });
+}
 inline void store_truncated(Float8 a, std::int32_t* out) {
   for (int i = 0; i < 8; ++i) out[i] = static_cast<std::int32_t>(a.v[i]);
 }
