@@ -225,8 +225,12 @@ Result<PassStats> RayTracePass::execute(World& world, const PassInputs& inputs, 
     frame.normals = wanted(Output::kColorRgba8) || wanted(Output::kColorRgba32f) || wanted(Output::kNormal);
     rt::Scene& scene = world.impl().scene;
     const auto start = std::chrono::steady_clock::now();
+    World::Impl& state = world.impl();
+    state.prepared_changes = 0;  // half-prepared until it succeeds
     const auto prepared = scene.prepare_frame(frame, jobs);
     if (!prepared.ok()) return detail::to_api_error(prepared.status());
+    state.prepared_changes = state.changes;
+    state.prepared_exact = desc.fallback;
     PassStats stats;
     stats.prepare_ms = ms_since(start);
     stats.escaped_triangles = prepared->escaped_triangles;

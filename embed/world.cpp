@@ -42,9 +42,11 @@ Result<int> clip_index(const Instance& instance, std::string_view clip) {
 
 // The instance `id` if it exists and has the wanted driver.
 Result<Instance*> find_instance(World::Impl& world, InstanceId id, Driver wanted, const char* call) {
-  if (id >= world.instances.size() || world.instances[id].is_static) {
+  if (id >= world.instances.size() || world.instances[id].is_static || world.instances[id].removed) {
+    const bool removed = id < world.instances.size() && world.instances[id].removed;
     return detail::api_error(ErrorCode::kNotFound,
-                             std::string(call) + ": instance " + std::to_string(id) + ": no such character instance");
+                             std::string(call) + ": instance " + std::to_string(id) + ": " +
+                                 (removed ? "removed (World::remove)" : "no such character instance"));
   }
   Instance& instance = world.instances[id];
   if (instance.driver != wanted) {
@@ -64,6 +66,7 @@ void reset_mixer(Instance& instance) {
 
 // `instance.local` -> limits -> model space -> skinning matrices -> the scene.
 Status finish_pose(World::Impl& world, InstanceId id) {
+  world.changed();
   Instance& instance = world.instances[id];
   const editor::ImportedModel& model = instance.core->model();
   if (instance.limits && !instance.core->pack.limits().empty()) {
@@ -170,6 +173,7 @@ Result<InstanceId> World::add_static_mesh(const StaticMeshDesc& mesh) noexcept {
     if (!id.ok()) return detail::to_api_error(id.status());
     if (impl_->instances.size() <= *id) impl_->instances.resize(*id + 1);
     impl_->instances[*id].is_static = true;
+    impl_->changed();
     return static_cast<InstanceId>(*id);
   });
 }
@@ -194,6 +198,7 @@ Status World::set_bone_matrices(InstanceId id, std::span<const Matrix3x4> skinni
       }
     }
     for (std::size_t b = 0; b < skinning.size(); ++b) instance.skin[b] = detail::to_internal(skinning[b]);
+    impl_->changed();
     return detail::to_api_status(impl_->scene.set_bones(id, instance.skin));
   });
 }
@@ -275,7 +280,7 @@ Status World::advance(float dt_seconds) noexcept {
     }
     for (InstanceId id = 0; id < impl_->instances.size(); ++id) {
       Instance& instance = impl_->instances[id];
-      if (instance.is_static || instance.driver != Driver::kMixer) continue;
+      if (instance.removed || instance.is_static || instance.driver != Driver::kMixer) continue;
       instance.mixer->update(dt_seconds);
       const Status posed = pose_from_mixer(*impl_, id);
       if (!posed.ok()) return posed;
@@ -284,6 +289,30 @@ Status World::advance(float dt_seconds) noexcept {
   });
 }
 
-std::size_t World::instance_count() const noexcept { return impl_->instances.size(); }
+Status World::remove(InstanceId id) noexcept {
+  return detail::guarded("World::remove", [&]() -> Status {
+    if (id >= impl_->instances.size() || impl_->instances[id].removed) {
+      return detail::api_error(ErrorCode::kNotFound,
+                               "World::remove: instance " + std::to_string(id) + ": " +
+                                   (id < impl_->instances.size() ? "removed already"
+                                                                 : "no such instance or static mesh"));
+    }
+    SINEW_RETURN_IF_ERROR_API(impl_->scene.remove(id));
+    // Its mixer, poses and share of the character go; the character's
+    // scene entry (and trees) stay for later instances of it.
+    Instance removed;
+    removed.removed = true;
+    removed.is_static = impl_->instances[id].is_static;
+    impl_->instances[id] = std::move(removed);
+    impl_->changed();
+    return Status();
+  });
+}
+
+std::size_t World::instance_count() const noexcept {
+  std::size_t live = 0;
+  for (const Instance& instance : impl_->instances) live += instance.removed ? 0 : 1;
+  return live;
+}
 
 }  // namespace sinew::api

@@ -11,6 +11,7 @@
 #include "animation/mixer.h"
 #include "embed/character_impl.h"
 #include "raytrace/scene/scene.h"
+#include "runtime/jobs/job_system.h"
 #include "runtime/math/affine.h"
 #include "sinew/world.h"
 
@@ -18,6 +19,7 @@ namespace sinew::api {
 
 struct World::Impl {
   struct Instance {
+    bool removed = false;  // World::remove: its id is never given again
     bool is_static = false;
     std::shared_ptr<const Character::Impl> core;  // null for static meshes
     Driver driver = Driver::kMixer;
@@ -37,6 +39,16 @@ struct World::Impl {
   std::vector<std::shared_ptr<const Character::Impl>> cores;  // by scene character index
   rt::Scene scene;
   std::vector<Instance> instances;  // by InstanceId (the scene's numbering)
+
+  // What the scene's frame state (skinned positions, boxes, top level) was
+  // last prepared from: queries prepare it again when anything moved since,
+  // or when the last prepare left escaped triangles out (a pass without
+  // the fallback).
+  std::uint64_t changes = 1;           // bumped by every change to an instance
+  std::uint64_t prepared_changes = 0;  // `changes` at the last prepare
+  bool prepared_exact = false;         // that prepare routed escaped triangles
+  std::unique_ptr<JobSystem> query_jobs;  // one thread, made by the first query that prepares
+  void changed() { ++changes; }
 };
 
 }  // namespace sinew::api

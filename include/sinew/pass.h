@@ -56,10 +56,7 @@ class OutputMask {
 };
 constexpr OutputMask operator|(Output a, Output b) { return OutputMask(a) | OutputMask(b); }
 
-enum class TriangleTest : std::uint8_t {
-  kFast,        // Möller–Trumbore, no per-triangle precomputation: fastest
-  kWatertight,  // Woop, Benthin and Wald 2013: no ray leaks between adjacent triangles
-};
+// TriangleTest: sinew/world.h (the World's ray queries take one too).
 
 struct PassDesc {
   int width = 1024;

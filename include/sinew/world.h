@@ -9,6 +9,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <span>
 #include <string_view>
@@ -24,6 +25,33 @@ namespace sinew::api {
 // pass's instance-id output.
 using InstanceId = std::uint32_t;
 inline constexpr std::uint32_t kNoHit = 0xFFFFFFFFu;  // id outputs on a miss
+
+enum class TriangleTest : std::uint8_t {
+  kFast,        // Möller–Trumbore, no per-triangle precomputation: fastest
+  kWatertight,  // Woop, Benthin and Wald 2013: no ray leaks between adjacent triangles
+};
+
+// A ray for World's queries: the points origin + t direction with
+// t_min <= t < t_max (the direction need not be unit length: t is in its
+// units).
+struct Ray {
+  Float3 origin;
+  Float3 direction{0.0f, 0.0f, 1.0f};
+  float t_min = 0.0f;
+  float t_max = std::numeric_limits<float>::infinity();
+};
+
+// The nearest hit of a ray, or a miss (instance and triangle kNoHit, t
+// infinite). The hit point is origin + t direction = (1 - u - v) p0 + u p1
+// + v p2 on the triangle's corners (as posed, in world space).
+struct RayHit {
+  float t = std::numeric_limits<float>::infinity();
+  float u = 0.0f;
+  float v = 0.0f;
+  InstanceId instance = kNoHit;
+  std::uint32_t triangle = kNoHit;  // the character's (or static mesh's) triangle
+  bool hit() const noexcept { return instance != kNoHit; }
+};
 
 enum class Driver : std::uint8_t {
   kMixer,  // World::play_cycle / play_action / advance pose it
@@ -89,7 +117,34 @@ class SINEW_API World {
   // Advances every mixer-driven instance's mixer by dt seconds and poses it.
   Status advance(float dt_seconds) noexcept;
 
-  std::size_t instance_count() const noexcept;  // characters and static meshes
+  // Removes a character instance or a static mesh (a host despawning it):
+  // it leaves the next pass and query, and its per-frame memory is freed.
+  // Its id is never given again, so a stale id fails with kNotFound instead
+  // of reaching a newer instance. Errors: kNotFound (never added, or removed
+  // already).
+  Status remove(InstanceId instance) noexcept;
+
+  // Characters and static meshes in the world (removed ones not counted).
+  std::size_t instance_count() const noexcept;
+
+  // Ray queries on the world as posed now (picking, hit tests, gameplay
+  // rays), exact like the pass's images: triangles outside the baked pose
+  // space included. Poses set since the last pass or query are first
+  // skinned and their trees' boxes and top level rebuilt (as a pass's
+  // prepare, on the calling thread: fractions of a millisecond per
+  // character), so query between passes, as for every other World call.
+  // The batch forms answer rays[i] in hits[i] (or blocked[i]: 1 when
+  // something lies on the ray, else 0), on the calling thread.
+  // Errors: kInvalidArgument (a non-finite origin or direction, a zero
+  // direction, a NaN or negative t_min, t_max below t_min; spans of
+  // different sizes), naming the ray; nothing is written then.
+  Result<RayHit> intersect(const Ray& ray, TriangleTest test = TriangleTest::kFast) noexcept;
+  Status intersect(std::span<const Ray> rays, std::span<RayHit> hits,
+                   TriangleTest test = TriangleTest::kFast) noexcept;
+  // Whether anything lies on the ray (any hit: cheaper than the nearest).
+  Result<bool> occluded(const Ray& ray, TriangleTest test = TriangleTest::kFast) noexcept;
+  Status occluded(std::span<const Ray> rays, std::span<std::uint8_t> blocked,
+                  TriangleTest test = TriangleTest::kFast) noexcept;
 
   struct Impl;
 

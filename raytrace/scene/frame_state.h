@@ -22,6 +22,7 @@ namespace sinew::rt {
 struct InstanceFrame {
   std::uint32_t character = 0;
   std::uint32_t instance_id = 0;  // scene-wide id reported in hits
+  bool live = true;               // false once removed (Scene::remove): its data is freed
 
   std::vector<Affine3> skinning;         // per bone: bind pose -> world
   std::vector<Affine3> bone_from_world;  // per bone: the inverse (the bone frame)

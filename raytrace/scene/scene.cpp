@@ -85,10 +85,37 @@ Expected<std::uint32_t> Scene::add_static_mesh(StaticMeshDesc mesh, const KdBuil
   return static_cast<std::uint32_t>(slots_.size() - 1);
 }
 
+bool Scene::contains(std::uint32_t id) const {
+  if (id >= slots_.size()) return false;
+  const ObjectSlot& slot = slots_[id];
+  return slot.kind == ObjectKind::kCharacter ? instances_[slot.index].live : statics_[slot.index].live;
+}
+
+Status Scene::remove(std::uint32_t id) {
+  if (!contains(id)) {
+    return make_error(ErrorCode::kNotFound, "scene", "id", std::to_string(id),
+                      id < slots_.size() ? "removed already" : "no such instance or static mesh");
+  }
+  const ObjectSlot& slot = slots_[id];
+  if (slot.kind == ObjectKind::kCharacter) {
+    InstanceFrame& frame = instances_[slot.index];
+    InstanceFrame removed;
+    removed.character = frame.character;
+    removed.instance_id = frame.instance_id;
+    removed.live = false;
+    frame = std::move(removed);
+  } else {
+    StaticMesh& mesh = statics_[slot.index];
+    mesh = StaticMesh{StaticMeshDesc{}, KdTree{}, mesh.instance_id, false};
+  }
+  return {};
+}
+
 Status Scene::set_bones(std::uint32_t instance, std::span<const Affine3> skinning) {
   if (instance >= slots_.size() || slots_[instance].kind != ObjectKind::kCharacter) {
     return invalid_argument("instance", std::to_string(instance), "not a character instance");
   }
+  if (!contains(instance)) return invalid_argument("instance", std::to_string(instance), "removed");
   InstanceFrame& frame = instances_[slots_[instance].index];
   if (skinning.size() != frame.skinning.size()) {
     return invalid_argument("skinning", std::to_string(skinning.size()),
@@ -110,6 +137,7 @@ Expected<FrameStats> Scene::prepare_frame(const FrameOptions& options, JobSystem
   double boxes_ms = 0.0;
   double fallback_ms = 0.0;
   for (InstanceFrame& frame : instances_) {
+    if (!frame.live) continue;
     const Character& character = characters_[frame.character];
     auto start = std::chrono::steady_clock::now();
     update_bone_frames(frame, character.fuzzy);
@@ -138,6 +166,7 @@ Expected<FrameStats> Scene::prepare_frame(const FrameOptions& options, JobSystem
   std::vector<TopLevelObject> objects = top_level_.take_objects();
   for (std::uint32_t i = 0; i < instances_.size(); ++i) {
     const InstanceFrame& frame = instances_[i];
+    if (!frame.live) continue;
     const FuzzyCharacterView& fuzzy = characters_[frame.character].fuzzy;
     for (std::uint32_t b = 0; b < fuzzy.bone_count; ++b) {
       if (fuzzy.bone_trees[b].triangle_count == 0 || fuzzy.bone_trees[b].node_count == 0 ||
@@ -151,7 +180,7 @@ Expected<FrameStats> Scene::prepare_frame(const FrameOptions& options, JobSystem
     }
   }
   for (std::uint32_t s = 0; s < statics_.size(); ++s) {
-    if (statics_[s].tree.nodes.empty()) continue;
+    if (!statics_[s].live || statics_[s].tree.nodes.empty()) continue;
     objects.push_back({TopLevelObject::Kind::kStatic, s, 0, statics_[s].tree.bounds});
   }
   SINEW_RETURN_IF_ERROR(top_level_.build(std::move(objects), within_traversal_depth(options.top_level_kd)));

@@ -86,6 +86,14 @@ class Scene {
   // Builds the static mesh's kd-tree once.
   Expected<std::uint32_t> add_static_mesh(StaticMeshDesc mesh, const KdBuildOptions& kd = {});
 
+  // Removes an instance or a static mesh: its per-frame data and tree are
+  // freed, the next prepare_frame leaves it out, and its id is never given
+  // again (a stale id is refused, not taken for a newer object). Errors: an
+  // id that was never given or is removed already.
+  Status remove(std::uint32_t id);
+  // Whether `id` names an instance or static mesh not removed.
+  bool contains(std::uint32_t id) const;
+
   // This frame's skinning matrices of an instance (bind pose -> world), one
   // per bone of its character. Copied. Non-finite matrices are rejected.
   Status set_bones(std::uint32_t instance, std::span<const Affine3> skinning);
@@ -105,6 +113,7 @@ class Scene {
     StaticMeshDesc desc;
     KdTree tree;
     std::uint32_t instance_id = 0;  // scene-wide id reported in hits
+    bool live = true;               // false once removed (its mesh and tree freed)
   };
   enum class ObjectKind : std::uint8_t { kCharacter, kStatic };
   struct ObjectSlot {

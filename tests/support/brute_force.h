@@ -33,6 +33,7 @@ struct SoupTriangle {
 inline std::vector<SoupTriangle> world_triangles(const rt::Scene& scene) {
   std::vector<SoupTriangle> soup;
   for (const rt::InstanceFrame& frame : scene.instances()) {
+    if (!frame.live) continue;
     const SkinnedMesh& mesh = *scene.characters()[frame.character].mesh;
     for (std::uint32_t t = 0; t < mesh.triangles.size(); ++t) {
       const auto& v = mesh.triangles[t];
@@ -40,6 +41,7 @@ inline std::vector<SoupTriangle> world_triangles(const rt::Scene& scene) {
     }
   }
   for (const rt::Scene::StaticMesh& mesh : scene.static_meshes()) {
+    if (!mesh.live) continue;
     for (std::uint32_t t = 0; t < mesh.desc.triangles.size(); ++t) {
       const auto& v = mesh.desc.triangles[t];
       soup.push_back({mesh.desc.positions[v[0]], mesh.desc.positions[v[1]], mesh.desc.positions[v[2]], t,

@@ -1,0 +1,136 @@
+// sinew::api::World's ray queries: single rays through rt::intersect and
+// rt::occluded (render/traversal.h) on the scene's frame state, prepared
+// again first when an instance changed since the last pass or query.
+#include <cmath>
+#include <string>
+
+#include "embed/api_errors.h"
+#include "embed/convert.h"
+#include "embed/world_impl.h"
+#include "raytrace/render/traversal.h"
+
+namespace sinew::api {
+namespace {
+
+rt::TriangleTest to_internal(TriangleTest test) {
+  return test == TriangleTest::kWatertight ? rt::TriangleTest::kWatertight : rt::TriangleTest::kFast;
+}
+
+bool finite(const Float3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+// What is wrong with `ray`, or empty.
+std::string ray_problem(const Ray& ray) {
+  if (!finite(ray.origin)) return "origin is not finite";
+  if (!finite(ray.direction)) return "direction is not finite";
+  if (ray.direction.x == 0.0f && ray.direction.y == 0.0f && ray.direction.z == 0.0f) return "direction is zero";
+  if (!(ray.t_min >= 0.0f) || !std::isfinite(ray.t_min)) {
+    return "t_min = " + std::to_string(ray.t_min) + ": expected a finite t >= 0";
+  }
+  if (!(ray.t_max >= ray.t_min)) return "t_max = " + std::to_string(ray.t_max) + ": expected t_max >= t_min";
+  return {};
+}
+
+Status check_rays(const char* call, std::span<const Ray> rays) {
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    const std::string problem = ray_problem(rays[i]);
+    if (!problem.empty()) {
+      return detail::api_error(ErrorCode::kInvalidArgument,
+                               std::string(call) + ": rays[" + std::to_string(i) + "]: " + problem);
+    }
+  }
+  return Status();
+}
+
+sinew::Ray to_internal(const Ray& ray) {
+  sinew::Ray r;
+  r.origin = detail::to_internal(ray.origin);
+  r.direction = detail::to_internal(ray.direction);
+  r.t_min = ray.t_min;
+  r.t_max = ray.t_max;
+  return r;
+}
+
+RayHit to_api(const Hit& hit) {
+  RayHit h;
+  if (!hit.valid()) return h;
+  h.t = hit.t;
+  h.u = hit.u;
+  h.v = hit.v;
+  h.instance = hit.instance_id;
+  h.triangle = hit.triangle_id;
+  return h;
+}
+
+// The scene's frame state for the world as posed now, escaped triangles
+// routed: prepared again unless the last pass or query left exactly that.
+Status prepare_for_queries(World::Impl& world) {
+  if (world.prepared_changes == world.changes && world.prepared_exact) return Status();
+  if (!world.query_jobs) world.query_jobs = std::make_unique<JobSystem>(1);
+  rt::FrameOptions options;
+  options.normals = false;  // queries read positions only; a pass prepares its own frame
+  options.fallback = true;
+  world.prepared_changes = 0;
+  const auto prepared = world.scene.prepare_frame(options, *world.query_jobs);
+  if (!prepared.ok()) return detail::to_api_error(prepared.status());
+  world.prepared_changes = world.changes;
+  world.prepared_exact = true;
+  return Status();
+}
+
+}  // namespace
+
+Result<RayHit> World::intersect(const Ray& ray, TriangleTest test) noexcept {
+  return detail::guarded("World::intersect", [&]() -> Result<RayHit> {
+    const Status valid = check_rays("World::intersect", std::span<const Ray>(&ray, 1));
+    if (!valid.ok()) return valid.error();
+    const Status prepared = prepare_for_queries(*impl_);
+    if (!prepared.ok()) return prepared.error();
+    return to_api(rt::intersect(impl_->scene, to_internal(ray), to_internal(test)));
+  });
+}
+
+Status World::intersect(std::span<const Ray> rays, std::span<RayHit> hits, TriangleTest test) noexcept {
+  return detail::guarded("World::intersect", [&]() -> Status {
+    if (hits.size() != rays.size()) {
+      return detail::api_error(ErrorCode::kInvalidArgument, "World::intersect: hits: " +
+                                                                std::to_string(hits.size()) + " entries for " +
+                                                                std::to_string(rays.size()) + " rays");
+    }
+    if (Status status = check_rays("World::intersect", rays); !status.ok()) return status;
+    if (Status status = prepare_for_queries(*impl_); !status.ok()) return status;
+    const rt::TriangleTest internal = to_internal(test);
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+      hits[i] = to_api(rt::intersect(impl_->scene, to_internal(rays[i]), internal));
+    }
+    return Status();
+  });
+}
+
+Result<bool> World::occluded(const Ray& ray, TriangleTest test) noexcept {
+  return detail::guarded("World::occluded", [&]() -> Result<bool> {
+    const Status valid = check_rays("World::occluded", std::span<const Ray>(&ray, 1));
+    if (!valid.ok()) return valid.error();
+    const Status prepared = prepare_for_queries(*impl_);
+    if (!prepared.ok()) return prepared.error();
+    return rt::occluded(impl_->scene, to_internal(ray), to_internal(test));
+  });
+}
+
+Status World::occluded(std::span<const Ray> rays, std::span<std::uint8_t> blocked, TriangleTest test) noexcept {
+  return detail::guarded("World::occluded", [&]() -> Status {
+    if (blocked.size() != rays.size()) {
+      return detail::api_error(ErrorCode::kInvalidArgument, "World::occluded: blocked: " +
+                                                                std::to_string(blocked.size()) + " entries for " +
+                                                                std::to_string(rays.size()) + " rays");
+    }
+    if (Status status = check_rays("World::occluded", rays); !status.ok()) return status;
+    if (Status status = prepare_for_queries(*impl_); !status.ok()) return status;
+    const rt::TriangleTest internal = to_internal(test);
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+      blocked[i] = rt::occluded(impl_->scene, to_internal(rays[i]), internal) ? 1 : 0;
+    }
+    return Status();
+  });
+}
+
+}  // namespace sinew::api
