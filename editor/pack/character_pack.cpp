@@ -26,6 +26,9 @@ constexpr SectionId kVertexCheckBegin = make_section_id("FVCB");
 constexpr SectionId kVertexChecks = make_section_id("FVCK");
 constexpr SectionId kTriangleChecks = make_section_id("FTCK");
 constexpr std::uint32_t kSectionVersion = 1;
+// LIMT version 1 held the limits as JSON text; version 2 is binary, so
+// loading a pack parses no JSON (JSON stays the editor's authoring format).
+constexpr std::uint32_t kLimitsVersion = 2;
 
 // Counts a pack may declare: beyond them a file is refused before any
 // allocation (a corrupt count must not exhaust memory).
@@ -110,6 +113,26 @@ std::vector<std::byte> encode_pose_space(const PoseSpaceRecord& r) {
   e.put(r.padding);
   e.put(static_cast<std::uint32_t>(r.desc.clips.size()));
   for (const std::string& name : r.desc.clips) e.put_string(name);
+  return std::move(e.bytes());
+}
+
+// Per joint: kind, Euler order, two reserved bytes, then every field of
+// both limit forms (the unused one as its defaults), 56 bytes a joint.
+std::vector<std::byte> encode_limits(std::span<const anim::JointLimit> limits) {
+  SectionEncoder e;
+  e.put(static_cast<std::uint32_t>(limits.size()));
+  for (const anim::JointLimit& l : limits) {
+    e.put(static_cast<std::uint8_t>(l.kind));
+    e.put(static_cast<std::uint8_t>(l.euler.order));
+    e.put(std::uint16_t{0});
+    for (const Vec3& v : {l.euler.min, l.euler.max, l.swing_twist.twist_axis}) {
+      for (int a = 0; a < 3; ++a) e.put(v[a]);
+    }
+    e.put(l.swing_twist.swing_max_1);
+    e.put(l.swing_twist.swing_max_2);
+    e.put(l.swing_twist.twist_min);
+    e.put(l.swing_twist.twist_max);
+  }
   return std::move(e.bytes());
 }
 
@@ -337,6 +360,47 @@ Expected<PoseSpaceRecord> decode_pose_space(SectionDecoder& d) {
   return r;
 }
 
+Expected<anim::JointLimits> decode_limits(SectionDecoder& d, const anim::Skeleton& skeleton) {
+  std::uint32_t count = 0;
+  SINEW_RETURN_IF_ERROR(d.get(count, "joint_count"));
+  if (count != skeleton.joint_count()) {
+    return d.error("joint_count", std::to_string(count),
+                   "differs from the skeleton's " + std::to_string(skeleton.joint_count()) + " joints");
+  }
+  anim::JointLimits limits(count);
+  for (std::uint32_t j = 0; j < count; ++j) {
+    const std::string f = "joints[" + std::to_string(j) + "]";
+    anim::JointLimit& l = limits[j];
+    std::uint8_t kind = 0, order = 0;
+    std::uint16_t reserved = 0;
+    SINEW_RETURN_IF_ERROR(d.get(kind, f + ".kind"));
+    SINEW_RETURN_IF_ERROR(d.get(order, f + ".euler.order"));
+    SINEW_RETURN_IF_ERROR(d.get(reserved, f + ".reserved"));
+    if (kind > static_cast<std::uint8_t>(anim::LimitKind::kSwingTwist)) {
+      return d.error(f + ".kind", std::to_string(kind), "unknown limit kind (0 free, 1 Euler, 2 swing-twist)");
+    }
+    if (order > static_cast<std::uint8_t>(anim::RotationOrder::kZYX)) {
+      return d.error(f + ".euler.order", std::to_string(order), "unknown rotation order (0 to 5)");
+    }
+    if (reserved != 0) return d.error(f + ".reserved", std::to_string(reserved), "not 0");
+    l.kind = static_cast<anim::LimitKind>(kind);
+    l.euler.order = static_cast<anim::RotationOrder>(order);
+    Vec3* const vectors[3] = {&l.euler.min, &l.euler.max, &l.swing_twist.twist_axis};
+    const char* const names[3] = {".euler.min", ".euler.max", ".swing_twist.twist_axis"};
+    for (int v = 0; v < 3; ++v) {
+      for (int a = 0; a < 3; ++a) SINEW_RETURN_IF_ERROR(d.get((*vectors[v])[a], f + names[v]));
+    }
+    SINEW_RETURN_IF_ERROR(d.get(l.swing_twist.swing_max_1, f + ".swing_twist.swing_max_1"));
+    SINEW_RETURN_IF_ERROR(d.get(l.swing_twist.swing_max_2, f + ".swing_twist.swing_max_2"));
+    SINEW_RETURN_IF_ERROR(d.get(l.swing_twist.twist_min, f + ".swing_twist.twist_min"));
+    SINEW_RETURN_IF_ERROR(d.get(l.swing_twist.twist_max, f + ".swing_twist.twist_max"));
+  }
+  SINEW_RETURN_IF_ERROR(d.finish());
+  // Ranges, finiteness and unit axes, as for limits read from JSON.
+  SINEW_RETURN_IF_ERROR(anim::validate_joint_limits(limits, d.pack() + " " + d.section()));
+  return limits;
+}
+
 Expected<Provenance> decode_provenance(SectionDecoder& d) {
   Provenance p;
   SINEW_RETURN_IF_ERROR(d.get_string(p.source_name, "source_name"));
@@ -390,8 +454,11 @@ Expected<PackWriter> character_pack_writer(const CharacterPackContents& c) {
   SINEW_RETURN_IF_ERROR(w.add_section(kMesh, kSectionVersion, encode_mesh(*c.model)));
   SINEW_RETURN_IF_ERROR(w.add_section(kClips, kSectionVersion, encode_clips(c.model->clips)));
   if (!c.limits.empty()) {
-    const std::string json = anim::joint_limits_to_json(c.limits, c.model->skeleton);
-    SINEW_RETURN_IF_ERROR(w.add_section(kLimits, kSectionVersion, std::as_bytes(std::span(json.data(), json.size()))));
+    if (c.limits.size() != c.model->skeleton.joint_count()) {
+      return invalid_argument("contents.limits", std::to_string(c.limits.size()) + " joints",
+                              "the skeleton has " + std::to_string(c.model->skeleton.joint_count()));
+    }
+    SINEW_RETURN_IF_ERROR(w.add_section(kLimits, kLimitsVersion, encode_limits(c.limits)));
   }
   SINEW_RETURN_IF_ERROR(w.add_section(kPoseSpace, kSectionVersion, encode_pose_space(c.pose_space)));
   SINEW_RETURN_IF_ERROR(w.add_section(kProvenance, kSectionVersion, encode_provenance(c.provenance)));
@@ -466,11 +533,15 @@ Expected<CharacterPack> CharacterPack::load(PackReader reader) {
     SectionDecoder d = decoder(r, kClips);
     SINEW_ASSIGN_OR_RETURN(pack.model_.clips, decode_clips(d, pack.model_.skeleton));
   }
-  if (r.contains(kLimits)) {
-    SINEW_RETURN_IF_ERROR(check_version(r, kLimits));
-    const auto bytes = r.section_bytes(*r.find(kLimits));
-    const std::string_view json(reinterpret_cast<const char*>(bytes.data()), bytes.size());
-    SINEW_ASSIGN_OR_RETURN(pack.limits_, anim::parse_joint_limits(json, pack.model_.skeleton, r.name() + " LIMT"));
+  if (const SectionInfo* limits = r.find(kLimits)) {
+    if (limits->version != kLimitsVersion) {
+      return make_error(ErrorCode::kUnsupportedVersion, r.name(), "LIMT.version", std::to_string(limits->version),
+                        limits->version == 1 ? "joint limits as JSON text, which this build no longer reads: "
+                                               "re-bake the pack with this sinew-editor"
+                                             : "this build reads version " + std::to_string(kLimitsVersion));
+    }
+    SectionDecoder d = decoder(r, kLimits);
+    SINEW_ASSIGN_OR_RETURN(pack.limits_, decode_limits(d, pack.model_.skeleton));
   }
   {
     SectionDecoder d = decoder(r, kPoseSpace);
