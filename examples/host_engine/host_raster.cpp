@@ -228,4 +228,23 @@ void composite_by_depth(const Image& sinew_color, const Image& sinew_depth, Imag
   }
 }
 
+void highlight_instance(const Image& instance_ids, const Image& sinew_depth, std::uint32_t selected,
+                        Image& host_color, const Image& host_depth) {
+  // In sRGB bytes, like the frame: a highlight needs no linear light.
+  constexpr std::array<int, 3> kOrange{255, 140, 0};
+  for (int y = 0; y < host_color.height(); ++y) {
+    const std::uint32_t* ids = instance_ids.row<std::uint32_t>(y);
+    const float* from_depth = sinew_depth.row<float>(y);
+    const float* to_depth = host_depth.row<float>(y);
+    std::uint8_t* color_row = host_color.row<std::uint8_t>(y);
+    for (int x = 0; x < host_color.width(); ++x) {
+      if (ids[x] != selected || from_depth[x] != to_depth[x]) continue;
+      std::uint8_t* rgb = color_row + 4 * x;
+      for (std::size_t c = 0; c < kOrange.size(); ++c) {
+        rgb[c] = static_cast<std::uint8_t>((rgb[c] + kOrange[c] + 1) / 2);
+      }
+    }
+  }
+}
+
 }  // namespace host

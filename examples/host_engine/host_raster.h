@@ -103,4 +103,11 @@ void draw_host_pass(const PinholeCamera& camera, const Ground& ground, const Hos
 void composite_by_depth(const Image& sinew_color, const Image& sinew_depth, Image& host_color,
                         Image& host_depth);
 
+// After the composite: blends the pixels that show instance `selected`
+// (Sinew's instance-id output) halfway toward orange. Only where the
+// composite kept Sinew's pixel: where the host's pass hides part of the
+// character, the highlight must not show through.
+void highlight_instance(const Image& instance_ids, const Image& sinew_depth, std::uint32_t selected,
+                        Image& host_color, const Image& host_depth);
+
 }  // namespace host

@@ -7,6 +7,11 @@
 //
 //   host_engine --pack cesium.pack --headless --out frames/
 //   host_engine --pack cesium.pack --scheduler host --threads 4   (a window)
+//
+// It also asks the world questions between passes, as a game does: a click
+// (or --pick) casts the camera ray through a pixel to select a character,
+// and each printed frame a line-of-sight test casts one ray from the light
+// toward every character.
 #include <algorithm>
 #include <charconv>
 #include <chrono>
@@ -41,6 +46,11 @@ constexpr float kInstanceSpacing = 1.0f;  // instance i stands i units along +X
 
 // --- options ---------------------------------------------------------------
 
+struct Pixel {
+  int x = 0;
+  int y = 0;  // 0: the top row, as in the pass's images
+};
+
 struct Options {
   std::string pack;
   std::string clip = "#0";
@@ -55,6 +65,7 @@ struct Options {
   bool host_scheduler = false;
   bool headless = false;
   std::string out = ".";
+  std::optional<Pixel> pick;
 };
 
 const char* const kUsage =
@@ -74,6 +85,12 @@ const char* const kUsage =
     "  --scheduler tbb|host   Sinew's own TBB arena, or the host's thread pool (default tbb)\n"
     "  --headless             no window: write OUT/sinew_color.ppm, sinew_depth.pfm, frame.ppm\n"
     "  --out DIR              output folder of --headless (default .)\n"
+    "  --pick X,Y             select the character under pixel X,Y (0,0 the top left) before the\n"
+    "                         written (windowed: the first) frame; frame.ppm shows it tinted\n"
+    "                         orange (sinew_color.ppm stays Sinew's own). Windowed, a left click\n"
+    "                         selects too; a click on nothing clears the selection\n"
+    "Each printed frame also reports a line-of-sight test: one ray from the light toward each\n"
+    "instance's middle, and whether it reaches that instance or another one is in the way.\n"
     "Exit status: 0 success, 1 a Sinew (or file) error, 2 bad usage.\n";
 
 bool parse_number(std::string_view text, float& value) {
@@ -98,6 +115,17 @@ std::optional<std::vector<float>> parse_floats(std::string_view text, std::size_
   }
   if (values.size() != count) return std::nullopt;
   return values;
+}
+
+// "X,Y"; checked against the image size once --size is known.
+std::optional<Pixel> parse_pixel(std::string_view text) {
+  const std::size_t comma = text.find(',');
+  Pixel p;
+  if (comma == std::string_view::npos || !parse_number(text.substr(0, comma), p.x) ||
+      !parse_number(text.substr(comma + 1), p.y)) {
+    return std::nullopt;
+  }
+  return p;
 }
 
 // Returns the error that makes the command line unusable, or "".
@@ -146,11 +174,18 @@ std::string parse_options(int argc, char** argv, Options& o) {
       o.host_scheduler = value == "host";
     } else if (flag == "--out") {
       o.out = value;
+    } else if (flag == "--pick") {
+      o.pick = parse_pixel(value);
+      if (!o.pick) return bad;
     } else {
       return "unknown option " + std::string(flag);
     }
   }
   if (o.pack.empty()) return "--pack is required";
+  if (o.pick && (o.pick->x < 0 || o.pick->x >= o.width || o.pick->y < 0 || o.pick->y >= o.height)) {
+    return "--pick " + std::to_string(o.pick->x) + "," + std::to_string(o.pick->y) + " lies outside the " +
+           std::to_string(o.width) + "x" + std::to_string(o.height) + " image";
+  }
   return "";
 }
 
@@ -286,9 +321,14 @@ host::Ground ground_under(const Framing& f) {
 
 struct Frame {
   explicit Frame(int w, int h)
-      : sinew_color(w, h, 4), sinew_depth(w, h, sizeof(float)), host_color(w, h, 4), host_depth(w, h, sizeof(float)) {}
+      : sinew_color(w, h, 4),
+        sinew_depth(w, h, sizeof(float)),
+        sinew_instance(w, h, sizeof(api::InstanceId)),
+        host_color(w, h, 4),
+        host_depth(w, h, sizeof(float)) {}
   host::Image sinew_color;
   host::Image sinew_depth;
+  host::Image sinew_instance;  // which instance each pixel shows: the selection's highlight
   host::Image host_color;  // after composite_by_depth: the finished frame
   host::Image host_depth;
 };
@@ -306,6 +346,8 @@ struct Engine {
   host::Ground ground;
   host::HostLighting lighting;
   Frame frame;
+  Framing framing;  // where the line-of-sight test aims
+  api::InstanceId selection = api::kNoHit;  // picked by a click or --pick
 };
 
 struct FrameStats {
@@ -326,6 +368,7 @@ api::Result<FrameStats> render_frame(Engine& e) {
   api::PassOutputs outputs;
   outputs.color_rgba8 = e.frame.sinew_color.as_output();
   outputs.depth = e.frame.sinew_depth.as_output();
+  outputs.instance_id = e.frame.sinew_instance.as_output();
   auto sinew = e.pass.execute(e.world, e.inputs, outputs, e.pool ? &e.scheduler : nullptr);
   if (!sinew) return sinew.error();
   stats.sinew = *sinew;
@@ -336,6 +379,10 @@ api::Result<FrameStats> render_frame(Engine& e) {
 
   start = std::chrono::steady_clock::now();
   host::composite_by_depth(e.frame.sinew_color, e.frame.sinew_depth, e.frame.host_color, e.frame.host_depth);
+  if (e.selection != api::kNoHit) {
+    host::highlight_instance(e.frame.sinew_instance, e.frame.sinew_depth, e.selection, e.frame.host_color,
+                             e.frame.host_depth);
+  }
   stats.composite_ms = ms_since(start);
   return stats;
 }
@@ -354,6 +401,76 @@ int sinew_failed(const api::Error& error) {
   return kExitSinewError;
 }
 
+// --- queries between passes ------------------------------------------------
+
+// The camera ray through the pixel's centre, the ray the pass traced for
+// it: what it meets first is what the pixel shows. The world must still be
+// posed as in the frame the user sees (query before the next advance).
+api::Status pick(Engine& e, Pixel pixel) {
+  const host::Vec3 direction = e.camera.ray_direction(pixel.x, pixel.y);
+  api::Ray ray;
+  ray.origin = e.inputs.camera.eye;
+  ray.direction = {direction.x, direction.y, direction.z};
+  auto hit = e.world.intersect(ray);
+  if (!hit) return hit.error();
+  e.selection = hit->instance;  // kNoHit on a miss: the selection is cleared
+  if (hit->hit()) {
+    std::printf("pick %d,%d: selected instance %u, triangle %u, %.3f from the eye\n", pixel.x, pixel.y,
+                static_cast<unsigned>(hit->instance), static_cast<unsigned>(hit->triangle),
+                static_cast<double>(hit->t));  // the direction is unit: t is the distance
+  } else {
+    std::printf("pick %d,%d: nothing there, selection cleared\n", pixel.x, pixel.y);
+  }
+  std::fflush(stdout);
+  return {};
+}
+
+// A gameplay ray test: can the light see each character? One segment per
+// instance, from the light to the middle of where it stands (the bind-pose
+// framing: instance i stands kInstanceSpacing * i along +X of the first).
+// Only another instance or a static mesh on the segment hides it: reaching
+// the middle without meeting its own surface (a gap in its pose) still
+// counts as seen.
+api::Result<std::string> line_of_sight(Engine& e) {
+  const host::Vec3 middle = center_of(e.framing);
+  const float row = kInstanceSpacing * static_cast<float>(e.instances.size() - 1);
+  const api::Float3 from = e.light.position;
+  std::vector<api::Ray> rays(e.instances.size());
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    const float x = middle.x - 0.5f * row + kInstanceSpacing * static_cast<float>(i);
+    rays[i].origin = from;
+    rays[i].direction = {x - from.x, middle.y - from.y, middle.z - from.z};
+    rays[i].t_max = 1.0f;  // the segment ends at the middle: nothing behind it counts
+  }
+  std::vector<api::RayHit> hits(rays.size());
+  if (auto s = e.world.intersect(rays, hits); !s) return s.error();
+
+  std::string report = "line of sight from the light:";
+  for (std::size_t i = 0; i < hits.size(); ++i) {
+    const api::InstanceId blocker = hits[i].instance;
+    report += (i == 0 ? " instance " : ", instance ") + std::to_string(e.instances[i]);
+    if (blocker == api::kNoHit || blocker == e.instances[i]) {
+      report += " visible";
+    } else if (std::find(e.instances.begin(), e.instances.end(), blocker) != e.instances.end()) {
+      report += " hidden behind instance " + std::to_string(blocker);
+    } else {
+      report += " blocked by static mesh " + std::to_string(blocker);
+    }
+  }
+  return report;
+}
+
+// The stats line, then the line-of-sight test on the frame just rendered
+// (the world is posed as the pass saw it, so the query reuses its work).
+api::Status report_frame(Engine& e, int frame, const FrameStats& stats) {
+  print_stats(frame, stats);
+  auto sight = line_of_sight(e);
+  if (!sight) return sight.error();
+  std::printf("frame %d: %s\n", frame, sight->c_str());
+  std::fflush(stdout);
+  return {};
+}
+
 // Every instance plays the clip through the mixer, so World::advance moves
 // them all at once.
 api::Status start_playing(Engine& e, const Options& o) {
@@ -369,19 +486,21 @@ int run_headless(Engine& e, const Options& o) {
     for (const api::InstanceId id : e.instances) {
       if (auto s = e.world.pose_at(id, o.clip, o.time); !s) return sinew_failed(s.error());
     }
-    auto stats = render_frame(e);
-    if (!stats) return sinew_failed(stats.error());
-    print_stats(0, *stats);
   } else {
     if (auto s = start_playing(e, o); !s) return sinew_failed(s.error());
-    for (int f = 0; f < o.frames; ++f) {
-      if (f > 0) {
-        if (auto s = e.world.advance(kFrameStep); !s) return sinew_failed(s.error());
-      }
-      auto stats = render_frame(e);
-      if (!stats) return sinew_failed(stats.error());
-      print_stats(f, *stats);
+  }
+  const int frames = std::max(o.frames, 1);
+  for (int f = 0; f < frames; ++f) {
+    if (f > 0) {
+      if (auto s = e.world.advance(kFrameStep); !s) return sinew_failed(s.error());
     }
+    // Picked on the pose about to be rendered: the frame written is the one picked in.
+    if (o.pick && f == frames - 1) {
+      if (auto s = pick(e, *o.pick); !s) return sinew_failed(s.error());
+    }
+    auto stats = render_frame(e);
+    if (!stats) return sinew_failed(stats.error());
+    if (auto s = report_frame(e, f, *stats); !s) return sinew_failed(s.error());
   }
   std::error_code ec;
   std::filesystem::create_directories(o.out, ec);
@@ -397,6 +516,34 @@ int run_headless(Engine& e, const Options& o) {
 }
 
 #if HOST_ENGINE_WINDOW
+// A left click waits here, in window coordinates, until the loop is between
+// passes: the callback runs inside glfwPollEvents.
+struct PendingClick {
+  bool pending = false;
+  double x = 0.0;
+  double y = 0.0;
+};
+
+void on_mouse_button(GLFWwindow* window, int button, int action, int /*mods*/) {
+  if (button != GLFW_MOUSE_BUTTON_LEFT || action != GLFW_PRESS) return;
+  auto* click = static_cast<PendingClick*>(glfwGetWindowUserPointer(window));
+  glfwGetCursorPos(window, &click->x, &click->y);
+  click->pending = true;
+}
+
+// Window coordinates (screen units, which HiDPI scaling or a window manager
+// may make differ from the image's pixels) to the image pixel under them.
+std::optional<Pixel> image_pixel(GLFWwindow* window, const PendingClick& click, int width, int height) {
+  int window_width = 0;
+  int window_height = 0;
+  glfwGetWindowSize(window, &window_width, &window_height);
+  if (window_width <= 0 || window_height <= 0) return std::nullopt;
+  const double x = std::floor(click.x * width / window_width);
+  const double y = std::floor(click.y * height / window_height);
+  if (x < 0.0 || x >= width || y < 0.0 || y >= height) return std::nullopt;
+  return Pixel{static_cast<int>(x), static_cast<int>(y)};
+}
+
 int run_windowed(Engine& e, const Options& o) {
   if (glfwInit() == GLFW_FALSE) {
     std::fprintf(stderr, "host_engine: no display (GLFW failed to start): use --headless\n");
@@ -411,6 +558,9 @@ int run_windowed(Engine& e, const Options& o) {
   }
   glfwMakeContextCurrent(window);
   glfwSwapInterval(1);
+  PendingClick click;
+  glfwSetWindowUserPointer(window, &click);
+  glfwSetMouseButtonCallback(window, on_mouse_button);
 
   int status = 0;
   std::vector<std::uint8_t> bottom_up(static_cast<std::size_t>(o.width) * static_cast<std::size_t>(o.height) * 4);
@@ -419,6 +569,18 @@ int run_windowed(Engine& e, const Options& o) {
   for (int f = 0; status == 0 && !glfwWindowShouldClose(window) && (o.frames == 0 || f < o.frames); ++f) {
     glfwPollEvents();
     if (glfwGetKey(window, GLFW_KEY_ESCAPE) == GLFW_PRESS) break;
+    // Before advance: the world is still posed as in the frame clicked on.
+    std::optional<Pixel> picked = f == 0 ? o.pick : std::nullopt;
+    if (click.pending) {
+      click.pending = false;
+      picked = image_pixel(window, click, o.width, o.height);
+    }
+    if (picked) {
+      if (auto s = pick(e, *picked); !s) {
+        status = sinew_failed(s.error());
+        break;
+      }
+    }
     // Real time, but never a jump of more than a few frames (a stall, a
     // debugger): the clip keeps cycling smoothly.
     const double now = glfwGetTime();
@@ -433,7 +595,12 @@ int run_windowed(Engine& e, const Options& o) {
       status = sinew_failed(stats.error());
       break;
     }
-    if (o.frames != 0 || f % 30 == 0) print_stats(f, *stats);
+    if (o.frames != 0 || f % 30 == 0) {
+      if (auto s = report_frame(e, f, *stats); !s) {
+        status = sinew_failed(s.error());
+        break;
+      }
+    }
 
     // glDrawPixels wants rows bottom to top; Sinew and the host write top down.
     const std::size_t row_bytes = static_cast<std::size_t>(o.width) * 4;
@@ -467,13 +634,14 @@ api::Result<std::unique_ptr<Engine>> make_engine(const Options& o) {
   api::PassDesc desc;
   desc.width = o.width;
   desc.height = o.height;
-  desc.outputs = api::Output::kColorRgba8 | api::Output::kDepth;
+  desc.outputs = api::Output::kColorRgba8 | api::Output::kDepth | api::Output::kInstanceId;
   desc.threads = o.threads;
   auto pass = api::RayTracePass::create(desc);
   if (!pass) return pass.error();
 
   auto e = std::unique_ptr<Engine>(new Engine{std::move(*character), std::move(*world), std::move(*pass), {}, {}, {},
-                                              nullptr, {}, {}, {}, {}, Frame(o.width, o.height)});
+                                              nullptr, {}, {}, {}, {}, Frame(o.width, o.height), {},
+                                              api::kNoHit});
   for (int i = 0; i < o.instances; ++i) {
     api::InstanceDesc instance;
     instance.transform = api::Matrix3x4::translation(kInstanceSpacing * static_cast<float>(i), 0.0f, 0.0f);
@@ -485,6 +653,7 @@ api::Result<std::unique_ptr<Engine>> make_engine(const Options& o) {
   // do not depend on --clip and --time.
   auto framing = measure_world(e->world, e->character, o.instances);
   if (!framing) return framing.error();
+  e->framing = *framing;
   e->ground = ground_under(*framing);
 
   // One camera and one light for both passes: that is what makes them one image.

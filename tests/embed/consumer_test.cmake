@@ -2,16 +2,26 @@
 # ctest "package.consumer"): install Sinew to a fresh prefix, configure and
 # build the example host engine against it with find_package(Sinew), build
 # the minimal example through pkg-config, then render one frame headless and
-# compare it with sinew-editor render of the same frame.
+# compare it with sinew-editor render of the same frame, and pick the
+# character in it with a ray query.
 #
 # Variables: BUILD_DIR SOURCE_DIR WORK_DIR EDITOR IMAGE_DIFF MODEL CXX
 cmake_minimum_required(VERSION 3.25)
 
+# Leaves the command's standard output in run_output, for expect_output.
 function(run)
   execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
   message("$ ${ARGN}\n${out}${err}")
   if(NOT rc EQUAL 0)
     message(FATAL_ERROR "failed (${rc}): ${ARGN}")
+  endif()
+  set(run_output "${out}" PARENT_SCOPE)
+endfunction()
+
+function(expect_output text)
+  string(FIND "${run_output}" "${text}" at)
+  if(at EQUAL -1)
+    message(FATAL_ERROR "the output lacks '${text}'")
   endif()
 endfunction()
 
@@ -62,13 +72,38 @@ run(${WORK_DIR}/host-build/host_engine --headless --pack ${WORK_DIR}/cesium.pack
     --camera ${camera} --light 2,4,3 --size 200x150 --scheduler host --threads 3 --out ${WORK_DIR}/host-pool)
 run(${IMAGE_DIFF} ${WORK_DIR}/host-pool/frame.ppm ${WORK_DIR}/host/frame.ppm --max-channel-diff 0)
 
-# 6. The windowed engine frame, where a display can be made (Xvfb).
+# 6. Ray queries: the camera frames CesiumMan in the image's centre, so
+#    picking pixel 100,75 selects him, and the light's line of sight to him is
+#    clear. The highlight goes into frame.ppm only: a query before the pass
+#    leaves Sinew's own output identical to the editor's.
+run(${WORK_DIR}/host-build/host_engine --headless --pack ${WORK_DIR}/cesium.pack --clip "#0" --time 0.7
+    --camera ${camera} --light 2,4,3 --size 200x150 --threads 2 --pick 100,75 --out ${WORK_DIR}/host-pick)
+expect_output("pick 100,75: selected instance 0,")
+expect_output("line of sight from the light: instance 0 visible")
+run(${IMAGE_DIFF} ${WORK_DIR}/host-pick/sinew_color.ppm ${WORK_DIR}/editor/color.png
+    --max-channel-diff 0 --max-differing-pixels 0)
+execute_process(COMMAND ${IMAGE_DIFF} ${WORK_DIR}/host-pick/frame.ppm ${WORK_DIR}/host/frame.ppm
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+message("${out}${err}")
+if(NOT rc EQUAL 1)  # 1: the images differ; 2 would be a read error
+  message(FATAL_ERROR "the picked character is not highlighted in frame.ppm (sinew-image-diff: ${rc})")
+endif()
+# A pixel outside the image is bad usage.
+execute_process(COMMAND ${WORK_DIR}/host-build/host_engine --headless --pack ${WORK_DIR}/cesium.pack
+                        --size 200x150 --pick 200,75 --out ${WORK_DIR}/host-pick-outside
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+message("${out}${err}")
+if(NOT rc EQUAL 2)
+  message(FATAL_ERROR "--pick 200,75 in a 200x150 image exited with ${rc}, not 2 (bad usage)")
+endif()
+
+# 7. The windowed engine frame, where a display can be made (Xvfb).
 find_program(xvfb_run xvfb-run)
 if(xvfb_run)
   run(${xvfb_run} -a -s "-screen 0 640x480x24" ${WORK_DIR}/host-build/host_engine --pack ${WORK_DIR}/cesium.pack
       --size 320x240 --frames 3 --threads 2)
 endif()
 
-# 7. The 30-line example runs.
+# 8. The 30-line example runs.
 run(${WORK_DIR}/minimal ${WORK_DIR}/cesium.pack ${WORK_DIR}/minimal.ppm)
 message("package.consumer: passed")
