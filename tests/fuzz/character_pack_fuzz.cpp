@@ -27,7 +27,7 @@
 // The harness traps (a finding) when a refused pack's error has no code or
 // no message, or when a rendered pixel names a triangle the mesh does not
 // have. Field and value may legitimately be empty ("MESH: section missing"
-// has no value; LIMT's "not valid JSON" is about the whole document).
+// has no value).
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
