@@ -13,6 +13,7 @@
 #include "raytrace/render/renderer.h"
 #include "runtime/jobs/executor.h"
 #include "runtime/jobs/job_system.h"
+#include "runtime/timing/stopwatch.h"
 #include "sinew/pass.h"
 
 namespace sinew::api {
@@ -77,9 +78,6 @@ std::unique_ptr<Executor> scheduler_executor(const TaskScheduler& scheduler) {
       });
 }
 
-double ms_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-}
 
 }  // namespace
 

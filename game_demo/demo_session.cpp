@@ -10,6 +10,7 @@
 #include "editor/bake/in_memory_bake.h"
 #include "editor/cli/render_command.h"
 #include "editor/import/model_loader.h"
+#include "runtime/timing/stopwatch.h"
 
 namespace sinew::demo {
 namespace {
@@ -22,9 +23,6 @@ Expected<editor::ImportedModel> load_model(const std::string& path) {
   return editor::load_model(path);
 }
 
-double ms_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-}
 
 }  // namespace
 

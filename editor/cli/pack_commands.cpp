@@ -26,6 +26,7 @@
 #include "runtime/io/mapped_file.h"
 #include "runtime/jobs/job_system.h"
 #include "runtime/pack/checksum.h"
+#include "runtime/timing/stopwatch.h"
 
 namespace sinew::editor {
 namespace {
@@ -277,9 +278,6 @@ Expected<Provenance> provenance_for(const std::string& model_path) {
   return p;
 }
 
-double ms_since(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 int fail(std::ostream& err, std::string_view command, const Status& s) {
   err << "sinew-editor " << command << ": " << s.message() << "\n";

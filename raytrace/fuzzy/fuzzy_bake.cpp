@@ -25,6 +25,7 @@
 
 #include "raytrace/skinning/skinning.h"
 #include "runtime/jobs/job_system.h"
+#include "runtime/timing/stopwatch.h"
 
 namespace sinew::rt {
 namespace {
@@ -38,9 +39,6 @@ constexpr std::size_t kTriangleGrain = 2048;
 // Share of the progress fraction spent before the kd-tree builds start.
 constexpr double kSweepShare = 0.9;
 
-double ms_since(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 std::string indexed(std::string_view name, std::size_t i) {
   return std::string(name) + "[" + std::to_string(i) + "]";

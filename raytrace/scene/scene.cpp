@@ -6,6 +6,7 @@
 
 #include "runtime/jobs/job_system.h"
 #include "runtime/timing/phase_timers.h"
+#include "runtime/timing/stopwatch.h"
 
 namespace sinew::rt {
 namespace {
@@ -19,9 +20,6 @@ KdBuildOptions within_traversal_depth(KdBuildOptions options) {
   return options;
 }
 
-double elapsed_ms(std::chrono::steady_clock::time_point since) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - since).count();
-}
 
 }  // namespace
 
@@ -142,11 +140,11 @@ Expected<FrameStats> Scene::prepare_frame(const FrameOptions& options, JobSystem
     auto start = std::chrono::steady_clock::now();
     update_bone_frames(frame, character.fuzzy);
     skin_instance(frame, *character.mesh, character.fuzzy, options.normals, options.skinning, jobs);
-    skinning_ms += elapsed_ms(start);
+    skinning_ms += ms_since(start);
 
     start = std::chrono::steady_clock::now();
     compute_bone_boxes(frame, character.fuzzy, options.bone_boxes == BoneBoxMode::kExact, jobs);
-    boxes_ms += elapsed_ms(start);
+    boxes_ms += ms_since(start);
 
     start = std::chrono::steady_clock::now();
     if (options.fallback) {
@@ -156,7 +154,7 @@ Expected<FrameStats> Scene::prepare_frame(const FrameOptions& options, JobSystem
       frame.escaped_triangles.clear();
       frame.fallback = KdTree{};
     }
-    fallback_ms += elapsed_ms(start);
+    fallback_ms += ms_since(start);
     stats.escaped_checks += frame.escaped_checks;
     stats.escaped_triangles += frame.escaped_triangles.size();
     stats.singular_bones += frame.singular_bones;
@@ -184,7 +182,7 @@ Expected<FrameStats> Scene::prepare_frame(const FrameOptions& options, JobSystem
     objects.push_back({TopLevelObject::Kind::kStatic, s, 0, statics_[s].tree.bounds});
   }
   SINEW_RETURN_IF_ERROR(top_level_.build(std::move(objects), within_traversal_depth(options.top_level_kd)));
-  const double top_ms = elapsed_ms(start);
+  const double top_ms = ms_since(start);
   stats.top_level_objects = static_cast<std::uint32_t>(top_level_.objects().size());
   stats.top_level_nodes = top_level_.stats().node_count;
 

@@ -14,6 +14,7 @@
 #include "content/mannequin/mannequin.h"
 #include "editor/import/cal3d_importer.h"
 #include "runtime/timing/phase_timers.h"
+#include "runtime/timing/stopwatch.h"
 #include "tests/support/cal3d_support.h"
 
 namespace sinew::bench {
@@ -21,9 +22,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-double ms_since(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 // Per-instance state on our side: what a game holds per character.
 struct OurInstance {

@@ -31,6 +31,7 @@
 #include "runtime/cpu/cpu_features.h"
 #include "runtime/jobs/job_system.h"
 #include "runtime/timing/phase_timers.h"
+#include "runtime/timing/stopwatch.h"
 
 namespace sinew::bench {
 namespace {
@@ -50,9 +51,6 @@ Status status_of(const Expected<T>& result) {
   return result.ok() ? Status{} : result.status();
 }
 
-double ms_since(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 double mib(std::size_t bytes) { return static_cast<double>(bytes) / kMiB; }
 

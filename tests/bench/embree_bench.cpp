@@ -26,6 +26,7 @@
 // Always included for EmbreeMode and EmbreeWidth, which the options name;
 // the tracer itself is only linked (and called) when Embree was found.
 #include "runtime/memory/line_aligned.h"
+#include "runtime/timing/stopwatch.h"
 #include "tests/bench/embree_tracer.h"
 
 namespace sinew::bench {
@@ -36,9 +37,6 @@ using Json = nlohmann::ordered_json;
 
 constexpr double kFramesPerSecond = 30.0;
 
-double ms_since(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 // --- options -------------------------------------------------------------------
 

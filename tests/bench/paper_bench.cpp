@@ -45,6 +45,7 @@
 #include "runtime/jobs/job_system.h"
 #include "runtime/memory/line_aligned.h"
 #include "runtime/timing/phase_timers.h"
+#include "runtime/timing/stopwatch.h"
 #include "tests/bench/bench_support.h"
 #include "tests/bench/brute_force_gate.h"
 
@@ -54,9 +55,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 using Json = nlohmann::ordered_json;
 
-double ms_since(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 // --- the paper's numbers ---------------------------------------------------------
 

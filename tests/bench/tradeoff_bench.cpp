@@ -31,6 +31,7 @@
 #include "raytrace/scene/scene.h"
 #include "runtime/jobs/job_system.h"
 #include "runtime/timing/phase_timers.h"
+#include "runtime/timing/stopwatch.h"
 #include "tests/bench/bench_support.h"
 #include "tests/bench/brute_force_gate.h"
 #include "tests/support/brute_force.h"
@@ -49,9 +50,6 @@ constexpr int kWalkGateStride = 7;
 constexpr std::uint64_t kHeldOutSeed = 0x9e3779b97f4a7c15ull;
 constexpr std::uint64_t kCrackSeed = 2006;
 
-double ms_since(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 // --- options -------------------------------------------------------------------
 
