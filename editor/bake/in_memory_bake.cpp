@@ -7,6 +7,7 @@
 
 #include "animation/pose.h"
 #include "runtime/jobs/job_system.h"
+#include "runtime/timing/stopwatch.h"
 
 namespace sinew::editor {
 namespace {
@@ -85,8 +86,7 @@ Expected<InMemoryBake> bake_in_memory(const ImportedModel& model, const BakeRequ
   SINEW_ASSIGN_OR_RETURN(std::vector<Affine3> samples,
                          pose_space_skinning(model, request.pose_space, request.limits, sample_bound));
   bake.memory.pose_samples = samples.capacity() * sizeof(Affine3);
-  bake.pose_sampling_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  bake.pose_sampling_ms = ms_since(start);
   rt::FuzzyBakeInput input;
   input.mesh = &model.mesh;
   input.bone_count = static_cast<std::uint32_t>(model.skeleton.joint_count());

@@ -14,6 +14,7 @@
 #include "raytrace/render/traversal_shared.h"
 #include "runtime/jobs/job_system.h"
 #include "runtime/timing/phase_timers.h"
+#include "runtime/timing/stopwatch.h"
 
 namespace sinew::rt {
 namespace {
@@ -219,7 +220,7 @@ Expected<RenderStats> Renderer::render(const Scene& scene, const PinholeCamera& 
   jobs.parallel_for_tiles(buffers.width, buffers.height, tile, [&](const Tile& t) {
     render_tile(scene, camera, settings, lights, out, t, records[static_cast<std::size_t>(t.index)]);
   });
-  const double wall_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+  const double wall_ms = ms_since(start);
 
   // Tile order keeps the sums deterministic.
   RenderStats stats;

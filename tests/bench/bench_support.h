@@ -25,6 +25,7 @@
 #include "runtime/core/expected.h"
 #include "runtime/cpu/cpu_features.h"
 #include "runtime/jobs/job_system.h"
+#include "runtime/timing/stopwatch.h"
 
 namespace sinew::bench {
 
@@ -267,8 +268,7 @@ inline Expected<double> build_exact_scene(const rt::Scene& fuzzy_scene, const Sk
   const auto build_start = std::chrono::steady_clock::now();
   const auto added = exact.add_static_mesh(std::move(skinned));
   if (!added.ok()) return added.status();
-  const double build_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - build_start).count();
+  const double build_ms = ms_since(build_start);
   const auto ground_added = exact.add_static_mesh(ground);
   if (!ground_added.ok()) return ground_added.status();
   const auto prepared = exact.prepare_frame(rt::FrameOptions{}, jobs);
