@@ -1,5 +1,7 @@
 #include "runtime/timing/phase_timers.h"
 
+#include <nlohmann/json.hpp>
+
 #include <algorithm>
 #include <cstdio>
 #include <numeric>
@@ -74,28 +76,13 @@ std::string PhaseTimers::table() const {
 }
 
 std::string PhaseTimers::json() const {
-  // Phase names are program-chosen identifiers; escape the two characters
-  // that could still break the document.
-  auto escape = [](const std::string& s) {
-    std::string e;
-    for (char c : s) {
-      if (c == '"' || c == '\\') e += '\\';
-      e += c;
-    }
-    return e;
-  };
-  std::string out = "{";
-  char buf[200];
-  bool first = true;
+  // Through nlohmann::json: any phase name (quotes, control characters,
+  // bytes that are not UTF-8) still makes a valid document.
+  nlohmann::ordered_json out = nlohmann::ordered_json::object();
   for (const PhaseSummary& s : summarize()) {
-    std::snprintf(buf, sizeof buf,
-                  "\"median_ms\": %.6f, \"min_ms\": %.6f, \"max_ms\": %.6f, \"samples\": %zu}",
-                  s.median_ms, s.min_ms, s.max_ms, s.samples);
-    out += (first ? "\"" : ", \"") + escape(s.name) + "\": {" + buf;
-    first = false;
+    out[s.name] = {{"median_ms", s.median_ms}, {"min_ms", s.min_ms}, {"max_ms", s.max_ms}, {"samples", s.samples}};
   }
-  out += "}";
-  return out;
+  return out.dump(-1, ' ', false, nlohmann::ordered_json::error_handler_t::replace);
 }
 
 double ScopedPhase::stop() {

@@ -1,6 +1,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <nlohmann/json.hpp>
+
 #include "runtime/timing/phase_timers.h"
 
 namespace sinew {
@@ -38,7 +40,22 @@ TEST(PhaseTimers, TableAndJsonNameEveryPhase) {
   t.record("top-level build", 0.01);
   EXPECT_THAT(t.table(), ::testing::HasSubstr("skinning"));
   EXPECT_THAT(t.table(), ::testing::HasSubstr("1.250"));
-  EXPECT_THAT(t.json(), ::testing::HasSubstr("\"top-level build\": {\"median_ms\": 0.010000"));
+  const auto doc = nlohmann::json::parse(t.json());
+  ASSERT_EQ(doc.size(), 2u);
+  EXPECT_EQ(doc.begin().key(), "skinning");  // first-use order
+  EXPECT_EQ(doc["top-level build"]["median_ms"].get<double>(), 0.01);
+  EXPECT_EQ(doc["skinning"]["samples"].get<std::size_t>(), 1u);
+}
+
+TEST(PhaseTimers, JsonStaysValidForAnyPhaseName) {
+  PhaseTimers t;
+  const std::string odd = std::string("say \"hi\"\\ \n\t\x01 ") + "\xff\xfe";
+  t.record(odd, 2.0);
+  const auto doc = nlohmann::json::parse(t.json());  // throws on an invalid document
+  ASSERT_EQ(doc.size(), 1u);
+  // The name's valid part survives; the bytes that are not UTF-8 are replaced.
+  EXPECT_EQ(doc.begin().key().rfind("say \"hi\"\\ \n\t\x01 ", 0), 0u);
+  EXPECT_EQ(doc.begin().value()["max_ms"].get<double>(), 2.0);
 }
 
 TEST(PhaseTimers, ScopedPhaseRecordsOnce) {
