@@ -25,6 +25,7 @@
 #include "runtime/io/atomic_file.h"
 #include "runtime/jobs/job_system.h"
 #include "runtime/pack/pack_writer.h"
+#include "tests/support/repack.h"
 #include "tests/support/same_model.h"
 #if SINEW_HAVE_CAL3D
 #include "editor/import/cal3d_importer.h"
@@ -262,22 +263,10 @@ class CorruptPack : public testing::Test {
     delete bytes_;
   }
 
-  // The pack with section `id`'s payload replaced by mutate(payload), the
-  // container's checksums recomputed: only the section's own decoding and
-  // validation stand between the bytes and the renderer.
+  // The pack with section `id`'s payload replaced by mutate(payload)
+  // (tests/support/repack.h).
   static std::vector<std::byte> repack(SectionId id, const std::function<void(std::vector<std::byte>&)>& mutate) {
-    auto reader = PackReader::from_bytes(*bytes_, "pristine");
-    EXPECT_TRUE(reader.ok());
-    PackWriter w;
-    for (const SectionInfo& s : reader->sections()) {
-      const auto payload = reader->section_bytes(s);
-      std::vector<std::byte> copy(payload.begin(), payload.end());
-      if (s.id == id) mutate(copy);
-      EXPECT_TRUE(w.add_section(s.id, s.version, std::move(copy)).ok());
-    }
-    auto out = w.serialize();
-    EXPECT_TRUE(out.ok());
-    return std::move(*out);
+    return testing_support::repack_section(*bytes_, id, mutate);
   }
 
   template <typename T>

@@ -15,7 +15,7 @@
 #include "content/mannequin/mannequin.h"
 #include "editor/pack/character_pack.h"
 #include "runtime/pack/pack_reader.h"
-#include "runtime/pack/pack_writer.h"
+#include "tests/support/repack.h"
 
 namespace sinew::editor {
 namespace {
@@ -44,22 +44,10 @@ class PackLimits : public testing::Test {
   }
 
   // The pack with LIMT's payload replaced by mutate(payload) and its
-  // version by `version`, checksums recomputed.
+  // version by `version` (tests/support/repack.h).
   static std::vector<std::byte> repack(const std::function<void(std::vector<std::byte>&)>& mutate,
                                        std::uint32_t version = 2) {
-    auto reader = PackReader::from_bytes(*bytes_, "pristine");
-    EXPECT_TRUE(reader.ok());
-    PackWriter w;
-    for (const SectionInfo& s : reader->sections()) {
-      const auto payload = reader->section_bytes(s);
-      std::vector<std::byte> copy(payload.begin(), payload.end());
-      const bool limits = s.id == make_section_id("LIMT");
-      if (limits) mutate(copy);
-      EXPECT_TRUE(w.add_section(s.id, limits ? version : s.version, std::move(copy)).ok());
-    }
-    auto out = w.serialize();
-    EXPECT_TRUE(out.ok());
-    return std::move(*out);
+    return testing_support::repack_section(*bytes_, make_section_id("LIMT"), mutate, version);
   }
   template <typename T>
   static void put(std::vector<std::byte>& payload, std::size_t offset, const T& value) {
@@ -140,7 +128,7 @@ TEST_F(PackLimits, EveryFieldIsValidatedOnLoad) {
   expect_refused(repack([&](auto& p) { put(p, joint_at(swing) + 4 + 24, 2.0f); }), s + ".swing_twist.twist_axis");
   // Counts and sizes: checked before anything is allocated.
   expect_refused(repack([](auto& p) { put(p, 0, std::uint32_t{0xFFFFFFF0u}); }), "LIMT.joint_count");
-  expect_refused(repack([](auto& p) { p.resize(p.size() - 3); }), "LIMT", ErrorCode::kTruncated);
+  expect_refused(repack([](auto& p) { p.erase(p.end() - 3, p.end()); }), "LIMT", ErrorCode::kTruncated);
   expect_refused(repack([](auto& p) { p.push_back(std::byte{0}); }), "LIMT");
 }
 

@@ -16,17 +16,12 @@ namespace sinew {
 namespace {
 
 using testing_support::Frame;
+using testing_support::load_mannequin;
 using testing_support::mannequin_pack_path;
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 constexpr int kW = 64;
 constexpr int kH = 56;
-
-api::Character load_mannequin() {
-  auto character = api::Character::load(mannequin_pack_path());
-  EXPECT_TRUE(character.ok()) << character.error().message;
-  return std::move(character).value();
-}
 
 const api::Float3 kQuad[] = {{-3, 0, -3}, {3, 0, -3}, {-3, 0, 3}, {3, 0, 3}};
 const std::uint32_t kQuadIndices[] = {0, 2, 1, 1, 2, 3};

@@ -22,17 +22,12 @@ namespace {
 
 using testing_support::Frame;
 using testing_support::kEveryOutput;
+using testing_support::load_mannequin;
 using testing_support::mannequin_pack_path;
 using testing_support::render_internal;
 
 constexpr int kW = 96;
 constexpr int kH = 80;
-
-api::Character load_mannequin() {
-  auto character = api::Character::load(mannequin_pack_path());
-  EXPECT_TRUE(character.ok()) << character.error().message;
-  return std::move(character).value();
-}
 
 editor::CharacterPack open_mannequin_pack() { return editor::CharacterPack::open(mannequin_pack_path()).value(); }
 

@@ -39,6 +39,13 @@ inline const std::string& mannequin_pack_path() {
   return path;
 }
 
+// The mannequin pack through the public API.
+inline api::Character load_mannequin() {
+  auto character = api::Character::load(mannequin_pack_path());
+  EXPECT_TRUE(character.ok()) << character.error().message;
+  return std::move(character).value();
+}
+
 // Every output of one frame, packed rows, also as the API's PassOutputs.
 struct Frame : AovFrame {
   using AovFrame::AovFrame;
