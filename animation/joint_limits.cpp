@@ -14,6 +14,7 @@
 #include <string>
 
 #include "animation/skeleton.h"
+#include "runtime/core/format_number.h"
 
 namespace sinew::anim {
 namespace {
@@ -469,12 +470,6 @@ bool valid_quat(const Quat& q) {
   return std::isfinite(q.w) && std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z);
 }
 
-std::string fmt(double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof(buf), "%.9g", v);
-  return buf;
-}
-
 }  // namespace
 
 void swing_twist_basis(const Vec3& twist_axis, Vec3& axis_1, Vec3& axis_2) {
@@ -594,7 +589,7 @@ Status validate_joint_limits(std::span<const JointLimit> limits, std::string_vie
   const double pi_hi = kPi + kRangeSlack;
   auto bad = [&](std::size_t j, const std::string& field, double value, const char* detail) {
     return make_error(ErrorCode::kInvalidData, source, "joints[" + std::to_string(j) + "]." + field,
-                      fmt(value), detail);
+                      format_number(value), detail);
   };
   static constexpr const char* kAxis[3] = {"x", "y", "z"};
   for (std::size_t j = 0; j < limits.size(); ++j) {

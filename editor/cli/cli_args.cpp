@@ -7,6 +7,8 @@
 #include <cmath>
 #include <limits>
 
+#include "runtime/core/format_number.h"
+
 namespace sinew::editor::cli {
 namespace {
 
@@ -41,16 +43,6 @@ std::optional<T> whole_number(std::string_view text) {
   const auto [end, ec] = std::from_chars(text.data(), last, value);
   if (text.empty() || ec != std::errc() || end != last) return std::nullopt;
   return value;
-}
-
-std::string format_number(double x) {
-  std::string s = std::to_string(x);
-  // Drop the trailing zeros std::to_string pads with ("180.000000" -> "180").
-  if (s.find('.') != std::string::npos) {
-    s.erase(s.find_last_not_of('0') + 1);
-    if (s.back() == '.') s.pop_back();
-  }
-  return s;
 }
 
 }  // namespace

@@ -4,16 +4,13 @@
 #include <cmath>
 #include <cstdio>
 
+#include "runtime/core/format_number.h"
+
 namespace sinew::editor {
 namespace {
 
 std::string weight_field(std::size_t v) { return "weights[" + std::to_string(v) + "]"; }
 
-std::string format_sum(double sum) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", sum);
-  return buf;
-}
 
 }  // namespace
 
@@ -64,7 +61,7 @@ Status normalize_skin_weights(SkinnedMesh& mesh, std::string_view source, std::v
   }
   if (off_rows > 0) {
     warnings.push_back(std::string(source) + ": " + weight_field(first_off) + ": skin weights sum to " +
-                       format_sum(first_off_sum) + ", not 1; renormalised (" + std::to_string(off_rows) +
+                       format_number(first_off_sum) + ", not 1; renormalised (" + std::to_string(off_rows) +
                        " of " + std::to_string(mesh.weights.size()) + " vertices)");
   }
   return {};

@@ -6,18 +6,14 @@
 #include <limits>
 #include <string>
 
+#include "runtime/core/format_number.h"
+
 namespace sinew::rt {
 namespace {
 
-std::string format_float(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.9g", v);
-  return buf;
-}
-
 std::string format_vec(const Vec3& v) {
-  return "(" + format_float(static_cast<double>(v.x)) + ", " + format_float(static_cast<double>(v.y)) + ", " +
-         format_float(static_cast<double>(v.z)) + ")";
+  return "(" + format_number(static_cast<double>(v.x)) + ", " + format_number(static_cast<double>(v.y)) + ", " +
+         format_number(static_cast<double>(v.z)) + ")";
 }
 
 bool all_finite(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
@@ -33,7 +29,7 @@ Expected<PinholeCamera> PinholeCamera::create(const CameraDesc& desc, int width,
   }
   if (!all_finite(desc.up)) return invalid_argument("camera.up", format_vec(desc.up), "must be finite");
   if (!(desc.fovy_degrees > 0.0f && desc.fovy_degrees < 180.0f)) {
-    return invalid_argument("camera.fovy_degrees", format_float(static_cast<double>(desc.fovy_degrees)),
+    return invalid_argument("camera.fovy_degrees", format_number(static_cast<double>(desc.fovy_degrees)),
                             "must lie in (0, 180)");
   }
   if (width < 1) return invalid_argument("width", std::to_string(width), "must be at least 1");

@@ -24,6 +24,7 @@
 #include <utility>
 
 #include "raytrace/skinning/skinning.h"
+#include "runtime/core/format_number.h"
 #include "runtime/jobs/job_system.h"
 #include "runtime/timing/stopwatch.h"
 
@@ -48,17 +49,11 @@ std::string indexed(std::string_view name, std::size_t i, std::size_t j) {
   return indexed(name, i) + "[" + std::to_string(j) + "]";
 }
 
-std::string format_float(float x) {
-  char text[32];
-  std::snprintf(text, sizeof(text), "%g", static_cast<double>(x));
-  return text;
-}
-
 std::string format_matrix(const Affine3& m) {
   std::string out = "[";
   for (int r = 0; r < 3; ++r) {
     for (int c = 0; c < 4; ++c) {
-      out += format_float(m(r, c));
+      out += format_number(m(r, c));
       out += c < 3 ? " " : (r < 2 ? "; " : "]");
     }
   }
@@ -119,7 +114,7 @@ Status validate_mesh(const SkinnedMesh& mesh, std::uint32_t bone_count) {
     const Vec3& p = mesh.positions[v];
     if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
       return make_error(ErrorCode::kInvalidData, "", indexed("positions", v),
-                        format_float(p.x) + " " + format_float(p.y) + " " + format_float(p.z),
+                        format_number(p.x) + " " + format_number(p.y) + " " + format_number(p.z),
                         "not finite");
     }
     for (std::size_t k = 0; k < static_cast<std::size_t>(kMaxInfluences); ++k) {
@@ -131,7 +126,7 @@ Status validate_mesh(const SkinnedMesh& mesh, std::uint32_t bone_count) {
       }
       if (!std::isfinite(mesh.weights[v][k])) {
         return make_error(ErrorCode::kInvalidData, "", indexed("weights", v, k),
-                          format_float(mesh.weights[v][k]), "not finite");
+                          format_number(mesh.weights[v][k]), "not finite");
       }
     }
   }
@@ -184,7 +179,7 @@ Status validate_input(const FuzzyBakeInput& input, const FuzzyBakeOptions& optio
                             "not a multiple of bone_count (" + std::to_string(bones) + ")");
   }
   if (!std::isfinite(options.padding) || options.padding < 0.0f) {
-    return invalid_argument("padding", format_float(options.padding),
+    return invalid_argument("padding", format_number(options.padding),
                             "must be finite and not negative");
   }
   return validate_mesh(*input.mesh, bones);

@@ -34,6 +34,7 @@
 #include <vector>
 
 #include "raytrace/kdtree/kd_tree.h"
+#include "runtime/core/format_number.h"
 
 namespace sinew::rt {
 namespace {
@@ -105,29 +106,23 @@ double surface_area(const Aabb& cell) {
 
 enum Side : std::uint8_t { kBelow = 1, kAbove = 2, kBoth = 3 };
 
-std::string format_float(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.9g", v);
-  return buf;
-}
-
 std::string format_box(const Aabb& b) {
   std::string s = "lower=(";
-  for (int a = 0; a < 3; ++a) s += format_float(static_cast<double>(b.lower[a])) + (a < 2 ? ", " : ")");
+  for (int a = 0; a < 3; ++a) s += format_number(static_cast<double>(b.lower[a])) + (a < 2 ? ", " : ")");
   s += " upper=(";
-  for (int a = 0; a < 3; ++a) s += format_float(static_cast<double>(b.upper[a])) + (a < 2 ? ", " : ")");
+  for (int a = 0; a < 3; ++a) s += format_number(static_cast<double>(b.upper[a])) + (a < 2 ? ", " : ")");
   return s;
 }
 
 Status validate_options(const KdBuildOptions& o) {
   if (!std::isfinite(o.traversal_cost) || o.traversal_cost < 0.0f)
-    return invalid_argument("options.traversal_cost", format_float(static_cast<double>(o.traversal_cost)),
+    return invalid_argument("options.traversal_cost", format_number(static_cast<double>(o.traversal_cost)),
                             "must be finite and >= 0");
   if (!std::isfinite(o.intersection_cost) || o.intersection_cost < 0.0f)
     return invalid_argument("options.intersection_cost",
-                            format_float(static_cast<double>(o.intersection_cost)), "must be finite and >= 0");
+                            format_number(static_cast<double>(o.intersection_cost)), "must be finite and >= 0");
   if (!(o.empty_bonus >= 0.0f && o.empty_bonus < 1.0f))
-    return invalid_argument("options.empty_bonus", format_float(static_cast<double>(o.empty_bonus)),
+    return invalid_argument("options.empty_bonus", format_number(static_cast<double>(o.empty_bonus)),
                             "must be in [0, 1)");
   if (o.max_leaf_items < 1)
     return invalid_argument("options.max_leaf_items", std::to_string(o.max_leaf_items), "must be >= 1");
