@@ -77,27 +77,35 @@ Status prepare_for_queries(World::Impl& world) {
   return Status();
 }
 
+// What every query checks before tracing: one answer slot per ray, valid
+// rays, and the frame state prepared for the world as posed now.
+Status ready_for(World::Impl& world, const char* call, std::span<const Ray> rays, const char* answers_name,
+                 std::size_t answers) {
+  if (answers != rays.size()) {
+    return detail::api_error(ErrorCode::kInvalidArgument, std::string(call) + ": " + answers_name + ": " +
+                                                              std::to_string(answers) + " entries for " +
+                                                              std::to_string(rays.size()) + " rays");
+  }
+  if (Status status = check_rays(call, rays); !status.ok()) return status;
+  return prepare_for_queries(world);
+}
+
 }  // namespace
 
 Result<RayHit> World::intersect(const Ray& ray, TriangleTest test) noexcept {
   return detail::guarded("World::intersect", [&]() -> Result<RayHit> {
-    const Status valid = check_rays("World::intersect", std::span<const Ray>(&ray, 1));
-    if (!valid.ok()) return valid.error();
-    const Status prepared = prepare_for_queries(*impl_);
-    if (!prepared.ok()) return prepared.error();
-    return to_api(rt::intersect(impl_->scene, to_internal(ray), to_internal(test)));
+    RayHit hit;
+    const Status status = intersect(std::span<const Ray>(&ray, 1), std::span<RayHit>(&hit, 1), test);
+    if (!status.ok()) return status.error();
+    return hit;
   });
 }
 
 Status World::intersect(std::span<const Ray> rays, std::span<RayHit> hits, TriangleTest test) noexcept {
   return detail::guarded("World::intersect", [&]() -> Status {
-    if (hits.size() != rays.size()) {
-      return detail::api_error(ErrorCode::kInvalidArgument, "World::intersect: hits: " +
-                                                                std::to_string(hits.size()) + " entries for " +
-                                                                std::to_string(rays.size()) + " rays");
+    if (Status status = ready_for(*impl_, "World::intersect", rays, "hits", hits.size()); !status.ok()) {
+      return status;
     }
-    if (Status status = check_rays("World::intersect", rays); !status.ok()) return status;
-    if (Status status = prepare_for_queries(*impl_); !status.ok()) return status;
     const rt::TriangleTest internal = to_internal(test);
     for (std::size_t i = 0; i < rays.size(); ++i) {
       hits[i] = to_api(rt::intersect(impl_->scene, to_internal(rays[i]), internal));
@@ -108,23 +116,18 @@ Status World::intersect(std::span<const Ray> rays, std::span<RayHit> hits, Trian
 
 Result<bool> World::occluded(const Ray& ray, TriangleTest test) noexcept {
   return detail::guarded("World::occluded", [&]() -> Result<bool> {
-    const Status valid = check_rays("World::occluded", std::span<const Ray>(&ray, 1));
-    if (!valid.ok()) return valid.error();
-    const Status prepared = prepare_for_queries(*impl_);
-    if (!prepared.ok()) return prepared.error();
-    return rt::occluded(impl_->scene, to_internal(ray), to_internal(test));
+    std::uint8_t blocked = 0;
+    const Status status = occluded(std::span<const Ray>(&ray, 1), std::span<std::uint8_t>(&blocked, 1), test);
+    if (!status.ok()) return status.error();
+    return blocked != 0;
   });
 }
 
 Status World::occluded(std::span<const Ray> rays, std::span<std::uint8_t> blocked, TriangleTest test) noexcept {
   return detail::guarded("World::occluded", [&]() -> Status {
-    if (blocked.size() != rays.size()) {
-      return detail::api_error(ErrorCode::kInvalidArgument, "World::occluded: blocked: " +
-                                                                std::to_string(blocked.size()) + " entries for " +
-                                                                std::to_string(rays.size()) + " rays");
+    if (Status status = ready_for(*impl_, "World::occluded", rays, "blocked", blocked.size()); !status.ok()) {
+      return status;
     }
-    if (Status status = check_rays("World::occluded", rays); !status.ok()) return status;
-    if (Status status = prepare_for_queries(*impl_); !status.ok()) return status;
     const rt::TriangleTest internal = to_internal(test);
     for (std::size_t i = 0; i < rays.size(); ++i) {
       blocked[i] = rt::occluded(impl_->scene, to_internal(rays[i]), internal) ? 1 : 0;
