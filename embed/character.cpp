@@ -1,4 +1,4 @@
-// sinew::api::Character over editor::CharacterPack.
+// sinew::api::Character over character::Pack.
 #include <string>
 
 #include "animation/pose_space.h"
@@ -10,7 +10,7 @@
 #include "sinew/version.h"
 
 namespace sinew::api {
-Result<Character> CharacterFactory::make(editor::CharacterPack pack, std::string name) {
+Result<Character> CharacterFactory::make(character::Pack pack, std::string name) {
   if (!pack.has_fuzzy()) {
     return detail::api_error(ErrorCode::kUnsupported,
                              name + ": a model-only pack (no fuzzy kd-trees): bake it first "
@@ -23,7 +23,7 @@ Result<Character> CharacterFactory::make(editor::CharacterPack pack, std::string
 
 namespace {
 
-Result<Character> adopt(Expected<editor::CharacterPack> pack, std::string name) {
+Result<Character> adopt(Expected<character::Pack> pack, std::string name) {
   if (!pack.ok()) return detail::to_api_error(pack.status());
   return CharacterFactory::make(std::move(*pack), std::move(name));
 }
@@ -33,14 +33,14 @@ Result<Character> adopt(Expected<editor::CharacterPack> pack, std::string name) 
 Result<Character> Character::load(std::string_view path) noexcept {
   return detail::guarded("Character::load", [&]() -> Result<Character> {
     const std::string p(path);
-    return adopt(editor::CharacterPack::open(p), p);
+    return adopt(character::Pack::open(p), p);
   });
 }
 
 Result<Character> Character::from_memory(std::span<const std::byte> bytes, std::string_view name) noexcept {
   return detail::guarded("Character::from_memory", [&]() -> Result<Character> {
     const std::string n(name);
-    return adopt(editor::CharacterPack::from_bytes(bytes, n), n);
+    return adopt(character::Pack::from_bytes(bytes, n), n);
   });
 }
 

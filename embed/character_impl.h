@@ -5,22 +5,22 @@
 #include <memory>
 #include <string>
 
-#include "editor/pack/character_pack.h"
+#include "character/pack.h"
 #include "sinew/character.h"
 
 namespace sinew::api {
 
 struct Character::Impl {
-  explicit Impl(editor::CharacterPack p) : pack(std::move(p)) {}
-  editor::CharacterPack pack;
+  explicit Impl(character::Pack p) : pack(std::move(p)) {}
+  character::Pack pack;
   std::string name;
 
-  const editor::ImportedModel& model() const { return pack.model(); }
+  const character::Model& model() const { return pack.model(); }
 };
 
 // The one place that makes Character handles and reads their shared core.
 struct CharacterFactory {
-  static Result<Character> make(editor::CharacterPack pack, std::string name);
+  static Result<Character> make(character::Pack pack, std::string name);
   static std::shared_ptr<const Character::Impl> share(const Character& c) { return c.impl_; }
 };
 

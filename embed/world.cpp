@@ -68,7 +68,7 @@ void reset_mixer(Instance& instance) {
 Status finish_pose(World::Impl& world, InstanceId id) {
   world.changed();
   Instance& instance = world.instances[id];
-  const editor::ImportedModel& model = instance.core->model();
+  const character::Model& model = instance.core->model();
   if (instance.limits && !instance.core->pack.limits().empty()) {
     SINEW_RETURN_IF_ERROR_API(anim::apply_joint_limits(model.skeleton, instance.core->pack.limits(), instance.local));
   }
@@ -80,7 +80,7 @@ Status finish_pose(World::Impl& world, InstanceId id) {
 
 Status pose_from_mixer(World::Impl& world, InstanceId id) {
   Instance& instance = world.instances[id];
-  const editor::ImportedModel& model = instance.core->model();
+  const character::Model& model = instance.core->model();
   SINEW_RETURN_IF_ERROR_API(anim::evaluate_layers(model.skeleton, model.clips, instance.mixer->layers(),
                                                   instance.caches, instance.local, &instance.scratch));
   return finish_pose(world, id);
@@ -262,7 +262,7 @@ Status World::pose_at(InstanceId id, std::string_view clip, double seconds) noex
     const auto index = clip_index(instance, clip);
     if (!index.ok()) return index.error();
     reset_mixer(instance);
-    const editor::ImportedModel& model = instance.core->model();
+    const character::Model& model = instance.core->model();
     const anim::Clip& c = model.clips[static_cast<std::size_t>(*index)];
     SINEW_RETURN_IF_ERROR_API(anim::rest_pose(model.skeleton, instance.local));
     anim::sample_clip(c, anim::clip_time(c, seconds, /*loop=*/true), instance.caches[static_cast<std::size_t>(*index)],

@@ -31,7 +31,7 @@ std::string demo_usage() {
          "  --size WxH      frame size (default 1024x1024)\n"
          "  --seed S        seed of the arena and the characters' wandering (default 1)\n"
          "  --characters N  characters in the arena, one of them yours (default 6)\n"
-         "  --model PATH    the character: glTF (.gltf, .glb), Cal3D (.cfg) or a baked .pack;\n"
+         "  --model PATH    the character: a content pack (sinew-editor bake MODEL -o PATH);\n"
          "                  default the procedural mannequin\n"
          "  --script FILE   take the keys from an input script (frame key down|up|tap per\n"
          "                  line) with fixed 1/30 s steps, windowed or headless\n"

@@ -6,10 +6,9 @@
 #include <filesystem>
 #include <optional>
 
+#include "character/bake.h"
+#include "character/framing.h"
 #include "content/mannequin/mannequin.h"
-#include "editor/bake/in_memory_bake.h"
-#include "editor/cli/render_command.h"
-#include "editor/import/model_loader.h"
 #include "runtime/timing/stopwatch.h"
 
 namespace sinew::demo {
@@ -18,17 +17,12 @@ namespace {
 constexpr float kCharacterHeight = 1.8f;
 constexpr int kObstacles = 8;
 
-Expected<editor::ImportedModel> load_model(const std::string& path) {
-  if (path.empty()) return content::make_mannequin();
-  return editor::load_model(path);
-}
-
 
 }  // namespace
 
-Affine3 model_to_world(const editor::ImportedModel& model) {
-  const Aabb rest = editor::rest_bounds(model);
-  const int up = editor::up_axis_of(rest);
+Affine3 model_to_world(const character::Model& model) {
+  const Aabb rest = character::rest_bounds(model);
+  const int up = character::up_axis_of(rest);
   const float height = std::max(rest.extent()[up], 1e-6f);
   const float scale = kCharacterHeight / height;
   // Z-up to Y-up: (x, y, z) -> (x, z, -y), so a model facing -Y faces +Z.
@@ -57,25 +51,43 @@ rt::CameraDesc follow_camera_desc(const FollowCamera& camera, const Vec3& target
   return desc;
 }
 
-DemoSession::DemoSession(SessionOptions options, editor::ImportedModel model, World world)
+DemoSession::DemoSession(SessionOptions options, character::Model model, World world)
     : options_(std::move(options)), model_(std::move(model)), world_(std::move(world)) {}
 
 DemoSession::~DemoSession() = default;
 
 Expected<std::unique_ptr<DemoSession>> DemoSession::create(const SessionOptions& options, JobSystem& jobs) {
+  if (options.model_path.empty()) {
+    SINEW_ASSIGN_OR_RETURN(character::Model mannequin, content::make_mannequin());
+    return create(options, std::move(mannequin), std::nullopt, jobs);
+  }
+  // The demo is a game: it loads baked content. Source models (glTF, Cal3D)
+  // are the editor's to import and bake.
+  if (!character::is_pack_path(options.model_path)) {
+    return invalid_argument("--model", options.model_path,
+                            "not a content pack (.pack); bake it first: sinew-editor bake " + options.model_path +
+                                " -o character.pack");
+  }
+  SINEW_ASSIGN_OR_RETURN(character::Pack pack, character::Pack::open(options.model_path));
+  character::Model model = pack.model();
+  // A baked pack brings its fuzzy trees (used in place); a model-only pack
+  // is baked in memory like the mannequin.
+  std::optional<character::Pack> baked;
+  if (pack.has_fuzzy()) baked.emplace(std::move(pack));
+  return create(options, std::move(model), std::move(baked), jobs);
+}
+
+Expected<std::unique_ptr<DemoSession>> DemoSession::create(const SessionOptions& options, character::Model model,
+                                                           JobSystem& jobs) {
+  return create(options, std::move(model), std::nullopt, jobs);
+}
+
+Expected<std::unique_ptr<DemoSession>> DemoSession::create(const SessionOptions& options, character::Model model,
+                                                           std::optional<character::Pack> pack, JobSystem& jobs) {
   if (options.width < 1 || options.height < 1) {
     return invalid_argument("--size", std::to_string(options.width) + "x" + std::to_string(options.height),
                             "must be at least 1x1");
   }
-  // A baked pack brings its fuzzy trees (used in place); anything else,
-  // a model-only pack included, is baked in memory below.
-  std::optional<editor::CharacterPack> pack;
-  if (editor::is_pack_path(options.model_path)) {
-    SINEW_ASSIGN_OR_RETURN(editor::CharacterPack loaded, editor::CharacterPack::open(options.model_path));
-    if (loaded.has_fuzzy()) pack.emplace(std::move(loaded));
-  }
-  SINEW_ASSIGN_OR_RETURN(editor::ImportedModel model,
-                         pack ? Expected<editor::ImportedModel>(pack->model()) : load_model(options.model_path));
   const Arena arena = Arena::generate(options.seed, kObstacles);
   WorldOptions world_options;
   world_options.characters = options.characters;
@@ -95,7 +107,7 @@ Expected<std::unique_ptr<DemoSession>> DemoSession::create(const SessionOptions&
     fuzzy = s.pack_->fuzzy();
     s.bake_info_.from_pack = true;
   } else {
-    SINEW_ASSIGN_OR_RETURN(editor::InMemoryBake bake, editor::bake_in_memory(s.model_, editor::BakeRequest{}, jobs));
+    SINEW_ASSIGN_OR_RETURN(character::InMemoryBake bake, character::bake_in_memory(s.model_, character::BakeRequest{}, jobs));
     s.fuzzy_ = std::move(bake.fuzzy);
     fuzzy = s.fuzzy_.view();
   }

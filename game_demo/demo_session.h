@@ -18,8 +18,8 @@
 #include <string>
 #include <vector>
 
-#include "editor/import/imported_model.h"
-#include "editor/pack/character_pack.h"
+#include "character/model.h"
+#include "character/pack.h"
 #include "game_demo/arena.h"
 #include "game_demo/world.h"
 #include "raytrace/camera/camera.h"
@@ -33,7 +33,7 @@
 namespace sinew::demo {
 
 struct SessionOptions {
-  std::string model_path;  // empty: the procedural mannequin
+  std::string model_path;  // a content pack (.pack); empty: the procedural mannequin
   int characters = 6;
   std::uint32_t seed = 1;
   int width = 1024;
@@ -69,11 +69,17 @@ struct BakeInfo {
 
 class DemoSession {
  public:
-  // Loads the model (glTF .gltf/.glb, Cal3D .cfg, or a content pack; the
-  // mannequin when options.model_path is empty), bakes it over all its clips
-  // unless a baked pack brings its fuzzy trees, builds the arena and the
-  // world. Errors name the file and what was wrong.
+  // Loads the character (a content pack, the mannequin when
+  // options.model_path is empty), bakes it over all its clips unless the
+  // pack brings its fuzzy trees, builds the arena and the world. Source
+  // models (glTF, Cal3D) are refused with the editor command that bakes
+  // them. Errors name the file and what was wrong.
   static Expected<std::unique_ptr<DemoSession>> create(const SessionOptions& options, JobSystem& jobs);
+  // The same for a model the caller already has (a benchmark importing a
+  // source model with the editor's importers), baked in memory;
+  // options.model_path only names it.
+  static Expected<std::unique_ptr<DemoSession>> create(const SessionOptions& options, character::Model model,
+                                                       JobSystem& jobs);
 
   // Steps the world by dt with `input` (input.camera_yaw is taken from
   // `camera`), poses the characters and renders into rgba().
@@ -96,14 +102,16 @@ class DemoSession {
   ~DemoSession();
 
  private:
-  DemoSession(SessionOptions options, editor::ImportedModel model, World world);
+  DemoSession(SessionOptions options, character::Model model, World world);
+  static Expected<std::unique_ptr<DemoSession>> create(const SessionOptions& options, character::Model model,
+                                                       std::optional<character::Pack> pack, JobSystem& jobs);
 
   SessionOptions options_;
   // The model and the bake are referenced by the scene: they stay put
   // (the session is heap-allocated and never moves).
-  editor::ImportedModel model_;
+  character::Model model_;
   rt::FuzzyCharacterData fuzzy_;               // an in-memory bake, or
-  std::optional<editor::CharacterPack> pack_;  // a baked pack's trees, in place
+  std::optional<character::Pack> pack_;  // a baked pack's trees, in place
   Arena arena_;
   World world_;
   rt::Scene scene_;
@@ -119,7 +127,7 @@ class DemoSession {
 // Model space -> demo world: the rest pose's up axis (Y or Z, the larger
 // extent) turned to +Y, scaled to 1.8 m tall, feet on y = 0, centred on the
 // origin in x and z. Models are assumed to face +Z (Y-up) or -Y (Z-up).
-Affine3 model_to_world(const editor::ImportedModel& model);
+Affine3 model_to_world(const character::Model& model);
 
 // The follow camera for a character standing at `target` (its feet).
 rt::CameraDesc follow_camera_desc(const FollowCamera& camera, const Vec3& target);

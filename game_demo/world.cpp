@@ -158,7 +158,7 @@ Status validate(const WorldOptions& o) {
 
 }  // namespace
 
-ClipRoles find_clip_roles(const editor::ImportedModel& model) {
+ClipRoles find_clip_roles(const character::Model& model) {
   ClipRoles roles;
   const int count = static_cast<int>(model.clips.size());
   std::vector<std::string> names;
@@ -426,7 +426,7 @@ void World::Impl::pose(Character& c) {
   (void)anim::skinning_matrices(skeleton, c.model_pose, instance, c.skin);
 }
 
-Expected<World> World::create(const editor::ImportedModel& model, const WorldOptions& options) {
+Expected<World> World::create(const character::Model& model, const WorldOptions& options) {
   SINEW_RETURN_IF_ERROR(validate(options));
   ClipRoles roles = find_clip_roles(model);
   if (roles.walk < 0) {

@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "animation/mixer.h"
-#include "editor/import/imported_model.h"
+#include "character/model.h"
 #include "runtime/core/expected.h"
 #include "runtime/math/aabb.h"
 #include "runtime/math/affine.h"
@@ -70,7 +70,7 @@ class World {
  public:
   // Errors: kInvalidArgument (characters < 1 or > 256, bad speeds or arena),
   // kNotFound when the model has no clip usable as a walk.
-  static Expected<World> create(const editor::ImportedModel& model, const WorldOptions& options);
+  static Expected<World> create(const character::Model& model, const WorldOptions& options);
 
   // Advances every character by dt seconds (dt <= 0 or non-finite: no
   // motion), then poses them.
@@ -99,7 +99,7 @@ class World {
 };
 
 // The clip roles of `model` (see ClipRoles).
-ClipRoles find_clip_roles(const editor::ImportedModel& model);
+ClipRoles find_clip_roles(const character::Model& model);
 
 // The headless demo's scripted player: a fixed, deterministic input
 // sequence (walk, turn, run, an action, pauses, Tab once) repeating every

@@ -662,7 +662,7 @@ Expected<anim::Clip> make_kick(const anim::Skeleton& sk) {
 
 }  // namespace
 
-Expected<editor::ImportedModel> make_mannequin(const MannequinOptions& options) {
+Expected<character::Model> make_mannequin(const MannequinOptions& options) {
   if (options.detail < 1 || options.detail > 16) {
     return invalid_argument("detail", std::to_string(options.detail), "must be in [1, 16]");
   }
@@ -671,7 +671,7 @@ Expected<editor::ImportedModel> make_mannequin(const MannequinOptions& options) 
                             "must be a finite positive number of metres");
   }
   const float scale = options.height / kDesignHeight;
-  editor::ImportedModel model;
+  character::Model model;
   model.source = kSourceName;
   SINEW_ASSIGN_OR_RETURN(model.skeleton, build_skeleton(scale));
   build_mesh(model.skeleton, scale, options.detail, model.mesh);

@@ -26,7 +26,7 @@
 
 #include "animation/joint_limits.h"
 #include "animation/skeleton.h"
-#include "editor/import/imported_model.h"
+#include "character/model.h"
 #include "runtime/core/expected.h"
 
 namespace sinew::content {
@@ -41,7 +41,7 @@ struct MannequinOptions {
 
 // Errors: kInvalidArgument for detail outside [1, 16] or a height that is not
 // finite and positive. Deterministic: equal options give identical data.
-Expected<editor::ImportedModel> make_mannequin(const MannequinOptions& options = {});
+Expected<character::Model> make_mannequin(const MannequinOptions& options = {});
 
 // Plausible human ranges for the mannequin's joints, looked up by name (so
 // any skeleton with these joint names works; other joints stay free):

@@ -17,11 +17,11 @@
 #include <sstream>
 
 #include "animation/joint_limits.h"
-#include "editor/bake/in_memory_bake.h"
+#include "character/bake.h"
+#include "character/pack.h"
 #include "editor/cli/cli_args.h"
 #include "editor/import/model_loader.h"
 #include "editor/mesh/subdivide.h"
-#include "editor/pack/character_pack.h"
 #include "editor/scene/scene_recipe.h"
 #include "runtime/io/mapped_file.h"
 #include "runtime/jobs/job_system.h"
@@ -40,13 +40,13 @@ struct BakeOptions {
   std::string model_path;  // may come from the scene recipe
   std::optional<SceneRecipe> scene;
   std::string out_path;
-  anim::PoseSpaceDesc pose_space = default_pose_space();
+  anim::PoseSpaceDesc pose_space = character::default_pose_space();
   std::string limits_path;
   float padding = 0.0f;
   rt::CandidateBones candidates = rt::CandidateBones::kAll;
   float sah_intersection_cost = rt::FuzzyBakeOptions{}.kd.intersection_cost;
   int threads = 0;
-  std::size_t max_memory_bytes = BakeRequest{}.max_memory_bytes;
+  std::size_t max_memory_bytes = character::BakeRequest{}.max_memory_bytes;
   GltfImportOptions gltf;
   bool help = false;
 };
@@ -125,7 +125,7 @@ Expected<BakeOptions> parse_bake_options(std::vector<std::string> args) {
   }
   SINEW_RETURN_IF_ERROR(cli::parse_import_limits(parsed, o.gltf.limits));
   if (o.out_path.empty()) return invalid_argument("-o", "", "missing: where to write the pack");
-  if (!is_pack_path(o.out_path)) return invalid_argument("-o", o.out_path, "expected a .pack file name");
+  if (!character::is_pack_path(o.out_path)) return invalid_argument("-o", o.out_path, "expected a .pack file name");
   bool samples_given = false;
   if (auto v = parsed.value("--pose-space")) {
     const std::string mode = *v;
@@ -268,8 +268,8 @@ Expected<std::uint64_t> file_hash(const std::string& path) {
 }
 
 // Who made a pack from which file, and when (SOURCE_DATE_EPOCH when set).
-Expected<Provenance> provenance_for(const std::string& model_path) {
-  Provenance p;
+Expected<character::Provenance> provenance_for(const std::string& model_path) {
+  character::Provenance p;
   p.source_name = std::filesystem::path(model_path).filename().string();
   SINEW_ASSIGN_OR_RETURN(p.source_hash, file_hash(model_path));
   p.tool_version = std::string("sinew-editor ") + SINEW_VERSION;
@@ -329,16 +329,16 @@ std::string utc_text(std::int64_t unix_time) {
   return text;
 }
 
-Json inspect_json(const CharacterPack& pack) {
-  const ImportedModel& m = pack.model();
+Json inspect_json(const character::Pack& pack) {
+  const character::Model& m = pack.model();
   Json sections = Json::array();
   for (const SectionInfo& s : pack.reader().sections()) {
     sections.push_back({{"id", section_id_name(s.id)}, {"version", s.version}, {"bytes", s.size}});
   }
   Json clips = Json::array();
   for (const anim::Clip& c : m.clips) clips.push_back({{"name", c.name()}, {"seconds", c.duration()}});
-  const PoseSpaceRecord& ps = pack.pose_space();
-  const Provenance& p = pack.provenance();
+  const character::PoseSpaceRecord& ps = pack.pose_space();
+  const character::Provenance& p = pack.provenance();
   Json out = {
       {"file", pack.reader().name()},
       {"bytes", pack.reader().bytes().size()},
@@ -431,7 +431,7 @@ long max_rss_kib() {
 // The estimate counts the bake's large buffers; the RSS peak is what the
 // process really touched (it includes the loaded model and the allocator's
 // slack, and only grows, so a bake below an earlier peak adds nothing).
-void print_bake_memory(const BakeMemory& m, long rss_before_kib, long rss_after_kib, std::ostream& out) {
+void print_bake_memory(const character::BakeMemory& m, long rss_before_kib, long rss_after_kib, std::ostream& out) {
   const auto mib = [](double bytes) { return bytes / (1024.0 * 1024.0); };
   out << std::fixed << std::setprecision(1) << "bake memory: peak " << mib(static_cast<double>(m.peak()))
       << " MiB estimated (pose samples " << mib(static_cast<double>(m.pose_samples)) << " MiB + fuzzy bake "
@@ -465,7 +465,7 @@ int run_bake(const std::vector<std::string>& args, std::ostream& out, std::ostre
     if (!kept.ok()) return fail(err, "bake", kept.status());
     model = std::move(kept);
   }
-  BakeRequest request;
+  character::BakeRequest request;
   request.pose_space = o.pose_space;
   request.fuzzy.padding = o.padding;
   request.fuzzy.candidates = o.candidates;
@@ -485,9 +485,9 @@ int run_bake(const std::vector<std::string>& args, std::ostream& out, std::ostre
       << " pose space on " << jobs.thread_count() << " threads\n"
       << std::flush;
   const long rss_before_kib = max_rss_kib();
-  Expected<InMemoryBake> bake = [&] {
+  Expected<character::InMemoryBake> bake = [&] {
     ScopedInterruptHandler interrupts;
-    return bake_in_memory(*model, request, jobs);
+    return character::bake_in_memory(*model, request, jobs);
   }();
   progress.done();
   if (bake.ok()) print_bake_memory(bake->memory, rss_before_kib, max_rss_kib(), out);
@@ -499,7 +499,7 @@ int run_bake(const std::vector<std::string>& args, std::ostream& out, std::ostre
     return fail(err, "bake", bake.status());
   }
 
-  CharacterPackContents contents;
+  character::PackContents contents;
   contents.model = &*model;
   contents.limits = request.limits;
   contents.fuzzy = &bake->fuzzy;
@@ -508,14 +508,14 @@ int run_bake(const std::vector<std::string>& args, std::ostream& out, std::ostre
   contents.pose_space.candidates = o.candidates;
   auto provenance = provenance_for(o.model_path);
   if (!provenance.ok()) return fail(err, "bake", provenance.status());
-  Provenance& p = contents.provenance = std::move(*provenance);
+  character::Provenance& p = contents.provenance = std::move(*provenance);
   if (!source_date_epoch()) {  // reproducible bakes record no timings
     p.pose_sampling_ms = bake->pose_sampling_ms;
     p.sampling_ms = bake->fuzzy.stats.sampling_ms;
     p.assignment_ms = bake->fuzzy.stats.assignment_ms;
     p.build_ms = bake->fuzzy.stats.build_ms;
   }
-  if (Status s = write_character_pack(o.out_path, contents); !s.ok()) return fail(err, "bake", s);
+  if (Status s = character::write_pack(o.out_path, contents); !s.ok()) return fail(err, "bake", s);
   const rt::FuzzyBakeStats& st = bake->fuzzy.stats;
   out << "wrote " << o.out_path << ": " << std::filesystem::file_size(o.out_path) << " bytes, " << st.sample_count
       << " pose samples, fuzzy area " << std::fixed << std::setprecision(3)
@@ -546,7 +546,7 @@ int run_subdivide(const std::vector<std::string>& args, std::ostream& out, std::
   const auto levels_text = parsed->value("--levels");
   const auto out_path = parsed->value("--out");
   if (!levels_text) return usage_error(err, "subdivide", invalid_argument("--levels", "", "missing"), usage);
-  if (!out_path || !is_pack_path(*out_path)) {
+  if (!out_path || !character::is_pack_path(*out_path)) {
     return usage_error(err, "subdivide", invalid_argument("-o", out_path.value_or(""), "expected a .pack file name"),
                        usage);
   }
@@ -558,12 +558,12 @@ int run_subdivide(const std::vector<std::string>& args, std::ostream& out, std::
   for (const std::string& warning : model->warnings) err << "sinew-editor subdivide: warning: " << warning << "\n";
   auto finer = subdivide(*model, static_cast<int>(*levels));
   if (!finer.ok()) return fail(err, "subdivide", finer.status());
-  CharacterPackContents contents;
+  character::PackContents contents;
   contents.model = &*finer;
   auto provenance = provenance_for(model_path);
   if (!provenance.ok()) return fail(err, "subdivide", provenance.status());
   contents.provenance = std::move(*provenance);
-  if (Status s = write_character_pack(*out_path, contents); !s.ok()) return fail(err, "subdivide", s);
+  if (Status s = character::write_pack(*out_path, contents); !s.ok()) return fail(err, "subdivide", s);
   out << "wrote " << *out_path << ": " << finer->mesh.vertex_count() << " vertices, " << finer->mesh.triangle_count()
       << " triangles (from " << model->mesh.triangle_count() << ", " << *levels << " levels)\n";
   return 0;
@@ -580,7 +580,7 @@ int run_inspect(const std::vector<std::string>& args, std::ostream& out, std::os
   if (parsed->positionals.size() != 1) {
     return usage_error(err, "inspect", invalid_argument("PACK", "", "expected one pack file"), usage);
   }
-  auto pack = CharacterPack::open(parsed->positionals.front());
+  auto pack = character::Pack::open(parsed->positionals.front());
   if (!pack.ok()) return fail(err, "inspect", pack.status());
   const Json j = inspect_json(*pack);
   if (parsed->has("--json")) {
@@ -606,7 +606,7 @@ int run_validate(const std::vector<std::string>& args, std::ostream& out, std::o
     return usage_error(err, "validate", invalid_argument("PACK", "", "expected one pack file"), usage);
   }
   const auto start = Clock::now();
-  auto pack = CharacterPack::open(parsed->positionals.front());
+  auto pack = character::Pack::open(parsed->positionals.front());
   const double load_ms = ms_since(start);
   if (!pack.ok()) return fail(err, "validate", pack.status());
   out << parsed->positionals.front() << ": valid, checked in " << std::fixed << std::setprecision(1) << load_ms

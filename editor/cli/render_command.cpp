@@ -14,10 +14,11 @@
 
 #include "animation/joint_limits.h"
 #include "animation/pose.h"
-#include "editor/bake/in_memory_bake.h"
+#include "character/bake.h"
+#include "character/framing.h"
+#include "character/pack.h"
 #include "editor/cli/cli_args.h"
 #include "editor/import/model_loader.h"
-#include "editor/pack/character_pack.h"
 #include "raytrace/render/renderer.h"
 #include "raytrace/skinning/skinning.h"
 #include "runtime/image/image_io.h"
@@ -31,9 +32,6 @@ namespace sinew::editor {
 namespace {
 
 constexpr double kFramesPerSecond = 30.0;
-constexpr double kInstanceTimeStep = 0.37;    // seconds between instances' clip times
-constexpr float kInstanceSpacing = 1.2f;      // x the rest bounds' largest extent
-constexpr float kDefaultFovyDegrees = 40.0f;
 constexpr int kMaxImageSide = 16384;
 
 const std::vector<cli::FlagSpec>& render_flags() {
@@ -72,7 +70,7 @@ Status parse_pose_space(const cli::ParsedArgs& args, RenderOptions& o) {
       o.pose_space = anim::PoseSpaceDesc{};  // random poses: 1000 samples, seed 1
       o.pose_space.mode = *mode;
     } else {
-      o.pose_space.mode = *mode;  // keeps default_pose_space()'s every key + 1/30 s
+      o.pose_space.mode = *mode;  // keeps character::default_pose_space()'s every key + 1/30 s
       if (clip_mode) o.pose_space.clips = {clip_name};
     }
   }
@@ -178,26 +176,15 @@ Status parse_run(const cli::ParsedArgs& args, RenderOptions& o) {
 
 // --- model, pose and scene --------------------------------------------------
 
-Expected<std::vector<Affine3>> rest_skinning(const ImportedModel& model, const Affine3& placement) {
-  const std::size_t joints = model.skeleton.joint_count();
-  std::vector<anim::JointTransform> local(joints);
-  std::vector<Affine3> model_space(joints);
-  std::vector<Affine3> skin(joints);
-  SINEW_RETURN_IF_ERROR(anim::rest_pose(model.skeleton, local));
-  SINEW_RETURN_IF_ERROR(anim::local_to_model(model.skeleton, local, model_space));
-  SINEW_RETURN_IF_ERROR(anim::skinning_matrices(model.skeleton, model_space, placement, skin));
-  return skin;
-}
-
 // The instance's skinning matrices at playback time `seconds`: the clip
 // alone at weight 1 (looping), or the rest pose when there is no clip.
-Expected<std::vector<Affine3>> pose_instance(const ImportedModel& model, const anim::Clip* clip, double seconds,
+Expected<std::vector<Affine3>> pose_instance(const character::Model& model, const anim::Clip* clip, double seconds,
                                              const Affine3& placement) {
-  if (clip == nullptr) return rest_skinning(model, placement);
-  return clip_skinning(model, *clip, seconds, placement);
+  if (clip == nullptr) return character::rest_skinning(model, placement);
+  return character::clip_skinning(model, *clip, seconds, placement);
 }
 
-Expected<const anim::Clip*> resolve_clip(const ImportedModel& model, const RenderOptions& options) {
+Expected<const anim::Clip*> resolve_clip(const character::Model& model, const RenderOptions& options) {
   if (options.clip.empty()) return model.clips.empty() ? nullptr : &model.clips.front();
   if (const anim::Clip* clip = model.find_clip(options.clip)) return clip;
   std::string names;
@@ -206,16 +193,6 @@ Expected<const anim::Clip*> resolve_clip(const ImportedModel& model, const Rende
                     "no such clip (clips: " + (names.empty() ? std::string("none") : names) + ")");
 }
 
-
-Vec3 axis_vector(int axis, float sign = 1.0f) {
-  Vec3 v(0.0f);
-  v[axis] = sign;
-  return v;
-}
-
-Vec3 front_of(int up) { return up == 1 ? axis_vector(2) : axis_vector(1, -1.0f); }
-
-float bounding_radius(const Aabb& box) { return std::max(0.5f * glm::length(box.extent()), 1e-6f); }
 
 
 
@@ -227,8 +204,8 @@ struct FrameRecord {
   rt::RenderStats render;
 };
 
-Expected<std::string> stats_document(const RenderOptions& options, const ImportedModel& model,
-                                     const InMemoryBake& bake, const RenderOutputs& outputs) {
+Expected<std::string> stats_document(const RenderOptions& options, const character::Model& model,
+                                     const character::InMemoryBake& bake, const RenderOutputs& outputs) {
   const nlohmann::ordered_json phases = nlohmann::ordered_json::parse(outputs.timers.json(), nullptr, false);
   if (phases.is_discarded()) {
     return make_error(ErrorCode::kInternal, "stats.json", "phases", "", "PhaseTimers::json() is not valid JSON");
@@ -290,80 +267,6 @@ void report(const RenderOptions& options, const std::string& line) {
 }
 
 }  // namespace
-
-// --- conventions ------------------------------------------------------------
-
-Aabb posed_bounds(const rt::Scene& scene) {
-  Aabb box;
-  for (const rt::InstanceFrame& frame : scene.instances()) {
-    for (const Vec3& p : frame.positions) box.extend(p);
-  }
-  return box;
-}
-
-rt::CameraDesc default_camera(const Aabb& box, int up, int width, int height) {
-  const float radius = bounding_radius(box);
-  const float half_fovy = glm::radians(0.5f * kDefaultFovyDegrees);
-  const float aspect = static_cast<float>(width) / static_cast<float>(height);
-  const float half_fovx = std::atan(std::tan(half_fovy) * aspect);
-  const float distance = 1.15f * radius / std::sin(std::min(half_fovy, half_fovx));
-  const Vec3 view = glm::normalize(front_of(up) + 0.2f * axis_vector(up));
-  return {box.center() + distance * view, box.center(), axis_vector(up), kDefaultFovyDegrees};
-}
-
-Vec3 default_light(const Aabb& box, int up) {
-  const float radius = bounding_radius(box);
-  return box.center() + radius * (2.0f * front_of(up) + 3.0f * axis_vector(up) + axis_vector(0));
-}
-
-Aabb rest_bounds(const ImportedModel& model) {
-  Aabb box;
-  const auto skin = rest_skinning(model, Affine3::identity());
-  if (!skin.ok()) return box;
-  for (std::size_t v = 0; v < model.mesh.vertex_count(); ++v) box.extend(rt::skin_point(model.mesh, v, *skin));
-  return box;
-}
-
-int up_axis_of(const Aabb& rest) {
-  const Vec3 e = rest.extent();
-  return e.y >= e.z ? 1 : 2;
-}
-
-Affine3 instance_placement(const Aabb& rest, int index) {
-  const Vec3 e = rest.extent();
-  const float spacing = kInstanceSpacing * std::max({e.x, e.y, e.z});
-  return Affine3::translation(axis_vector(0, static_cast<float>(index) * spacing));
-}
-
-double instance_time_offset(int index) { return kInstanceTimeStep * index; }
-
-rt::StaticMeshDesc ground_plane_for(const Aabb& rest, int instances) {
-  const int up = up_axis_of(rest);
-  const Vec3 e = rest.extent();
-  const float largest = std::max({e.x, e.y, e.z, 1e-3f});
-  // Centred under the row of instances and reaching well past it, so the
-  // ground fills the background of the default camera.
-  const Vec3 row_end = instance_placement(rest, std::max(instances - 1, 0)).translation_part();
-  const Vec3 centre = rest.center() + 0.5f * row_end;
-  const float reach = 10.0f * largest + 0.5f * glm::length(row_end);
-  const int a = (up + 1) % 3;
-  const int b = (up + 2) % 3;
-  rt::StaticMeshDesc ground;
-  for (int corner = 0; corner < 4; ++corner) {
-    Vec3 p(0.0f);
-    p[up] = rest.lower[up];
-    p[a] = centre[a] + ((corner & 1) ? reach : -reach);
-    p[b] = centre[b] + ((corner & 2) ? reach : -reach);
-    ground.positions.push_back(p);
-  }
-  ground.triangles = {{0, 1, 3}, {0, 3, 2}};
-  ground.material_colors = {Vec3(0.5f)};
-  return ground;
-}
-
-rt::StaticMeshDesc ground_plane_for(const ImportedModel& model, int instances) {
-  return ground_plane_for(rest_bounds(model), instances);
-}
 
 // --- the command --------------------------------------------------------------
 
@@ -431,34 +334,34 @@ Expected<RenderOutputs> render_model(const RenderOptions& options) {
   }
   // A baked pack renders from its own fuzzy trees, in place; any other
   // model (or a model-only pack) is baked in memory first.
-  std::optional<CharacterPack> pack;
-  InMemoryBake bake;
+  std::optional<character::Pack> pack;
+  character::InMemoryBake bake;
   JobSystem jobs(options.threads);
-  if (is_pack_path(options.model_path)) {
+  if (character::is_pack_path(options.model_path)) {
     report(options, "loading " + options.model_path);
-    SINEW_ASSIGN_OR_RETURN(CharacterPack loaded, CharacterPack::open(options.model_path));
+    SINEW_ASSIGN_OR_RETURN(character::Pack loaded, character::Pack::open(options.model_path));
     pack.emplace(std::move(loaded));
   }
-  ImportedModel imported;
+  character::Model imported;
   if (!pack) {
     report(options, "importing " + options.model_path);
     SINEW_ASSIGN_OR_RETURN(imported, load_model(options.model_path, options.gltf));
     for (const std::string& warning : imported.warnings) report(options, "warning: " + warning);
   }
-  const ImportedModel& model = pack ? pack->model() : imported;
+  const character::Model& model = pack ? pack->model() : imported;
   if (model.mesh.triangle_count() == 0) {
     return make_error(ErrorCode::kInvalidData, options.model_path, "triangles", "0", "the model has no triangles");
   }
   SINEW_ASSIGN_OR_RETURN(const anim::Clip* clip, resolve_clip(model, options));
 
   if (!pack || !pack->has_fuzzy()) {
-    BakeRequest request;
+    character::BakeRequest request;
     request.pose_space = options.pose_space;
     if (!options.limits_path.empty()) {
       SINEW_ASSIGN_OR_RETURN(request.limits, anim::load_joint_limits(options.limits_path, model.skeleton));
     }
     report(options, "baking (" + std::string(anim::pose_space_mode_name(request.pose_space.mode)) + " pose space)");
-    SINEW_ASSIGN_OR_RETURN(bake, bake_in_memory(model, request, jobs));
+    SINEW_ASSIGN_OR_RETURN(bake, character::bake_in_memory(model, request, jobs));
   }
   const rt::FuzzyCharacterView fuzzy = pack && pack->has_fuzzy() ? pack->fuzzy() : bake.fuzzy.view();
   if (pack && pack->has_fuzzy()) bake.fuzzy.stats = pack->fuzzy_stats();  // reported in stats.json
@@ -467,8 +370,8 @@ Expected<RenderOutputs> render_model(const RenderOptions& options) {
   out.width = options.width;
   out.height = options.height;
   out.clip_name = clip != nullptr ? clip->name() : "";
-  const Aabb rest = rest_bounds(model);
-  const int up = up_axis_of(rest);
+  const Aabb rest = character::rest_bounds(model);
+  const int up = character::up_axis_of(rest);
 
   // Scene: the instances first (ids 0..n-1), then the ground.
   rt::Scene scene;
@@ -477,11 +380,11 @@ Expected<RenderOutputs> render_model(const RenderOptions& options) {
   for (int i = 0; i < options.instances; ++i) {
     SINEW_ASSIGN_OR_RETURN(const std::uint32_t id, scene.add_instance(character));
     instance_ids.push_back(id);
-    out.instance_placements.push_back(instance_placement(rest, i));
+    out.instance_placements.push_back(character::instance_placement(rest, i));
   }
   out.ground_instance_id = kInvalidId;
   if (options.ground) {
-    out.ground = ground_plane_for(rest, options.instances);
+    out.ground = character::ground_plane_for(rest, options.instances);
     SINEW_ASSIGN_OR_RETURN(out.ground_instance_id, scene.add_static_mesh(out.ground));
   }
 
@@ -520,7 +423,7 @@ Expected<RenderOutputs> render_model(const RenderOptions& options) {
       ScopedPhase animation(frame_timers, "animation");
       for (std::size_t i = 0; i < instance_ids.size(); ++i) {
         const int index = static_cast<int>(i);
-        SINEW_ASSIGN_OR_RETURN(bones[i], pose_instance(model, clip, seconds + instance_time_offset(index),
+        SINEW_ASSIGN_OR_RETURN(bones[i], pose_instance(model, clip, seconds + character::instance_time_offset(index),
                                                        out.instance_placements[i]));
         SINEW_RETURN_IF_ERROR(scene.set_bones(instance_ids[i], bones[i]));
       }
@@ -528,9 +431,9 @@ Expected<RenderOutputs> render_model(const RenderOptions& options) {
     SINEW_ASSIGN_OR_RETURN(const rt::FrameStats frame, scene.prepare_frame(frame_options, jobs, &frame_timers));
     if (!camera) {
       // Framed once, on the first frame's pose, so every frame shares one view.
-      const Aabb posed = posed_bounds(scene);
-      out.camera = options.camera ? *options.camera : default_camera(posed, up, options.width, options.height);
-      out.light.position = options.light ? *options.light : default_light(posed, up);
+      const Aabb posed = character::posed_bounds(scene);
+      out.camera = options.camera ? *options.camera : character::default_camera(posed, up, options.width, options.height);
+      out.light.position = options.light ? *options.light : character::default_light(posed, up);
       settings.light = out.light;
       SINEW_ASSIGN_OR_RETURN(camera, rt::PinholeCamera::create(out.camera, options.width, options.height));
     }

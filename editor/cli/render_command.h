@@ -12,21 +12,11 @@
 // the unit primary ray, +inf on a miss), DIR/triangle_id.exr (uint32,
 // 0xFFFFFFFF on a miss) and DIR/stats.json.
 //
-// Conventions of the defaults (the model's own axes; nothing is re-oriented):
-// * Rest bounds: the model skinned at its skeleton's rest pose.
-// * Up axis: whichever of Y and Z has the larger rest-bounds extent (glTF
-//   characters are Y-up, Cal3D ones usually Z-up). Front: +Z for Y-up
-//   models, -Y for Z-up models; right: +X in both (the image's right-hand
-//   side when the camera looks back along -front with that up).
-// * Instances: instance i is moved by i * 1.2 * (largest rest extent) along
-//   +X and plays the clip 0.37 s * i later than --time.
-// * Ground: a quad (2 triangles, a static mesh added after the instances)
-//   at the rest bounds' lowest up coordinate, reaching far beyond them.
-// * Camera (no --camera): looks at the centre of all instances' posed
-//   bounds at the first frame from the front, slightly above, far enough
-//   that the bounds' sphere fits the smaller of the two fields of view,
-//   fovy 40 degrees.
-// * Light (no --light): a point light above-front-right of those bounds.
+// The defaults follow character/framing.h (the model's own axes; nothing is
+// re-oriented): instance i plays the clip 0.37 s * i later than --time; the
+// ground is a static mesh added after the instances; the camera (no
+// --camera) frames all instances' posed bounds at the first frame, and the
+// light (no --light) sits above-front-right of them.
 // * --clip: default the model's first clip; a model without clips is
 //   rendered at its rest pose.
 #pragma once
@@ -40,9 +30,9 @@
 #include <vector>
 
 #include "animation/pose_space.h"
-#include "editor/bake/in_memory_bake.h"
+#include "character/bake.h"
+#include "character/model.h"
 #include "editor/import/gltf_importer.h"
-#include "editor/import/imported_model.h"
 #include "raytrace/camera/camera.h"
 #include "raytrace/geometry/triangle_intersect.h"
 #include "raytrace/render/renderer.h"
@@ -62,7 +52,7 @@ struct RenderOptions {
   int width = 512;
   int height = 512;
   std::string out_dir;  // empty: nothing is written (in-process use)
-  anim::PoseSpaceDesc pose_space = default_pose_space();
+  anim::PoseSpaceDesc pose_space = character::default_pose_space();
   std::string limits_path;         // joint limits JSON, for pose space "limits"
   bool shadows = true;
   std::optional<Vec3> light;  // empty: placed automatically
@@ -122,21 +112,6 @@ struct RenderOutputs {
   std::string stats_json;  // what stats.json holds
 };
 
-// The axis conventions above, exposed for tests.
-Aabb rest_bounds(const ImportedModel& model);
-int up_axis_of(const Aabb& rest);
-// Instance i's placement and clip time offset.
-Affine3 instance_placement(const Aabb& rest, int index);
-double instance_time_offset(int index);
-// The ground quad under `rest` sized for `instances` instances.
-rt::StaticMeshDesc ground_plane_for(const Aabb& rest, int instances);
-rt::StaticMeshDesc ground_plane_for(const ImportedModel& model, int instances = 1);
-// The bounds of every instance's skinned vertices (after prepare_frame).
-Aabb posed_bounds(const rt::Scene& scene);
-// The default camera framing `box` from the front, slightly above, and the
-// default point light above-front-right of it (render --help).
-rt::CameraDesc default_camera(const Aabb& box, int up, int width, int height);
-Vec3 default_light(const Aabb& box, int up);
 
 // Runs the whole command in-process. Errors (user errors, exit code 1) name
 // the file, the field and the value.

@@ -4,7 +4,7 @@
 
 namespace sinew::editor::gui {
 
-BakeJob::BakeJob(const ImportedModel& model, BakeRequest request, int threads) {
+BakeJob::BakeJob(const character::Model& model, character::BakeRequest request, int threads) {
   worker_ = std::thread([this, &model, request = std::move(request), threads]() mutable {
     run(model, std::move(request), threads);
   });
@@ -15,7 +15,7 @@ BakeJob::~BakeJob() {
   if (worker_.joinable()) worker_.join();
 }
 
-void BakeJob::run(const ImportedModel& model, BakeRequest request, int threads) {
+void BakeJob::run(const character::Model& model, character::BakeRequest request, int threads) {
   request.fuzzy.progress = [this](std::string_view phase, double fraction) {
     progress_.store(fraction);
     {
@@ -25,7 +25,7 @@ void BakeJob::run(const ImportedModel& model, BakeRequest request, int threads) 
     return !cancel_.load();
   };
   JobSystem jobs(threads);  // its own pool: the viewport's keeps rendering meanwhile
-  Expected<InMemoryBake> baked = bake_in_memory(model, request, jobs);
+  Expected<character::InMemoryBake> baked = character::bake_in_memory(model, request, jobs);
   // Pose sampling runs before the fuzzy bake reports progress, so a cancel
   // that arrives then is honoured here.
   if (baked.ok() && cancel_.load()) {
@@ -40,10 +40,10 @@ std::string BakeJob::phase() const {
   return phase_;
 }
 
-Expected<InMemoryBake> BakeJob::take() {
+Expected<character::InMemoryBake> BakeJob::take() {
   if (worker_.joinable()) worker_.join();
   if (!result_) return make_error(ErrorCode::kInternal, "", "bake", "none", "the bake result was already taken");
-  Expected<InMemoryBake> out = std::move(*result_);
+  Expected<character::InMemoryBake> out = std::move(*result_);
   result_.reset();
   return out;
 }

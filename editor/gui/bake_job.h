@@ -9,7 +9,7 @@
 #include <string>
 #include <thread>
 
-#include "editor/bake/in_memory_bake.h"
+#include "character/bake.h"
 #include "runtime/core/expected.h"
 
 namespace sinew::editor::gui {
@@ -17,7 +17,7 @@ namespace sinew::editor::gui {
 class BakeJob {
  public:
   // Starts baking `model` (which must outlive the job) at once.
-  BakeJob(const ImportedModel& model, BakeRequest request, int threads);
+  BakeJob(const character::Model& model, character::BakeRequest request, int threads);
   ~BakeJob();  // cancels and joins
   BakeJob(const BakeJob&) = delete;
   BakeJob& operator=(const BakeJob&) = delete;
@@ -27,17 +27,17 @@ class BakeJob {
   double progress() const { return progress_.load(); }
   std::string phase() const;
   // Joins the worker and hands over the result (once; done() must be true).
-  Expected<InMemoryBake> take();
+  Expected<character::InMemoryBake> take();
 
  private:
-  void run(const ImportedModel& model, BakeRequest request, int threads);
+  void run(const character::Model& model, character::BakeRequest request, int threads);
 
   std::atomic<bool> cancel_{false};
   std::atomic<bool> done_{false};
   std::atomic<double> progress_{0.0};
   mutable std::mutex phase_mutex_;
   std::string phase_ = "starting";
-  std::optional<Expected<InMemoryBake>> result_;
+  std::optional<Expected<character::InMemoryBake>> result_;
   std::thread worker_;
 };
 

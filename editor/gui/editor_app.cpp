@@ -9,11 +9,11 @@
 #include <cstdio>
 
 #include "animation/joint_limits.h"
+#include "character/pack.h"
 #include "editor/gui/bake_job.h"
 #include "editor/gui/panels.h"
 #include "editor/gui/pose_player.h"
 #include "editor/import/model_loader.h"
-#include "editor/pack/character_pack.h"
 #include "runtime/display/imgui_layer.h"
 #include "runtime/display/pixel_display.h"
 #include "runtime/display/window.h"
@@ -28,11 +28,11 @@ constexpr int kPanelWidth = 340;
 // The model and the trees in use. Heap-allocated so that the spans the
 // scene and the bake worker hold stay valid while it lives.
 struct Loaded {
-  std::optional<CharacterPack> pack;
-  ImportedModel imported;
+  std::optional<character::Pack> pack;
+  character::Model imported;
   std::unique_ptr<rt::FuzzyCharacterData> baked;  // null: the pack's trees
 
-  const ImportedModel& model() const { return pack ? pack->model() : imported; }
+  const character::Model& model() const { return pack ? pack->model() : imported; }
   rt::FuzzyCharacterView view() const { return baked ? baked->view() : pack->fuzzy(); }
   const rt::FuzzyBakeStats& stats() const { return baked ? baked->stats : pack->fuzzy_stats(); }
 };
@@ -121,11 +121,11 @@ Expected<std::unique_ptr<EditorApp>> EditorApp::create(const GuiOptions& options
 Status EditorApp::Impl::use_loaded(std::unique_ptr<Loaded> next) {
   bake.reset();  // cancels and joins: it may read the old model
   if (!next->pack || !next->pack->has_fuzzy()) {
-    BakeRequest request;  // the default pose space: every clip
-    SINEW_ASSIGN_OR_RETURN(InMemoryBake baked, bake_in_memory(next->model(), request, *jobs));
+    character::BakeRequest request;  // the default pose space: every clip
+    SINEW_ASSIGN_OR_RETURN(character::InMemoryBake baked, character::bake_in_memory(next->model(), request, *jobs));
     next->baked = std::make_unique<rt::FuzzyCharacterData>(std::move(baked.fuzzy));
   }
-  const ImportedModel& model = next->model();
+  const character::Model& model = next->model();
   if (model.mesh.triangle_count() == 0) {
     return make_error(ErrorCode::kInvalidData, model.source, "triangles", "0", "the model has no triangles");
   }
@@ -141,8 +141,8 @@ Status EditorApp::Impl::use_loaded(std::unique_ptr<Loaded> next) {
 
 Status EditorApp::Impl::load_path(const std::string& path) {
   auto next = std::make_unique<Loaded>();
-  if (is_pack_path(path)) {
-    SINEW_ASSIGN_OR_RETURN(CharacterPack pack, CharacterPack::open(path));
+  if (character::is_pack_path(path)) {
+    SINEW_ASSIGN_OR_RETURN(character::Pack pack, character::Pack::open(path));
     next->pack.emplace(std::move(pack));
   } else {
     SINEW_ASSIGN_OR_RETURN(next->imported, load_model(path));
@@ -162,7 +162,7 @@ Status EditorApp::load(const std::string& path) {
   return Status{};
 }
 
-Status EditorApp::load(ImportedModel model) {
+Status EditorApp::load(character::Model model) {
   auto next = std::make_unique<Loaded>();
   next->imported = std::move(model);
   return impl_->use_loaded(std::move(next));
@@ -170,7 +170,7 @@ Status EditorApp::load(ImportedModel model) {
 
 void EditorApp::Impl::poll_bake() {
   if (!bake || !bake->done()) return;
-  Expected<InMemoryBake> result = bake->take();
+  Expected<character::InMemoryBake> result = bake->take();
   bake.reset();
   if (!result.ok()) {
     // A cancelled or failed bake leaves the trees in use untouched.
@@ -192,7 +192,7 @@ void EditorApp::Impl::poll_bake() {
 Status EditorApp::Impl::start_bake(const BakeSettings& settings) {
   if (!loaded) return invalid_argument("bake", "no model", "load a model first");
   if (bake) return invalid_argument("bake", "running", "a bake is already running");
-  BakeRequest request;
+  character::BakeRequest request;
   request.pose_space = pose_space_of(settings);
   if (settings.mode == anim::PoseSpaceMode::kLimits) request.limits = panels.limits;
   request.fuzzy.padding = settings.padding;
@@ -206,12 +206,12 @@ Status EditorApp::Impl::save_pack(const std::string& path) {
   if (!loaded || !loaded->baked) {
     return invalid_argument("save", path, "only trees baked in this session can be saved");
   }
-  CharacterPackContents contents;
+  character::PackContents contents;
   contents.model = &loaded->model();
   contents.limits = panels.limits;
   contents.fuzzy = loaded->baked.get();
   contents.provenance.tool_version = "sinew-editor gui";
-  return write_character_pack(path, contents);
+  return character::write_pack(path, contents);
 }
 
 void EditorApp::Impl::handle_mouse(int viewport_width) {
@@ -347,7 +347,7 @@ Status EditorApp::set_bone(const std::string& name_or_index) {
 
 Status EditorApp::set_clip(const std::string& name) {
   if (!impl_->loaded) return invalid_argument("--clip", name, "no model loaded");
-  const ImportedModel& model = impl_->loaded->model();
+  const character::Model& model = impl_->loaded->model();
   const anim::Clip* clip = model.find_clip(name);
   if (clip == nullptr) return make_error(ErrorCode::kNotFound, model.source, "--clip", name, "no such clip");
   return set_cycles(static_cast<int>(clip - model.clips.data()), -1, 0.0f);
@@ -387,7 +387,7 @@ const std::string& EditorApp::message() const { return impl_->message; }
 void EditorApp::set_capture(bool on) { impl_->capture = on; }
 const Screenshot& EditorApp::last_shown() const { return impl_->shown; }
 
-const ImportedModel* EditorApp::model() const { return impl_->loaded ? &impl_->loaded->model() : nullptr; }
+const character::Model* EditorApp::model() const { return impl_->loaded ? &impl_->loaded->model() : nullptr; }
 rt::FuzzyCharacterView EditorApp::fuzzy() const {
   return impl_->loaded ? impl_->loaded->view() : rt::FuzzyCharacterView{};
 }

@@ -23,9 +23,9 @@
 #include <vector>
 
 #include "animation/pose_space.h"
+#include "character/model.h"
 #include "editor/gui/overlays.h"
 #include "editor/gui/viewport.h"
-#include "editor/import/imported_model.h"
 #include "runtime/core/expected.h"
 
 namespace sinew::editor::gui {
@@ -87,7 +87,7 @@ class EditorApp {
 
   // Replaces the model (a running bake is cancelled first).
   Status load(const std::string& path);
-  Status load(ImportedModel model);
+  Status load(character::Model model);
 
   // One frame: input, animation, bake polling, render, overlay, panels,
   // swap. False once the window was asked to close.
@@ -116,7 +116,7 @@ class EditorApp {
   void set_capture(bool on);
   const Screenshot& last_shown() const;
 
-  const ImportedModel* model() const;
+  const character::Model* model() const;
   rt::FuzzyCharacterView fuzzy() const;
   std::span<const Affine3> skinning() const;  // of the last frame
   const Viewport& viewport() const;

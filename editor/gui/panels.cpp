@@ -13,13 +13,13 @@ void copy_text(std::array<char, 512>& dst, const std::string& text) {
   std::snprintf(dst.data(), dst.size(), "%s", text.c_str());
 }
 
-const char* clip_name(const ImportedModel& model, int index) {
+const char* clip_name(const character::Model& model, int index) {
   if (index < 0 || static_cast<std::size_t>(index) >= model.clips.size()) return "(none)";
   return model.clips[static_cast<std::size_t>(index)].name().c_str();
 }
 
 // A combo over the model's clips; `allow_none` adds "(none)" as -1.
-bool clip_combo(const char* label, const ImportedModel& model, int& index, bool allow_none) {
+bool clip_combo(const char* label, const character::Model& model, int& index, bool allow_none) {
   bool changed = false;
   if (ImGui::BeginCombo(label, clip_name(model, index))) {
     if (allow_none && ImGui::Selectable("(none)", index < 0)) {
@@ -48,7 +48,7 @@ void model_panel(PanelState& state, const PanelContext& ctx, PanelActions& actio
 
 void clips_panel(PanelState& state, const PanelContext& ctx, PanelActions& actions) {
   if (ctx.model == nullptr || !ImGui::CollapsingHeader("Clips", ImGuiTreeNodeFlags_DefaultOpen)) return;
-  const ImportedModel& model = *ctx.model;
+  const character::Model& model = *ctx.model;
   PosePlayer& player = *ctx.player;
   if (model.clips.empty()) {
     ImGui::TextUnformatted("no clips: rest pose");
@@ -162,7 +162,7 @@ void stats_panel(const PanelContext& ctx) {
 
 }  // namespace
 
-void PanelState::reset_for(const ImportedModel& model, std::span<const anim::JointLimit> stored_limits) {
+void PanelState::reset_for(const character::Model& model, std::span<const anim::JointLimit> stored_limits) {
   clip_a = model.clips.empty() ? -1 : 0;
   clip_b = -1;
   blend = 0.0f;

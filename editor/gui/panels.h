@@ -28,14 +28,14 @@ struct PanelState {
   anim::JointLimits limits;
   int joint = 0;
 
-  void reset_for(const ImportedModel& model, std::span<const anim::JointLimit> stored_limits);
+  void reset_for(const character::Model& model, std::span<const anim::JointLimit> stored_limits);
   std::string load_path_text() const { return load_path.data(); }
   std::string pack_path_text() const { return pack_path.data(); }
   std::string limits_path_text() const { return limits_path.data(); }
 };
 
 struct PanelContext {
-  const ImportedModel* model = nullptr;  // null: nothing loaded
+  const character::Model* model = nullptr;  // null: nothing loaded
   rt::FuzzyCharacterView fuzzy;
   PosePlayer* player = nullptr;
   Viewport* viewport = nullptr;

@@ -7,7 +7,7 @@
 
 namespace sinew::editor::gui {
 
-PosePlayer::PosePlayer(const ImportedModel& model) : model_(&model), mixer_(model.clips) {
+PosePlayer::PosePlayer(const character::Model& model) : model_(&model), mixer_(model.clips) {
   const std::size_t joints = model.skeleton.joint_count();
   local_.resize(joints);
   model_pose_.resize(joints);

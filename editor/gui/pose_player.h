@@ -11,7 +11,7 @@
 #include "animation/blend.h"
 #include "animation/clip.h"
 #include "animation/mixer.h"
-#include "editor/import/imported_model.h"
+#include "character/model.h"
 #include "runtime/core/status.h"
 #include "runtime/math/affine.h"
 
@@ -20,7 +20,7 @@ namespace sinew::editor::gui {
 class PosePlayer {
  public:
   // Starts on the model's first clip with tracks (rest pose without one).
-  explicit PosePlayer(const ImportedModel& model);
+  explicit PosePlayer(const character::Model& model);
 
   // clip_a/clip_b: clip indices, -1 for none. blend in [0, 1].
   Status set_cycles(int clip_a, int clip_b, float blend);
@@ -41,7 +41,7 @@ class PosePlayer {
  private:
   Status rebuild();
 
-  const ImportedModel* model_;
+  const character::Model* model_;
   anim::Mixer mixer_;
   int clip_a_ = -1;
   int clip_b_ = -1;

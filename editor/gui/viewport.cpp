@@ -3,20 +3,20 @@
 #include <algorithm>
 #include <cmath>
 
-#include "editor/cli/render_command.h"
+#include "character/framing.h"
 #include "runtime/jobs/job_system.h"
 #include "runtime/timing/phase_timers.h"
 
 namespace sinew::editor::gui {
 
-Status Viewport::reset(const ImportedModel& model, const rt::FuzzyCharacterView& fuzzy, bool reframe) {
+Status Viewport::reset(const character::Model& model, const rt::FuzzyCharacterView& fuzzy, bool reframe) {
   auto scene = std::make_unique<rt::Scene>();
   SINEW_ASSIGN_OR_RETURN(const std::uint32_t character, scene->add_character(model.mesh, fuzzy));
   SINEW_ASSIGN_OR_RETURN(instance_, scene->add_instance(character));
-  const Aabb rest = rest_bounds(model);
-  SINEW_ASSIGN_OR_RETURN(const std::uint32_t ground, scene->add_static_mesh(ground_plane_for(rest, 1)));
+  const Aabb rest = character::rest_bounds(model);
+  SINEW_ASSIGN_OR_RETURN(const std::uint32_t ground, scene->add_static_mesh(character::ground_plane_for(rest, 1)));
   (void)ground;
-  up_ = up_axis_of(rest);
+  up_ = character::up_axis_of(rest);
   scene_ = std::move(scene);
   model_ = &model;
   fuzzy_ = fuzzy;
@@ -39,9 +39,9 @@ Expected<ViewportFrame> Viewport::render(std::span<const Affine3> skinning, JobS
   SINEW_RETURN_IF_ERROR(scene_->set_bones(instance_, skinning));
   SINEW_ASSIGN_OR_RETURN(frame.scene, scene_->prepare_frame(frame_options, jobs, timers));
   if (reframe_) {
-    const Aabb posed = posed_bounds(*scene_);
-    camera_ = default_camera(posed, up_, width_, height_);
-    settings.light.position = default_light(posed, up_);
+    const Aabb posed = character::posed_bounds(*scene_);
+    camera_ = character::default_camera(posed, up_, width_, height_);
+    settings.light.position = character::default_light(posed, up_);
     reframe_ = false;
   }
   SINEW_ASSIGN_OR_RETURN(const rt::PinholeCamera camera, rt::PinholeCamera::create(camera_, width_, height_));

@@ -8,8 +8,8 @@
 #include <span>
 #include <vector>
 
+#include "character/model.h"
 #include "editor/gui/overlays.h"
-#include "editor/import/imported_model.h"
 #include "raytrace/render/renderer.h"
 #include "raytrace/scene/scene.h"
 #include "runtime/core/expected.h"
@@ -31,7 +31,7 @@ class Viewport {
  public:
   // (Re)builds the scene over `model` (mesh) and `fuzzy`; both must outlive
   // the viewport or the next reset. Keeps the camera unless `reframe`.
-  Status reset(const ImportedModel& model, const rt::FuzzyCharacterView& fuzzy, bool reframe);
+  Status reset(const character::Model& model, const rt::FuzzyCharacterView& fuzzy, bool reframe);
   void resize(int width, int height);
 
   // Poses the character, renders and draws the overlay into image().
@@ -62,7 +62,7 @@ class Viewport {
  private:
   void apply_overlay(std::span<const Affine3> skinning, ViewportFrame& frame);
 
-  const ImportedModel* model_ = nullptr;
+  const character::Model* model_ = nullptr;
   rt::FuzzyCharacterView fuzzy_;
   std::unique_ptr<rt::Scene> scene_;
   std::uint32_t instance_ = 0;

@@ -10,7 +10,7 @@
 
 #include <cal3d/cal3d.h>
 
-#include "editor/import/imported_model.h"
+#include "character/model.h"
 #include "runtime/core/expected.h"
 
 namespace sinew::editor::cal3d_detail {

@@ -2,9 +2,9 @@
 // the .cfg and the files it names (cal3d_files.h), each checked before Cal3D
 // loads it (cal3d_validate.h), then converted (cal3d_convert.h); Cal3D's
 // errors and exceptions become Statuses naming the file.
-#include "editor/import/cal3d_importer.h"
 #include "editor/import/cal3d_convert.h"
 #include "editor/import/cal3d_files.h"
+#include "editor/import/cal3d_importer.h"
 #include "editor/import/cal3d_validate.h"
 #include "runtime/io/regular_file.h"
 
@@ -93,7 +93,7 @@ class CoreModelTrackReleaser {
   CalCoreModel& core_;
 };
 
-Expected<ImportedModel> import_impl(const std::string& cfg_path, std::string& current) {
+Expected<character::Model> import_impl(const std::string& cfg_path, std::string& current) {
   SINEW_RETURN_IF_ERROR(check_file(cfg_path));
   std::ifstream in(cfg_path, std::ios::binary);
   if (!in) return make_error(ErrorCode::kIoError, cfg_path, "", "", "cannot open");
@@ -150,7 +150,7 @@ Expected<ImportedModel> import_impl(const std::string& cfg_path, std::string& cu
   // After loading everything, so meshes, skeleton and keyframes all scale.
   if (cfg.scale != 1.0f) core.scale(cfg.scale);
 
-  ImportedModel out;
+  character::Model out;
   out.source = cfg_path;
   std::vector<int> raw_to_sorted;
   SINEW_ASSIGN_OR_RETURN(out.skeleton,
@@ -192,13 +192,13 @@ Expected<ImportedModel> import_impl(const std::string& cfg_path, std::string& cu
                                                          out.skeleton, raw_to_sorted));
     out.clips.push_back(std::move(clip));
   }
-  SINEW_RETURN_IF_ERROR(normalize_skin_weights(out));
+  SINEW_RETURN_IF_ERROR(character::normalize_skin_weights(out));
   return out;
 }
 
 }  // namespace
 
-Expected<ImportedModel> import_cal3d(const std::string& cfg_path) {
+Expected<character::Model> import_cal3d(const std::string& cfg_path) {
   // Cal3D allocates with plain new and std::vector from counts in the file;
   // a corrupt count can throw. Errors are values here, so that ends as one.
   std::string current = cfg_path;

@@ -50,7 +50,7 @@
 #include <string_view>
 #include <vector>
 
-#include "editor/import/imported_model.h"
+#include "character/model.h"
 #include "runtime/core/expected.h"
 
 namespace sinew::editor {
@@ -82,6 +82,6 @@ Expected<Cal3dConfig> parse_cal3d_config(std::string_view text, std::string_view
 // kBadMagic / kUnsupportedVersion / kTruncated (what Cal3D reported, or what
 // the conversion found: bone ids out of range, non-finite values, vertices
 // without influences), plus the errors of Skeleton::build and Clip::build.
-Expected<ImportedModel> import_cal3d(const std::string& cfg_path);
+Expected<character::Model> import_cal3d(const std::string& cfg_path);
 
 }  // namespace sinew::editor

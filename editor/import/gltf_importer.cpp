@@ -2,13 +2,13 @@
 // the file is read within the limits and parsed by tinygltf; convert() then
 // runs the parts: node graph, skeleton plan and skeleton (gltf_skeleton.h),
 // materials (here), meshes (gltf_mesh.h) and clips (gltf_clips.h).
-#include "editor/import/gltf_importer.h"
 #include "editor/import/gltf_clips.h"
 #include "editor/import/gltf_container.h"
+#include "editor/import/gltf_importer.h"
 #include "editor/import/gltf_mesh.h"
 #include "editor/import/gltf_skeleton.h"
-#include "runtime/io/regular_file.h"
 #include "runtime/io/atomic_file.h"
+#include "runtime/io/regular_file.h"
 
 #include <tiny_gltf.h>
 
@@ -39,8 +39,8 @@ using gltf_detail::NodeGraph;
 using gltf_detail::plan_skeleton;
 using gltf_detail::SkeletonPlan;
 
-Expected<ImportedModel> convert(const Ctx& c) {
-  ImportedModel out;
+Expected<character::Model> convert(const Ctx& c) {
+  character::Model out;
   out.source = c.file;
   SINEW_ASSIGN_OR_RETURN(NodeGraph g, build_graph(c));
   SINEW_ASSIGN_OR_RETURN(SkeletonPlan plan, plan_skeleton(c, g));
@@ -115,7 +115,7 @@ Expected<ImportedModel> convert(const Ctx& c) {
   SINEW_ASSIGN_OR_RETURN(out.clips, build_clips(c, plan, out.skeleton, raw_to_sorted));
   // Weights that do not sum to 1 are renormalised here, with a warning when
   // they were off by more than rounding (the rule all importers share).
-  SINEW_RETURN_IF_ERROR(normalize_skin_weights(out));
+  SINEW_RETURN_IF_ERROR(character::normalize_skin_weights(out));
   return out;
 }
 
@@ -174,7 +174,7 @@ bool guarded_read(std::vector<unsigned char>* out, std::string* err, const std::
 
 }  // namespace
 
-Expected<ImportedModel> import_gltf(const std::string& path, const GltfImportOptions& options) {
+Expected<character::Model> import_gltf(const std::string& path, const GltfImportOptions& options) {
   const std::size_t max_bytes = options.limits.max_bytes;
   const auto too_big = [&](std::uintmax_t size) {
     return make_error(ErrorCode::kLimitExceeded, path, "size", std::to_string(size) + " bytes",

@@ -48,7 +48,7 @@
 #include <string>
 #include <vector>
 
-#include "editor/import/imported_model.h"
+#include "character/model.h"
 #include "runtime/core/expected.h"
 
 namespace sinew::editor {
@@ -76,6 +76,6 @@ struct GltfImportOptions {
   std::vector<std::string> asset_roots;  // more folders external files may come from
   ImportLimits limits;
 };
-Expected<ImportedModel> import_gltf(const std::string& path, const GltfImportOptions& options = {});
+Expected<character::Model> import_gltf(const std::string& path, const GltfImportOptions& options = {});
 
 }  // namespace sinew::editor

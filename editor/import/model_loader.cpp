@@ -4,8 +4,8 @@
 #include <cctype>
 #include <filesystem>
 
+#include "character/pack.h"
 #include "editor/import/gltf_importer.h"
-#include "editor/pack/character_pack.h"
 #if SINEW_HAVE_CAL3D
 #include "editor/import/cal3d_importer.h"
 #include "runtime/io/regular_file.h"
@@ -19,7 +19,7 @@ std::string lower_extension(const std::string& path) {
   return ext;
 }
 
-Expected<ImportedModel> load_model(const std::string& path, const GltfImportOptions& gltf) {
+Expected<character::Model> load_model(const std::string& path, const GltfImportOptions& gltf) {
   const std::string ext = lower_extension(path);
   const bool is_gltf = ext == ".gltf" || ext == ".glb";
   if (!is_gltf && ext != ".cfg" && ext != ".pack") {
@@ -29,7 +29,7 @@ Expected<ImportedModel> load_model(const std::string& path, const GltfImportOpti
   SINEW_RETURN_IF_ERROR(check_regular_file(path));
   if (is_gltf) return import_gltf(path, gltf);
   if (ext == ".pack") {
-    SINEW_ASSIGN_OR_RETURN(CharacterPack pack, CharacterPack::open(path));
+    SINEW_ASSIGN_OR_RETURN(character::Pack pack, character::Pack::open(path));
     return pack.model();
   }
 #if SINEW_HAVE_CAL3D

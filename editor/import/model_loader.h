@@ -5,8 +5,8 @@
 
 #include <string>
 
+#include "character/model.h"
 #include "editor/import/gltf_importer.h"
-#include "editor/import/imported_model.h"
 #include "runtime/core/expected.h"
 
 namespace sinew::editor {
@@ -14,7 +14,7 @@ namespace sinew::editor {
 // Errors: kNotFound (no such file), kInvalidArgument (unknown extension, or
 // Cal3D in a build without libcal3d), and the importer's or loader's own.
 // `gltf`: the glTF importer's options (the folders external files may come from).
-Expected<ImportedModel> load_model(const std::string& path, const GltfImportOptions& gltf = {});
+Expected<character::Model> load_model(const std::string& path, const GltfImportOptions& gltf = {});
 
 // The lower-case extension with its dot (".glb"), "" when there is none.
 std::string lower_extension(const std::string& path);

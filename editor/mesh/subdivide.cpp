@@ -39,7 +39,7 @@ MeshCounts counts_after(MeshCounts counts, int levels) {
   return counts;
 }
 
-Status size_error(const ImportedModel& model, const char* field, std::size_t size,
+Status size_error(const character::Model& model, const char* field, std::size_t size,
                   const std::string& expected) {
   return make_error(ErrorCode::kInvalidData, model.source, field, std::to_string(size),
                     "expected " + expected);
@@ -47,7 +47,7 @@ Status size_error(const ImportedModel& model, const char* field, std::size_t siz
 
 // The per-vertex and per-triangle arrays must line up, or the averages
 // below would read past their ends.
-Status check_array_sizes(const ImportedModel& model) {
+Status check_array_sizes(const character::Model& model) {
   const SkinnedMesh& mesh = model.mesh;
   const std::size_t vertices = mesh.vertex_count();
   const std::string per_vertex = std::to_string(vertices) + " entries, one per vertex";
@@ -72,7 +72,7 @@ Status check_array_sizes(const ImportedModel& model) {
   return {};
 }
 
-Status check_vertex_indices(const ImportedModel& model) {
+Status check_vertex_indices(const character::Model& model) {
   const SkinnedMesh& mesh = model.mesh;
   const std::size_t vertices = mesh.vertex_count();
   for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
@@ -311,7 +311,7 @@ std::uint64_t count_unique_edges(const std::vector<std::array<std::uint32_t, 3>>
   return edge_ids.size();
 }
 
-Status too_large(const ImportedModel& model, int levels, std::uint64_t count, const char* what) {
+Status too_large(const character::Model& model, int levels, std::uint64_t count, const char* what) {
   return make_error(ErrorCode::kLimitExceeded, model.source, "levels", std::to_string(levels),
                     "the result would have " + std::to_string(count) + " " + what +
                         ", more than 2^31");
@@ -319,7 +319,7 @@ Status too_large(const ImportedModel& model, int levels, std::uint64_t count, co
 
 }  // namespace
 
-Expected<ImportedModel> subdivide(const ImportedModel& model, int levels) {
+Expected<character::Model> subdivide(const character::Model& model, int levels) {
   if (levels < 0 || levels > kMaxSubdivisionLevels) {
     return invalid_argument("levels", std::to_string(levels),
                             "must be in [0, " + std::to_string(kMaxSubdivisionLevels) + "]");
@@ -342,7 +342,7 @@ Expected<ImportedModel> subdivide(const ImportedModel& model, int levels) {
   const MeshCounts output = counts_after(input, levels);
   if (output.vertices > kMaxElements) return too_large(model, levels, output.vertices, "vertices");
 
-  ImportedModel result = model;
+  character::Model result = model;
   result.source += " (subdivided " + std::to_string(levels) + ")";
   reserve_vertices(result.mesh, static_cast<std::size_t>(output.vertices));
   MeshCounts counts = input;

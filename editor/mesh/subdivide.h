@@ -21,7 +21,7 @@
 // v2, then the middle one, all with the winding of t and t's material.
 #pragma once
 
-#include "editor/import/imported_model.h"
+#include "character/model.h"
 #include "runtime/core/expected.h"
 
 namespace sinew::editor {
@@ -35,6 +35,6 @@ inline constexpr int kMaxSubdivisionLevels = 8;
 // kLimitExceeded when the result would exceed 2^31 triangles or vertices;
 // kInvalidData naming the triangle whose vertex index is out of range, or
 // the per-vertex or per-triangle array whose length is wrong.
-Expected<ImportedModel> subdivide(const ImportedModel& model, int levels);
+Expected<character::Model> subdivide(const character::Model& model, int levels);
 
 }  // namespace sinew::editor

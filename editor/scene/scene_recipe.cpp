@@ -88,8 +88,8 @@ Expected<SceneRecipe> load_scene_recipe(const std::string& path) {
   return parse_scene_recipe(text.str(), path);
 }
 
-Expected<ImportedModel> keep_recipe_clips(const ImportedModel& model, const SceneRecipe& recipe) {
-  ImportedModel kept;
+Expected<character::Model> keep_recipe_clips(const character::Model& model, const SceneRecipe& recipe) {
+  character::Model kept;
   kept.source = model.source;
   kept.skeleton = model.skeleton;
   kept.mesh = model.mesh;

@@ -17,7 +17,7 @@
 #include <string_view>
 #include <vector>
 
-#include "editor/import/imported_model.h"
+#include "character/model.h"
 #include "runtime/core/expected.h"
 
 namespace sinew::editor {
@@ -38,6 +38,6 @@ Expected<SceneRecipe> load_scene_recipe(const std::string& path);
 
 // `model` keeping only the recipe's clips, in the recipe's order.
 // kNotFound names a clip the model does not have, and lists the ones it has.
-Expected<ImportedModel> keep_recipe_clips(const ImportedModel& model, const SceneRecipe& recipe);
+Expected<character::Model> keep_recipe_clips(const character::Model& model, const SceneRecipe& recipe);
 
 }  // namespace sinew::editor

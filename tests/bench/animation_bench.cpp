@@ -25,7 +25,7 @@ using Clock = std::chrono::steady_clock;
 
 // Per-instance state on our side: what a game holds per character.
 struct OurInstance {
-  explicit OurInstance(const editor::ImportedModel& m)
+  explicit OurInstance(const character::Model& m)
       : mixer(m.clips),
         caches(m.clips.size()),
         local(m.skeleton.joint_count()),
@@ -50,7 +50,7 @@ struct Row {
   std::optional<double> cal_skin_mvps;
 };
 
-Row bench_ours(const std::string& name, const editor::ImportedModel& m, int instances, int frames,
+Row bench_ours(const std::string& name, const character::Model& m, int instances, int frames,
                int walk_clip) {
   std::vector<std::unique_ptr<OurInstance>> pool;
   for (int i = 0; i < instances; ++i) {
@@ -138,7 +138,7 @@ void bench_cal3d(const std::string& dir, int instances, int frames, Row& row) {
   testing_support::free_cal3d_animation_tracks(core);
 }
 
-int walk_index(const editor::ImportedModel& m) {
+int walk_index(const character::Model& m) {
   for (std::size_t i = 0; i < m.clips.size(); ++i) {
     if (m.clips[i].name() == "walk") return static_cast<int>(i);
   }

@@ -1,3 +1,4 @@
+#include "character/framing.h"
 #include "tests/bench/bake_bench.h"
 #include "tests/bench/bench_support.h"
 
@@ -19,10 +20,9 @@
 #include <string>
 #include <string_view>
 
+#include "character/bake.h"
 #include "content/mannequin/mannequin.h"
-#include "editor/bake/in_memory_bake.h"
 #include "editor/cli/cli_args.h"
-#include "editor/cli/render_command.h"
 #include "editor/import/cal3d_importer.h"
 #include "raytrace/camera/camera.h"
 #include "raytrace/fuzzy/fuzzy_bake.h"
@@ -153,7 +153,7 @@ std::optional<double> status_kib(std::string_view key) {
 // renders), every bake's times, and every render's trace times.
 struct ModeResult {
   rt::CandidateBones mode = rt::CandidateBones::kAll;
-  editor::InMemoryBake bake;
+  character::InMemoryBake bake;
   PhaseTimers bake_timers;   // "pose sampling", "sampling", "assignment", "build", "total"
   PhaseTimers trace_timers;  // "primary", "shadow", "trace"
   std::uint64_t primary_hits = 0;
@@ -167,12 +167,12 @@ double phase_median(const PhaseTimers& timers, std::string_view phase) {
   return 0.0;
 }
 
-Status bake_mode(const editor::ImportedModel& model, JobSystem& jobs, ModeResult& out) {
-  editor::BakeRequest request;
+Status bake_mode(const character::Model& model, JobSystem& jobs, ModeResult& out) {
+  character::BakeRequest request;
   request.fuzzy.candidates = out.mode;
   for (int i = 0; i < kBakeRepeats; ++i) {
     const Clock::time_point start = Clock::now();
-    SINEW_ASSIGN_OR_RETURN(editor::InMemoryBake bake, editor::bake_in_memory(model, request, jobs));
+    SINEW_ASSIGN_OR_RETURN(character::InMemoryBake bake, character::bake_in_memory(model, request, jobs));
     const double total = ms_since(start);
     const rt::FuzzyBakeStats& s = bake.fuzzy.stats;
     out.bake_timers.record("pose sampling", bake.pose_sampling_ms);
@@ -187,26 +187,26 @@ Status bake_mode(const editor::ImportedModel& model, JobSystem& jobs, ModeResult
 
 // Renders the walk clip's pose at kTraceFrameSeconds with the mode's bake,
 // framed and lit as `sinew render` and the raytrace bench do.
-Status trace_mode(const editor::ImportedModel& model, const anim::Clip& walk, JobSystem& jobs, ModeResult& out) {
-  const Aabb rest = editor::rest_bounds(model);
-  const int up = editor::up_axis_of(rest);
+Status trace_mode(const character::Model& model, const anim::Clip& walk, JobSystem& jobs, ModeResult& out) {
+  const Aabb rest = character::rest_bounds(model);
+  const int up = character::up_axis_of(rest);
   rt::Scene scene;
   SINEW_ASSIGN_OR_RETURN(const std::uint32_t character, scene.add_character(model.mesh, out.bake.fuzzy.view()));
   SINEW_ASSIGN_OR_RETURN(const std::uint32_t instance, scene.add_instance(character));
-  SINEW_RETURN_IF_ERROR(status_of(scene.add_static_mesh(editor::ground_plane_for(rest, 1))));
+  SINEW_RETURN_IF_ERROR(status_of(scene.add_static_mesh(character::ground_plane_for(rest, 1))));
   SINEW_ASSIGN_OR_RETURN(const std::vector<Affine3> bones,
-                         editor::clip_skinning(model, walk, kTraceFrameSeconds, editor::instance_placement(rest, 0)));
+                         character::clip_skinning(model, walk, kTraceFrameSeconds, character::instance_placement(rest, 0)));
   SINEW_RETURN_IF_ERROR(scene.set_bones(instance, bones));
   SINEW_ASSIGN_OR_RETURN(const rt::FrameStats prepared, scene.prepare_frame(rt::FrameOptions{}, jobs));
   out.escaped_triangles = prepared.escaped_triangles;
 
-  const Aabb posed = editor::posed_bounds(scene);
+  const Aabb posed = character::posed_bounds(scene);
   rt::RenderSettings settings;
   settings.shadows = true;
   settings.light.kind = rt::Light::Kind::kPoint;
-  settings.light.position = editor::default_light(posed, up);
+  settings.light.position = character::default_light(posed, up);
   SINEW_ASSIGN_OR_RETURN(const rt::PinholeCamera camera,
-                         rt::PinholeCamera::create(editor::default_camera(posed, up, kImageSide, kImageSide),
+                         rt::PinholeCamera::create(character::default_camera(posed, up, kImageSide, kImageSide),
                                                    kImageSide, kImageSide));
   std::vector<std::uint8_t> color(4 * static_cast<std::size_t>(kImageSide) * kImageSide);
   rt::FrameBuffers buffers;
@@ -231,7 +231,7 @@ struct ModelResult {
   std::vector<ModeResult> modes;
 };
 
-Expected<ModelResult> run_model(const std::string& name, editor::ImportedModel model, JobSystem& jobs) {
+Expected<ModelResult> run_model(const std::string& name, character::Model model, JobSystem& jobs) {
   SINEW_ASSIGN_OR_RETURN(const std::size_t walk, find_walk_clip(model, name));
   ModelResult result;
   result.name = name;

@@ -14,10 +14,10 @@
 
 #include <chrono>
 
+#include "character/bake.h"
+#include "character/framing.h"
 #include "content/mannequin/mannequin.h"
-#include "editor/bake/in_memory_bake.h"
 #include "editor/cli/cli_args.h"
-#include "editor/cli/render_command.h"
 #include "editor/import/cal3d_importer.h"
 #include "editor/import/model_loader.h"
 #include "raytrace/render/renderer.h"
@@ -172,33 +172,33 @@ inline Expected<std::vector<int>> parse_int_list(std::string_view flag, const st
 // "mannequin" (procedural) or "cally" (from SHARED/content/cal3d/cally).
 // Cally is optional content: a missing file is a note, not a failure, so a
 // benchmark still runs on a machine with only the procedural mannequin.
-inline Expected<std::optional<editor::ImportedModel>> load_model(const std::string& name, const std::string& shared,
+inline Expected<std::optional<character::Model>> load_model(const std::string& name, const std::string& shared,
                                                           std::string& note) {
   if (name == "mannequin") {
-    SINEW_ASSIGN_OR_RETURN(editor::ImportedModel model, content::make_mannequin());
-    return std::optional<editor::ImportedModel>(std::move(model));
+    SINEW_ASSIGN_OR_RETURN(character::Model model, content::make_mannequin());
+    return std::optional<character::Model>(std::move(model));
   }
   const std::string cfg = shared + "/content/cal3d/cally/cally.cfg";
   std::error_code ec;
   if (!std::filesystem::is_regular_file(cfg, ec)) {
     note = "cally skipped: " + cfg + " not found (pass --shared DIR)";
-    return std::optional<editor::ImportedModel>();
+    return std::optional<character::Model>();
   }
-  SINEW_ASSIGN_OR_RETURN(editor::ImportedModel model, editor::import_cal3d(cfg));
-  return std::optional<editor::ImportedModel>(std::move(model));
+  SINEW_ASSIGN_OR_RETURN(character::Model model, editor::import_cal3d(cfg));
+  return std::optional<character::Model>(std::move(model));
 }
 
 // "mannequin", "cally", or the path of any model the tools read (glTF,
 // Cal3D .cfg, or a .pack, whose model is used and baked in memory).
-inline Expected<std::optional<editor::ImportedModel>> load_model_or_path(const std::string& name,
+inline Expected<std::optional<character::Model>> load_model_or_path(const std::string& name,
                                                                  const std::string& shared, std::string& note) {
   if (name == "mannequin" || name == "cally") return load_model(name, shared, note);
-  SINEW_ASSIGN_OR_RETURN(editor::ImportedModel model, editor::load_model(name));
-  return std::optional<editor::ImportedModel>(std::move(model));
+  SINEW_ASSIGN_OR_RETURN(character::Model model, editor::load_model(name));
+  return std::optional<character::Model>(std::move(model));
 }
 
 // The index of the clip called `clip`.
-inline Expected<std::size_t> find_clip(const editor::ImportedModel& model, const std::string& name,
+inline Expected<std::size_t> find_clip(const character::Model& model, const std::string& name,
                                        const std::string& clip) {
   for (std::size_t i = 0; i < model.clips.size(); ++i) {
     if (model.clips[i].name() == clip) return i;
@@ -210,7 +210,7 @@ inline Expected<std::size_t> find_clip(const editor::ImportedModel& model, const
 }
 
 // The index of the clip named "walk".
-inline Expected<std::size_t> find_walk_clip(const editor::ImportedModel& model, const std::string& name) {
+inline Expected<std::size_t> find_walk_clip(const character::Model& model, const std::string& name) {
   return find_clip(model, name, "walk");
 }
 
@@ -225,29 +225,29 @@ struct BenchStage {
   int up = 1;
 };
 
-inline Status stage_instances(const editor::ImportedModel& model, const rt::FuzzyCharacterView& fuzzy,
+inline Status stage_instances(const character::Model& model, const rt::FuzzyCharacterView& fuzzy,
                               int instances, BenchStage& stage) {
-  stage.rest = editor::rest_bounds(model);
-  stage.up = editor::up_axis_of(stage.rest);
+  stage.rest = character::rest_bounds(model);
+  stage.up = character::up_axis_of(stage.rest);
   SINEW_ASSIGN_OR_RETURN(const std::uint32_t character, stage.scene.add_character(model.mesh, fuzzy));
   for (int i = 0; i < instances; ++i) {
     SINEW_ASSIGN_OR_RETURN(const std::uint32_t id, stage.scene.add_instance(character));
     stage.ids.push_back(id);
-    stage.placements.push_back(editor::instance_placement(stage.rest, i));
+    stage.placements.push_back(character::instance_placement(stage.rest, i));
   }
-  stage.ground = editor::ground_plane_for(stage.rest, instances);
+  stage.ground = character::ground_plane_for(stage.rest, instances);
   const auto ground = stage.scene.add_static_mesh(stage.ground);
   return ground.ok() ? Status{} : ground.status();
 }
 
 // Poses every instance of `stage` at `seconds` through `clip` (instance i
-// offset by instance_time_offset(i)); prepare_frame comes next.
-inline Status pose_instances(const editor::ImportedModel& model, const anim::Clip& clip, double seconds,
+// offset by character::instance_time_offset(i)); prepare_frame comes next.
+inline Status pose_instances(const character::Model& model, const anim::Clip& clip, double seconds,
                              BenchStage& stage) {
   for (std::size_t i = 0; i < stage.ids.size(); ++i) {
-    const double t = seconds + editor::instance_time_offset(static_cast<int>(i));
+    const double t = seconds + character::instance_time_offset(static_cast<int>(i));
     SINEW_ASSIGN_OR_RETURN(const std::vector<Affine3> bones,
-                           editor::clip_skinning(model, clip, t, stage.placements[i]));
+                           character::clip_skinning(model, clip, t, stage.placements[i]));
     SINEW_RETURN_IF_ERROR(stage.scene.set_bones(stage.ids[i], bones));
   }
   return {};

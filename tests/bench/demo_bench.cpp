@@ -5,7 +5,9 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "character/pack.h"
 #include "editor/cli/cli_args.h"
+#include "editor/import/model_loader.h"
 #include "game_demo/demo_session.h"
 #include "game_demo/world.h"
 #include "runtime/jobs/job_system.h"
@@ -104,7 +106,14 @@ Expected<CountResult> measure(const DemoBenchOptions& o, int characters, JobSyst
   so.width = o.width;
   so.height = o.height;
   so.shadows = o.shadows;
-  SINEW_ASSIGN_OR_RETURN(std::unique_ptr<demo::DemoSession> session, demo::DemoSession::create(so, jobs));
+  // The demo loads packs; the bench also takes a source model, imported here.
+  std::unique_ptr<demo::DemoSession> session;
+  if (o.model_path.empty() || character::is_pack_path(o.model_path)) {
+    SINEW_ASSIGN_OR_RETURN(session, demo::DemoSession::create(so, jobs));
+  } else {
+    SINEW_ASSIGN_OR_RETURN(character::Model model, editor::load_model(o.model_path));
+    SINEW_ASSIGN_OR_RETURN(session, demo::DemoSession::create(so, std::move(model), jobs));
+  }
   CountResult r;
   r.characters = characters;
   r.triangles = session->bake_info().triangles;

@@ -13,7 +13,8 @@
 #include <string>
 #include <vector>
 
-#include "editor/bake/in_memory_bake.h"
+#include "character/bake.h"
+#include "character/framing.h"
 #include "editor/cli/cli_args.h"
 #include "editor/mesh/subdivide.h"
 #include "raytrace/camera/camera.h"
@@ -320,7 +321,7 @@ const ContenderResult* best_embree_of_mode(const ConfigResult& r, EmbreeMode mod
 
 // The frame's fixed inputs shared by every contender.
 struct FrameContext {
-  const editor::ImportedModel* model = nullptr;
+  const character::Model* model = nullptr;
   BenchStage* stage = nullptr;
   rt::PinholeCamera camera;
   rt::RenderSettings settings;
@@ -413,7 +414,7 @@ std::vector<Contender> contenders(const Options& o) {
   return order;
 }
 
-Expected<ConfigResult> run_configuration(const editor::ImportedModel& model, const rt::FuzzyCharacterView& fuzzy,
+Expected<ConfigResult> run_configuration(const character::Model& model, const rt::FuzzyCharacterView& fuzzy,
                                          const Options& o, const std::string& clip_name, std::size_t clip,
                                          int threads) {
   JobSystem jobs(threads);
@@ -463,9 +464,9 @@ Expected<ConfigResult> run_configuration(const editor::ImportedModel& model, con
     const double skinning_ms = phase(prepare, "skinning");
     result.shared.record("skinning", skinning_ms);
     if (f == 0) {
-      const Aabb posed = editor::posed_bounds(stage.scene);
-      ctx.settings.light.position = editor::default_light(posed, stage.up);
-      SINEW_ASSIGN_OR_RETURN(ctx.camera, rt::PinholeCamera::create(editor::default_camera(posed, stage.up, o.width,
+      const Aabb posed = character::posed_bounds(stage.scene);
+      ctx.settings.light.position = character::default_light(posed, stage.up);
+      SINEW_ASSIGN_OR_RETURN(ctx.camera, rt::PinholeCamera::create(character::default_camera(posed, stage.up, o.width,
                                                                                           o.height),
                                                                    o.width, o.height));
       gate.emplace(stage.scene, ctx.camera, o.check_stride);
@@ -742,7 +743,7 @@ int run_embree_bench(const std::vector<std::string>& args, const std::string& co
     std::printf("\n%s\n", note.c_str());
     return 0;
   }
-  editor::ImportedModel loaded_model = std::move(**loaded);
+  character::Model loaded_model = std::move(**loaded);
   if (o.subdivide > 0) {
     auto finer = editor::subdivide(loaded_model, o.subdivide);
     if (!finer.ok()) {
@@ -751,11 +752,11 @@ int run_embree_bench(const std::vector<std::string>& args, const std::string& co
     }
     loaded_model = std::move(*finer);
   }
-  const editor::ImportedModel model = std::move(loaded_model);
-  editor::InMemoryBake bake;
+  const character::Model model = std::move(loaded_model);
+  character::InMemoryBake bake;
   {
     JobSystem jobs(*std::max_element(o.threads.begin(), o.threads.end()));
-    auto baked = editor::bake_in_memory(model, editor::BakeRequest{}, jobs);
+    auto baked = character::bake_in_memory(model, character::BakeRequest{}, jobs);
     if (!baked.ok()) {
       std::fprintf(stderr, "sinew-bench embree: %s\n", baked.status().message().c_str());
       return 1;

@@ -12,7 +12,7 @@
 #include <tuple>
 #include <vector>
 
-#include "editor/cli/render_command.h"
+#include "character/framing.h"
 #include "raytrace/render/renderer.h"
 #include "runtime/jobs/job_system.h"
 #include "tests/bench/embree_tracer.h"
@@ -36,9 +36,9 @@ TEST_P(EmbreeTracerTest, PrimaryHitsEqualBruteForceOverTwoFrames) {
   rt::Scene scene;
   const std::uint32_t character = scene.add_character(m.model.mesh, m.bake.fuzzy.view()).value();
   const std::uint32_t instance = scene.add_instance(character).value();
-  const Aabb rest = editor::rest_bounds(m.model);
-  const int up = editor::up_axis_of(rest);
-  ASSERT_TRUE(scene.add_static_mesh(editor::ground_plane_for(rest, 1)).ok());
+  const Aabb rest = character::rest_bounds(m.model);
+  const int up = character::up_axis_of(rest);
+  ASSERT_TRUE(scene.add_static_mesh(character::ground_plane_for(rest, 1)).ok());
 
   const auto [mode, width] = GetParam();
   auto tracer = EmbreeTracer::create(mode, 2);
@@ -52,9 +52,9 @@ TEST_P(EmbreeTracerTest, PrimaryHitsEqualBruteForceOverTwoFrames) {
     ASSERT_TRUE(scene.set_bones(instance, testing_support::clip_pose(m.model, "kick", t)).ok());
     ASSERT_TRUE(scene.prepare_frame(rt::FrameOptions{}, jobs).ok());
     if (!camera) {
-      const Aabb posed = editor::posed_bounds(scene);
-      settings.light.position = editor::default_light(posed, up);
-      camera = rt::PinholeCamera::create(editor::default_camera(posed, up, kSize, kSize), kSize, kSize).value();
+      const Aabb posed = character::posed_bounds(scene);
+      settings.light.position = character::default_light(posed, up);
+      camera = rt::PinholeCamera::create(character::default_camera(posed, up, kSize, kSize), kSize, kSize).value();
     }
     const auto built = (*tracer)->update(scene);
     ASSERT_TRUE(built.ok()) << built.status().message();

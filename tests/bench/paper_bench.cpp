@@ -34,10 +34,10 @@
 #include "animation/joint_limits.h"
 #include "animation/pose.h"
 #include "animation/pose_space.h"
+#include "character/bake.h"
+#include "character/framing.h"
 #include "content/mannequin/mannequin.h"
-#include "editor/bake/in_memory_bake.h"
 #include "editor/cli/cli_args.h"
-#include "editor/cli/render_command.h"
 #include "editor/mesh/subdivide.h"
 #include "raytrace/camera/camera.h"
 #include "raytrace/render/renderer.h"
@@ -221,11 +221,11 @@ Expected<FirstFrame> frame_and_gate(BenchStage& stage, const PoseFrame& pose, in
   SINEW_RETURN_IF_ERROR(pose(0, stage));
   SINEW_RETURN_IF_ERROR(status_of(stage.scene.prepare_frame(rt::FrameOptions{}, jobs)));
   FirstFrame first;
-  const Aabb posed = editor::posed_bounds(stage.scene);
+  const Aabb posed = character::posed_bounds(stage.scene);
   first.settings.light.kind = rt::Light::Kind::kPoint;
-  first.settings.light.position = editor::default_light(posed, stage.up);
+  first.settings.light.position = character::default_light(posed, stage.up);
   SINEW_ASSIGN_OR_RETURN(first.camera,
-                         rt::PinholeCamera::create(editor::default_camera(posed, stage.up, width, height), width,
+                         rt::PinholeCamera::create(character::default_camera(posed, stage.up, width, height), width,
                                                    height));
   const Clock::time_point start = Clock::now();
   const BruteForceGate gate(stage.scene, first.camera, stride);
@@ -296,26 +296,26 @@ struct Table2Row {
 };
 
 anim::PoseSpaceDesc table2_pose_space(const Options& o) {
-  anim::PoseSpaceDesc space = editor::default_pose_space();
+  anim::PoseSpaceDesc space = character::default_pose_space();
   if (o.samples > 0) space.samples = o.samples;
   return space;
 }
 
-Expected<Table2Row> measure_level(const editor::ImportedModel& cally, std::size_t walk, int level, const Options& o) {
+Expected<Table2Row> measure_level(const character::Model& cally, std::size_t walk, int level, const Options& o) {
   const Clock::time_point level_start = Clock::now();
-  SINEW_ASSIGN_OR_RETURN(const editor::ImportedModel model, editor::subdivide(cally, level));
+  SINEW_ASSIGN_OR_RETURN(const character::Model model, editor::subdivide(cally, level));
   Table2Row row;
   row.level = level;
   row.triangles = model.mesh.triangle_count();
   const int bake_threads = *std::max_element(o.threads.begin(), o.threads.end());
   std::fprintf(stderr, "paper: table 2 level %d (%zu triangles): baking on %d thread%s...\n", level, row.triangles,
                bake_threads, bake_threads == 1 ? "" : "s");
-  editor::InMemoryBake bake;
+  character::InMemoryBake bake;
   {
     JobSystem jobs(bake_threads);
-    editor::BakeRequest request;
+    character::BakeRequest request;
     request.pose_space = table2_pose_space(o);
-    SINEW_ASSIGN_OR_RETURN(bake, editor::bake_in_memory(model, request, jobs));
+    SINEW_ASSIGN_OR_RETURN(bake, character::bake_in_memory(model, request, jobs));
   }
   const rt::FuzzyBakeStats& b = bake.fuzzy.stats;
   row.samples = b.sample_count;
@@ -542,7 +542,7 @@ struct LimitsCheck {
 
 constexpr float kLimitsTolerance = 1e-3f;
 
-Expected<std::pair<std::size_t, std::size_t>> count_violations(const editor::ImportedModel& model,
+Expected<std::pair<std::size_t, std::size_t>> count_violations(const character::Model& model,
                                                                const anim::JointLimits& limits, bool every_frame,
                                                                std::vector<std::size_t>* per_joint) {
   anim::PoseSpaceDesc space;
@@ -565,7 +565,7 @@ Expected<std::pair<std::size_t, std::size_t>> count_violations(const editor::Imp
   return std::pair{poses, violations};
 }
 
-Expected<LimitsCheck> check_limits(const editor::ImportedModel& model, const anim::JointLimits& limits) {
+Expected<LimitsCheck> check_limits(const character::Model& model, const anim::JointLimits& limits) {
   LimitsCheck check;
   std::vector<std::size_t> per_joint(model.skeleton.joint_count(), 0);
   SINEW_ASSIGN_OR_RETURN(const auto keys, count_violations(model, limits, false, &per_joint));
@@ -582,7 +582,7 @@ Expected<LimitsCheck> check_limits(const editor::ImportedModel& model, const ani
 
 // Per joint, the XYZ Euler angles (degrees) of its rotation relative to rest
 // over every clip key pose: the data Cally's limits were written from.
-Status print_clip_ranges(const editor::ImportedModel& model) {
+Status print_clip_ranges(const character::Model& model) {
   const anim::Skeleton& sk = model.skeleton;
   const std::size_t n = sk.joint_count();
   std::vector<Vec3> lo(n, Vec3(1e9f)), hi(n, Vec3(-1e9f));
@@ -624,17 +624,7 @@ anim::PoseSpaceDesc table1_pose_space(const PaperTable1Row& paper, const std::st
   return space;
 }
 
-Expected<std::vector<Affine3>> rest_skinning(const editor::ImportedModel& model, const Affine3& placement) {
-  const anim::Skeleton& sk = model.skeleton;
-  std::vector<anim::JointTransform> local(sk.joint_count());
-  std::vector<Affine3> world(sk.joint_count()), skin(sk.joint_count());
-  SINEW_RETURN_IF_ERROR(anim::rest_pose(sk, local));
-  SINEW_RETURN_IF_ERROR(anim::local_to_model(sk, local, world));
-  SINEW_RETURN_IF_ERROR(anim::skinning_matrices(sk, world, placement, skin));
-  return skin;
-}
-
-Expected<Table1Row> measure_mode(const editor::ImportedModel& model, const std::string& name,
+Expected<Table1Row> measure_mode(const character::Model& model, const std::string& name,
                                  const PaperTable1Row& paper, const anim::JointLimits& limits,
                                  const std::string& walk, const Options& o) {
   Table1Row row;
@@ -643,13 +633,13 @@ Expected<Table1Row> measure_mode(const editor::ImportedModel& model, const std::
   const int bake_threads = *std::max_element(o.threads.begin(), o.threads.end());
   std::fprintf(stderr, "paper: table 1 %s, pose space %s (%d samples): baking...\n", name.c_str(), paper.mode,
                paper.samples);
-  editor::InMemoryBake bake;
+  character::InMemoryBake bake;
   {
     JobSystem jobs(bake_threads);
-    editor::BakeRequest request;
+    character::BakeRequest request;
     request.pose_space = table1_pose_space(paper, walk);
     if (request.pose_space.mode == anim::PoseSpaceMode::kLimits) request.limits = limits;
-    SINEW_ASSIGN_OR_RETURN(bake, editor::bake_in_memory(model, request, jobs));
+    SINEW_ASSIGN_OR_RETURN(bake, character::bake_in_memory(model, request, jobs));
   }
   const rt::FuzzyBakeStats& b = bake.fuzzy.stats;
   row.samples = b.sample_count;
@@ -659,7 +649,7 @@ Expected<Table1Row> measure_mode(const editor::ImportedModel& model, const std::
 
   BenchStage stage;
   SINEW_RETURN_IF_ERROR(stage_instances(model, bake.fuzzy.view(), 1, stage));
-  SINEW_ASSIGN_OR_RETURN(const std::vector<Affine3> rest, rest_skinning(model, stage.placements[0]));
+  SINEW_ASSIGN_OR_RETURN(const std::vector<Affine3> rest, character::rest_skinning(model, stage.placements[0]));
   const PoseFrame pose = [&](int, BenchStage& s) { return s.scene.set_bones(s.ids[0], rest); };
   SINEW_ASSIGN_OR_RETURN(const FirstFrame first,
                          frame_and_gate(stage, pose, o.width, o.height, o.check_stride, bake_threads));
@@ -766,7 +756,7 @@ std::string method_threads(const Options& o) {
   return join_ints(o.threads) + " render thread" + (o.threads.size() == 1 && o.threads[0] == 1 ? "" : "s");
 }
 
-void run_table2(const editor::ImportedModel& cally, Run& run) {
+void run_table2(const character::Model& cally, Run& run) {
   const Options& o = *run.o;
   const auto walk = find_walk_clip(cally, "cally");
   if (!walk.ok()) return run.fail("table 2", walk.status());
@@ -796,7 +786,7 @@ void run_table2(const editor::ImportedModel& cally, Run& run) {
   const int bake_threads = *std::max_element(o.threads.begin(), o.threads.end());
   const std::string pose_space =
       o.samples > 0 ? "all clips, key times + 30 Hz, at most " + std::to_string(o.samples) + " poses"
-                    : "all clips, key times + 30 Hz (editor::default_pose_space)";
+                    : "all clips, key times + 30 Hz (character::default_pose_space)";
   std::string md = "## Paper Table 2: performance vs mesh size (Cally, subdivided)\n\n";
   md += "Method: Cally (Cal3D, " + std::to_string(cally.mesh.triangle_count()) +
         " triangles) subdivided by editor::subdivide at levels " + join_ints(o.levels) +
@@ -838,7 +828,7 @@ void run_table2(const editor::ImportedModel& cally, Run& run) {
   run.doc["table2"] = std::move(table);
 }
 
-Expected<anim::JointLimits> limits_for(const std::string& name, const editor::ImportedModel& model,
+Expected<anim::JointLimits> limits_for(const std::string& name, const character::Model& model,
                                        const Options& o, std::string& source) {
   if (name == "mannequin") {
     source = "content::mannequin_joint_limits";
@@ -848,7 +838,7 @@ Expected<anim::JointLimits> limits_for(const std::string& name, const editor::Im
   return anim::load_joint_limits(o.cally_limits, model.skeleton);
 }
 
-void run_table1(std::optional<editor::ImportedModel>& cally, Run& run) {
+void run_table1(std::optional<character::Model>& cally, Run& run) {
   const Options& o = *run.o;
   std::string md = "## Paper Table 1: pose space vs fuzzy area and rest-pose fps\n\n";
   md += "Method: for each model, four in-memory bakes with the paper's pose spaces and sample counts: arbitrary "
@@ -868,7 +858,7 @@ void run_table1(std::optional<editor::ImportedModel>& cally, Run& run) {
   Json models = Json::array();
   std::string walk_name = "walk";
   for (const std::string name : {"cally", "mannequin"}) {
-    std::optional<editor::ImportedModel> loaded;
+    std::optional<character::Model> loaded;
     if (name == "cally") {
       if (!cally) continue;
       loaded = *cally;
@@ -881,7 +871,7 @@ void run_table1(std::optional<editor::ImportedModel>& cally, Run& run) {
       }
       loaded = std::move(**m);
     }
-    const editor::ImportedModel& model = *loaded;
+    const character::Model& model = *loaded;
     Table1Model result;
     result.name = name;
     result.triangles = model.mesh.triangle_count();
@@ -954,7 +944,7 @@ int run_paper_bench(const std::vector<std::string>& args, const std::string& com
     std::fprintf(stderr, "sinew-bench paper: cally: %s\n", loaded.status().message().c_str());
     return 1;
   }
-  std::optional<editor::ImportedModel> cally = std::move(*loaded);
+  std::optional<character::Model> cally = std::move(*loaded);
   if (o.clip_ranges) {
     if (!cally) {
       std::fprintf(stderr, "sinew-bench paper: %s\n", note.c_str());

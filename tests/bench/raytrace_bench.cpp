@@ -1,6 +1,7 @@
-#include "tests/bench/raytrace_bench.h"
+#include "character/framing.h"
 #include "tests/bench/bench_support.h"
 #include "tests/bench/brute_force_gate.h"
+#include "tests/bench/raytrace_bench.h"
 
 #include <algorithm>
 #include <chrono>
@@ -15,10 +16,9 @@
 #include <string>
 #include <string_view>
 
+#include "character/bake.h"
 #include "content/mannequin/mannequin.h"
-#include "editor/bake/in_memory_bake.h"
 #include "editor/cli/cli_args.h"
-#include "editor/cli/render_command.h"
 #include "editor/import/cal3d_importer.h"
 #include "raytrace/camera/camera.h"
 #include "raytrace/render/renderer.h"
@@ -127,9 +127,9 @@ void print_usage(std::FILE* to) {
 
 struct BenchModel {
   std::string name;
-  editor::ImportedModel model;
+  character::Model model;
   std::size_t walk_clip = 0;
-  editor::InMemoryBake bake;
+  character::InMemoryBake bake;
   int bake_threads = 0;
 };
 
@@ -198,10 +198,10 @@ Status compare_with_exact(const rt::Scene& fuzzy_scene, const SkinnedMesh& mesh,
 
 Expected<RunResult> run_configuration(const BenchModel& m, const BenchOptions& o, int instances, int threads) {
   JobSystem jobs(threads);
-  const editor::ImportedModel& model = m.model;
+  const character::Model& model = m.model;
   const anim::Clip& walk = model.clips[m.walk_clip];
-  const Aabb rest = editor::rest_bounds(model);
-  const int up = editor::up_axis_of(rest);
+  const Aabb rest = character::rest_bounds(model);
+  const int up = character::up_axis_of(rest);
 
   rt::Scene scene;
   SINEW_ASSIGN_OR_RETURN(const std::uint32_t character, scene.add_character(model.mesh, m.bake.fuzzy.view()));
@@ -210,9 +210,9 @@ Expected<RunResult> run_configuration(const BenchModel& m, const BenchOptions& o
   for (int i = 0; i < instances; ++i) {
     SINEW_ASSIGN_OR_RETURN(const std::uint32_t id, scene.add_instance(character));
     ids.push_back(id);
-    placements.push_back(editor::instance_placement(rest, i));
+    placements.push_back(character::instance_placement(rest, i));
   }
-  const rt::StaticMeshDesc ground = editor::ground_plane_for(rest, instances);
+  const rt::StaticMeshDesc ground = character::ground_plane_for(rest, instances);
   SINEW_RETURN_IF_ERROR(status_of(scene.add_static_mesh(ground)));
 
   rt::FrameOptions frame_options;
@@ -243,8 +243,8 @@ Expected<RunResult> run_configuration(const BenchModel& m, const BenchOptions& o
     {
       ScopedPhase animation(frame, "animation");
       for (std::size_t i = 0; i < ids.size(); ++i) {
-        const double t = seconds + editor::instance_time_offset(static_cast<int>(i));
-        SINEW_ASSIGN_OR_RETURN(const std::vector<Affine3> bones, editor::clip_skinning(model, walk, t, placements[i]));
+        const double t = seconds + character::instance_time_offset(static_cast<int>(i));
+        SINEW_ASSIGN_OR_RETURN(const std::vector<Affine3> bones, character::clip_skinning(model, walk, t, placements[i]));
         SINEW_RETURN_IF_ERROR(scene.set_bones(ids[i], bones));
       }
     }
@@ -252,10 +252,10 @@ Expected<RunResult> run_configuration(const BenchModel& m, const BenchOptions& o
     if (!camera) {
       // Framed on the first frame's pose, as the render command does, so
       // every frame and every configuration of this size shares the view.
-      const Aabb posed = editor::posed_bounds(scene);
-      settings.light.position = editor::default_light(posed, up);
+      const Aabb posed = character::posed_bounds(scene);
+      settings.light.position = character::default_light(posed, up);
       SINEW_ASSIGN_OR_RETURN(camera,
-                             rt::PinholeCamera::create(editor::default_camera(posed, up, o.width, o.height), o.width, o.height));
+                             rt::PinholeCamera::create(character::default_camera(posed, up, o.width, o.height), o.width, o.height));
     }
     SINEW_ASSIGN_OR_RETURN(const rt::RenderStats rendered,
                            renderer.render(scene, *camera, settings, buffers, jobs, &frame));
@@ -380,7 +380,7 @@ int run_raytrace_bench(const std::vector<std::string>& args, const std::string& 
   std::printf("  %dx%d, %d frames at 30 fps through the walk clip (instance i %.2f s later), point light,\n"
               "  shadows on, diffuse shading, triangle test %s, bone boxes %s, fallback on; each\n"
               "  configuration's first frame is checked against brute force (every 7th pixel)\n",
-              o.width, o.height, o.frames, editor::instance_time_offset(1), triangle_test_name(o.triangle_test),
+              o.width, o.height, o.frames, character::instance_time_offset(1), triangle_test_name(o.triangle_test),
               bone_boxes_name(o.bone_boxes));
   std::fflush(stdout);
 
@@ -428,7 +428,7 @@ int run_raytrace_bench(const std::vector<std::string>& args, const std::string& 
     m.walk_clip = *walk;
     {
       JobSystem jobs(bake_threads);
-      auto bake = editor::bake_in_memory(m.model, editor::BakeRequest{}, jobs);
+      auto bake = character::bake_in_memory(m.model, character::BakeRequest{}, jobs);
       if (!bake.ok()) {
         fail(bake.status());
         continue;

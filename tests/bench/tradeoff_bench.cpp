@@ -21,11 +21,11 @@
 
 #include "animation/joint_limits.h"
 #include "animation/pose_space.h"
+#include "character/bake.h"
+#include "character/framing.h"
+#include "character/pack.h"
 #include "content/mannequin/mannequin.h"
-#include "editor/bake/in_memory_bake.h"
 #include "editor/cli/cli_args.h"
-#include "editor/cli/render_command.h"
-#include "editor/pack/character_pack.h"
 #include "raytrace/camera/camera.h"
 #include "raytrace/render/renderer.h"
 #include "raytrace/scene/scene.h"
@@ -169,7 +169,7 @@ void print_usage(std::FILE* to) {
 
 struct BenchModel {
   std::string name;
-  editor::ImportedModel model;
+  character::Model model;
   std::size_t walk_clip = 0;
   int up = 1;
 };
@@ -197,7 +197,7 @@ struct ModeSpec {
 };
 
 // The distinct clip times kClips/kClip would visit with 30 Hz sampling.
-int clip_space_size(const editor::ImportedModel& model, const ModeSpec& spec) {
+int clip_space_size(const character::Model& model, const ModeSpec& spec) {
   std::size_t n = 0;
   for (const anim::Clip& clip : model.clips) {
     if (spec.mode == anim::PoseSpaceMode::kClip && clip.name() != spec.clips.front()) continue;
@@ -231,7 +231,7 @@ Expected<std::vector<std::vector<Affine3>>> held_out_poses(const BenchModel& m, 
     desc.mode = spec.mode;
     desc.samples = count;
     desc.seed = kHeldOutSeed;
-    SINEW_ASSIGN_OR_RETURN(const std::vector<Affine3> all, editor::pose_space_skinning(m.model, desc, spec.limits));
+    SINEW_ASSIGN_OR_RETURN(const std::vector<Affine3> all, character::pose_space_skinning(m.model, desc, spec.limits));
     for (std::size_t p = 0; p + joints <= all.size(); p += joints) {
       poses.emplace_back(all.begin() + static_cast<std::ptrdiff_t>(p),
                          all.begin() + static_cast<std::ptrdiff_t>(p + joints));
@@ -248,7 +248,7 @@ Expected<std::vector<std::vector<Affine3>>> held_out_poses(const BenchModel& m, 
   for (int i = 0; i < count; ++i) {
     const anim::Clip& clip = *clips[static_cast<std::size_t>(random() % clips.size())];
     const double t = anim::unit_double(random()) * static_cast<double>(clip.duration());
-    SINEW_ASSIGN_OR_RETURN(std::vector<Affine3> bones, editor::clip_skinning(m.model, clip, t));
+    SINEW_ASSIGN_OR_RETURN(std::vector<Affine3> bones, character::clip_skinning(m.model, clip, t));
     poses.push_back(std::move(bones));
   }
   return poses;
@@ -312,10 +312,10 @@ Expected<WalkResult> measure_walk(const BenchModel& m, const rt::FuzzyCharacterV
     SINEW_RETURN_IF_ERROR(status_of(stage.scene.prepare_frame(frame_options, jobs, &timers)));
     const double prepare_ms = ms_since(prepare_start);
     if (!shared.camera) {
-      const Aabb posed = editor::posed_bounds(stage.scene);
-      shared.light = editor::default_light(posed, stage.up);
+      const Aabb posed = character::posed_bounds(stage.scene);
+      shared.light = character::default_light(posed, stage.up);
       SINEW_ASSIGN_OR_RETURN(shared.camera, rt::PinholeCamera::create(
-                                                editor::default_camera(posed, stage.up, o.width, o.height),
+                                                character::default_camera(posed, stage.up, o.width, o.height),
                                                 o.width, o.height));
     }
     settings.light.position = shared.light;
@@ -387,9 +387,9 @@ Expected<HeldOutResult> measure_held_out(const BenchModel& m, const rt::FuzzyCha
     double off_ms = ms_since(off_start);
     if (!state.references[i]) {  // the skinned triangles are the same for every bake
       const Clock::time_point ref_start = Clock::now();
-      const Aabb posed = editor::posed_bounds(scene);
+      const Aabb posed = character::posed_bounds(scene);
       SINEW_ASSIGN_OR_RETURN(state.cameras[i],
-                             rt::PinholeCamera::create(editor::default_camera(posed, m.up, o.hole_width, o.hole_height),
+                             rt::PinholeCamera::create(character::default_camera(posed, m.up, o.hole_width, o.hole_height),
                                                        o.hole_width, o.hole_height));
       state.references[i] = std::make_unique<BruteForceGate>(scene, *state.cameras[i], 1);
       state.reference_ms += ms_since(ref_start);
@@ -438,16 +438,16 @@ struct SweepRow {
   HeldOutResult held_out;
 };
 
-Expected<std::size_t> pack_size(const BenchModel& m, const ModeSpec& spec, const editor::BakeRequest& request,
-                                const editor::InMemoryBake& bake) {
-  editor::CharacterPackContents contents;
+Expected<std::size_t> pack_size(const BenchModel& m, const ModeSpec& spec, const character::BakeRequest& request,
+                                const character::InMemoryBake& bake) {
+  character::PackContents contents;
   contents.model = &m.model;
   contents.limits = spec.limits;
   contents.fuzzy = &bake.fuzzy;
   contents.pose_space.desc = request.pose_space;
   contents.pose_space.padding = request.fuzzy.padding;
   contents.provenance.source_name = m.name;
-  SINEW_ASSIGN_OR_RETURN(const std::vector<std::byte> bytes, editor::serialize_character_pack(contents));
+  SINEW_ASSIGN_OR_RETURN(const std::vector<std::byte> bytes, character::serialize_pack(contents));
   return bytes.size();
 }
 
@@ -457,12 +457,12 @@ Expected<SweepRow> run_configuration(const BenchModel& m, const Options& o, Mode
   row.mode = state.spec.name;
   row.samples = samples;
   row.padding = padding;
-  editor::BakeRequest request;
+  character::BakeRequest request;
   request.pose_space = bake_space(state.spec, samples);
   request.limits = state.spec.limits;
   request.fuzzy.padding = static_cast<float>(padding);
   const Clock::time_point bake_start = Clock::now();
-  SINEW_ASSIGN_OR_RETURN(const editor::InMemoryBake bake, editor::bake_in_memory(m.model, request, jobs));
+  SINEW_ASSIGN_OR_RETURN(const character::InMemoryBake bake, character::bake_in_memory(m.model, request, jobs));
   row.bake_ms = ms_since(bake_start);
   const rt::FuzzyBakeStats& stats = bake.fuzzy.stats;
   row.samples_used = static_cast<int>(stats.sample_count);
@@ -594,7 +594,7 @@ std::string markdown(const Report& rep) {
   line("Model " + rep.model + " (" + std::to_string(rep.triangles) + " triangles). For every mode, sample count and "
        "padding the character is baked in memory (`bake ms`: `bake_in_memory` wall time on " +
        std::to_string(o.threads) + " threads, pose sampling included); `pack bytes` is the exact size of the character "
-       "pack the editor would write (`serialize_character_pack`); `area` is the fuzzy box area over the rest-pose "
+       "pack the editor would write (`character::serialize_pack`); `area` is the fuzzy box area over the rest-pose "
        "box area; `fps` is 1000 / the median of prepare_frame + render over " + std::to_string(o.frames) +
        " frames of the walk at 30 Hz, " + std::to_string(o.width) + "x" + std::to_string(o.height) +
        ", fallback on, shadows on, point light, fast triangle test; `tests/ray` is the triangle tests per traced "
@@ -882,7 +882,7 @@ int run_tradeoff_bench(const std::vector<std::string>& args, const std::string& 
     return 1;
   }
   m.walk_clip = *walk;
-  m.up = editor::up_axis_of(editor::rest_bounds(m.model));
+  m.up = character::up_axis_of(character::rest_bounds(m.model));
   rep.model = m.name;
   rep.triangles = m.model.mesh.triangle_count();
   std::printf("  model %s: %zu triangles, %zu bones; walk at %dx%d (%d frames), holes at %dx%d on %d held-out poses\n",
@@ -986,7 +986,7 @@ int run_tradeoff_bench(const std::vector<std::string>& args, const std::string& 
 
   // --- side studies on the default bake ---
   std::fprintf(stderr, "  [%.0f s] side studies\n", ms_since(run_start) / 1000.0);
-  auto bake = editor::bake_in_memory(m.model, editor::BakeRequest{}, jobs);
+  auto bake = character::bake_in_memory(m.model, character::BakeRequest{}, jobs);
   if (!bake.ok()) {
     std::fprintf(stderr, "sinew-bench tradeoff: default bake: %s\n", bake.status().message().c_str());
     return 1;

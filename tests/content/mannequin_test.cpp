@@ -16,8 +16,8 @@
 namespace sinew::content {
 namespace {
 
-const editor::ImportedModel& model() {
-  static const editor::ImportedModel m = *make_mannequin();
+const character::Model& model() {
+  static const character::Model m = *make_mannequin();
   return m;
 }
 

@@ -142,7 +142,7 @@ struct OracleErrors {
 
 // Poses both sides with one clip as a weight-1 cycle (no fade: delay 0) at
 // 2 * sample_count times and compares every bone and every skinned vertex.
-void run_oracle(const std::string& model, const ImportedModel& ours, CalSide& side,
+void run_oracle(const std::string& model, const character::Model& ours, CalSide& side,
                 const std::string& clip_name, int sample_count, OracleErrors& err) {
   const anim::Clip* clip = ours.find_clip(clip_name);
   ASSERT_NE(clip, nullptr) << clip_name;

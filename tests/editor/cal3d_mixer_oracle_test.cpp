@@ -42,7 +42,7 @@ struct Errors {
   int samples = 0;
 };
 
-int clip_index(const ImportedModel& model, const std::string& name) {
+int clip_index(const character::Model& model, const std::string& name) {
   for (std::size_t i = 0; i < model.clips.size(); ++i) {
     if (model.clips[i].name() == name) return static_cast<int>(i);
   }

@@ -57,7 +57,7 @@ float model_size(const SkinnedMesh& m) {
 }
 
 // Our pipeline: clip (or rest pose when clip is null) -> skinned positions.
-std::vector<Vec3> pose_and_skin(const ImportedModel& m, const anim::Clip* clip, float t) {
+std::vector<Vec3> pose_and_skin(const character::Model& m, const anim::Clip* clip, float t) {
   const std::size_t n = m.skeleton.joint_count();
   std::vector<anim::JointTransform> local(n);
   EXPECT_TRUE(anim::rest_pose(m.skeleton, local).ok());

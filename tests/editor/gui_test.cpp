@@ -10,11 +10,11 @@
 #include <sstream>
 #include <thread>
 
+#include "character/bake.h"
+#include "character/framing.h"
+#include "character/pack.h"
 #include "content/mannequin/mannequin.h"
-#include "editor/bake/in_memory_bake.h"
-#include "editor/cli/render_command.h"
 #include "editor/gui/editor_app.h"
-#include "editor/pack/character_pack.h"
 #include "raytrace/render/renderer.h"
 #include "raytrace/scene/scene.h"
 #include "runtime/display/window.h"
@@ -113,7 +113,7 @@ TEST_F(EditorGuiTest, WindowShowsTheCharacterExactlyAsAHeadlessRender) {
   ASSERT_TRUE(character.ok());
   auto instance = scene.add_instance(*character);
   ASSERT_TRUE(instance.ok());
-  ASSERT_TRUE(scene.add_static_mesh(ground_plane_for(*app_->model())).ok());
+  ASSERT_TRUE(scene.add_static_mesh(character::ground_plane_for(*app_->model())).ok());
   ASSERT_TRUE(scene.set_bones(*instance, app_->skinning()).ok());
   JobSystem jobs(2);
   ASSERT_TRUE(scene.prepare_frame(rt::FrameOptions{}, jobs).ok());
@@ -274,10 +274,10 @@ TEST(EditorOverlayTest, LeafHeatIsTheLargestLeafOfEachTriangle) {
   auto mannequin = content::make_mannequin();
   ASSERT_TRUE(mannequin.ok());
   JobSystem jobs(2);
-  BakeRequest request;
+  character::BakeRequest request;
   request.pose_space.mode = anim::PoseSpaceMode::kClip;
   request.pose_space.clips = {"walk"};
-  auto baked = bake_in_memory(*mannequin, request, jobs);
+  auto baked = character::bake_in_memory(*mannequin, request, jobs);
   ASSERT_TRUE(baked.ok());
   const rt::FuzzyCharacterView view = baked->fuzzy.view();
   const std::size_t triangles = mannequin->mesh.triangle_count();
@@ -335,19 +335,19 @@ TEST(EditorGuiCommandTest, WritesAScreenshotOfAPack) {
   auto mannequin = content::make_mannequin();
   ASSERT_TRUE(mannequin.ok());
   JobSystem jobs(2);
-  BakeRequest request;
+  character::BakeRequest request;
   request.pose_space.mode = anim::PoseSpaceMode::kClips;
   request.pose_space.samples = 20;
   request.pose_space.every_frame_30hz = false;
-  auto baked = bake_in_memory(*mannequin, request, jobs);
+  auto baked = character::bake_in_memory(*mannequin, request, jobs);
   ASSERT_TRUE(baked.ok()) << baked.status().message();
   const auto dir = std::filesystem::temp_directory_path() / "sinew_editor_gui_test";
   std::filesystem::create_directories(dir);
   const std::string pack = (dir / "mannequin.pack").string();
-  CharacterPackContents contents;
+  character::PackContents contents;
   contents.model = &*mannequin;
   contents.fuzzy = &baked->fuzzy;
-  ASSERT_TRUE(write_character_pack(pack, contents).ok());
+  ASSERT_TRUE(character::write_pack(pack, contents).ok());
   const std::string png = (dir / "shot.png").string();
   std::filesystem::remove(png);
   std::ostringstream out, err;

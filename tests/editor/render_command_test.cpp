@@ -16,7 +16,8 @@
 #include <string>
 #include <vector>
 
-#include "editor/bake/in_memory_bake.h"
+#include "character/bake.h"
+#include "character/framing.h"
 #include "editor/cli/cli_args.h"
 #include "editor/cli/render_command.h"
 #include "editor/import/gltf_importer.h"
@@ -156,7 +157,7 @@ RefHit nearest(const std::vector<SoupTriangle>& soup, const Ray& ray) {
   return best;
 }
 
-Expected<ImportedModel> import_any(const std::string& path) {
+Expected<character::Model> import_any(const std::string& path) {
 #if SINEW_HAVE_CAL3D
   if (path.ends_with(".cfg")) return import_cal3d(path);
 #endif
@@ -165,9 +166,9 @@ Expected<ImportedModel> import_any(const std::string& path) {
 
 // The model posed again from scratch: clip_skinning at the same time, each
 // vertex skinned with the scalar reference, plus the ground quad.
-std::vector<SoupTriangle> posed_soup(const ImportedModel& model, const anim::Clip& clip, double seconds,
+std::vector<SoupTriangle> posed_soup(const character::Model& model, const anim::Clip& clip, double seconds,
                                      const rt::StaticMeshDesc& ground) {
-  const auto bones = clip_skinning(model, clip, seconds);
+  const auto bones = character::clip_skinning(model, clip, seconds);
   EXPECT_TRUE(bones.ok()) << bones.status().message();
   if (!bones.ok()) return {};
   std::vector<Vec3> world(model.mesh.vertex_count());
@@ -198,7 +199,7 @@ void expect_aovs_match_brute_force(const std::string& path, double seconds) {
   ASSERT_TRUE(model.ok()) << model.status().message();
   ASSERT_FALSE(model->clips.empty());
   // The ground the command added, derived again from the model alone.
-  const rt::StaticMeshDesc ground = ground_plane_for(*model, 1);
+  const rt::StaticMeshDesc ground = character::ground_plane_for(*model, 1);
   ASSERT_EQ(ground.positions.size(), outputs->ground.positions.size());
   for (std::size_t i = 0; i < ground.positions.size(); ++i) EXPECT_EQ(ground.positions[i], outputs->ground.positions[i]);
   const std::vector<SoupTriangle> soup = posed_soup(*model, model->clips.front(), seconds, ground);
@@ -293,10 +294,10 @@ TEST(RenderCommand, InstancesStandSideBySideWithDifferentPoses) {
   // The second instance plays 0.37 s later: posed differently from the first.
   const auto model = import_gltf(kCesiumMan);
   ASSERT_TRUE(model.ok());
-  const auto a = clip_skinning(*model, model->clips.front(), 0.0);
-  const auto b = clip_skinning(*model, model->clips.front(), instance_time_offset(1));
+  const auto a = character::clip_skinning(*model, model->clips.front(), 0.0);
+  const auto b = character::clip_skinning(*model, model->clips.front(), character::instance_time_offset(1));
   ASSERT_TRUE(a.ok() && b.ok());
-  EXPECT_EQ(instance_time_offset(1), 0.37);
+  EXPECT_EQ(character::instance_time_offset(1), 0.37);
   bool differ = false;
   for (std::size_t j = 0; j < a->size(); ++j) differ = differ || (*a)[j].rows != (*b)[j].rows;
   EXPECT_TRUE(differ);
@@ -319,9 +320,9 @@ TEST(RenderCommand, GroundOffLeavesTheCharactersAlone) {
 }
 
 TEST(RenderCommand, UpAxisIsTheLargerOfYAndZ) {
-  EXPECT_EQ(up_axis_of(Aabb{Vec3(0.0f), Vec3(5.0f, 2.0f, 1.0f)}), 1);
-  EXPECT_EQ(up_axis_of(Aabb{Vec3(0.0f), Vec3(5.0f, 1.0f, 2.0f)}), 2);
-  const rt::StaticMeshDesc ground = ground_plane_for(Aabb{Vec3(-1.0f, -0.5f, 0.0f), Vec3(1.0f, 0.5f, 3.0f)}, 1);
+  EXPECT_EQ(character::up_axis_of(Aabb{Vec3(0.0f), Vec3(5.0f, 2.0f, 1.0f)}), 1);
+  EXPECT_EQ(character::up_axis_of(Aabb{Vec3(0.0f), Vec3(5.0f, 1.0f, 2.0f)}), 2);
+  const rt::StaticMeshDesc ground = character::ground_plane_for(Aabb{Vec3(-1.0f, -0.5f, 0.0f), Vec3(1.0f, 0.5f, 3.0f)}, 1);
   ASSERT_EQ(ground.triangles.size(), 2u);
   for (const Vec3& p : ground.positions) EXPECT_EQ(p.z, 0.0f);  // Z-up: under the box's lowest z
 }
@@ -447,8 +448,8 @@ TEST(RenderCommand, OptionsMapToTheirSettings) {
   EXPECT_EQ(d->instances, 1);
   EXPECT_EQ(d->threads, 0);
   EXPECT_FALSE(d->camera.has_value());
-  EXPECT_EQ(d->pose_space.mode, default_pose_space().mode);
-  EXPECT_EQ(d->pose_space.every_frame_30hz, default_pose_space().every_frame_30hz);
+  EXPECT_EQ(d->pose_space.mode, character::default_pose_space().mode);
+  EXPECT_EQ(d->pose_space.every_frame_30hz, character::default_pose_space().every_frame_30hz);
 
   const auto r = parse_render_options({"m.glb", "--out", "o", "--pose-space", "arbitrary", "--samples", "50",
                                        "--seed", "18446744073709551615"});

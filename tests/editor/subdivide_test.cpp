@@ -16,11 +16,11 @@
 #include <utility>
 #include <vector>
 
+#include "character/bake.h"
 #include "content/mannequin/mannequin.h"
-#include "editor/bake/in_memory_bake.h"
 #include "editor/mesh/subdivide.h"
-#include "tests/support/same_model.h"
 #include "runtime/jobs/job_system.h"
+#include "tests/support/same_model.h"
 
 #if SINEW_HAVE_CAL3D
 #include "editor/import/cal3d_importer.h"
@@ -34,8 +34,8 @@ using JointRow = std::array<std::uint16_t, kMaxInfluences>;
 using WeightRow = std::array<float, kMaxInfluences>;
 
 // A model whose every vertex is bound to joint 0 alone, one material.
-ImportedModel make_model(std::vector<Vec3> positions, std::vector<Triangle> triangles) {
-  ImportedModel model;
+character::Model make_model(std::vector<Vec3> positions, std::vector<Triangle> triangles) {
+  character::Model model;
   model.source = "test";
   const std::size_t vertices = positions.size();
   model.mesh.positions = std::move(positions);
@@ -51,18 +51,18 @@ ImportedModel make_model(std::vector<Vec3> positions, std::vector<Triangle> tria
   return model;
 }
 
-ImportedModel tetrahedron() {
+character::Model tetrahedron() {
   // Outward-facing, consistently wound.
   return make_model({Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)},
                     {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}});
 }
 
-const ImportedModel& mannequin() {
-  static const ImportedModel model = content::make_mannequin().value();
+const character::Model& mannequin() {
+  static const character::Model model = content::make_mannequin().value();
   return model;
 }
 
-ImportedModel subdivided(const ImportedModel& model, int levels) {
+character::Model subdivided(const character::Model& model, int levels) {
   auto result = subdivide(model, levels);
   EXPECT_TRUE(result.ok()) << result.status().message();
   return std::move(result).value();
@@ -108,13 +108,13 @@ void expect_closed_and_oriented(const SkinnedMesh& mesh, const std::string& what
 // ------------------------------------------------------------ documented order
 
 TEST(Subdivide, SingleTriangleOneLevelFollowsTheDocumentedOrder) {
-  ImportedModel model = make_model({Vec3(0, 0, 0), Vec3(4, 0, 0), Vec3(0, 2, 6)}, {{0, 1, 2}});
+  character::Model model = make_model({Vec3(0, 0, 0), Vec3(4, 0, 0), Vec3(0, 2, 6)}, {{0, 1, 2}});
   model.mesh.normals = {Vec3(0, 0, 1), Vec3(0, 1, 0), Vec3(1, 0, 0)};
   model.mesh.uvs = {Vec2(0.0f, 0.0f), Vec2(1.0f, 0.0f), Vec2(0.0f, 1.0f)};
   model.mesh.material_colors.push_back(Vec3(1.0f, 0.0f, 0.0f));
   model.mesh.triangle_material = {1};
 
-  const ImportedModel out = subdivided(model, 1);
+  const character::Model out = subdivided(model, 1);
   const SkinnedMesh& mesh = out.mesh;
   ASSERT_EQ(mesh.vertex_count(), 6u);
   ASSERT_EQ(mesh.triangle_count(), 4u);
@@ -154,7 +154,7 @@ TEST(Subdivide, SingleTriangleOneLevelFollowsTheDocumentedOrder) {
 }
 
 TEST(Subdivide, OppositeNormalsFallBackToTheFirstEndpoint) {
-  ImportedModel model = make_model({Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0)}, {{0, 1, 2}});
+  character::Model model = make_model({Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0)}, {{0, 1, 2}});
   model.mesh.normals = {Vec3(0, 0, 1), Vec3(0, 0, -1), Vec3(0, 0, 1)};
   const SkinnedMesh mesh = subdivided(model, 1).mesh;
   EXPECT_EQ(mesh.normals[3], Vec3(0, 0, 1));  // (v0, v1): v0 first
@@ -167,7 +167,7 @@ TEST(Subdivide, OppositeNormalsFallBackToTheFirstEndpoint) {
 
 TEST(Subdivide, SharedEdgeGetsOneMidpoint) {
   // Two triangles sharing edge 1-2, met as (1,2) in the first and (2,1) in the second.
-  const ImportedModel model =
+  const character::Model model =
       make_model({Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(1, 1, 0)}, {{0, 1, 2}, {2, 1, 3}});
   const SkinnedMesh mesh = subdivided(model, 1).mesh;
   ASSERT_EQ(mesh.vertex_count(), 9u);  // 4 + 5 unique edges
@@ -199,7 +199,7 @@ TEST(Subdivide, SharedEdgeGetsOneMidpoint) {
 }
 
 TEST(Subdivide, ClosedMeshStaysClosed) {
-  const ImportedModel tet = tetrahedron();
+  const character::Model tet = tetrahedron();
   expect_closed_and_oriented(tet.mesh, "tetrahedron");
   for (int levels = 1; levels <= 3; ++levels) {
     expect_closed_and_oriented(subdivided(tet, levels).mesh, "tetrahedron level " + std::to_string(levels));
@@ -215,7 +215,7 @@ TEST(Subdivide, ClosedMeshStaysClosed) {
 std::pair<JointRow, WeightRow> midpoint_influences(const JointRow& joints_a, const WeightRow& weights_a,
                                                    const JointRow& joints_b, const WeightRow& weights_b,
                                                    bool reversed) {
-  ImportedModel model = make_model({Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0)},
+  character::Model model = make_model({Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0)},
                                    {reversed ? Triangle{1, 0, 2} : Triangle{0, 1, 2}});
   model.mesh.joints[0] = joints_a;
   model.mesh.weights[0] = weights_a;
@@ -298,15 +298,15 @@ struct Counts {
 
 // Subdivides 1..4 levels and checks T * 4^L triangles and V + E vertices per
 // level, E counted independently from the previous level's result.
-std::vector<Counts> checked_counts(const ImportedModel& model, int max_levels) {
+std::vector<Counts> checked_counts(const character::Model& model, int max_levels) {
   std::vector<Counts> counts;
-  ImportedModel previous = model;
+  character::Model previous = model;
   std::size_t expected_vertices = model.mesh.vertex_count();
   std::size_t expected_triangles = model.mesh.triangle_count();
   for (int levels = 1; levels <= max_levels; ++levels) {
     expected_vertices += unique_edge_count(previous.mesh);
     expected_triangles *= 4;
-    ImportedModel current = subdivided(model, levels);
+    character::Model current = subdivided(model, levels);
     EXPECT_EQ(current.mesh.triangle_count(), expected_triangles) << "level " << levels;
     EXPECT_EQ(current.mesh.vertex_count(), expected_vertices) << "level " << levels;
     EXPECT_EQ(current.mesh.joints.size(), expected_vertices);
@@ -320,7 +320,7 @@ std::vector<Counts> checked_counts(const ImportedModel& model, int max_levels) {
   return counts;
 }
 
-void print_counts(const std::string& name, const ImportedModel& model, const std::vector<Counts>& counts) {
+void print_counts(const std::string& name, const character::Model& model, const std::vector<Counts>& counts) {
   std::cout << name << " level 0: " << model.mesh.vertex_count() << " vertices, " << model.mesh.triangle_count()
             << " triangles\n";
   for (std::size_t i = 0; i < counts.size(); ++i) {
@@ -346,8 +346,8 @@ TEST(Subdivide, MannequinCountsLevels1To4) {
 }
 
 TEST(Subdivide, IteratingOneLevelEqualsSeveralLevels) {
-  const ImportedModel twice = subdivided(subdivided(mannequin(), 1), 2);
-  const ImportedModel at_once = subdivided(mannequin(), 3);
+  const character::Model twice = subdivided(subdivided(mannequin(), 1), 2);
+  const character::Model at_once = subdivided(mannequin(), 3);
   EXPECT_EQ(twice.mesh.triangles, at_once.mesh.triangles);
   EXPECT_EQ(twice.mesh.positions, at_once.mesh.positions);
   EXPECT_EQ(twice.mesh.weights, at_once.mesh.weights);
@@ -454,7 +454,7 @@ TEST(Subdivide, LevelsOutsideTheRangeAreInvalidArguments) {
 }
 
 TEST(Subdivide, OutOfRangeVertexIndexNamesTheTriangle) {
-  ImportedModel model = tetrahedron();
+  character::Model model = tetrahedron();
   model.mesh.triangles[2][1] = 4;
   for (const int levels : {0, 1}) {
     auto result = subdivide(model, levels);
@@ -467,7 +467,7 @@ TEST(Subdivide, OutOfRangeVertexIndexNamesTheTriangle) {
 }
 
 TEST(Subdivide, MismatchedAttributeArraysAreInvalidData) {
-  ImportedModel model = tetrahedron();
+  character::Model model = tetrahedron();
   model.mesh.normals = {Vec3(0, 0, 1)};
   auto result = subdivide(model, 1);
   ASSERT_FALSE(result.ok());
@@ -484,7 +484,7 @@ TEST(Subdivide, MismatchedAttributeArraysAreInvalidData) {
 TEST(Subdivide, TooManyTrianglesIsLimitExceeded) {
   // 32,769 * 4^8 > 2^31 triangles: refused before anything is built.
   std::vector<Triangle> triangles(32769, Triangle{0, 1, 2});
-  const ImportedModel model = make_model({Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0)}, triangles);
+  const character::Model model = make_model({Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0)}, triangles);
   auto result = subdivide(model, kMaxSubdivisionLevels);
   ASSERT_FALSE(result.ok());
   EXPECT_EQ(result.status().code(), ErrorCode::kLimitExceeded);
@@ -492,15 +492,15 @@ TEST(Subdivide, TooManyTrianglesIsLimitExceeded) {
 }
 
 TEST(Subdivide, LevelZeroIsAnIdenticalCopy) {
-  const ImportedModel& model = mannequin();
-  const ImportedModel copy = subdivided(model, 0);
+  const character::Model& model = mannequin();
+  const character::Model copy = subdivided(model, 0);
   EXPECT_EQ(copy.source, model.source);
   testing_support::expect_same_model(model, copy);
 }
 
 TEST(Subdivide, EmptyMeshStaysEmpty) {
-  const ImportedModel model = make_model({}, {});
-  const ImportedModel out = subdivided(model, 3);
+  const character::Model model = make_model({}, {});
+  const character::Model out = subdivided(model, 3);
   EXPECT_EQ(out.mesh.vertex_count(), 0u);
   EXPECT_EQ(out.mesh.triangle_count(), 0u);
 }
@@ -508,9 +508,9 @@ TEST(Subdivide, EmptyMeshStaysEmpty) {
 // ------------------------------------------------------------ bake oracle
 
 TEST(Subdivide, SubdividedMannequinBakes) {
-  const ImportedModel model = subdivided(mannequin(), 1);
+  const character::Model model = subdivided(mannequin(), 1);
   JobSystem jobs(2);
-  auto bake = bake_in_memory(model, BakeRequest{}, jobs);
+  auto bake = character::bake_in_memory(model, character::BakeRequest{}, jobs);
   ASSERT_TRUE(bake.ok()) << bake.status().message();
   EXPECT_EQ(bake->fuzzy.triangle_bone.size(), model.mesh.triangle_count());
   EXPECT_EQ(bake->fuzzy.bone_count, model.skeleton.joint_count());

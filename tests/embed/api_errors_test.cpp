@@ -55,9 +55,9 @@ TEST(ApiErrors, LoadingNamesTheFileAndWhatIsWrong) {
 
 TEST(ApiErrors, AModelOnlyPackIsRefusedWithTheCommandThatBakesIt) {
   const testing_support::BakedModel& baked = testing_support::idle_mannequin();
-  editor::CharacterPackContents contents;
+  character::PackContents contents;
   contents.model = &baked.model;  // no fuzzy trees
-  const auto bytes = editor::serialize_character_pack(contents);
+  const auto bytes = character::serialize_pack(contents);
   ASSERT_TRUE(bytes.ok());
   expect_error(api::Character::from_memory(*bytes, "model-only.pack"), api::ErrorCode::kUnsupported,
                "sinew-editor bake");

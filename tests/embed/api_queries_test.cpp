@@ -62,7 +62,7 @@ struct Scenes {
   // The posed triangles of instances at `poses` with the ground between the
   // first and the second, as World numbers them.
   static std::vector<testing_support::SoupTriangle> reference(const std::vector<Pose>& poses) {
-    const editor::CharacterPack pack = editor::CharacterPack::open(mannequin_pack_path()).value();
+    const character::Pack pack = character::Pack::open(mannequin_pack_path()).value();
     rt::Scene scene;
     const std::uint32_t character = scene.add_character(pack.model().mesh, pack.fuzzy()).value();
     for (std::size_t i = 0; i < poses.size(); ++i) {

@@ -29,7 +29,7 @@ using testing_support::render_internal;
 constexpr int kW = 96;
 constexpr int kH = 80;
 
-editor::CharacterPack open_mannequin_pack() { return editor::CharacterPack::open(mannequin_pack_path()).value(); }
+character::Pack open_mannequin_pack() { return character::Pack::open(mannequin_pack_path()).value(); }
 
 api::RayTracePass make_pass(api::OutputMask outputs, int w = kW, int h = kH) {
   api::PassDesc desc;
@@ -91,7 +91,7 @@ TEST(ApiVersion, MatchesTheHeadersAndThePackFormat) {
 
 TEST(ApiCharacter, DescribesThePack) {
   const api::Character c = load_mannequin();
-  const editor::CharacterPack pack = open_mannequin_pack();
+  const character::Pack pack = open_mannequin_pack();
   ASSERT_EQ(c.bone_count(), pack.model().skeleton.joint_count());
   for (std::size_t b = 0; b < c.bone_count(); ++b) {
     EXPECT_EQ(c.bone_name(b), pack.model().skeleton.names()[b]);
@@ -129,7 +129,7 @@ TEST(ApiCharacter, DescribesThePack) {
 
 TEST(ApiPass, PoseAtRendersWhatTheRendererRendersForThatClipPose) {
   const api::Character character = load_mannequin();
-  const editor::CharacterPack pack = open_mannequin_pack();
+  const character::Pack pack = open_mannequin_pack();
   auto world = api::World::create();
   ASSERT_TRUE(world.ok());
   const auto id = world->add_instance(character);
@@ -153,8 +153,8 @@ TEST(ApiPass, PoseAtRendersWhatTheRendererRendersForThatClipPose) {
 
 TEST(ApiPass, TheMixerDrivesInstancesLikeTheAnimationSystem) {
   const api::Character character = load_mannequin();
-  const editor::CharacterPack pack = open_mannequin_pack();
-  const editor::ImportedModel& model = pack.model();
+  const character::Pack pack = open_mannequin_pack();
+  const character::Model& model = pack.model();
   auto world = api::World::create();
   ASSERT_TRUE(world.ok());
   api::InstanceDesc desc;
@@ -191,7 +191,7 @@ TEST(ApiPass, TheMixerDrivesInstancesLikeTheAnimationSystem) {
 
 TEST(ApiPass, HostMatricesRenderTheSameAsTheMixerAtThatPose) {
   const api::Character character = load_mannequin();
-  const editor::CharacterPack pack = open_mannequin_pack();
+  const character::Pack pack = open_mannequin_pack();
   const std::vector<Affine3> pose = testing_support::clip_pose(pack.model(), "kick", 0.55);
   std::vector<api::Matrix3x4> host(pose.size());
   for (std::size_t b = 0; b < pose.size(); ++b) host[b] = to_api(pose[b]);

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "editor/pack/character_pack.h"
+#include "character/pack.h"
 #include "raytrace/camera/camera.h"
 #include "raytrace/render/renderer.h"
 #include "raytrace/scene/scene.h"
@@ -23,7 +23,7 @@ namespace sinew::testing_support {
 inline const std::string& mannequin_pack_path() {
   static const std::string path = [] {
     const BakedModel& baked = idle_mannequin();
-    editor::CharacterPackContents contents;
+    character::PackContents contents;
     contents.model = &baked.model;
     contents.fuzzy = &baked.bake.fuzzy;
     contents.pose_space.desc.mode = anim::PoseSpaceMode::kClip;
@@ -33,7 +33,7 @@ inline const std::string& mannequin_pack_path() {
     const std::string p = (std::filesystem::temp_directory_path() /
                            ("sinew_api_test_mannequin_" + std::to_string(::getpid()) + ".pack"))
                               .string();
-    EXPECT_TRUE(editor::write_character_pack(p, contents).ok());
+    EXPECT_TRUE(character::write_pack(p, contents).ok());
     return p;
   }();
   return path;
@@ -78,7 +78,7 @@ inline api::Light test_light() {
 }
 
 // The reference: the internal Scene and Renderer over the same baked data.
-inline Frame render_internal(const editor::CharacterPack& pack, const std::vector<std::vector<Affine3>>& poses,
+inline Frame render_internal(const character::Pack& pack, const std::vector<std::vector<Affine3>>& poses,
                              int width, int height, bool shadows = true) {
   Frame frame(width, height);
   rt::Scene scene;

@@ -11,10 +11,10 @@
 #include <string>
 #include <vector>
 
-#include "editor/bake/in_memory_bake.h"
-#include "editor/cli/render_command.h"
+#include "character/bake.h"
+#include "character/framing.h"
+#include "character/pack.h"
 #include "editor/import/cal3d_importer.h"
-#include "editor/pack/character_pack.h"
 #include "runtime/jobs/job_system.h"
 #include "sinew/sinew.h"
 #include "tests/support/cal3d_support.h"
@@ -73,15 +73,15 @@ TEST(HostBones, Cal3dMatricesRenderLikeTheMixerAtTheSamePose) {
   auto model = editor::import_cal3d(cfg_path);
   ASSERT_TRUE(model.ok()) << model.status().message();
   JobSystem jobs(2);
-  editor::BakeRequest request;
-  auto bake = editor::bake_in_memory(*model, request, jobs);
+  character::BakeRequest request;
+  auto bake = character::bake_in_memory(*model, request, jobs);
   ASSERT_TRUE(bake.ok()) << bake.status().message();
   testing_support::TempDir dir;
-  editor::CharacterPackContents contents;
+  character::PackContents contents;
   contents.model = &*model;
   contents.fuzzy = &bake->fuzzy;
   contents.pose_space.desc = request.pose_space;
-  ASSERT_TRUE(editor::write_character_pack(dir.file("cally.pack"), contents).ok());
+  ASSERT_TRUE(character::write_pack(dir.file("cally.pack"), contents).ok());
   auto character = api::Character::load(dir.file("cally.pack"));
   ASSERT_TRUE(character.ok()) << character.error().message;
 
@@ -128,10 +128,10 @@ TEST(HostBones, Cal3dMatricesRenderLikeTheMixerAtTheSamePose) {
 
   // Both framed like sinew-editor render frames Cally.
   constexpr int kSize = 256;
-  const Aabb rest = editor::rest_bounds(*model);
-  const int up = editor::up_axis_of(rest);
-  const rt::CameraDesc c = editor::default_camera(rest, up, kSize, kSize);
-  const Vec3 l = editor::default_light(rest, up);
+  const Aabb rest = character::rest_bounds(*model);
+  const int up = character::up_axis_of(rest);
+  const rt::CameraDesc c = character::default_camera(rest, up, kSize, kSize);
+  const Vec3 l = character::default_light(rest, up);
   api::PassInputs inputs;
   inputs.camera = {{c.eye.x, c.eye.y, c.eye.z}, {c.target.x, c.target.y, c.target.z}, {c.up.x, c.up.y, c.up.z},
                    c.fovy_degrees};

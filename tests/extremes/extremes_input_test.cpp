@@ -8,9 +8,9 @@
 #include <vector>
 
 #include "animation/clip.h"
+#include "character/bake.h"
+#include "character/model.h"
 #include "content/mannequin/mannequin.h"
-#include "editor/bake/in_memory_bake.h"
-#include "editor/import/imported_model.h"
 #include "tests/extremes/extremes_support.h"
 
 namespace sinew::extremes {
@@ -58,13 +58,13 @@ TEST(ExtremeClips, ASingleKeyClipBakesAndRendersItsPoseAtEveryTime) {
     ASSERT_TRUE(clip.ok()) << clip.status().message();
     EXPECT_EQ(clip->duration(), key_time);
     m.model.clips = {std::move(*clip)};
-    editor::BakeRequest request;
+    character::BakeRequest request;
     request.pose_space.mode = anim::PoseSpaceMode::kClip;
     request.pose_space.clips = {"raise"};
     request.pose_space.samples = 0;
     request.pose_space.every_frame_30hz = true;
     JobSystem jobs(2);
-    auto bake = editor::bake_in_memory(m.model, request, jobs);
+    auto bake = character::bake_in_memory(m.model, request, jobs);
     ASSERT_TRUE(bake.ok()) << bake.status().message();
     m.bake = std::move(*bake);
     const std::vector<Affine3> at_zero = testing_support::clip_pose(m.model, "raise", 0.0);
@@ -87,15 +87,15 @@ TEST(ExtremeClips, ASingleKeyClipBakesAndRendersItsPoseAtEveryTime) {
 // --- skin weights ---------------------------------------------------------------
 
 TEST(ExtremeWeights, WeightsSummingToHalfOrTwoAreRenormalisedWithAWarning) {
-  const editor::ImportedModel original = content::make_mannequin().value();
-  editor::ImportedModel odd = original;
+  const character::Model original = content::make_mannequin().value();
+  character::Model odd = original;
   odd.source = "odd.glb";
   // Halve some rows, double others: exact in binary floating point, so the
   // renormalised rows must equal the original's renormalised rows bit for bit.
   for (std::size_t v = 0; v < odd.mesh.weights.size(); ++v) {
     for (float& w : odd.mesh.weights[v]) w *= (v % 2 == 0) ? 0.5f : 2.0f;
   }
-  ASSERT_TRUE(editor::normalize_skin_weights(odd).ok());
+  ASSERT_TRUE(character::normalize_skin_weights(odd).ok());
   ASSERT_EQ(odd.warnings.size(), 1u);
   EXPECT_NE(odd.warnings[0].find("odd.glb"), std::string::npos) << odd.warnings[0];
   EXPECT_NE(odd.warnings[0].find("weights[0]"), std::string::npos) << odd.warnings[0];
@@ -105,8 +105,8 @@ TEST(ExtremeWeights, WeightsSummingToHalfOrTwoAreRenormalisedWithAWarning) {
             std::string::npos)
       << odd.warnings[0];
 
-  editor::ImportedModel reference = original;
-  ASSERT_TRUE(editor::normalize_skin_weights(reference).ok());
+  character::Model reference = original;
+  ASSERT_TRUE(character::normalize_skin_weights(reference).ok());
   EXPECT_TRUE(reference.warnings.empty()) << "the mannequin's own weights sum to 1: " << reference.warnings[0];
   EXPECT_EQ(odd.mesh.weights, reference.mesh.weights);
 
@@ -114,12 +114,12 @@ TEST(ExtremeWeights, WeightsSummingToHalfOrTwoAreRenormalisedWithAWarning) {
   // brute force over the ORIGINAL model's skinned triangles.
   BakedModel m;
   m.model = std::move(odd);
-  editor::BakeRequest request;
+  character::BakeRequest request;
   request.pose_space.mode = anim::PoseSpaceMode::kClip;
   request.pose_space.clips = {"walk"};
   request.pose_space.samples = 0;
   JobSystem jobs(2);
-  auto bake = editor::bake_in_memory(m.model, request, jobs);
+  auto bake = character::bake_in_memory(m.model, request, jobs);
   ASSERT_TRUE(bake.ok()) << bake.status().message();
   m.bake = std::move(*bake);
   const std::vector<Affine3> bones = testing_support::clip_pose(m.model, "walk", 0.35);
@@ -148,7 +148,7 @@ TEST(ExtremeWeights, RoundingLevelSumsAreRenormalisedSilently) {
   mesh.positions = {Vec3(0.0f), Vec3(1.0f), Vec3(2.0f)};
   mesh.weights = {{0.5f, 0.5f}, {0.2f, 0.3f, 0.499f}, {1.0f}};
   std::vector<std::string> warnings;
-  ASSERT_TRUE(editor::normalize_skin_weights(mesh, "q.glb", warnings).ok());
+  ASSERT_TRUE(character::normalize_skin_weights(mesh, "q.glb", warnings).ok());
   EXPECT_TRUE(warnings.empty());
   EXPECT_EQ(mesh.weights[0][0], 0.5f) << "an exact row keeps its bits";
   double sum = 0.0;
@@ -169,7 +169,7 @@ TEST(ExtremeWeights, UnusableWeightsAreClearErrors) {
     mesh.positions = {Vec3(0.0f), Vec3(1.0f)};
     mesh.weights = {{1.0f}, c.row};
     std::vector<std::string> warnings;
-    const Status s = editor::normalize_skin_weights(mesh, "bad.glb", warnings);
+    const Status s = character::normalize_skin_weights(mesh, "bad.glb", warnings);
     ASSERT_FALSE(s.ok()) << c.field;
     EXPECT_EQ(s.code(), ErrorCode::kInvalidData);
     EXPECT_EQ(s.field(), c.field);

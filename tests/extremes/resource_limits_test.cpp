@@ -13,10 +13,10 @@
 #include <string>
 #include <vector>
 
+#include "character/bake.h"
+#include "character/pack.h"
 #include "content/mannequin/mannequin.h"
-#include "editor/bake/in_memory_bake.h"
 #include "editor/cli/pack_commands.h"
-#include "editor/pack/character_pack.h"
 #include "raytrace/fuzzy/fuzzy_bake.h"
 #include "runtime/jobs/job_system.h"
 #include "runtime/pack/checksum.h"
@@ -82,10 +82,10 @@ class CharacterPackLimits : public testing::Test {
  protected:
   static void SetUpTestSuite() {
     const auto& m = testing_support::idle_mannequin();
-    editor::CharacterPackContents contents;
+    character::PackContents contents;
     contents.model = &m.model;
     contents.fuzzy = &m.bake.fuzzy;
-    pristine_ = new std::vector<std::byte>(editor::serialize_character_pack(contents).value());
+    pristine_ = new std::vector<std::byte>(character::serialize_pack(contents).value());
   }
   static void TearDownTestSuite() { delete pristine_; }
 
@@ -108,7 +108,7 @@ class CharacterPackLimits : public testing::Test {
   }
 
   static Status load(const std::vector<std::byte>& bytes) {
-    const auto pack = editor::CharacterPack::from_bytes(bytes, "absurd.pack");
+    const auto pack = character::Pack::from_bytes(bytes, "absurd.pack");
     return pack.ok() ? Status{} : pack.status();
   }
 
@@ -162,21 +162,21 @@ TEST(BakeLimits, AMillionBoneSkeletonIsRefusedBeforeAllocating) {
 }
 
 TEST(BakeLimits, APoseSpaceBeyondTheMemoryBoundIsRefusedWhileSampling) {
-  const editor::ImportedModel model = content::make_mannequin().value();
-  editor::BakeRequest request;
+  const character::Model model = content::make_mannequin().value();
+  character::BakeRequest request;
   request.pose_space.mode = anim::PoseSpaceMode::kArbitrary;
   request.pose_space.samples = anim::kMaxPoseSamples;
   request.fuzzy.memory_budget_bytes = std::size_t{1} << 20;
   request.max_memory_bytes = request.fuzzy.memory_budget_bytes + (std::size_t{2} << 20);
   JobSystem jobs(1);
-  const auto bake = editor::bake_in_memory(model, request, jobs);
+  const auto bake = character::bake_in_memory(model, request, jobs);
   ASSERT_FALSE(bake.ok());
   EXPECT_EQ(bake.status().code(), ErrorCode::kLimitExceeded) << bake.status().message();
   EXPECT_EQ(bake.status().field(), "pose_space");
   EXPECT_NE(bake.status().message().find("1 MiB"), std::string::npos) << bake.status().message();
   // No room at all beside the box budget: a clear argument error.
   request.max_memory_bytes = request.fuzzy.memory_budget_bytes;
-  const auto none = editor::bake_in_memory(model, request, jobs);
+  const auto none = character::bake_in_memory(model, request, jobs);
   ASSERT_FALSE(none.ok());
   EXPECT_EQ(none.status().field(), "max_memory_bytes");
 }
@@ -184,14 +184,14 @@ TEST(BakeLimits, APoseSpaceBeyondTheMemoryBoundIsRefusedWhileSampling) {
 // The reported peak counts the samples, their inverses and the vertex boxes
 // (checked against the sizes computed here), and stays within the bound.
 TEST(BakeLimits, TheBakeReportsItsPeakMemory) {
-  const editor::ImportedModel model = content::make_mannequin().value();
-  editor::BakeRequest request;
+  const character::Model model = content::make_mannequin().value();
+  character::BakeRequest request;
   request.pose_space.mode = anim::PoseSpaceMode::kClip;
   request.pose_space.clips = {"walk"};
   request.pose_space.samples = 0;
   request.fuzzy.memory_budget_bytes = std::size_t{256} << 10;  // forces bone chunks
   JobSystem jobs(2);
-  const auto bake = editor::bake_in_memory(model, request, jobs);
+  const auto bake = character::bake_in_memory(model, request, jobs);
   ASSERT_TRUE(bake.ok()) << bake.status().message();
   const std::size_t bones = model.skeleton.joint_count();
   const std::size_t samples = bake->fuzzy.stats.sample_count;
@@ -208,11 +208,11 @@ TEST(BakeLimits, TheBakeReportsItsPeakMemory) {
 
 TEST(BakeLimits, SinewEditorBakePrintsTheBakeMemory) {
   testing_support::TempDir dir;
-  const editor::ImportedModel model = content::make_mannequin().value();
-  editor::CharacterPackContents contents;
+  const character::Model model = content::make_mannequin().value();
+  character::PackContents contents;
   contents.model = &model;
   const std::string model_pack = dir.file("mannequin.pack");
-  ASSERT_TRUE(editor::write_character_pack(model_pack, contents).ok());
+  ASSERT_TRUE(character::write_pack(model_pack, contents).ok());
   std::ostringstream out, err;
   const int code = editor::run_bake({model_pack, "-o", dir.file("baked.pack"), "--pose-space", "clip:wave",
                                      "--samples", "8", "--threads", "2"},

@@ -1,4 +1,4 @@
-// libFuzzer target for character content packs (editor/pack/character_pack.h):
+// libFuzzer target for character content packs (character/pack.h):
 // load, validate and, when the pack loads, render a tiny image from it.
 //
 // The contract under test is the loader's promise: "a pack that loads is
@@ -36,9 +36,9 @@
 #include <span>
 #include <vector>
 
-#include "editor/bake/in_memory_bake.h"
-#include "editor/cli/render_command.h"
-#include "editor/pack/character_pack.h"
+#include "character/bake.h"
+#include "character/framing.h"
+#include "character/pack.h"
 #include "raytrace/camera/camera.h"
 #include "raytrace/render/renderer.h"
 #include "raytrace/scene/scene.h"
@@ -104,8 +104,8 @@ JobSystem& serial_jobs() {
 }
 
 // Renders the loaded pack's character; returns early on any refused step.
-void render(const editor::CharacterPack& pack) {
-  const editor::ImportedModel& model = pack.model();
+void render(const character::Pack& pack) {
+  const character::Model& model = pack.model();
   if (model.mesh.triangle_count() > kMaxRenderedTriangles) return;
   JobSystem& jobs = serial_jobs();
 
@@ -115,16 +115,16 @@ void render(const editor::CharacterPack& pack) {
   auto instance = scene.add_instance(*character);
   if (!instance.ok()) return;
   if (!model.clips.empty()) {
-    auto skinning = editor::clip_skinning(model, model.clips.front(), 0.25);
+    auto skinning = character::clip_skinning(model, model.clips.front(), 0.25);
     if (!skinning.ok()) return;
     if (!scene.set_bones(*instance, *skinning).ok()) return;
   }
   if (!scene.prepare_frame(rt::FrameOptions{}, jobs).ok()) return;
 
-  const Aabb posed = editor::posed_bounds(scene);
-  const int up = editor::up_axis_of(editor::rest_bounds(model));
+  const Aabb posed = character::posed_bounds(scene);
+  const int up = character::up_axis_of(character::rest_bounds(model));
   // A huge or non-finite pose gives no camera: refused, not a bug.
-  auto camera = rt::PinholeCamera::create(editor::default_camera(posed, up, kImageSize, kImageSize),
+  auto camera = rt::PinholeCamera::create(character::default_camera(posed, up, kImageSize, kImageSize),
                                           kImageSize, kImageSize);
   if (!camera.ok()) return;
 
@@ -137,7 +137,7 @@ void render(const editor::CharacterPack& pack) {
   buffers.triangle_id = triangles;
   rt::RenderSettings settings;
   settings.shadows = true;
-  settings.light.position = editor::default_light(posed, up);
+  settings.light.position = character::default_light(posed, up);
   auto stats = rt::Renderer().render(scene, *camera, settings, buffers, jobs);
   if (!stats.ok()) return;
 
@@ -153,7 +153,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   AlignedBytes bytes(std::span(data, size));
   sinew::fuzz::reseal_pack(bytes.span());
 
-  auto pack = editor::CharacterPack::from_bytes(bytes.span(), "fuzz.pack");
+  auto pack = character::Pack::from_bytes(bytes.span(), "fuzz.pack");
   if (!pack.ok()) {
     const Status& status = pack.status();
     require(status.code() != ErrorCode::kOk);

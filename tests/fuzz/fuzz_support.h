@@ -15,7 +15,7 @@
 
 #include "animation/clip.h"
 #include "animation/joint_transform.h"
-#include "editor/import/imported_model.h"
+#include "character/model.h"
 #include "runtime/core/status.h"
 
 namespace sinew::fuzz {
@@ -57,7 +57,7 @@ inline void write_file(const std::filesystem::path& path, const void* data, std:
 // What every importer promises about a model it returns: parallel mesh
 // arrays, triangle, joint and material indices in range, and clips that can
 // be sampled over the skeleton's rest pose (at start, middle and end).
-inline void require_consistent_model(const editor::ImportedModel& model) {
+inline void require_consistent_model(const character::Model& model) {
   const SkinnedMesh& mesh = model.mesh;
   const std::size_t vertices = mesh.vertex_count();
   const std::size_t joints = model.skeleton.joint_count();

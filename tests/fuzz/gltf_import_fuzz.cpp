@@ -17,7 +17,7 @@
 //
 // A finding: any sanitizer report, leak, trap, time-out or OOM; a refusal
 // without an error code or message; or an imported model whose mesh or
-// skeleton breaks the ImportedModel invariants checked below.
+// skeleton breaks the character::Model invariants checked below.
 #include <cstddef>
 #include <cstdint>
 

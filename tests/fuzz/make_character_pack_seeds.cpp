@@ -14,7 +14,7 @@
 //   the fuzzer mutates mostly structure rather than vertex data.
 //
 // Every seed must load (a seed that does not would only teach the fuzzer a
-// dead end) and stay under 1 MB. Provenance is fixed so the bytes are
+// dead end) and stay under 1 MB. character::Provenance is fixed so the bytes are
 // reproducible.
 #include <cmath>
 #include <cstdio>
@@ -22,9 +22,9 @@
 #include <string>
 #include <vector>
 
+#include "character/bake.h"
+#include "character/pack.h"
 #include "content/mannequin/mannequin.h"
-#include "editor/bake/in_memory_bake.h"
-#include "editor/pack/character_pack.h"
 #include "runtime/jobs/job_system.h"
 
 namespace {
@@ -38,10 +38,10 @@ bool report(const Status& status) {
   return status.ok();
 }
 
-bool emit(const std::string& dir, const std::string& name, const editor::CharacterPackContents& contents) {
+bool emit(const std::string& dir, const std::string& name, const character::PackContents& contents) {
   const std::string path = dir + "/" + name;
-  if (!report(editor::write_character_pack(path, contents))) return false;
-  auto pack = editor::CharacterPack::open(path);
+  if (!report(character::write_pack(path, contents))) return false;
+  auto pack = character::Pack::open(path);
   if (!pack.ok()) return report(pack.status());
   const std::size_t bytes = pack->reader().bytes().size();
   std::printf("%s: %zu triangles, %zu clips, %s, %zu bytes\n", path.c_str(),
@@ -54,8 +54,8 @@ bool emit(const std::string& dir, const std::string& name, const editor::Charact
   return true;
 }
 
-editor::CharacterPackContents contents_for(const editor::ImportedModel& model, const std::string& source) {
-  editor::CharacterPackContents contents;
+character::PackContents contents_for(const character::Model& model, const std::string& source) {
+  character::PackContents contents;
   contents.model = &model;
   contents.provenance.source_name = source;
   contents.provenance.tool_version = "sinew_make_character_pack_seeds";
@@ -66,8 +66,8 @@ editor::CharacterPackContents contents_for(const editor::ImportedModel& model, c
 // A square tube along +Y from 0 to 2: rings of 4 vertices at y = 0, 0.5, ...,
 // 2, bone 0 ("root") below y = 1 and bone 1 ("tip") above, blended over the
 // middle ring. The clip bends the tip 60 degrees about Z and back.
-Expected<editor::ImportedModel> make_two_bone() {
-  editor::ImportedModel model;
+Expected<character::Model> make_two_bone() {
+  character::Model model;
   model.source = "two_bone";
 
   anim::RawSkeleton raw;
@@ -140,16 +140,16 @@ Expected<editor::ImportedModel> make_two_bone() {
 
 struct Baked {
   rt::FuzzyCharacterData fuzzy;
-  editor::PoseSpaceRecord pose_space;
+  character::PoseSpaceRecord pose_space;
 };
 
-Expected<Baked> bake(const editor::ImportedModel& model, const anim::PoseSpaceDesc& space,
+Expected<Baked> bake(const character::Model& model, const anim::PoseSpaceDesc& space,
                      std::span<const anim::JointLimit> limits, JobSystem& jobs) {
-  editor::BakeRequest request;
+  character::BakeRequest request;
   request.pose_space = space;
   request.limits.assign(limits.begin(), limits.end());
   request.fuzzy.padding = 0.01f;
-  SINEW_ASSIGN_OR_RETURN(editor::InMemoryBake baked, editor::bake_in_memory(model, request, jobs));
+  SINEW_ASSIGN_OR_RETURN(character::InMemoryBake baked, character::bake_in_memory(model, request, jobs));
   Baked out;
   out.fuzzy = std::move(baked.fuzzy);
   out.pose_space.desc = space;
@@ -170,7 +170,7 @@ bool write_mannequin(const std::string& dir, JobSystem& jobs) {
   auto baked = bake(*mannequin, space, limits, jobs);
   if (!baked.ok()) return report(baked.status());
 
-  editor::CharacterPackContents contents = contents_for(*mannequin, "mannequin");
+  character::PackContents contents = contents_for(*mannequin, "mannequin");
   bool ok = emit(dir, "mannequin_model.pack", contents);
   contents.limits = limits;
   contents.fuzzy = &baked->fuzzy;
@@ -188,7 +188,7 @@ bool write_two_bone(const std::string& dir, JobSystem& jobs) {
   auto baked = bake(*model, space, {}, jobs);
   if (!baked.ok()) return report(baked.status());
 
-  editor::CharacterPackContents contents = contents_for(*model, "two_bone");
+  character::PackContents contents = contents_for(*model, "two_bone");
   bool ok = emit(dir, "two_bone_model.pack", contents);
   contents.fuzzy = &baked->fuzzy;
   contents.pose_space = baked->pose_space;

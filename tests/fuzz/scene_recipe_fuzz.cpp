@@ -24,8 +24,8 @@ namespace {
 
 using namespace sinew;
 
-const editor::ImportedModel& mannequin() {
-  static const editor::ImportedModel model = [] {
+const character::Model& mannequin() {
+  static const character::Model model = [] {
     auto made = content::make_mannequin();
     fuzz::require(made.ok());
     return *made;

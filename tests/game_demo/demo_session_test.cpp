@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
+#include "character/bake.h"
+#include "character/pack.h"
 #include "content/mannequin/mannequin.h"
-#include "editor/bake/in_memory_bake.h"
-#include "editor/pack/character_pack.h"
 #include "game_demo/demo_session.h"
 #include "runtime/jobs/job_system.h"
 
@@ -97,14 +97,29 @@ TEST(DemoSession, CharactersCastShadowsOnTheGround) {
 TEST(DemoSession, BadModelPathsAreClearErrors) {
   JobSystem jobs(1);
   SessionOptions options;
-  options.model_path = "/nonexistent/model.glb";
+  options.model_path = "/nonexistent/character.pack";
   auto missing = DemoSession::create(options, jobs);
   ASSERT_FALSE(missing.ok());
-  EXPECT_NE(missing.status().message().find("/nonexistent/model.glb"), std::string::npos);
+  EXPECT_NE(missing.status().message().find("/nonexistent/character.pack"), std::string::npos);
   options.model_path = "character.fbx";
   auto unknown = DemoSession::create(options, jobs);
   ASSERT_FALSE(unknown.ok());
   EXPECT_NE(unknown.status().message().find(".fbx"), std::string::npos);
+}
+
+// The demo loads baked content only: a source model is refused with the
+// editor command that bakes it, before any file is read.
+TEST(DemoSession, SourceModelsAreRefusedWithTheBakeCommand) {
+  JobSystem jobs(1);
+  for (const std::string path : {"/data/hero.glb", "/data/hero.gltf", "/data/cally.cfg"}) {
+    SessionOptions options;
+    options.model_path = path;
+    auto session = DemoSession::create(options, jobs);
+    ASSERT_FALSE(session.ok()) << path;
+    EXPECT_EQ(session.status().code(), ErrorCode::kInvalidArgument) << path;
+    EXPECT_NE(session.status().message().find("sinew-editor bake " + path), std::string::npos)
+        << session.status().message();
+  }
 }
 
 // The mannequin baked into a pack with the demo's own settings (every clip,
@@ -113,14 +128,14 @@ TEST(DemoSession, ABakedPackPlaysLikeTheInMemoryBake) {
   JobSystem jobs(2);
   auto mannequin = content::make_mannequin();
   ASSERT_TRUE(mannequin.ok());
-  auto baked = editor::bake_in_memory(*mannequin, editor::BakeRequest{}, jobs);
+  auto baked = character::bake_in_memory(*mannequin, character::BakeRequest{}, jobs);
   ASSERT_TRUE(baked.ok());
-  editor::CharacterPackContents contents;
+  character::PackContents contents;
   contents.model = &*mannequin;
   contents.fuzzy = &baked->fuzzy;
-  contents.pose_space.desc = editor::BakeRequest{}.pose_space;
+  contents.pose_space.desc = character::BakeRequest{}.pose_space;
   const std::string path = (std::filesystem::path(testing::TempDir()) / "demo_mannequin.pack").string();
-  ASSERT_TRUE(editor::write_character_pack(path, contents).ok());
+  ASSERT_TRUE(character::write_pack(path, contents).ok());
 
   SessionOptions options;
   options.width = 96;

@@ -20,20 +20,20 @@ namespace {
 constexpr float kDt = 1.0f / 30.0f;
 constexpr float kPi = std::numbers::pi_v<float>;
 
-const editor::ImportedModel& mannequin() {
-  static const editor::ImportedModel m = *content::make_mannequin();
+const character::Model& mannequin() {
+  static const character::Model m = *content::make_mannequin();
   return m;
 }
 
-int clip_named(const editor::ImportedModel& m, const std::string& name) {
+int clip_named(const character::Model& m, const std::string& name) {
   for (std::size_t i = 0; i < m.clips.size(); ++i) {
     if (m.clips[i].name() == name) return static_cast<int>(i);
   }
   return -1;
 }
 
-editor::ImportedModel walk_only() {
-  editor::ImportedModel m = mannequin();
+character::Model walk_only() {
+  character::Model m = mannequin();
   const anim::Clip walk = m.clips[static_cast<std::size_t>(clip_named(m, "walk"))];
   m.clips = {walk};
   return m;
@@ -46,7 +46,7 @@ WorldOptions single(float arena = 12.0f) {
   return o;
 }
 
-World make_world(const WorldOptions& o, const editor::ImportedModel& m = mannequin()) {
+World make_world(const WorldOptions& o, const character::Model& m = mannequin()) {
   Expected<World> w = World::create(m, o);
   EXPECT_TRUE(w.ok()) << (w.ok() ? "" : w.status().message());
   return std::move(w).value();
@@ -103,7 +103,7 @@ TEST(WorldRoles, MannequinHasAllRoles) {
 }
 
 TEST(WorldRoles, NamesMatchCaseInsensitivelyAndJogIsARun) {
-  editor::ImportedModel m = mannequin();
+  character::Model m = mannequin();
   // Rebuild the clips under other names: only the names matter here.
   std::vector<anim::Clip> renamed;
   for (const char* name : {"Paladin_Idle", "WALK_cycle", "jog", "Shoot_Arrow", "strut"}) {
@@ -123,7 +123,7 @@ TEST(WorldRoles, NamesMatchCaseInsensitivelyAndJogIsARun) {
 }
 
 TEST(WorldRoles, WalkOnlyModelStillMakesAWorld) {
-  const editor::ImportedModel m = walk_only();
+  const character::Model m = walk_only();
   const ClipRoles roles = find_clip_roles(m);
   EXPECT_EQ(roles.idle, -1);
   EXPECT_EQ(roles.walk, 0);
@@ -155,7 +155,7 @@ TEST(WorldRoles, WalkOnlyModelStillMakesAWorld) {
 }
 
 TEST(WorldCreate, RejectsModelsWithoutAWalkAndBadOptions) {
-  editor::ImportedModel no_clips = mannequin();
+  character::Model no_clips = mannequin();
   no_clips.clips.clear();
   Expected<World> none = World::create(no_clips, WorldOptions{});
   ASSERT_FALSE(none.ok());
@@ -399,7 +399,7 @@ TEST(WorldPlayer, TabPassesControlOn) {
 }
 
 TEST(WorldPose, SettledIdleMatchesADirectSampleOfTheClip) {
-  const editor::ImportedModel& m = mannequin();
+  const character::Model& m = mannequin();
   const ClipRoles roles = find_clip_roles(m);
   WorldOptions o = single();
   o.model_to_world = Affine3::from_trs(Vec3(0.1f, 0.02f, -0.3f),
@@ -495,7 +495,7 @@ TEST(ScriptedInput, EdgesFireOnceAPeriodAndThePlayerKeepsMoving) {
 TEST(WorldCally, Cal3dModelWorks) {
   const std::string cfg = std::string(SINEW_SHARED_DIR) + "/content/cal3d/cally/cally.cfg";
   if (!std::filesystem::exists(cfg)) GTEST_SKIP() << cfg << " not present";
-  Expected<editor::ImportedModel> cally = editor::import_cal3d(cfg);
+  Expected<character::Model> cally = editor::import_cal3d(cfg);
   ASSERT_TRUE(cally.ok()) << cally.status().message();
   const ClipRoles roles = find_clip_roles(*cally);
   EXPECT_EQ(cally->clips[static_cast<std::size_t>(roles.walk)].name(), "walk");

@@ -18,8 +18,8 @@
 #include <vector>
 
 #include "animation/pose_space.h"
+#include "character/bake.h"
 #include "content/mannequin/mannequin.h"
-#include "editor/bake/in_memory_bake.h"
 #include "raytrace/camera/camera.h"
 #include "raytrace/render/packet_traversal.h"
 #include "raytrace/render/traversal.h"
@@ -45,7 +45,7 @@ using Mannequin = testing_support::BakedModel;
 using testing_support::idle_mannequin;
 
 
-std::vector<Affine3> pose(const editor::ImportedModel& model, const std::string& clip, double t,
+std::vector<Affine3> pose(const character::Model& model, const std::string& clip, double t,
                           const Affine3& instance = Affine3::identity()) {
   return testing_support::clip_pose(model, clip, t, instance);
 }

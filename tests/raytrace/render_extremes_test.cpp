@@ -14,11 +14,11 @@
 #include <vector>
 
 #include "animation/pose_space.h"
+#include "character/bake.h"
 #include "content/mannequin/mannequin.h"
-#include "editor/bake/in_memory_bake.h"
 #include "raytrace/camera/camera.h"
-#include "raytrace/render/renderer.h"
 #include "raytrace/render/packet_traversal.h"
+#include "raytrace/render/renderer.h"
 #include "raytrace/render/traversal.h"
 #include "raytrace/scene/scene.h"
 #include "runtime/jobs/job_system.h"
@@ -41,7 +41,7 @@ using Mannequin = testing_support::BakedModel;
 using testing_support::idle_mannequin;
 
 
-std::vector<Affine3> pose(const editor::ImportedModel& model, const std::string& clip, double t,
+std::vector<Affine3> pose(const character::Model& model, const std::string& clip, double t,
                           const Affine3& instance = Affine3::identity()) {
   return testing_support::clip_pose(model, clip, t, instance);
 }
@@ -207,12 +207,12 @@ TEST(RenderExtremes, ZeroAreaTrianglesNeverHitAndDoNotDisturbTheirNeighbours) {
     tri[2] = tri[1];
     if (t % 5 == 0) tri[1] = tri[0];
   }
-  editor::BakeRequest request;
+  character::BakeRequest request;
   request.pose_space.mode = anim::PoseSpaceMode::kClip;
   request.pose_space.clips = {"walk"};
   request.pose_space.samples = 0;
   JobSystem jobs(2);
-  m.bake = editor::bake_in_memory(m.model, request, jobs).value();
+  m.bake = character::bake_in_memory(m.model, request, jobs).value();
   const rt::Scene scene = scene_with(m, pose(m.model, "walk", 0.2), rt::FrameOptions{});
   const Checked checked = check_scene(scene, 3000, 13);
   EXPECT_EQ(checked.wrong, 0u) << checked.rays << " rays; first: " << checked.first;

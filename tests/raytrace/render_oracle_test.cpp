@@ -16,8 +16,8 @@
 #include <string>
 #include <vector>
 
+#include "character/bake.h"
 #include "content/mannequin/mannequin.h"
-#include "editor/bake/in_memory_bake.h"
 #include "editor/import/gltf_importer.h"
 #include "editor/mesh/subdivide.h"
 #include "raytrace/camera/camera.h"
@@ -69,7 +69,7 @@ struct Subject {
 // gtest prints parameters in test names and failures: show the model's name.
 void PrintTo(const Subject& subject, std::ostream* os) { *os << subject.name; }
 
-Expected<editor::ImportedModel> load(const Subject& subject) {
+Expected<character::Model> load(const Subject& subject) {
   const std::string shared = SINEW_SHARED_DIR;
   if (subject.name == "mannequin") return content::make_mannequin();
   if (subject.name == "cally") {
@@ -110,25 +110,25 @@ rt::StaticMeshDesc ground_under(const Aabb& box, int up) {
 // One model baked once in memory with the default pose space (every clip,
 // every key and every 1/30 s), and the samples that bake saw.
 struct Baked {
-  editor::ImportedModel model;
-  editor::InMemoryBake bake;
+  character::Model model;
+  character::InMemoryBake bake;
   std::vector<Affine3> samples;
   std::size_t bones = 0;
   std::size_t sample_count() const { return samples.size() / bones; }
   std::span<const Affine3> sample(std::size_t s) const { return std::span(samples).subspan(s * bones, bones); }
 };
 
-Baked bake(const Subject& subject, JobSystem& jobs, const editor::BakeRequest& request = {}) {
+Baked bake(const Subject& subject, JobSystem& jobs, const character::BakeRequest& request = {}) {
   Baked out;
   auto model = load(subject);
   EXPECT_TRUE(model.ok()) << model.status().message();
   if (!model.ok()) return out;
   out.model = std::move(model).value();
   out.bones = out.model.skeleton.joint_count();
-  auto samples = editor::pose_space_skinning(out.model, request.pose_space, request.limits);
+  auto samples = character::pose_space_skinning(out.model, request.pose_space, request.limits);
   EXPECT_TRUE(samples.ok()) << samples.status().message();
   out.samples = std::move(samples).value();
-  auto baked = editor::bake_in_memory(out.model, request, jobs);
+  auto baked = character::bake_in_memory(out.model, request, jobs);
   EXPECT_TRUE(baked.ok()) << baked.status().message();
   if (baked.ok()) out.bake = std::move(baked).value();
   return out;
@@ -309,14 +309,14 @@ TEST(SubdividedCallyOracle, LevelsOneToFourMatchBruteForce) {
     SCOPED_TRACE("level " + std::to_string(level));
     auto model = editor::subdivide(*cally, level);
     ASSERT_TRUE(model.ok()) << model.status().message();
-    editor::BakeRequest request;
+    character::BakeRequest request;
     request.pose_space.mode = anim::PoseSpaceMode::kClip;
     request.pose_space.clips = {"walk"};
     request.pose_space.samples = 6;
     request.pose_space.every_frame_30hz = false;
-    auto samples = editor::pose_space_skinning(*model, request.pose_space, {});
+    auto samples = character::pose_space_skinning(*model, request.pose_space, {});
     ASSERT_TRUE(samples.ok()) << samples.status().message();
-    auto baked = editor::bake_in_memory(*model, request, jobs);
+    auto baked = character::bake_in_memory(*model, request, jobs);
     ASSERT_TRUE(baked.ok()) << baked.status().message();
     const std::size_t bones = model->skeleton.joint_count();
     const std::size_t sample_count = samples->size() / bones;

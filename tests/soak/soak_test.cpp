@@ -41,13 +41,12 @@
 #include <string>
 #include <vector>
 
-#include "tests/support/aov_frame.h"
 #include "animation/blend.h"
 #include "animation/mixer.h"
 #include "animation/pose.h"
 #include "animation/pose_space.h"
+#include "character/bake.h"
 #include "content/mannequin/mannequin.h"
-#include "editor/bake/in_memory_bake.h"
 #include "game_demo/arena.h"
 #include "game_demo/demo_session.h"
 #include "game_demo/world.h"
@@ -56,6 +55,7 @@
 #include "raytrace/scene/scene.h"
 #include "runtime/jobs/job_system.h"
 #include "runtime/math/ray.h"
+#include "tests/support/aov_frame.h"
 
 #if defined(__SANITIZE_ADDRESS__)
 #define SINEW_SOAK_UNDER_ASAN 1
@@ -191,7 +191,7 @@ struct Puppet {
   anim::BlendScratch scratch;
   std::uint32_t instance = 0;
 
-  Puppet(const editor::ImportedModel& model, std::uint32_t id)
+  Puppet(const character::Model& model, std::uint32_t id)
       : local(model.skeleton.joint_count()),
         model_pose(model.skeleton.joint_count()),
         skin(model.skeleton.joint_count()),
@@ -200,7 +200,7 @@ struct Puppet {
     for (std::size_t k = 0; k < model.clips.size(); ++k) caches[k].reset(model.clips[k]);
   }
 
-  Status finish(const editor::ImportedModel& model, const Affine3& world) {
+  Status finish(const character::Model& model, const Affine3& world) {
     SINEW_RETURN_IF_ERROR(anim::local_to_model(model.skeleton, local, model_pose));
     return anim::skinning_matrices(model.skeleton, model_pose, world, skin);
   }
@@ -327,11 +327,11 @@ TEST(Soak, LongRandomRunKeepsMemoryFlatPoseSpaceInsideAndAovsClean) {
   const long rss_start = resident_bytes();
   auto made = content::make_mannequin();
   ASSERT_TRUE(made.ok()) << made.status().message();
-  const editor::ImportedModel& model = *made;
+  const character::Model& model = *made;
   const Affine3 to_world = model_to_world(model);
   // The demo's bake: every clip at its key times and every 1/30 s.
-  const editor::BakeRequest request;
-  auto bake = editor::bake_in_memory(model, request, jobs);
+  const character::BakeRequest request;
+  auto bake = character::bake_in_memory(model, request, jobs);
   ASSERT_TRUE(bake.ok()) << bake.status().message();
   ASSERT_EQ(request.pose_space.mode, anim::PoseSpaceMode::kClips);
   ASSERT_TRUE(request.pose_space.every_frame_30hz);

@@ -8,37 +8,37 @@
 #include <vector>
 
 #include "animation/pose_space.h"
+#include "character/bake.h"
 #include "content/mannequin/mannequin.h"
-#include "editor/bake/in_memory_bake.h"
 #include "runtime/jobs/job_system.h"
 
 namespace sinew::testing_support {
 
 struct BakedModel {
-  editor::ImportedModel model;
-  editor::InMemoryBake bake;
+  character::Model model;
+  character::InMemoryBake bake;
 };
 
 inline const BakedModel& idle_mannequin() {
   static const BakedModel m = [] {
     BakedModel out;
     out.model = content::make_mannequin().value();
-    editor::BakeRequest request;
+    character::BakeRequest request;
     request.pose_space.mode = anim::PoseSpaceMode::kClip;
     request.pose_space.clips = {"idle"};
     request.pose_space.samples = 0;
     request.pose_space.every_frame_30hz = false;
     JobSystem jobs(2);
-    out.bake = editor::bake_in_memory(out.model, request, jobs).value();
+    out.bake = character::bake_in_memory(out.model, request, jobs).value();
     return out;
   }();
   return m;
 }
 
 // The model posed by one clip alone at playback time `t`, placed by `instance`.
-inline std::vector<Affine3> clip_pose(const editor::ImportedModel& model, const std::string& clip, double t,
+inline std::vector<Affine3> clip_pose(const character::Model& model, const std::string& clip, double t,
                                       const Affine3& instance = Affine3::identity()) {
-  return editor::clip_skinning(model, *model.find_clip(clip), t, instance).value();
+  return character::clip_skinning(model, *model.find_clip(clip), t, instance).value();
 }
 
 }  // namespace sinew::testing_support

@@ -6,11 +6,11 @@
 
 #include <cstring>
 
-#include "editor/import/imported_model.h"
+#include "character/model.h"
 
 namespace sinew::testing_support {
 
-inline void expect_same_model(const editor::ImportedModel& a, const editor::ImportedModel& b) {
+inline void expect_same_model(const character::Model& a, const character::Model& b) {
   ASSERT_EQ(a.skeleton.joint_count(), b.skeleton.joint_count());
   for (std::size_t j = 0; j < a.skeleton.joint_count(); ++j) {
     EXPECT_EQ(a.skeleton.names()[j], b.skeleton.names()[j]);

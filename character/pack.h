@@ -4,7 +4,7 @@
 //
 // Loading copies the small, editable parts (skeleton, mesh, clips, limits)
 // into their usual types and leaves the fuzzy data where it lies: the
-// FuzzyCharacterView of a CharacterPack points into the mapped file, so a
+// FuzzyCharacterView of a Pack points into the mapped file, so a
 // 300k-triangle pack loads in milliseconds and renders bit-identically to
 // the in-memory bake it was written from. Every section is decoded with
 // bounds checks and validated (indices, counts, finite values, kd-tree
@@ -23,12 +23,12 @@
 
 #include "animation/joint_limits.h"
 #include "animation/pose_space.h"
-#include "editor/import/imported_model.h"
+#include "character/model.h"
 #include "raytrace/fuzzy/fuzzy_character.h"
 #include "runtime/core/expected.h"
 #include "runtime/pack/pack_reader.h"
 
-namespace sinew::editor {
+namespace sinew::character {
 
 // How the fuzzy boxes were sampled: enough to repeat the bake.
 struct PoseSpaceRecord {
@@ -49,8 +49,8 @@ struct Provenance {
 };
 
 // What goes into a pack. `fuzzy` null: a model-only pack.
-struct CharacterPackContents {
-  const ImportedModel* model = nullptr;
+struct PackContents {
+  const Model* model = nullptr;
   std::span<const anim::JointLimit> limits;  // empty: none stored
   const rt::FuzzyCharacterData* fuzzy = nullptr;
   PoseSpaceRecord pose_space;
@@ -58,22 +58,22 @@ struct CharacterPackContents {
 };
 
 // The pack's bytes: the same contents give the same bytes.
-Expected<std::vector<std::byte>> serialize_character_pack(const CharacterPackContents& contents);
+Expected<std::vector<std::byte>> serialize_pack(const PackContents& contents);
 // Written atomically: `path` keeps its old contents unless the whole new
 // pack is in place, and the new pack replaces it only after it loaded and
-// validated (CharacterPack::open) from the written bytes: a pack that
+// validated (Pack::open) from the written bytes: a pack that
 // would not load is never left behind.
-Status write_character_pack(const std::string& path, const CharacterPackContents& contents);
+Status write_pack(const std::string& path, const PackContents& contents);
 
-class CharacterPack {
+class Pack {
  public:
   // Maps and validates a pack file. Errors name the file, the section and
   // the field (`cally.pack: MESH.triangles[12]: index 9999 ...`).
-  static Expected<CharacterPack> open(const std::string& path);
+  static Expected<Pack> open(const std::string& path);
   // The same over bytes the caller keeps alive (tests, fuzzing).
-  static Expected<CharacterPack> from_bytes(std::span<const std::byte> bytes, const std::string& name);
+  static Expected<Pack> from_bytes(std::span<const std::byte> bytes, const std::string& name);
 
-  const ImportedModel& model() const { return model_; }
+  const Model& model() const { return model_; }
   std::span<const anim::JointLimit> limits() const { return limits_; }
   bool has_fuzzy() const { return has_fuzzy_; }
   // Spans into the pack (valid while this object lives; moving keeps them valid).
@@ -83,15 +83,15 @@ class CharacterPack {
   const Provenance& provenance() const { return provenance_; }
   const PackReader& reader() const { return reader_; }
 
-  CharacterPack(CharacterPack&&) noexcept = default;
-  CharacterPack& operator=(CharacterPack&&) noexcept = default;
+  Pack(Pack&&) noexcept = default;
+  Pack& operator=(Pack&&) noexcept = default;
 
  private:
-  explicit CharacterPack(PackReader reader) : reader_(std::move(reader)) {}
-  static Expected<CharacterPack> load(PackReader reader);
+  explicit Pack(PackReader reader) : reader_(std::move(reader)) {}
+  static Expected<Pack> load(PackReader reader);
 
   PackReader reader_;
-  ImportedModel model_;
+  Model model_;
   anim::JointLimits limits_;
   bool has_fuzzy_ = false;
   rt::FuzzyCharacterView fuzzy_;
@@ -103,4 +103,4 @@ class CharacterPack {
 // True when `path` names a content pack by its extension (".pack").
 bool is_pack_path(const std::string& path);
 
-}  // namespace sinew::editor
+}  // namespace sinew::character

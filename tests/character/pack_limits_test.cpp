@@ -12,8 +12,8 @@
 #include <vector>
 
 #include "animation/joint_limits.h"
+#include "character/pack.h"
 #include "content/mannequin/mannequin.h"
-#include "editor/pack/character_pack.h"
 #include "runtime/pack/pack_reader.h"
 #include "tests/support/repack.h"
 
@@ -27,13 +27,13 @@ class PackLimits : public testing::Test {
   static void SetUpTestSuite() {
     auto model = content::make_mannequin();
     ASSERT_TRUE(model.ok());
-    model_ = new ImportedModel(std::move(*model));
+    model_ = new character::Model(std::move(*model));
     limits_ = new anim::JointLimits(content::mannequin_joint_limits(model_->skeleton));
-    CharacterPackContents c;
+    character::PackContents c;
     c.model = model_;
     c.limits = *limits_;
     c.provenance.source_name = "mannequin";
-    auto bytes = serialize_character_pack(c);
+    auto bytes = character::serialize_pack(c);
     ASSERT_TRUE(bytes.ok()) << bytes.status().message();
     bytes_ = new std::vector<std::byte>(std::move(*bytes));
   }
@@ -65,14 +65,14 @@ class PackLimits : public testing::Test {
   // Loading must fail with `code`, the message naming the pack and `says`.
   static void expect_refused(const std::vector<std::byte>& bytes, const std::string& says,
                              ErrorCode code = ErrorCode::kInvalidData) {
-    auto pack = CharacterPack::from_bytes(bytes, "corrupt.pack");
+    auto pack = character::Pack::from_bytes(bytes, "corrupt.pack");
     ASSERT_FALSE(pack.ok()) << "accepted; expected an error saying " << says;
     EXPECT_EQ(pack.status().code(), code) << pack.status().message();
     EXPECT_NE(pack.status().message().find("corrupt.pack"), std::string::npos) << pack.status().message();
     EXPECT_NE(pack.status().message().find(says), std::string::npos) << pack.status().message();
   }
 
-  static inline ImportedModel* model_ = nullptr;
+  static inline character::Model* model_ = nullptr;
   static inline anim::JointLimits* limits_ = nullptr;
   static inline std::vector<std::byte>* bytes_ = nullptr;
 };
@@ -81,7 +81,7 @@ TEST_F(PackLimits, ReadBackBitForBit) {
   ASSERT_EQ(limits_->size(), model_->skeleton.joint_count());
   first_of(anim::LimitKind::kEuler);
   first_of(anim::LimitKind::kSwingTwist);
-  auto pack = CharacterPack::from_bytes(*bytes_, "limits.pack");
+  auto pack = character::Pack::from_bytes(*bytes_, "limits.pack");
   ASSERT_TRUE(pack.ok()) << pack.status().message();
   ASSERT_EQ(pack->limits().size(), limits_->size());
   const auto bits = [](const Vec3& v) {
@@ -143,10 +143,10 @@ TEST_F(PackLimits, OldJsonAndUnknownVersionsAskForARebake) {
 }
 
 TEST_F(PackLimits, LimitsForAnotherSkeletonAreNotWritten) {
-  CharacterPackContents c;
+  character::PackContents c;
   c.model = model_;
   c.limits = std::span<const anim::JointLimit>(limits_->data(), limits_->size() - 1);
-  const auto bytes = serialize_character_pack(c);
+  const auto bytes = character::serialize_pack(c);
   ASSERT_FALSE(bytes.ok());
   EXPECT_NE(bytes.status().message().find("contents.limits"), std::string::npos) << bytes.status().message();
 }

@@ -15,10 +15,10 @@
 #include <string>
 #include <vector>
 
+#include "character/bake.h"
+#include "character/framing.h"
+#include "character/pack.h"
 #include "content/mannequin/mannequin.h"
-#include "editor/bake/in_memory_bake.h"
-#include "editor/cli/render_command.h"
-#include "editor/pack/character_pack.h"
 #include "raytrace/camera/camera.h"
 #include "raytrace/render/renderer.h"
 #include "raytrace/scene/scene.h"
@@ -35,14 +35,14 @@ namespace sinew::editor {
 namespace {
 
 struct Baked {
-  ImportedModel model;
+  character::Model model;
   rt::FuzzyCharacterData fuzzy;
-  PoseSpaceRecord pose_space;
+  character::PoseSpaceRecord pose_space;
 };
 
-Baked bake(ImportedModel model, JobSystem& jobs, const BakeRequest& request = {}) {
+Baked bake(character::Model model, JobSystem& jobs, const character::BakeRequest& request = {}) {
   Baked b;
-  auto baked = bake_in_memory(model, request, jobs);
+  auto baked = character::bake_in_memory(model, request, jobs);
   EXPECT_TRUE(baked.ok()) << baked.status().message();
   if (baked.ok()) b.fuzzy = std::move(baked->fuzzy);
   b.pose_space.desc = request.pose_space;
@@ -52,8 +52,8 @@ Baked bake(ImportedModel model, JobSystem& jobs, const BakeRequest& request = {}
   return b;
 }
 
-CharacterPackContents contents_of(const Baked& b) {
-  CharacterPackContents c;
+character::PackContents contents_of(const Baked& b) {
+  character::PackContents c;
   c.model = &b.model;
   c.fuzzy = &b.fuzzy;
   c.pose_space = b.pose_space;
@@ -63,7 +63,7 @@ CharacterPackContents contents_of(const Baked& b) {
 }
 
 std::vector<std::byte> pack_bytes(const Baked& b) {
-  auto bytes = serialize_character_pack(contents_of(b));
+  auto bytes = character::serialize_pack(contents_of(b));
   EXPECT_TRUE(bytes.ok()) << bytes.status().message();
   return bytes.ok() ? std::move(*bytes) : std::vector<std::byte>{};
 }
@@ -79,7 +79,7 @@ struct Image {
 // `strict`: every step must succeed. Damaged packs that still load may pose
 // the character anywhere (huge but finite matrices): then only the absence
 // of crashes and sanitizer reports is asserted.
-Image render(const ImportedModel& model, const rt::FuzzyCharacterView& fuzzy, JobSystem& jobs, bool strict = true) {
+Image render(const character::Model& model, const rt::FuzzyCharacterView& fuzzy, JobSystem& jobs, bool strict = true) {
   constexpr int kSize = 96;
   Image image;
   rt::Scene scene;
@@ -89,7 +89,7 @@ Image render(const ImportedModel& model, const rt::FuzzyCharacterView& fuzzy, Jo
   auto instance = scene.add_instance(*character);
   EXPECT_TRUE(instance.ok());
   if (!model.clips.empty()) {
-    auto skinning = clip_skinning(model, model.clips.front(), 0.37);
+    auto skinning = character::clip_skinning(model, model.clips.front(), 0.37);
     EXPECT_TRUE(!strict || skinning.ok()) << skinning.status().message();
     if (!skinning.ok()) return image;
     const Status bones = scene.set_bones(*instance, *skinning);
@@ -98,8 +98,8 @@ Image render(const ImportedModel& model, const rt::FuzzyCharacterView& fuzzy, Jo
   const auto frame = scene.prepare_frame(rt::FrameOptions{}, jobs);
   EXPECT_TRUE(!strict || frame.ok());
   if (!frame.ok()) return image;
-  const int up = up_axis_of(rest_bounds(model));
-  auto camera = rt::PinholeCamera::create(default_camera(posed_bounds(scene), up, kSize, kSize), kSize, kSize);
+  const int up = character::up_axis_of(character::rest_bounds(model));
+  auto camera = rt::PinholeCamera::create(character::default_camera(character::posed_bounds(scene), up, kSize, kSize), kSize, kSize);
   EXPECT_TRUE(!strict || camera.ok()) << camera.status().message();
   if (!camera.ok()) return image;
   image.rgba.resize(kSize * kSize * 4);
@@ -110,21 +110,21 @@ Image render(const ImportedModel& model, const rt::FuzzyCharacterView& fuzzy, Jo
   buffers.color_rgba8 = image.rgba;
   buffers.triangle_id = image.triangles;
   rt::RenderSettings settings;
-  settings.light.position = default_light(posed_bounds(scene), up);
+  settings.light.position = character::default_light(character::posed_bounds(scene), up);
   auto stats = rt::Renderer().render(scene, *camera, settings, buffers, jobs);
   EXPECT_TRUE(!strict || stats.ok()) << stats.status().message();
   return image;
 }
 
-void check_round_trip(ImportedModel model) {
+void check_round_trip(character::Model model) {
   JobSystem jobs(2);
   const Baked baked = bake(std::move(model), jobs);
   const Image in_memory = render(baked.model, baked.fuzzy.view(), jobs);
 
   // Through a file, mapped.
   const std::string path = (std::filesystem::temp_directory_path() / "sinew_character_pack_test.pack").string();
-  ASSERT_TRUE(write_character_pack(path, contents_of(baked)).ok());
-  auto pack = CharacterPack::open(path);
+  ASSERT_TRUE(character::write_pack(path, contents_of(baked)).ok());
+  auto pack = character::Pack::open(path);
   ASSERT_TRUE(pack.ok()) << pack.status().message();
   ASSERT_TRUE(pack->has_fuzzy());
   testing_support::expect_same_model(baked.model, pack->model());
@@ -155,13 +155,13 @@ TEST(CharacterPack, APackThatWouldNotLoadReplacesNothing) {
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   const std::string path = (dir / "character.pack").string();
-  ASSERT_TRUE(write_character_pack(path, contents_of(good)).ok());
+  ASSERT_TRUE(character::write_pack(path, contents_of(good)).ok());
   const auto read_all = [&] { return read_file_text(path).value(); };
   const std::string before = read_all();
   Baked broken = good;
   broken.model.mesh.positions[0].y = std::numeric_limits<float>::quiet_NaN();
-  ASSERT_TRUE(serialize_character_pack(contents_of(broken)).ok()) << "the writer alone does not see it";
-  const Status s = write_character_pack(path, contents_of(broken));
+  ASSERT_TRUE(character::serialize_pack(contents_of(broken)).ok()) << "the writer alone does not see it";
+  const Status s = character::write_pack(path, contents_of(broken));
   ASSERT_FALSE(s.ok());
   EXPECT_EQ(s.file(), path);
   EXPECT_NE(s.message().find("the written pack does not load, so nothing was replaced"), std::string::npos)
@@ -193,7 +193,7 @@ TEST(CharacterPack, CallyRoundTripRendersBitIdentically) {
 
 TEST(CharacterPack, TheSameInputsAndSeedGiveTheSameBytes) {
   JobSystem jobs(2);
-  BakeRequest request;
+  character::BakeRequest request;
   request.pose_space.mode = anim::PoseSpaceMode::kArbitrary;
   request.pose_space.samples = 40;
   request.pose_space.seed = 7;
@@ -213,21 +213,21 @@ TEST(CharacterPack, PoseSpaceAndProvenanceRoundTrip) {
   JobSystem jobs(2);
   auto model = content::make_mannequin();
   ASSERT_TRUE(model.ok());
-  BakeRequest request;
+  character::BakeRequest request;
   request.pose_space.mode = anim::PoseSpaceMode::kClip;
   request.pose_space.clips = {model->clips.front().name()};
   request.pose_space.samples = 0;
   request.pose_space.every_frame_30hz = true;
   request.fuzzy.candidates = rt::CandidateBones::kInfluencing;
   Baked baked = bake(std::move(*model), jobs, request);
-  CharacterPackContents c = contents_of(baked);
+  character::PackContents c = contents_of(baked);
   c.provenance.source_name = "mannequin.glb";
   c.provenance.source_hash = 0x0123456789abcdefull;
   c.provenance.bake_unix_time = 1'700'000'000;
   c.provenance.build_ms = 12.5;
-  auto bytes = serialize_character_pack(c);
+  auto bytes = character::serialize_pack(c);
   ASSERT_TRUE(bytes.ok());
-  auto pack = CharacterPack::from_bytes(*bytes, "mem.pack");
+  auto pack = character::Pack::from_bytes(*bytes, "mem.pack");
   ASSERT_TRUE(pack.ok()) << pack.status().message();
   EXPECT_EQ(pack->pose_space().desc.mode, anim::PoseSpaceMode::kClip);
   EXPECT_EQ(pack->pose_space().desc.clips, request.pose_space.clips);
@@ -239,9 +239,9 @@ TEST(CharacterPack, PoseSpaceAndProvenanceRoundTrip) {
   EXPECT_EQ(pack->provenance().build_ms, 12.5);
   // A model-only pack loads without fuzzy data.
   c.fuzzy = nullptr;
-  auto model_only = serialize_character_pack(c);
+  auto model_only = character::serialize_pack(c);
   ASSERT_TRUE(model_only.ok());
-  auto loaded = CharacterPack::from_bytes(*model_only, "model.pack");
+  auto loaded = character::Pack::from_bytes(*model_only, "model.pack");
   ASSERT_TRUE(loaded.ok()) << loaded.status().message();
   EXPECT_FALSE(loaded->has_fuzzy());
   testing_support::expect_same_model(baked.model, loaded->model());
@@ -277,7 +277,7 @@ class CorruptPack : public testing::Test {
 
   // Loading must fail, naming `section` in the message.
   static void expect_rejected(const std::vector<std::byte>& bytes, const std::string& section) {
-    auto pack = CharacterPack::from_bytes(bytes, "corrupt.pack");
+    auto pack = character::Pack::from_bytes(bytes, "corrupt.pack");
     ASSERT_FALSE(pack.ok()) << "a corrupt " << section << " was accepted";
     EXPECT_NE(pack.status().message().find("corrupt.pack"), std::string::npos) << pack.status().message();
     EXPECT_NE(pack.status().message().find(section), std::string::npos) << pack.status().message();
@@ -288,7 +288,7 @@ class CorruptPack : public testing::Test {
 };
 
 TEST_F(CorruptPack, ThePristinePackLoads) {
-  auto pack = CharacterPack::from_bytes(*bytes_, "pristine.pack");
+  auto pack = character::Pack::from_bytes(*bytes_, "pristine.pack");
   ASSERT_TRUE(pack.ok()) << pack.status().message();
 }
 
@@ -298,7 +298,7 @@ TEST_F(CorruptPack, TruncationAtEverySectionIsRefused) {
   for (const SectionInfo& s : reader->sections()) {
     for (std::uint64_t cut : {s.offset, s.offset + s.size / 2}) {
       std::vector<std::byte> cut_bytes(bytes_->begin(), bytes_->begin() + static_cast<std::ptrdiff_t>(cut));
-      auto pack = CharacterPack::from_bytes(cut_bytes, "cut.pack");
+      auto pack = character::Pack::from_bytes(cut_bytes, "cut.pack");
       EXPECT_FALSE(pack.ok()) << "cut at " << cut << " in " << section_id_name(s.id);
     }
   }
@@ -311,7 +311,7 @@ TEST_F(CorruptPack, AFlippedByteInEverySectionIsRefusedByItsChecksum) {
     if (s.size == 0) continue;
     std::vector<std::byte> flipped = *bytes_;
     flipped[s.offset + s.size / 3] ^= std::byte{0x40};
-    auto pack = CharacterPack::from_bytes(flipped, "flipped.pack");
+    auto pack = character::Pack::from_bytes(flipped, "flipped.pack");
     ASSERT_FALSE(pack.ok()) << section_id_name(s.id);
     EXPECT_EQ(pack.status().code(), ErrorCode::kChecksumMismatch) << pack.status().message();
   }
@@ -394,7 +394,7 @@ TEST_F(CorruptPack, WellFormedButInconsistentFuzzyDataIsRefused) {
       {make_section_id("FTCK"), "FTCK"}};
   for (const auto& [id, name] : sections) {
     const auto zeroed = repack(id, [](auto& p) { std::fill(p.begin(), p.end(), std::byte{0}); });
-    auto pack = CharacterPack::from_bytes(zeroed, "corrupt.pack");
+    auto pack = character::Pack::from_bytes(zeroed, "corrupt.pack");
     EXPECT_FALSE(pack.ok()) << name << " zeroed was accepted";
   }
   // Two bones with triangles swap their tree entries (48 bytes each).
@@ -447,7 +447,7 @@ TEST_F(CorruptPack, RandomDamageNeverCrashes) {
       const auto bytes = repack(s.id, [&](std::vector<std::byte>& p) {
         for (int k = 0; k < 3; ++k) p[random() % p.size()] = static_cast<std::byte>(random() & 0xffu);
       });
-      auto pack = CharacterPack::from_bytes(bytes, "damaged.pack");
+      auto pack = character::Pack::from_bytes(bytes, "damaged.pack");
       if (!pack.ok()) {
         ++refused;
         continue;

@@ -1,4 +1,4 @@
-#include "editor/bake/in_memory_bake.h"
+#include "character/bake.h"
 
 #include <algorithm>
 #include <chrono>
@@ -9,7 +9,7 @@
 #include "runtime/jobs/job_system.h"
 #include "runtime/timing/stopwatch.h"
 
-namespace sinew::editor {
+namespace sinew::character {
 namespace {
 
 Status append_skinning(const anim::Skeleton& skeleton, std::span<const anim::JointTransform> local,
@@ -41,7 +41,7 @@ anim::PoseSpaceDesc default_pose_space() {
   return space;
 }
 
-Expected<std::vector<Affine3>> pose_space_skinning(const ImportedModel& model,
+Expected<std::vector<Affine3>> pose_space_skinning(const Model& model,
                                                    const anim::PoseSpaceDesc& space,
                                                    std::span<const anim::JointLimit> limits,
                                                    std::size_t max_bytes) {
@@ -61,7 +61,18 @@ Expected<std::vector<Affine3>> pose_space_skinning(const ImportedModel& model,
   return out;
 }
 
-Expected<std::vector<Affine3>> clip_skinning(const ImportedModel& model, const anim::Clip& clip,
+Expected<std::vector<Affine3>> rest_skinning(const Model& model, const Affine3& placement) {
+  const std::size_t joints = model.skeleton.joint_count();
+  std::vector<anim::JointTransform> local(joints);
+  std::vector<Affine3> model_space(joints);
+  std::vector<Affine3> skin(joints);
+  SINEW_RETURN_IF_ERROR(anim::rest_pose(model.skeleton, local));
+  SINEW_RETURN_IF_ERROR(anim::local_to_model(model.skeleton, local, model_space));
+  SINEW_RETURN_IF_ERROR(anim::skinning_matrices(model.skeleton, model_space, placement, skin));
+  return skin;
+}
+
+Expected<std::vector<Affine3>> clip_skinning(const Model& model, const anim::Clip& clip,
                                              double seconds, const Affine3& instance) {
   std::vector<anim::JointTransform> local(model.skeleton.joint_count());
   SINEW_RETURN_IF_ERROR(anim::rest_pose(model.skeleton, local));
@@ -73,7 +84,7 @@ Expected<std::vector<Affine3>> clip_skinning(const ImportedModel& model, const a
   return out;
 }
 
-Expected<InMemoryBake> bake_in_memory(const ImportedModel& model, const BakeRequest& request, JobSystem& jobs) {
+Expected<InMemoryBake> bake_in_memory(const Model& model, const BakeRequest& request, JobSystem& jobs) {
   InMemoryBake bake;
   // The fuzzy bake holds an inverse per sample matrix beside its boxes.
   if (request.max_memory_bytes <= request.fuzzy.memory_budget_bytes) {
@@ -97,4 +108,4 @@ Expected<InMemoryBake> bake_in_memory(const ImportedModel& model, const BakeRequ
   return bake;
 }
 
-}  // namespace sinew::editor
+}  // namespace sinew::character

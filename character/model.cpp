@@ -1,4 +1,4 @@
-#include "editor/import/imported_model.h"
+#include "character/model.h"
 
 #include <charconv>
 #include <cmath>
@@ -6,7 +6,7 @@
 
 #include "runtime/core/format_number.h"
 
-namespace sinew::editor {
+namespace sinew::character {
 namespace {
 
 std::string weight_field(std::size_t v) { return "weights[" + std::to_string(v) + "]"; }
@@ -14,7 +14,7 @@ std::string weight_field(std::size_t v) { return "weights[" + std::to_string(v) 
 
 }  // namespace
 
-const anim::Clip* ImportedModel::find_clip(const std::string& name) const {
+const anim::Clip* Model::find_clip(const std::string& name) const {
   if (!name.empty() && name[0] == '#') {
     std::size_t index = 0;
     const char* first = name.data() + 1;
@@ -67,4 +67,4 @@ Status normalize_skin_weights(SkinnedMesh& mesh, std::string_view source, std::v
   return {};
 }
 
-}  // namespace sinew::editor
+}  // namespace sinew::character

@@ -1,4 +1,4 @@
-#include "editor/pack/character_pack.h"
+#include "character/pack.h"
 
 #include <cmath>
 #include <cstring>
@@ -7,7 +7,7 @@
 #include "runtime/pack/pack_writer.h"
 #include "runtime/pack/section_codec.h"
 
-namespace sinew::editor {
+namespace sinew::character {
 namespace {
 
 // Section ids and the payload versions this build writes and reads.
@@ -55,7 +55,7 @@ std::vector<std::byte> encode_skeleton(const anim::Skeleton& skeleton) {
   return std::move(e.bytes());
 }
 
-std::vector<std::byte> encode_mesh(const ImportedModel& model) {
+std::vector<std::byte> encode_mesh(const Model& model) {
   const SkinnedMesh& m = model.mesh;
   SectionEncoder e;
   e.put(static_cast<std::uint32_t>(m.vertex_count()));
@@ -207,7 +207,7 @@ Expected<anim::Skeleton> decode_skeleton(SectionDecoder& d) {
   return std::move(*skeleton);
 }
 
-Status decode_mesh(SectionDecoder& d, std::size_t joint_count, ImportedModel& model) {
+Status decode_mesh(SectionDecoder& d, std::size_t joint_count, Model& model) {
   SkinnedMesh& m = model.mesh;
   std::uint32_t vertices = 0, triangles = 0, materials = 0;
   std::uint8_t has_normals = 0, has_uvs = 0, has_triangle_material = 0, has_names = 0;
@@ -447,7 +447,7 @@ bool is_pack_path(const std::string& path) {
 
 namespace {
 
-Expected<PackWriter> character_pack_writer(const CharacterPackContents& c) {
+Expected<PackWriter> character_pack_writer(const PackContents& c) {
   if (c.model == nullptr) return invalid_argument("contents.model", "null", "a pack needs a model");
   PackWriter w;
   SINEW_RETURN_IF_ERROR(w.add_section(kSkeleton, kSectionVersion, encode_skeleton(c.model->skeleton)));
@@ -491,33 +491,33 @@ Expected<PackWriter> character_pack_writer(const CharacterPackContents& c) {
 
 }  // namespace
 
-Expected<std::vector<std::byte>> serialize_character_pack(const CharacterPackContents& contents) {
+Expected<std::vector<std::byte>> serialize_pack(const PackContents& contents) {
   SINEW_ASSIGN_OR_RETURN(const PackWriter writer, character_pack_writer(contents));
   return writer.serialize();
 }
 
-Status write_character_pack(const std::string& path, const CharacterPackContents& contents) {
+Status write_pack(const std::string& path, const PackContents& contents) {
   SINEW_ASSIGN_OR_RETURN(const PackWriter writer, character_pack_writer(contents));
   return writer.write(path, [](const std::string& written) -> Status {
-    auto loaded = CharacterPack::open(written);
+    auto loaded = Pack::open(written);
     if (loaded.ok()) return {};
     return make_error(loaded.status().code(), "", "", "",
                       "the written pack does not load, so nothing was replaced: " + loaded.status().message());
   });
 }
 
-Expected<CharacterPack> CharacterPack::open(const std::string& path) {
+Expected<Pack> Pack::open(const std::string& path) {
   SINEW_ASSIGN_OR_RETURN(PackReader reader, PackReader::open(path));
   return load(std::move(reader));
 }
 
-Expected<CharacterPack> CharacterPack::from_bytes(std::span<const std::byte> bytes, const std::string& name) {
+Expected<Pack> Pack::from_bytes(std::span<const std::byte> bytes, const std::string& name) {
   SINEW_ASSIGN_OR_RETURN(PackReader reader, PackReader::from_bytes(bytes, name));
   return load(std::move(reader));
 }
 
-Expected<CharacterPack> CharacterPack::load(PackReader reader) {
-  CharacterPack pack(std::move(reader));
+Expected<Pack> Pack::load(PackReader reader) {
+  Pack pack(std::move(reader));
   const PackReader& r = pack.reader_;
   for (SectionId id : {kSkeleton, kMesh, kClips, kPoseSpace, kProvenance}) SINEW_RETURN_IF_ERROR(check_version(r, id));
   pack.model_.source = r.name();
@@ -612,4 +612,4 @@ Expected<CharacterPack> CharacterPack::load(PackReader reader) {
   return pack;
 }
 
-}  // namespace sinew::editor
+}  // namespace sinew::character

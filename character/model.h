@@ -1,4 +1,4 @@
-// ImportedModel: what every importer produces (docs/ANIMATION.md, "Importers"), in
+// Model: what every importer produces (docs/ANIMATION.md, "Importers"), in
 // Sinew's own types. Importers are the only code that knows file formats
 // other than the content pack.
 //
@@ -13,7 +13,7 @@
 // with a positive sum; rows that do not sum to 1 are divided by their sum.
 // Rows off by more than kSkinWeightSumTolerance (a file that meant
 // something else, e.g. weights summing to 0.5 or 2) are also reported in
-// ImportedModel::warnings, so the caller can show them; rounding-level
+// Model::warnings, so the caller can show them; rounding-level
 // differences (8-bit glTF weights) are renormalised silently.
 #pragma once
 
@@ -26,9 +26,9 @@
 #include "runtime/core/status.h"
 #include "runtime/mesh/skinned_mesh.h"
 
-namespace sinew::editor {
+namespace sinew::character {
 
-struct ImportedModel {
+struct Model {
   std::string source;  // the file it came from
   anim::Skeleton skeleton;
   SkinnedMesh mesh;  // joint indices refer to skeleton's (sorted) joint order
@@ -54,8 +54,8 @@ inline constexpr double kSkinWeightSumTolerance = 0.01;
 Status normalize_skin_weights(SkinnedMesh& mesh, std::string_view source, std::vector<std::string>& warnings);
 
 // The same for a whole model, warnings going to model.warnings.
-inline Status normalize_skin_weights(ImportedModel& model) {
+inline Status normalize_skin_weights(Model& model) {
   return normalize_skin_weights(model.mesh, model.source, model.warnings);
 }
 
-}  // namespace sinew::editor
+}  // namespace sinew::character

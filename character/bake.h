@@ -13,7 +13,7 @@
 
 #include "animation/joint_limits.h"
 #include "animation/pose_space.h"
-#include "editor/import/imported_model.h"
+#include "character/model.h"
 #include "raytrace/fuzzy/fuzzy_bake.h"
 #include "runtime/core/expected.h"
 #include "runtime/math/affine.h"
@@ -22,7 +22,7 @@ namespace sinew {
 class JobSystem;
 }
 
-namespace sinew::editor {
+namespace sinew::character {
 
 // The pose space `render` bakes by default: every clip of the model, at
 // every key time and every 1/30 s.
@@ -34,15 +34,19 @@ anim::PoseSpaceDesc default_pose_space();
 // `max_bytes` bounds the matrices produced: a space that would need more is
 // refused (kLimitExceeded, field "pose_space") as soon as it passes the
 // bound, so the refusal costs at most `max_bytes`.
-Expected<std::vector<Affine3>> pose_space_skinning(const ImportedModel& model,
+Expected<std::vector<Affine3>> pose_space_skinning(const Model& model,
                                                    const anim::PoseSpaceDesc& space,
                                                    std::span<const anim::JointLimit> limits,
                                                    std::size_t max_bytes = SIZE_MAX);
 
 // Skinning matrices of the model posed by one clip alone at weight 1 at
 // playback time `seconds` (looping), placed in the world by `instance`.
-Expected<std::vector<Affine3>> clip_skinning(const ImportedModel& model, const anim::Clip& clip,
+Expected<std::vector<Affine3>> clip_skinning(const Model& model, const anim::Clip& clip,
                                              double seconds, const Affine3& instance = Affine3::identity());
+
+// Skinning matrices of the model at its skeleton's rest pose, placed in the
+// world by `placement`.
+Expected<std::vector<Affine3>> rest_skinning(const Model& model, const Affine3& placement = Affine3::identity());
 
 struct BakeRequest {
   anim::PoseSpaceDesc pose_space = default_pose_space();
@@ -75,6 +79,6 @@ struct InMemoryBake {
 // pose space needs more than that room (refused while sampling, before the
 // matrices outgrow the bound).
 
-Expected<InMemoryBake> bake_in_memory(const ImportedModel& model, const BakeRequest& request, JobSystem& jobs);
+Expected<InMemoryBake> bake_in_memory(const Model& model, const BakeRequest& request, JobSystem& jobs);
 
-}  // namespace sinew::editor
+}  // namespace sinew::character

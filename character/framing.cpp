@@ -1,0 +1,102 @@
+#include "character/framing.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "character/bake.h"
+#include "raytrace/skinning/skinning.h"
+
+namespace sinew::character {
+namespace {
+
+constexpr double kInstanceTimeStep = 0.37;  // seconds between instances' clip times
+constexpr float kInstanceSpacing = 1.2f;    // x the rest bounds' largest extent
+constexpr float kDefaultFovyDegrees = 40.0f;
+
+Vec3 axis_vector(int axis, float sign = 1.0f) {
+  Vec3 v(0.0f);
+  v[axis] = sign;
+  return v;
+}
+
+Vec3 front_of(int up) { return up == 1 ? axis_vector(2) : axis_vector(1, -1.0f); }
+
+float bounding_radius(const Aabb& box) { return std::max(0.5f * glm::length(box.extent()), 1e-6f); }
+
+}  // namespace
+
+Aabb posed_bounds(const rt::Scene& scene) {
+  Aabb box;
+  for (const rt::InstanceFrame& frame : scene.instances()) {
+    for (const Vec3& p : frame.positions) box.extend(p);
+  }
+  return box;
+}
+
+rt::CameraDesc default_camera(const Aabb& box, int up, int width, int height) {
+  const float radius = bounding_radius(box);
+  const float half_fovy = glm::radians(0.5f * kDefaultFovyDegrees);
+  const float aspect = static_cast<float>(width) / static_cast<float>(height);
+  const float half_fovx = std::atan(std::tan(half_fovy) * aspect);
+  const float distance = 1.15f * radius / std::sin(std::min(half_fovy, half_fovx));
+  const Vec3 view = glm::normalize(front_of(up) + 0.2f * axis_vector(up));
+  return {box.center() + distance * view, box.center(), axis_vector(up), kDefaultFovyDegrees};
+}
+
+Vec3 default_light(const Aabb& box, int up) {
+  const float radius = bounding_radius(box);
+  return box.center() + radius * (2.0f * front_of(up) + 3.0f * axis_vector(up) + axis_vector(0));
+}
+
+Aabb rest_bounds(const Model& model) {
+  Aabb box;
+  const auto skin = rest_skinning(model, Affine3::identity());
+  if (!skin.ok()) return box;
+  for (std::size_t v = 0; v < model.mesh.vertex_count(); ++v) box.extend(rt::skin_point(model.mesh, v, *skin));
+  return box;
+}
+
+int up_axis_of(const Aabb& rest) {
+  const Vec3 e = rest.extent();
+  return e.y >= e.z ? 1 : 2;
+}
+
+Affine3 instance_placement(const Aabb& rest, int index) {
+  const Vec3 e = rest.extent();
+  const float spacing = kInstanceSpacing * std::max({e.x, e.y, e.z});
+  return Affine3::translation(axis_vector(0, static_cast<float>(index) * spacing));
+}
+
+double instance_time_offset(int index) { return kInstanceTimeStep * index; }
+
+rt::StaticMeshDesc ground_plane_for(const Aabb& rest, int instances) {
+  const int up = up_axis_of(rest);
+  const Vec3 e = rest.extent();
+  const float largest = std::max({e.x, e.y, e.z, 1e-3f});
+  // Centred under the row of instances and reaching well past it, so the
+  // ground fills the background of the default camera.
+  const Vec3 row_end = instance_placement(rest, std::max(instances - 1, 0)).translation_part();
+  const Vec3 centre = rest.center() + 0.5f * row_end;
+  const float reach = 10.0f * largest + 0.5f * glm::length(row_end);
+  const int a = (up + 1) % 3;
+  const int b = (up + 2) % 3;
+  rt::StaticMeshDesc ground;
+  for (int corner = 0; corner < 4; ++corner) {
+    Vec3 p(0.0f);
+    p[up] = rest.lower[up];
+    p[a] = centre[a] + ((corner & 1) ? reach : -reach);
+    p[b] = centre[b] + ((corner & 2) ? reach : -reach);
+    ground.positions.push_back(p);
+  }
+  ground.triangles = {{0, 1, 3}, {0, 3, 2}};
+  ground.material_colors = {Vec3(0.5f)};
+  return ground;
+}
+
+rt::StaticMeshDesc ground_plane_for(const Model& model, int instances) {
+  return ground_plane_for(rest_bounds(model), instances);
+}
+
+// --- the command --------------------------------------------------------------
+
+}  // namespace sinew::character
