@@ -4,6 +4,7 @@
 #include <cstring>
 #include <utility>
 
+#include "runtime/mesh/mesh_checks.h"
 #include "runtime/pack/pack_writer.h"
 #include "runtime/pack/section_codec.h"
 
@@ -35,8 +36,6 @@ constexpr std::uint32_t kLimitsVersion = 2;
 constexpr std::uint32_t kMaxClips = 65536;
 constexpr std::uint32_t kMaxMaterials = 65536;
 
-bool finite(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
-bool finite(const Vec2& v) { return std::isfinite(v.x) && std::isfinite(v.y); }
 
 // --- encoding ------------------------------------------------------------------
 
@@ -236,35 +235,7 @@ Status decode_mesh(SectionDecoder& d, std::size_t joint_count, Model& model) {
   }
   SINEW_RETURN_IF_ERROR(d.finish());
 
-  for (std::size_t v = 0; v < vertices; ++v) {
-    const std::string f = "[" + std::to_string(v) + "]";
-    if (!finite(m.positions[v])) return d.error("positions" + f, "", "not finite");
-    if (!m.normals.empty() && !finite(m.normals[v])) return d.error("normals" + f, "", "not finite");
-    if (!m.uvs.empty() && !finite(m.uvs[v])) return d.error("uvs" + f, "", "not finite");
-    for (std::size_t k = 0; k < kMaxInfluences; ++k) {
-      if (m.joints[v][k] >= joint_count) {
-        return d.error("joints" + f, std::to_string(m.joints[v][k]), "no such joint", ErrorCode::kOutOfBounds);
-      }
-      const float w = m.weights[v][k];
-      if (!std::isfinite(w) || w < 0.0f) return d.error("weights" + f, std::to_string(w), "not a finite weight >= 0");
-    }
-  }
-  for (std::size_t t = 0; t < triangles; ++t) {
-    for (const std::uint32_t v : m.triangles[t]) {
-      if (v >= vertices) {
-        return d.error("triangles[" + std::to_string(t) + "]", std::to_string(v), "no such vertex",
-                       ErrorCode::kOutOfBounds);
-      }
-    }
-    if (!m.triangle_material.empty() && m.triangle_material[t] >= materials) {
-      return d.error("triangle_material[" + std::to_string(t) + "]", std::to_string(m.triangle_material[t]),
-                     "no such material", ErrorCode::kOutOfBounds);
-    }
-  }
-  for (std::size_t i = 0; i < materials; ++i) {
-    if (!finite(m.material_colors[i])) return d.error("material_colors[" + std::to_string(i) + "]", "", "not finite");
-  }
-  return {};
+  return check_skinned_mesh(MeshOrigin{d.pack(), "MESH."}, m, joint_count);
 }
 
 template <typename T>

@@ -25,6 +25,7 @@
 
 #include "raytrace/skinning/skinning.h"
 #include "runtime/core/format_number.h"
+#include "runtime/mesh/mesh_checks.h"
 #include "runtime/jobs/job_system.h"
 #include "runtime/timing/stopwatch.h"
 
@@ -40,13 +41,8 @@ constexpr std::size_t kTriangleGrain = 2048;
 // Share of the progress fraction spent before the kd-tree builds start.
 constexpr double kSweepShare = 0.9;
 
-
 std::string indexed(std::string_view name, std::size_t i) {
   return std::string(name) + "[" + std::to_string(i) + "]";
-}
-
-std::string indexed(std::string_view name, std::size_t i, std::size_t j) {
-  return indexed(name, i) + "[" + std::to_string(j) + "]";
 }
 
 std::string format_matrix(const Affine3& m) {
@@ -99,49 +95,6 @@ class MemoryLedger {
 // ---------------------------------------------------------------------------
 // Validation
 
-Status validate_mesh(const SkinnedMesh& mesh, std::uint32_t bone_count) {
-  const std::size_t n = mesh.vertex_count();
-  const std::string expected_rows = "expected one row per position (" + std::to_string(n) + ")";
-  if (mesh.joints.size() != n) {
-    return make_error(ErrorCode::kInvalidData, "", "joints", std::to_string(mesh.joints.size()),
-                      expected_rows);
-  }
-  if (mesh.weights.size() != n) {
-    return make_error(ErrorCode::kInvalidData, "", "weights", std::to_string(mesh.weights.size()),
-                      expected_rows);
-  }
-  for (std::size_t v = 0; v < n; ++v) {
-    const Vec3& p = mesh.positions[v];
-    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
-      return make_error(ErrorCode::kInvalidData, "", indexed("positions", v),
-                        format_number(p.x) + " " + format_number(p.y) + " " + format_number(p.z),
-                        "not finite");
-    }
-    for (std::size_t k = 0; k < static_cast<std::size_t>(kMaxInfluences); ++k) {
-      // Every slot is checked, weighted or not: SIMD skinning reads them all.
-      if (mesh.joints[v][k] >= bone_count) {
-        return make_error(ErrorCode::kInvalidData, "", indexed("joints", v, k),
-                          std::to_string(mesh.joints[v][k]),
-                          "not below bone_count (" + std::to_string(bone_count) + ")");
-      }
-      if (!std::isfinite(mesh.weights[v][k])) {
-        return make_error(ErrorCode::kInvalidData, "", indexed("weights", v, k),
-                          format_number(mesh.weights[v][k]), "not finite");
-      }
-    }
-  }
-  for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
-    for (std::size_t i = 0; i < 3; ++i) {
-      if (mesh.triangles[t][i] >= n) {
-        return make_error(ErrorCode::kInvalidData, "", indexed("triangles", t, i),
-                          std::to_string(mesh.triangles[t][i]),
-                          "not below the vertex count (" + std::to_string(n) + ")");
-      }
-    }
-  }
-  return {};
-}
-
 Status validate_input(const FuzzyBakeInput& input, const FuzzyBakeOptions& options) {
   if (input.mesh == nullptr) return invalid_argument("mesh", "null", "there is no mesh to bake");
   const std::uint32_t bones = input.bone_count;
@@ -182,7 +135,7 @@ Status validate_input(const FuzzyBakeInput& input, const FuzzyBakeOptions& optio
     return invalid_argument("padding", format_number(options.padding),
                             "must be finite and not negative");
   }
-  return validate_mesh(*input.mesh, bones);
+  return check_skinned_mesh(MeshOrigin{}, *input.mesh, bones);
 }
 
 // Inverts every sample matrix once (sample-major, like the input), rejecting

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "runtime/mesh/mesh_checks.h"
 #include "runtime/mesh/skinned_mesh.h"
 
 namespace sinew::rt {
@@ -178,6 +179,8 @@ Status validate_fuzzy_character(const SkinnedMesh& mesh, const FuzzyCharacterVie
     return bad_character("bone_trees", std::to_string(fuzzy.bone_trees.size()),
                          "expected one tree per bone (" + std::to_string(fuzzy.bone_count) + ")");
   }
+  // The mesh first: everything below indexes through it.
+  SINEW_RETURN_IF_ERROR(check_skinned_mesh(MeshOrigin{"character", ""}, mesh, fuzzy.bone_count));
   if (fuzzy.triangle_bone.size() != triangles || fuzzy.triangle_checks.size() != triangles) {
     return bad_character("triangle_bone", std::to_string(fuzzy.triangle_bone.size()),
                          "expected one entry per triangle (" + std::to_string(triangles) + ")");
@@ -187,19 +190,10 @@ Status validate_fuzzy_character(const SkinnedMesh& mesh, const FuzzyCharacterVie
     return bad_character("vertex_check_begin", std::to_string(fuzzy.vertex_check_begin.size()),
                          "expected vertex_count + 1 offsets covering the checks");
   }
-  if (mesh.joints.size() != vertices || mesh.weights.size() != vertices ||
-      (!mesh.normals.empty() && mesh.normals.size() != vertices)) {
-    return bad_character("mesh", std::to_string(vertices), "per-vertex arrays differ in length");
-  }
   for (std::size_t v = 0; v < vertices; ++v) {
     if (fuzzy.vertex_check_begin[v] > fuzzy.vertex_check_begin[v + 1]) {
       return bad_character("vertex_check_begin[" + std::to_string(v) + "]",
                            std::to_string(fuzzy.vertex_check_begin[v]), "offsets decrease");
-    }
-    for (const std::uint16_t j : mesh.joints[v]) {
-      if (j >= fuzzy.bone_count) {
-        return bad_character("joints[" + std::to_string(v) + "]", std::to_string(j), "no such bone");
-      }
     }
   }
   for (std::size_t c = 0; c < fuzzy.vertex_checks.size(); ++c) {
@@ -219,9 +213,6 @@ Status validate_fuzzy_character(const SkinnedMesh& mesh, const FuzzyCharacterVie
     for (int i = 0; i < 3; ++i) {
       const std::uint32_t v = mesh.triangles[t][static_cast<std::size_t>(i)];
       const std::uint32_t c = fuzzy.triangle_checks[t][static_cast<std::size_t>(i)];
-      if (v >= vertices) {
-        return bad_character("triangles[" + std::to_string(t) + "]", std::to_string(v), "no such vertex");
-      }
       // Each corner's check must be the vertex's check in the triangle's
       // bone: the fallback and escape logic read it as such.
       if (c < fuzzy.vertex_check_begin[v] || c >= fuzzy.vertex_check_begin[v + 1] ||

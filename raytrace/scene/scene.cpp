@@ -5,6 +5,7 @@
 #include <utility>
 
 #include "runtime/jobs/job_system.h"
+#include "runtime/mesh/mesh_checks.h"
 #include "runtime/timing/phase_timers.h"
 #include "runtime/timing/stopwatch.h"
 
@@ -49,32 +50,13 @@ Expected<std::uint32_t> Scene::add_instance(std::uint32_t character) {
 
 Expected<std::uint32_t> Scene::add_static_mesh(StaticMeshDesc mesh, const KdBuildOptions& kd) {
   const std::string id = "static_meshes[" + std::to_string(statics_.size()) + "]";
+  SINEW_RETURN_IF_ERROR(check_triangle_mesh(MeshOrigin{id, ""}, mesh.positions, mesh.triangles,
+                                            mesh.triangle_material, mesh.material_colors));
   std::vector<Aabb> boxes;
   boxes.reserve(mesh.triangles.size());
-  for (std::size_t p = 0; p < mesh.positions.size(); ++p) {
-    const Vec3& v = mesh.positions[p];
-    if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z)) {
-      return make_error(ErrorCode::kInvalidData, id, "positions[" + std::to_string(p) + "]", "",
-                        "not finite");
-    }
-  }
-  if (!mesh.triangle_material.empty() && mesh.triangle_material.size() != mesh.triangles.size()) {
-    return make_error(ErrorCode::kInvalidData, id, "triangle_material",
-                      std::to_string(mesh.triangle_material.size()), "expected one per triangle");
-  }
-  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+  for (const auto& triangle : mesh.triangles) {
     Aabb box;
-    for (const std::uint32_t v : mesh.triangles[t]) {
-      if (v >= mesh.positions.size()) {
-        return make_error(ErrorCode::kInvalidData, id, "triangles[" + std::to_string(t) + "]",
-                          std::to_string(v), "no such vertex");
-      }
-      box.extend(mesh.positions[v]);
-    }
-    if (!mesh.triangle_material.empty() && mesh.triangle_material[t] >= std::max<std::size_t>(1, mesh.material_colors.size())) {
-      return make_error(ErrorCode::kInvalidData, id, "triangle_material[" + std::to_string(t) + "]",
-                        std::to_string(mesh.triangle_material[t]), "no such material");
-    }
+    for (const std::uint32_t v : triangle) box.extend(mesh.positions[v]);
     boxes.push_back(box);
   }
   SINEW_ASSIGN_OR_RETURN(KdTree tree, build_kd_tree(boxes, within_traversal_depth(kd)));
