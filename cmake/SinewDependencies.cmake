@@ -9,6 +9,8 @@ find_package(TBB CONFIG REQUIRED)
 pkg_check_modules(OIIO REQUIRED IMPORTED_TARGET OpenImageIO)
 pkg_check_modules(XXHASH REQUIRED IMPORTED_TARGET libxxhash)
 find_package(nlohmann_json CONFIG REQUIRED)
+# Debian's libcli11-dev (header-only): every program's command line.
+find_package(CLI11 CONFIG REQUIRED)
 # Debian's libtinygltf-dev ships a compiled library, so no
 # TINYGLTF_IMPLEMENTATION unit is needed; its headers sit in /usr/include,
 # a system directory, so their warnings stay out of -Werror.

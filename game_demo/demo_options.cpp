@@ -1,89 +1,95 @@
 #include "game_demo/demo_options.h"
 
-#include <charconv>
+#include <cstdint>
 #include <limits>
+#include <type_traits>
+#include <optional>
+
+#include "runtime/cli/command_line.h"
+#include "runtime/cli/option_values.h"
 
 namespace sinew::demo {
 namespace {
 
-template <typename T>
-Expected<T> parse_number(const std::string& flag, const std::string& text, T lo, T hi) {
-  T value{};
-  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
-  if (ec != std::errc() || end != text.data() + text.size() || value < lo || value > hi) {
-    return invalid_argument(flag, text,
-                            "expected an integer from " + std::to_string(lo) + " to " +
-                                std::to_string(hi));
-  }
-  return value;
-}
+// The options, declared in the order --help lists them.
+struct DemoFlags {
+  explicit DemoFlags(cli::CommandLine& l)
+      : headless(l.flag("--headless", "no window: a scripted, deterministic run writing frames to DIR")),
+        frames(l.option("--frames", "N", "frames to run (headless default 120; windowed: until Esc)")),
+        out(l.option("--out", "DIR", "where headless frames and timings.json go (default out/demo)")),
+        threads(l.option("--threads", "N", "worker threads (default 0: all cores)")),
+        size(l.option("--size", "WxH", "frame size (default 1024x1024; 16 to 8192 each)")),
+        seed(l.option("--seed", "S", "seed of the arena and the characters' wandering (default 1)")),
+        characters(l.option("--characters", "N", "characters in the arena, one of them yours (default 6)")),
+        model(l.option("--model", "PATH",
+                       "the character: a content pack (sinew-editor bake MODEL -o PATH);\n"
+                       "default the procedural mannequin")),
+        script(l.option("--script", "FILE",
+                        "take the keys from an input script (frame key down|up|tap per\n"
+                        "line) with fixed 1/30 s steps, windowed or headless")),
+        screenshot(l.option("--screenshot", "PATH", "windowed: write the last frame as shown (HUD included) as PNG")),
+        no_hud(l.flag("--no-hud", "windowed: start with the HUD hidden (F1 shows it)")) {}
+
+  const bool& headless;
+  const std::optional<std::string>& frames;
+  const std::optional<std::string>& out;
+  const std::optional<std::string>& threads;
+  const std::optional<std::string>& size;
+  const std::optional<std::string>& seed;
+  const std::optional<std::string>& characters;
+  const std::optional<std::string>& model;
+  const std::optional<std::string>& script;
+  const std::optional<std::string>& screenshot;
+  const bool& no_hud;
+};
+
+const char* const kDescription =
+    "The playable demo: skinned characters walk the arena, ray traced with shadows each frame.\n"
+    "With a display it opens a window; without one, or with --headless, it runs a scripted,\n"
+    "deterministic session and writes frames and timings.\n";
 
 }  // namespace
 
 std::string demo_usage() {
-  return "usage: sinew-demo [--headless] [--frames N] [--out DIR] [--threads N]\n"
-         "                  [--size WxH] [--seed S] [--characters N] [--model PATH]\n"
-         "                  [--script FILE] [--screenshot PATH] [--no-hud]\n"
-         "  --headless      no window: a scripted, deterministic run writing frames to DIR\n"
-         "  --frames N      frames to run (headless default 120; windowed: until Esc)\n"
-         "  --out DIR       where headless frames and timings.json go (default out/demo)\n"
-         "  --threads N     worker threads (default: all cores)\n"
-         "  --size WxH      frame size (default 1024x1024)\n"
-         "  --seed S        seed of the arena and the characters' wandering (default 1)\n"
-         "  --characters N  characters in the arena, one of them yours (default 6)\n"
-         "  --model PATH    the character: a content pack (sinew-editor bake MODEL -o PATH);\n"
-         "                  default the procedural mannequin\n"
-         "  --script FILE   take the keys from an input script (frame key down|up|tap per\n"
-         "                  line) with fixed 1/30 s steps, windowed or headless\n"
-         "  --screenshot PATH  windowed: write the last frame as shown (HUD included) as PNG\n"
-         "  --no-hud        windowed: start with the HUD hidden (F1 shows it)\n";
+  cli::CommandLine line("sinew-demo", kDescription);
+  const DemoFlags flags(line);
+  return line.help();
 }
 
 Expected<DemoOptions> parse_demo_options(const std::vector<std::string>& args) {
+  cli::CommandLine line("sinew-demo", kDescription);
+  const DemoFlags f(line);
+  SINEW_ASSIGN_OR_RETURN(const cli::ParseResult result, line.parse(args));
   DemoOptions o;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    auto next = [&]() -> Expected<std::string> {
-      if (i + 1 >= args.size()) return invalid_argument(a, "", "missing value");
-      return args[++i];
-    };
-    if (a == "--headless") {
-      o.headless = true;
-    } else if (a == "--help" || a == "-h") {
-      o.help = true;
-    } else if (a == "--frames") {
-      SINEW_ASSIGN_OR_RETURN(std::string v, next());
-      SINEW_ASSIGN_OR_RETURN(o.frames, parse_number<int>(a, v, 1, 1000000));
-    } else if (a == "--threads") {
-      SINEW_ASSIGN_OR_RETURN(std::string v, next());
-      SINEW_ASSIGN_OR_RETURN(o.threads, parse_number<int>(a, v, 1, 1024));
-    } else if (a == "--seed") {
-      SINEW_ASSIGN_OR_RETURN(std::string v, next());
-      SINEW_ASSIGN_OR_RETURN(o.seed, parse_number<std::uint32_t>(
-                                          a, v, 0, std::numeric_limits<std::uint32_t>::max()));
-    } else if (a == "--characters") {
-      SINEW_ASSIGN_OR_RETURN(std::string v, next());
-      SINEW_ASSIGN_OR_RETURN(o.characters, parse_number<int>(a, v, 1, 256));
-    } else if (a == "--model") {
-      SINEW_ASSIGN_OR_RETURN(o.model_path, next());
-    } else if (a == "--script") {
-      SINEW_ASSIGN_OR_RETURN(o.script_path, next());
-    } else if (a == "--screenshot") {
-      SINEW_ASSIGN_OR_RETURN(o.screenshot_path, next());
-    } else if (a == "--no-hud") {
-      o.hud = false;
-    } else if (a == "--out") {
-      SINEW_ASSIGN_OR_RETURN(o.out_dir, next());
-    } else if (a == "--size") {
-      SINEW_ASSIGN_OR_RETURN(std::string v, next());
-      const auto x = v.find('x');
-      if (x == std::string::npos) return invalid_argument(a, v, "expected WxH, e.g. 1024x1024");
-      SINEW_ASSIGN_OR_RETURN(o.width, parse_number<int>(a, v.substr(0, x), 16, 8192));
-      SINEW_ASSIGN_OR_RETURN(o.height, parse_number<int>(a, v.substr(x + 1), 16, 8192));
-    } else {
-      return invalid_argument("argument", a, "unknown option (see --help)");
-    }
+  if (result == cli::ParseResult::kHelp) {
+    o.help = true;
+    return o;
   }
+  o.headless = f.headless;
+  o.hud = !f.no_hud;
+  const auto int_option = [](const char* flag, const std::optional<std::string>& text, std::int64_t lo,
+                             std::int64_t hi, auto& target) -> Status {
+    if (text) {
+      SINEW_ASSIGN_OR_RETURN(const std::int64_t n, cli::parse_int(flag, *text, lo, hi));
+      target = static_cast<std::remove_reference_t<decltype(target)>>(n);
+    }
+    return {};
+  };
+  SINEW_RETURN_IF_ERROR(int_option("--frames", f.frames, 1, 1000000, o.frames));
+  SINEW_RETURN_IF_ERROR(int_option("--seed", f.seed, 0, std::numeric_limits<std::uint32_t>::max(), o.seed));
+  SINEW_RETURN_IF_ERROR(int_option("--characters", f.characters, 1, 256, o.characters));
+  if (f.threads) {
+    SINEW_ASSIGN_OR_RETURN(o.threads, cli::parse_threads("--threads", *f.threads));
+  }
+  if (f.size) {
+    SINEW_ASSIGN_OR_RETURN(const cli::Size2 size, cli::parse_size("--size", *f.size, 8192, 16));
+    o.width = size.width;
+    o.height = size.height;
+  }
+  if (f.out) o.out_dir = *f.out;
+  if (f.model) o.model_path = *f.model;
+  if (f.script) o.script_path = *f.script;
+  if (f.screenshot) o.screenshot_path = *f.screenshot;
   if (o.headless && o.frames == 0) o.frames = 120;
   return o;
 }

@@ -144,7 +144,7 @@ int run_windowed(const DemoOptions& opt, const InputScript* script, DemoSession&
 int run(const std::vector<std::string>& args) {
   auto parsed = parse_demo_options(args);
   if (!parsed.ok()) {
-    std::fprintf(stderr, "sinew-demo: %s\n%s", parsed.status().message().c_str(), demo_usage().c_str());
+    std::fprintf(stderr, "sinew-demo: %s\n", parsed.status().message().c_str());
     return 2;
   }
   const DemoOptions& opt = *parsed;

@@ -9,26 +9,13 @@
 
 #include "editor/cli/pack_commands.h"
 #include "editor/cli/render_command.h"
+#include "runtime/cli/command_line.h"
 #include "runtime/core/status.h"
 #ifdef SINEW_HAVE_GUI
 #include "editor/gui/editor_app.h"
 #endif
 
 namespace {
-
-const char* const kUsage =
-    "usage: sinew-editor <command> [args]   (sinew-editor <command> --help for its options)\n";
-
-void print_help(std::ostream& out) {
-  out << kUsage
-      << "\ncommands:\n"
-         "  bake     bake a model's fuzzy kd-trees into a content pack\n"
-         "  inspect  sizes, counts, pose space, fuzzy area, tree depths, provenance of a pack\n"
-         "  validate check a pack completely (exit 0 when valid)\n"
-         "  subdivide  split every triangle into four, L times (the paper's larger Cally variants)\n"
-         "  render   pose with one clip and ray trace a model or a pack\n"
-         "  gui      the editor window: clips, bake, joint limits, overlays, stats\n";
-}
 
 // The command line, dispatched to the command.
 int run(const std::vector<std::string>& args);
@@ -57,31 +44,32 @@ int main(int argc, char** argv) {
 namespace {
 
 int run(const std::vector<std::string>& args) {
-  if (args.empty()) {
-    std::cerr << "sinew-editor: missing command\n" << kUsage;
-    return 2;
-  }
-  const std::string& command = args.front();
-  const std::vector<std::string> rest(args.begin() + 1, args.end());
-  if (command == "--help" || command == "-h" || command == "help") {
-    print_help(std::cout);
-    return 0;
+  sinew::cli::CommandLine line("sinew-editor", "The offline tool: content packs, renders and the editor window.\n");
+  line.command("bake", "bake a model's fuzzy kd-trees into a content pack");
+  line.command("inspect", "sizes, counts, pose space, fuzzy area, tree depths, provenance of a pack");
+  line.command("validate", "check a pack completely (exit 0 when valid)");
+  line.command("subdivide", "split every triangle into four, L times (the paper's larger Cally variants)");
+  line.command("render", "pose with one clip and ray trace a model or a pack");
+  line.command("gui", "the editor window: clips, bake, joint limits, overlays, stats");
+  line.footer("Run `sinew-editor COMMAND --help` for a command's options.\n");
+  if (const auto done = sinew::cli::help_or_usage_error(line, line.parse(args), std::cout, std::cerr)) return *done;
+  const std::string& command = line.chosen_command();
+  const std::vector<std::string>& rest = line.command_arguments();
+  if (command.empty()) {
+    return sinew::cli::usage_error("sinew-editor", sinew::invalid_argument("COMMAND", "", "missing (see --help)"),
+                                   std::cerr);
   }
   if (command == "bake") return sinew::editor::run_bake(rest, std::cout, std::cerr);
   if (command == "subdivide") return sinew::editor::run_subdivide(rest, std::cout, std::cerr);
   if (command == "inspect") return sinew::editor::run_inspect(rest, std::cout, std::cerr);
   if (command == "validate") return sinew::editor::run_validate(rest, std::cout, std::cerr);
-  if (command == "gui") {
-#ifdef SINEW_HAVE_GUI
-    return sinew::editor::run_gui(rest, std::cout, std::cerr);
-#else
-    std::cerr << "sinew-editor: this build has no window (configured with SINEW_BUILD_DISPLAY=OFF)\n";
-    return 1;
-#endif
-  }
   if (command == "render") return sinew::editor::run_render(rest, std::cout, std::cerr);
-  std::cerr << "sinew-editor: unknown command '" << command << "'\n" << kUsage;
-  return 2;
+#ifdef SINEW_HAVE_GUI
+  return sinew::editor::run_gui(rest, std::cout, std::cerr);
+#else
+  std::cerr << "sinew-editor: this build has no window (configured with SINEW_BUILD_DISPLAY=OFF)\n";
+  return 1;
+#endif
 }
 
 }  // namespace

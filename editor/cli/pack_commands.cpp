@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
+#include <memory>
 #include <optional>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -19,10 +20,12 @@
 #include "animation/joint_limits.h"
 #include "character/bake.h"
 #include "character/pack.h"
-#include "editor/cli/cli_args.h"
+#include "editor/cli/import_limit_flags.h"
 #include "editor/import/model_loader.h"
 #include "editor/mesh/subdivide.h"
 #include "editor/scene/scene_recipe.h"
+#include "runtime/cli/command_line.h"
+#include "runtime/cli/option_values.h"
 #include "runtime/io/mapped_file.h"
 #include "runtime/jobs/job_system.h"
 #include "runtime/pack/checksum.h"
@@ -51,59 +54,78 @@ struct BakeOptions {
   bool help = false;
 };
 
-std::string bake_usage() {
-  return "usage: sinew-editor bake MODEL -o OUT.pack [options]\n"
-         "       sinew-editor bake --scene RECIPE.json [MODEL] -o OUT.pack [options]\n"
-         "  MODEL                 .gltf, .glb, .cfg (Cal3D) or a model-only .pack\n"
-         "  --asset-roots A:B     more folders a glTF file's buffers may be read from (by\n"
-         "                        default only its own folder and below)\n"
-         "  --scene RECIPE.json   bake only what a scene needs: the pose space of the recipe's\n"
-         "                        clips, and only those clips in the pack (content/scenes/)\n"
-         "  -o, --out OUT.pack    the pack to write (atomically: an existing file is replaced\n"
-         "                        only by a complete new pack)\n"
-         "  --pose-space MODE     arbitrary | limits | clips | clip:NAME (default clips: every\n"
-         "                        key of every clip, and every 1/30 s)\n"
-         "  --clips a,b,c         the clips of --pose-space clips (default all)\n"
-         "  --samples N           poses: arbitrary/limits need N > 0 (default 1000); clip modes:\n"
-         "                        at most N of the key times (0 = all)\n"
-         "  --seed S              random pose seed (default 1)\n"
-         "  --limits FILE.json    joint limits (needed by --pose-space limits; stored in the pack)\n"
-         "  --pad FRACTION        grow every fuzzy box by this fraction of the model's size (default 0)\n"
-         "  --candidates MODE     all (the paper's) | influencing (faster; default all)\n"
-         "  --sah-intersection-cost C  the bone trees' triangle cost against a cell visit's 1\n"
-         "                        (default 0.5, tuned for 64-ray packets; 1.5\n"
-         "                        builds deeper trees, which suit --packet-rays 1)\n"
-         "  --threads N           worker threads (default all cores)\n"
-         "  --max-memory-mib M    refuse a bake whose working set would exceed M MiB\n"
-         "                        (default 8192, at least 4; a quarter of it at most goes\n"
-         "                        to the fuzzy boxes, processed in bone chunks)\n" +
-         cli::import_limits_usage() +
-         "Set SOURCE_DATE_EPOCH for a reproducible pack (fixed date, no timings).\n";
+// bake's options, declared in the order --help lists them.
+struct BakeFlags {
+  explicit BakeFlags(cli::CommandLine& l)
+      : model(l.positionals("MODEL", ".gltf, .glb, .cfg (Cal3D) or a model-only .pack", 1)),
+        asset_roots(l.option("--asset-roots", "A:B",
+                             "more folders a glTF file's buffers may be read from (by\n"
+                             "default only its own folder and below)")),
+        scene(l.option("--scene", "RECIPE.json",
+                       "bake only what a scene needs: the pose space of the recipe's\n"
+                       "clips, and only those clips in the pack (content/scenes/)")),
+        out(l.option("-o,--out", "OUT.pack",
+                     "the pack to write (atomically: an existing file is replaced\n"
+                     "only by a complete new pack)")),
+        pose_space(l.option("--pose-space", "MODE",
+                            "arbitrary | limits | clips | clip:NAME (default clips: every\n"
+                            "key of every clip, and every 1/30 s)")),
+        clips(l.option("--clips", "a,b,c", "the clips of --pose-space clips (default all)")),
+        samples(l.option("--samples", "N",
+                         "poses: arbitrary/limits need N > 0 (default 1000); clip modes:\n"
+                         "at most N of the key times (0 = all)")),
+        seed(l.option("--seed", "S", "random pose seed (default 1)")),
+        limits(l.option("--limits", "FILE.json", "joint limits (needed by --pose-space limits; stored in the pack)")),
+        pad(l.option("--pad", "FRACTION", "grow every fuzzy box by this fraction of the model's size (default 0)")),
+        candidates(l.option("--candidates", "MODE", "all (the paper's) | influencing (faster; default all)")),
+        sah_intersection_cost(l.option("--sah-intersection-cost", "C",
+                                       "the bone trees' triangle cost against a cell visit's 1\n"
+                                       "(default 0.5, tuned for 64-ray packets; 1.5\n"
+                                       "builds deeper trees, which suit --packet-rays 1)")),
+        threads(l.option("--threads", "N", "worker threads (default 0: all cores)")),
+        max_memory_mib(l.option("--max-memory-mib", "M",
+                                "refuse a bake whose working set would exceed M MiB\n"
+                                "(default 8192, at least 4; a quarter of it at most goes\n"
+                                "to the fuzzy boxes, processed in bone chunks)")),
+        import_limits(l) {}
+
+  const std::vector<std::string>& model;
+  const std::optional<std::string>& asset_roots;
+  const std::optional<std::string>& scene;
+  const std::optional<std::string>& out;
+  const std::optional<std::string>& pose_space;
+  const std::optional<std::string>& clips;
+  const std::optional<std::string>& samples;
+  const std::optional<std::string>& seed;
+  const std::optional<std::string>& limits;
+  const std::optional<std::string>& pad;
+  const std::optional<std::string>& candidates;
+  const std::optional<std::string>& sah_intersection_cost;
+  const std::optional<std::string>& threads;
+  const std::optional<std::string>& max_memory_mib;
+  ImportLimitFlags import_limits;
+};
+
+std::unique_ptr<cli::CommandLine> bake_command_line() {
+  auto line = std::make_unique<cli::CommandLine>(
+      "sinew-editor bake",
+      "Bakes a model's fuzzy kd-trees into a content pack:\n"
+      "  sinew-editor bake MODEL -o OUT.pack [options]\n"
+      "  sinew-editor bake --scene RECIPE.json [MODEL] -o OUT.pack [options]\n");
+  line->footer("Set SOURCE_DATE_EPOCH for a reproducible pack (fixed date, no timings).\n");
+  return line;
 }
 
-const std::vector<cli::FlagSpec>& bake_flags() {
-  static const std::vector<cli::FlagSpec> flags = {
-      {"--help", false}, {"-h", false},      {"--out"},     {"--pose-space"}, {"--clips"},
-      {"--samples"},     {"--seed"},         {"--limits"}, {"--pad"},  {"--candidates"}, {"--sah-intersection-cost"}, {"--threads"},
-      {"--scene"},       {"--max-memory-mib"}, {"--asset-roots"}, {"--max-triangles"}, {"--max-clips"},
-      {"--max-keys"},    {"--max-nodes"},    {"--max-bytes"},
-  };
-  return flags;
-}
-
-Expected<BakeOptions> parse_bake_options(std::vector<std::string> args) {
-  // -o is the short form of --out (the option parser knows long flags only).
-  for (std::string& a : args) {
-    if (a == "-o") a = "--out";
-  }
-  SINEW_ASSIGN_OR_RETURN(const cli::ParsedArgs parsed, cli::parse_args(args, bake_flags()));
+Expected<BakeOptions> parse_bake_options(const std::vector<std::string>& args, cli::CommandLine& line,
+                                         const BakeFlags& f) {
+  SINEW_ASSIGN_OR_RETURN(const cli::ParseResult result, line.parse(args));
   BakeOptions o;
-  if (parsed.has("--help") || parsed.has("-h")) {
+  if (result == cli::ParseResult::kHelp) {
     o.help = true;
     return o;
   }
-  if (auto v = parsed.value("--scene")) {
-    if (parsed.has("--pose-space") || parsed.has("--clips")) {
+  if (const std::optional<std::string>& v = f.scene) {
+    if (f.pose_space || f.clips) {
       return invalid_argument("--scene", *v, "the recipe sets the pose space: drop --pose-space and --clips");
     }
     SINEW_ASSIGN_OR_RETURN(SceneRecipe recipe, load_scene_recipe(*v));
@@ -115,19 +137,19 @@ Expected<BakeOptions> parse_bake_options(std::vector<std::string> args) {
     o.padding = recipe.padding;
     o.scene = std::move(recipe);
   }
-  if (parsed.positionals.size() > 1 || (parsed.positionals.empty() && o.model_path.empty())) {
-    return invalid_argument("MODEL", std::to_string(parsed.positionals.size()) + " given", "expected one model file");
+  if (f.model.empty() && o.model_path.empty()) {
+    return invalid_argument("MODEL", "0 given", "expected one model file");
   }
-  if (!parsed.positionals.empty()) o.model_path = parsed.positionals.front();
-  if (auto v = parsed.value("--out")) o.out_path = *v;
-  if (auto v = parsed.value("--asset-roots")) {
+  if (!f.model.empty()) o.model_path = f.model.front();
+  if (const std::optional<std::string>& v = f.out) o.out_path = *v;
+  if (const std::optional<std::string>& v = f.asset_roots) {
     SINEW_ASSIGN_OR_RETURN(o.gltf.asset_roots, cli::parse_folder_list("--asset-roots", *v));
   }
-  SINEW_RETURN_IF_ERROR(cli::parse_import_limits(parsed, o.gltf.limits));
+  SINEW_RETURN_IF_ERROR(f.import_limits.apply(o.gltf.limits));
   if (o.out_path.empty()) return invalid_argument("-o", "", "missing: where to write the pack");
   if (!character::is_pack_path(o.out_path)) return invalid_argument("-o", o.out_path, "expected a .pack file name");
   bool samples_given = false;
-  if (auto v = parsed.value("--pose-space")) {
+  if (const std::optional<std::string>& v = f.pose_space) {
     const std::string mode = *v;
     if (mode == "arbitrary") {
       o.pose_space.mode = anim::PoseSpaceMode::kArbitrary;
@@ -142,13 +164,13 @@ Expected<BakeOptions> parse_bake_options(std::vector<std::string> args) {
       return invalid_argument("--pose-space", mode, "expected arbitrary, limits, clips or clip:NAME");
     }
   }
-  if (auto v = parsed.value("--clips")) {
+  if (const std::optional<std::string>& v = f.clips) {
     if (o.pose_space.mode != anim::PoseSpaceMode::kClips) {
       return invalid_argument("--clips", *v, "only with --pose-space clips");
     }
     SINEW_ASSIGN_OR_RETURN(o.pose_space.clips, cli::parse_list("--clips", *v));
   }
-  if (auto v = parsed.value("--samples")) {
+  if (const std::optional<std::string>& v = f.samples) {
     SINEW_ASSIGN_OR_RETURN(const std::int64_t n, cli::parse_int("--samples", *v, 0, anim::kMaxPoseSamples));
     o.pose_space.samples = static_cast<int>(n);
     samples_given = true;
@@ -161,30 +183,29 @@ Expected<BakeOptions> parse_bake_options(std::vector<std::string> args) {
   if (!random_mode && !samples_given && !o.scene) o.pose_space.samples = 0;
   if (random_mode) o.pose_space.every_frame_30hz = false;
   if (random_mode && !samples_given) o.pose_space.samples = 1000;
-  if (auto v = parsed.value("--seed")) {
+  if (const std::optional<std::string>& v = f.seed) {
     SINEW_ASSIGN_OR_RETURN(o.pose_space.seed, cli::parse_uint64("--seed", *v));
   }
-  if (auto v = parsed.value("--limits")) o.limits_path = *v;
+  if (const std::optional<std::string>& v = f.limits) o.limits_path = *v;
   if (o.pose_space.mode == anim::PoseSpaceMode::kLimits && o.limits_path.empty()) {
     return invalid_argument("--limits", "", "--pose-space limits needs a joint-limits file");
   }
-  if (auto v = parsed.value("--pad")) {
+  if (const std::optional<std::string>& v = f.pad) {
     SINEW_ASSIGN_OR_RETURN(const double pad, cli::parse_double("--pad", *v, 0.0, 1.0));
     o.padding = static_cast<float>(pad);
   }
-  if (auto v = parsed.value("--candidates")) {
+  if (const std::optional<std::string>& v = f.candidates) {
     SINEW_ASSIGN_OR_RETURN(const int c, cli::parse_choice("--candidates", *v, {"all", "influencing"}));
     o.candidates = c == 0 ? rt::CandidateBones::kAll : rt::CandidateBones::kInfluencing;
   }
-  if (auto v = parsed.value("--sah-intersection-cost")) {
+  if (const std::optional<std::string>& v = f.sah_intersection_cost) {
     SINEW_ASSIGN_OR_RETURN(const double cost, cli::parse_double("--sah-intersection-cost", *v, 0.01, 100.0));
     o.sah_intersection_cost = static_cast<float>(cost);
   }
-  if (auto v = parsed.value("--threads")) {
-    SINEW_ASSIGN_OR_RETURN(const std::int64_t n, cli::parse_int("--threads", *v, 1, 1024));
-    o.threads = static_cast<int>(n);
+  if (const std::optional<std::string>& v = f.threads) {
+    SINEW_ASSIGN_OR_RETURN(o.threads, cli::parse_threads("--threads", *v));
   }
-  if (auto v = parsed.value("--max-memory-mib")) {
+  if (const std::optional<std::string>& v = f.max_memory_mib) {
     SINEW_ASSIGN_OR_RETURN(const std::int64_t mib, cli::parse_int("--max-memory-mib", *v, 4, std::int64_t{1} << 30));
     o.max_memory_bytes = static_cast<std::size_t>(mib) << 20;
   }
@@ -284,9 +305,8 @@ int fail(std::ostream& err, std::string_view command, const Status& s) {
   return 1;
 }
 
-int usage_error(std::ostream& err, std::string_view command, const Status& s, const std::string& usage) {
-  err << "sinew-editor " << command << ": " << s.message() << "\n" << usage;
-  return 2;
+int usage_error(std::ostream& err, std::string_view command, const Status& s) {
+  return cli::usage_error("sinew-editor " + std::string(command), s, err);
 }
 
 // --- inspect ------------------------------------------------------------------------
@@ -444,16 +464,18 @@ void print_bake_memory(const character::BakeMemory& m, long rss_before_kib, long
 }  // namespace
 
 int run_bake(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
-  auto parsed = parse_bake_options(args);
+  const auto line = bake_command_line();
+  const BakeFlags flags(*line);
+  auto parsed = parse_bake_options(args, *line, flags);
   if (!parsed.ok()) {
     // A scene recipe is read while parsing: an error naming a file is about
     // its contents (exit 1), one naming only an option is a usage error.
     if (!parsed.status().file().empty()) return fail(err, "bake", parsed.status());
-    return usage_error(err, "bake", parsed.status(), bake_usage());
+    return usage_error(err, "bake", parsed.status());
   }
   const BakeOptions& o = *parsed;
   if (o.help) {
-    out << bake_usage();
+    out << line->help();
     return 0;
   }
   const auto start = Clock::now();
@@ -525,34 +547,23 @@ int run_bake(const std::vector<std::string>& args, std::ostream& out, std::ostre
 }
 
 int run_subdivide(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
-  const std::string usage =
-      "usage: sinew-editor subdivide MODEL --levels L -o OUT.pack\n"
-      "  splits every triangle into four at its edge midpoints, L times (1..8); shared edges\n"
-      "  share their midpoint (no cracks), midpoints average the attributes and merge the skin\n"
-      "  weights. Writes a model-only pack, which `bake` takes as its MODEL.\n";
-  std::vector<std::string> renamed = args;
-  for (std::string& a : renamed) {
-    if (a == "-o") a = "--out";
-  }
-  auto parsed = cli::parse_args(renamed, {{"--help", false}, {"-h", false}, {"--levels"}, {"--out"}});
-  if (!parsed.ok()) return usage_error(err, "subdivide", parsed.status(), usage);
-  if (parsed->has("--help") || parsed->has("-h")) {
-    out << usage;
-    return 0;
-  }
-  if (parsed->positionals.size() != 1) {
-    return usage_error(err, "subdivide", invalid_argument("MODEL", "", "expected one model file"), usage);
-  }
-  const auto levels_text = parsed->value("--levels");
-  const auto out_path = parsed->value("--out");
-  if (!levels_text) return usage_error(err, "subdivide", invalid_argument("--levels", "", "missing"), usage);
+  cli::CommandLine line("sinew-editor subdivide",
+                        "Splits every triangle into four at its edge midpoints, L times; shared edges\n"
+                        "share their midpoint (no cracks), midpoints average the attributes and merge the skin\n"
+                        "weights. Writes a model-only pack, which `bake` takes as its MODEL.\n");
+  const auto& model_arg = line.positionals("MODEL", ".gltf, .glb, .cfg (Cal3D) or a .pack", 1);
+  const auto& levels_text = line.option("--levels", "L", "subdivision levels (1.." +
+                                                             std::to_string(kMaxSubdivisionLevels) + "; required)");
+  const auto& out_path = line.option("-o,--out", "OUT.pack", "the model-only pack to write (required)");
+  if (const auto done = cli::help_or_usage_error(line, line.parse(args), out, err)) return *done;
+  if (model_arg.empty()) return usage_error(err, "subdivide", invalid_argument("MODEL", "", "expected one model file"));
+  if (!levels_text) return usage_error(err, "subdivide", invalid_argument("--levels", "", "missing"));
   if (!out_path || !character::is_pack_path(*out_path)) {
-    return usage_error(err, "subdivide", invalid_argument("-o", out_path.value_or(""), "expected a .pack file name"),
-                       usage);
+    return usage_error(err, "subdivide", invalid_argument("-o", out_path.value_or(""), "expected a .pack file name"));
   }
   auto levels = cli::parse_int("--levels", *levels_text, 1, kMaxSubdivisionLevels);
-  if (!levels.ok()) return usage_error(err, "subdivide", levels.status(), usage);
-  const std::string& model_path = parsed->positionals.front();
+  if (!levels.ok()) return usage_error(err, "subdivide", levels.status());
+  const std::string& model_path = model_arg.front();
   auto model = load_model(model_path);
   if (!model.ok()) return fail(err, "subdivide", model.status());
   for (const std::string& warning : model->warnings) err << "sinew-editor subdivide: warning: " << warning << "\n";
@@ -570,20 +581,16 @@ int run_subdivide(const std::vector<std::string>& args, std::ostream& out, std::
 }
 
 int run_inspect(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
-  const std::string usage = "usage: sinew-editor inspect PACK [--json]\n";
-  auto parsed = cli::parse_args(args, {{"--help", false}, {"-h", false}, {"--json", false}});
-  if (!parsed.ok()) return usage_error(err, "inspect", parsed.status(), usage);
-  if (parsed->has("--help") || parsed->has("-h")) {
-    out << usage;
-    return 0;
-  }
-  if (parsed->positionals.size() != 1) {
-    return usage_error(err, "inspect", invalid_argument("PACK", "", "expected one pack file"), usage);
-  }
-  auto pack = character::Pack::open(parsed->positionals.front());
+  cli::CommandLine line("sinew-editor inspect",
+                        "Sizes, counts, pose space, fuzzy area, tree depths and provenance of a pack.\n");
+  const auto& pack_arg = line.positionals("PACK", "the content pack", 1);
+  const bool& json = line.flag("--json", "print it as JSON");
+  if (const auto done = cli::help_or_usage_error(line, line.parse(args), out, err)) return *done;
+  if (pack_arg.empty()) return usage_error(err, "inspect", invalid_argument("PACK", "", "expected one pack file"));
+  auto pack = character::Pack::open(pack_arg.front());
   if (!pack.ok()) return fail(err, "inspect", pack.status());
   const Json j = inspect_json(*pack);
-  if (parsed->has("--json")) {
+  if (json) {
     out << j.dump(2) << "\n";
   } else {
     print_inspect(j, out);
@@ -592,24 +599,17 @@ int run_inspect(const std::vector<std::string>& args, std::ostream& out, std::os
 }
 
 int run_validate(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
-  const std::string usage =
-      "usage: sinew-editor validate PACK\n"
-      "  checks the container (checksums, bounds, alignment) and every section's contents\n"
-      "  (counts, indices, finite values, kd-tree links and depth); exit 0 when valid\n";
-  auto parsed = cli::parse_args(args, {{"--help", false}, {"-h", false}});
-  if (!parsed.ok()) return usage_error(err, "validate", parsed.status(), usage);
-  if (parsed->has("--help") || parsed->has("-h")) {
-    out << usage;
-    return 0;
-  }
-  if (parsed->positionals.size() != 1) {
-    return usage_error(err, "validate", invalid_argument("PACK", "", "expected one pack file"), usage);
-  }
+  cli::CommandLine line("sinew-editor validate",
+                        "Checks the container (checksums, bounds, alignment) and every section's contents\n"
+                        "(counts, indices, finite values, kd-tree links and depth); exit 0 when valid.\n");
+  const auto& pack_arg = line.positionals("PACK", "the content pack", 1);
+  if (const auto done = cli::help_or_usage_error(line, line.parse(args), out, err)) return *done;
+  if (pack_arg.empty()) return usage_error(err, "validate", invalid_argument("PACK", "", "expected one pack file"));
   const auto start = Clock::now();
-  auto pack = character::Pack::open(parsed->positionals.front());
+  auto pack = character::Pack::open(pack_arg.front());
   const double load_ms = ms_since(start);
   if (!pack.ok()) return fail(err, "validate", pack.status());
-  out << parsed->positionals.front() << ": valid, checked in " << std::fixed << std::setprecision(1) << load_ms
+  out << pack_arg.front() << ": valid, checked in " << std::fixed << std::setprecision(1) << load_ms
       << " ms (" << pack->reader().section_count() << " sections, "
       << pack->model().mesh.triangle_count() << " triangles, "
       << (pack->has_fuzzy() ? "fuzzy trees of " + std::to_string(pack->fuzzy().bone_count) + " bones"

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <optional>
 #include <iostream>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -17,10 +18,12 @@
 #include "character/bake.h"
 #include "character/framing.h"
 #include "character/pack.h"
-#include "editor/cli/cli_args.h"
+#include "editor/cli/import_limit_flags.h"
 #include "editor/import/model_loader.h"
 #include "raytrace/render/renderer.h"
 #include "raytrace/skinning/skinning.h"
+#include "runtime/cli/command_line.h"
+#include "runtime/cli/option_values.h"
 #include "runtime/image/image_io.h"
 #include "runtime/io/atomic_file.h"
 #include "runtime/jobs/job_system.h"
@@ -34,27 +37,86 @@ namespace {
 constexpr double kFramesPerSecond = 30.0;
 constexpr int kMaxImageSide = 16384;
 
-const std::vector<cli::FlagSpec>& render_flags() {
-  static const std::vector<cli::FlagSpec> flags = {
-      {"--help", false}, {"-h", false},          {"--clip"},      {"--time"},          {"--camera"},
-      {"--size"},        {"--out"},              {"--pose-space"}, {"--clips"},        {"--samples"},
-      {"--seed"},        {"--shadows"},          {"--light"},      {"--threads"},      {"--instances"},
-      {"--frames"},      {"--triangle-test"},    {"--bone-boxes"}, {"--fallback"},     {"--limits"},
-      {"--ground"},      {"--packet-rays"},      {"--asset-roots"},   {"--max-triangles"}, {"--max-clips"},
-      {"--max-keys"},    {"--max-nodes"},        {"--max-bytes"},
-  };
-  return flags;
-}
+const char* const kProgram = "sinew-editor render";
 
-std::string usage_line() {
-  return "usage: sinew-editor render MODEL --out DIR [--clip NAME] [--time SECONDS] [options]"
-         " (sinew-editor render --help lists them)";
+// The command's options, declared in the order --help lists them.
+struct RenderFlags {
+  explicit RenderFlags(cli::CommandLine& l)
+      : model(l.positionals("MODEL", "a glTF (.gltf/.glb) or Cal3D (.cfg) model, or a content pack (.pack)", 1)),
+        out(l.option("--out", "DIR", "output folder (created if missing; required)")),
+        clip(l.option("--clip", "NAME|#I", "the clip, by name or index (default: the first; rest pose without clips)")),
+        time(l.option("--time", "SECONDS", "playback time, looping (default 0)")),
+        camera(l.option("--camera", "ex,ey,ez,tx,ty,tz,ux,uy,uz,fovy_deg",
+                        "eye, target, up, vertical field of view (default: frames the\n"
+                        "posed model from the front, +Z for Y-up models, -Y for Z-up)")),
+        size(l.option("--size", "WxH", "image size (default 512x512)")),
+        pose_space(l.option("--pose-space", "MODE",
+                            "arbitrary|limits|clips|clip:NAME (default: clips, every key\n"
+                            "and every 1/30 s of every clip)")),
+        clips(l.option("--clips", "a,b,c", "the clips of --pose-space clips (default: all)")),
+        samples(l.option("--samples", "N", "pose samples (random modes: default 1000; clip modes: 0 = all)")),
+        seed(l.option("--seed", "S", "seed of the random pose spaces (default 1)")),
+        limits(l.option("--limits", "FILE.json", "joint limits, required by --pose-space limits")),
+        shadows(l.option("--shadows", "on|off", "shadow rays (default on)")),
+        light(l.option("--light", "x,y,z", "point light position (default: above-front of the model)")),
+        threads(l.option("--threads", "N", "worker threads (default 0: all cores)")),
+        instances(l.option("--instances", "N", "copies side by side along +X, each 0.37 s later (default 1)")),
+        frames(l.option("--frames", "N", "frames rendered at 30 fps from --time; the last is written (default 1)")),
+        triangle_test(l.option("--triangle-test", "fast|watertight", "ray-triangle test (default fast)")),
+        packet_rays(l.option("--packet-rays", "1|8|64|256",
+                             "rays traced together: single rays, 4x2, 8x8 or 16x16 pixels (default 256)")),
+        asset_roots(l.option("--asset-roots", "A:B",
+                             "more folders a glTF file's buffers may be read from (by default\n"
+                             "only its own folder and below)")),
+        bone_boxes(l.option("--bone-boxes", "exact|cheap", "per-frame bone boxes (default exact)")),
+        fallback(l.option("--fallback", "on|off",
+                          "exact rendering of triangles outside their fuzzy boxes (default on)")),
+        ground(l.option("--ground", "on|off", "the ground quad under the model (default on)")),
+        import_limits(l) {}
+
+  const std::vector<std::string>& model;
+  const std::optional<std::string>& out;
+  const std::optional<std::string>& clip;
+  const std::optional<std::string>& time;
+  const std::optional<std::string>& camera;
+  const std::optional<std::string>& size;
+  const std::optional<std::string>& pose_space;
+  const std::optional<std::string>& clips;
+  const std::optional<std::string>& samples;
+  const std::optional<std::string>& seed;
+  const std::optional<std::string>& limits;
+  const std::optional<std::string>& shadows;
+  const std::optional<std::string>& light;
+  const std::optional<std::string>& threads;
+  const std::optional<std::string>& instances;
+  const std::optional<std::string>& frames;
+  const std::optional<std::string>& triangle_test;
+  const std::optional<std::string>& packet_rays;
+  const std::optional<std::string>& asset_roots;
+  const std::optional<std::string>& bone_boxes;
+  const std::optional<std::string>& fallback;
+  const std::optional<std::string>& ground;
+  ImportLimitFlags import_limits;
+};
+
+// The command line of `render`, before RenderFlags declares its options.
+std::unique_ptr<cli::CommandLine> render_command_line() {
+  auto line = std::make_unique<cli::CommandLine>(
+      kProgram,
+      "Imports a glTF (.gltf/.glb) or Cal3D (.cfg) model and bakes it in memory, or loads a\n"
+      "content pack (.pack) and uses its baked trees in place (the --pose-space options then\n"
+      "do not apply); poses it with one clip and ray traces it. Writes DIR/color.png,\n"
+      "DIR/depth.exr, DIR/triangle_id.exr and DIR/stats.json.\n");
+  line->footer(
+      "The model's up axis is the larger of its rest bounds' Y and Z extents; a ground quad lies\n"
+      "under the rest bounds on that axis (unless --ground off).\n");
+  return line;
 }
 
 // --- option parsing -------------------------------------------------------
 
-Status parse_pose_space(const cli::ParsedArgs& args, RenderOptions& o) {
-  if (const auto text = args.value("--pose-space")) {
+Status parse_pose_space(const RenderFlags& f, RenderOptions& o) {
+  if (const std::optional<std::string>& text = f.pose_space) {
     std::string mode_name = *text;
     std::string clip_name;
     if (const std::size_t colon = text->find(':'); colon != std::string::npos) {
@@ -76,21 +138,21 @@ Status parse_pose_space(const cli::ParsedArgs& args, RenderOptions& o) {
   }
   const anim::PoseSpaceMode mode = o.pose_space.mode;
   const bool random = mode == anim::PoseSpaceMode::kArbitrary || mode == anim::PoseSpaceMode::kLimits;
-  if (const auto text = args.value("--clips")) {
+  if (const std::optional<std::string>& text = f.clips) {
     if (mode != anim::PoseSpaceMode::kClips) {
       return invalid_argument("--clips", *text, "applies to --pose-space clips only");
     }
     SINEW_ASSIGN_OR_RETURN(o.pose_space.clips, cli::parse_list("--clips", *text));
   }
-  if (const auto text = args.value("--samples")) {
+  if (const std::optional<std::string>& text = f.samples) {
     SINEW_ASSIGN_OR_RETURN(const std::int64_t n,
                            cli::parse_int("--samples", *text, random ? 1 : 0, anim::kMaxPoseSamples));
     o.pose_space.samples = static_cast<int>(n);
   }
-  if (const auto text = args.value("--seed")) {
+  if (const std::optional<std::string>& text = f.seed) {
     SINEW_ASSIGN_OR_RETURN(o.pose_space.seed, cli::parse_uint64("--seed", *text));
   }
-  if (const auto text = args.value("--limits")) {
+  if (const std::optional<std::string>& text = f.limits) {
     if (mode != anim::PoseSpaceMode::kLimits) {
       return invalid_argument("--limits", *text, "applies to --pose-space limits only");
     }
@@ -101,8 +163,8 @@ Status parse_pose_space(const cli::ParsedArgs& args, RenderOptions& o) {
   return {};
 }
 
-Status parse_view(const cli::ParsedArgs& args, RenderOptions& o) {
-  if (const auto text = args.value("--camera")) {
+Status parse_view(const RenderFlags& f, RenderOptions& o) {
+  if (const std::optional<std::string>& text = f.camera) {
     SINEW_ASSIGN_OR_RETURN(const std::vector<float> v, cli::parse_floats("--camera", *text, 10));
     rt::CameraDesc desc{{v[0], v[1], v[2]}, {v[3], v[4], v[5]}, {v[6], v[7], v[8]}, v[9]};
     // The camera's own checks (eye == target, up along the view, fovy range)
@@ -115,11 +177,11 @@ Status parse_view(const cli::ParsedArgs& args, RenderOptions& o) {
     }
     o.camera = desc;
   }
-  if (const auto text = args.value("--light")) {
+  if (const std::optional<std::string>& text = f.light) {
     SINEW_ASSIGN_OR_RETURN(const std::vector<float> v, cli::parse_floats("--light", *text, 3));
     o.light = Vec3(v[0], v[1], v[2]);
   }
-  if (const auto text = args.value("--size")) {
+  if (const std::optional<std::string>& text = f.size) {
     SINEW_ASSIGN_OR_RETURN(const cli::Size2 size, cli::parse_size("--size", *text, kMaxImageSide));
     o.width = size.width;
     o.height = size.height;
@@ -127,50 +189,53 @@ Status parse_view(const cli::ParsedArgs& args, RenderOptions& o) {
   return {};
 }
 
-Status parse_run(const cli::ParsedArgs& args, RenderOptions& o) {
-  if (const auto text = args.value("--clip")) {
+Status parse_run(const RenderFlags& f, RenderOptions& o) {
+  if (const std::optional<std::string>& text = f.clip) {
     if (text->empty()) return invalid_argument("--clip", "", "expected a clip name or #index");
     o.clip = *text;
   }
-  if (const auto text = args.value("--time")) {
+  if (const std::optional<std::string>& text = f.time) {
     SINEW_ASSIGN_OR_RETURN(o.time_seconds, cli::parse_double("--time", *text, 0.0, 1e6));
   }
-  if (const auto text = args.value("--out")) o.out_dir = *text;
-  if (const auto text = args.value("--shadows")) {
+  if (const std::optional<std::string>& text = f.out) o.out_dir = *text;
+  if (const std::optional<std::string>& text = f.shadows) {
     SINEW_ASSIGN_OR_RETURN(o.shadows, cli::parse_on_off("--shadows", *text));
   }
-  if (const auto text = args.value("--fallback")) {
+  if (const std::optional<std::string>& text = f.fallback) {
     SINEW_ASSIGN_OR_RETURN(o.fallback, cli::parse_on_off("--fallback", *text));
   }
-  if (const auto text = args.value("--ground")) {
+  if (const std::optional<std::string>& text = f.ground) {
     SINEW_ASSIGN_OR_RETURN(o.ground, cli::parse_on_off("--ground", *text));
   }
-  if (const auto text = args.value("--triangle-test")) {
+  if (const std::optional<std::string>& text = f.triangle_test) {
     SINEW_ASSIGN_OR_RETURN(const int i, cli::parse_choice("--triangle-test", *text, {"fast", "watertight"}));
     o.triangle_test = i == 0 ? rt::TriangleTest::kFast : rt::TriangleTest::kWatertight;
   }
-  if (const auto text = args.value("--asset-roots")) {
+  if (const std::optional<std::string>& text = f.asset_roots) {
     SINEW_ASSIGN_OR_RETURN(o.gltf.asset_roots, cli::parse_folder_list("--asset-roots", *text));
   }
-  SINEW_RETURN_IF_ERROR(cli::parse_import_limits(args, o.gltf.limits));
-  if (const auto text = args.value("--packet-rays")) {
+  SINEW_RETURN_IF_ERROR(f.import_limits.apply(o.gltf.limits));
+  if (const std::optional<std::string>& text = f.packet_rays) {
     SINEW_ASSIGN_OR_RETURN(const int i, cli::parse_choice("--packet-rays", *text, {"1", "8", "64", "256"}));
     o.packet_rays = std::array<int, 4>{1, 8, 64, 256}[static_cast<std::size_t>(i)];
   }
-  if (const auto text = args.value("--bone-boxes")) {
+  if (const std::optional<std::string>& text = f.bone_boxes) {
     SINEW_ASSIGN_OR_RETURN(const int i, cli::parse_choice("--bone-boxes", *text, {"exact", "cheap"}));
     o.bone_boxes = i == 0 ? rt::BoneBoxMode::kExact : rt::BoneBoxMode::kCheap;
   }
-  const auto int_flag = [&](const char* flag, std::int64_t lo, std::int64_t hi, int& target) -> Status {
-    if (const auto text = args.value(flag)) {
+  if (const std::optional<std::string>& text = f.threads) {
+    SINEW_ASSIGN_OR_RETURN(o.threads, cli::parse_threads("--threads", *text));
+  }
+  const auto int_flag = [](const char* flag, const std::optional<std::string>& text, std::int64_t lo,
+                           std::int64_t hi, int& target) -> Status {
+    if (text) {
       SINEW_ASSIGN_OR_RETURN(const std::int64_t n, cli::parse_int(flag, *text, lo, hi));
       target = static_cast<int>(n);
     }
     return {};
   };
-  SINEW_RETURN_IF_ERROR(int_flag("--threads", 0, 1024, o.threads));
-  SINEW_RETURN_IF_ERROR(int_flag("--instances", 1, 256, o.instances));
-  SINEW_RETURN_IF_ERROR(int_flag("--frames", 1, 100000, o.frames));
+  SINEW_RETURN_IF_ERROR(int_flag("--instances", f.instances, 1, 256, o.instances));
+  SINEW_RETURN_IF_ERROR(int_flag("--frames", f.frames, 1, 100000, o.frames));
   return {};
 }
 
@@ -271,58 +336,25 @@ void report(const RenderOptions& options, const std::string& line) {
 // --- the command --------------------------------------------------------------
 
 std::string render_usage() {
-  return usage_line() +
-         "\n\n"
-         "Imports a glTF (.gltf/.glb) or Cal3D (.cfg) model and bakes it in memory, or loads a\n"
-         "content pack (.pack) and uses its baked trees in place (the --pose-space options then\n"
-         "do not apply); poses it with one clip and ray traces it. Writes DIR/color.png,\n"
-         "DIR/depth.exr, DIR/triangle_id.exr and DIR/stats.json.\n\n"
-         "  --out DIR                 output folder (created if missing; required)\n"
-         "  --clip NAME|#I            the clip, by name or index (default: the first; rest pose without clips)\n"
-         "  --time SECONDS            playback time, looping (default 0)\n"
-         "  --camera ex,ey,ez,tx,ty,tz,ux,uy,uz,fovy_deg\n"
-         "                            eye, target, up, vertical field of view (default: frames the\n"
-         "                            posed model from the front, +Z for Y-up models, -Y for Z-up)\n"
-         "  --size WxH                image size (default 512x512)\n"
-         "  --pose-space MODE         arbitrary|limits|clips|clip:NAME (default: clips, every key\n"
-         "                            and every 1/30 s of every clip)\n"
-         "  --clips a,b,c             the clips of --pose-space clips (default: all)\n"
-         "  --samples N               pose samples (random modes: default 1000; clip modes: 0 = all)\n"
-         "  --seed S                  seed of the random pose spaces (default 1)\n"
-         "  --limits FILE.json        joint limits, required by --pose-space limits\n"
-         "  --shadows on|off          shadow rays (default on)\n"
-         "  --light x,y,z             point light position (default: above-front of the model)\n"
-         "  --threads N               worker threads (default 0: all cores)\n"
-         "  --instances N             copies side by side along +X, each 0.37 s later (default 1)\n"
-         "  --frames N                frames rendered at 30 fps from --time; the last is written (default 1)\n"
-         "  --triangle-test fast|watertight   ray-triangle test (default fast)\n"
-         "  --packet-rays 1|8|64|256  rays traced together: single rays, 4x2, 8x8 or 16x16 pixels (default 256)\n"
-         "  --asset-roots A:B         more folders a glTF file's buffers may be read from (by default\n"
-         "                            only its own folder and below)\n"
-         "  --bone-boxes exact|cheap  per-frame bone boxes (default exact)\n"
-         "  --fallback on|off         exact rendering of triangles outside their fuzzy boxes (default on)\n"
-         "  --ground on|off           the ground quad under the model (default on)\n"
-         "  --help                    this text\n" +
-         cli::import_limits_usage() +
-         "The model's up axis is the larger of its rest bounds' Y and Z extents; a ground quad lies\n"
-         "under the rest bounds on that axis (unless --ground off).\n";
+  const auto line = render_command_line();
+  const RenderFlags flags(*line);
+  return line->help();
 }
 
 Expected<RenderOptions> parse_render_options(const std::vector<std::string>& args) {
-  SINEW_ASSIGN_OR_RETURN(const cli::ParsedArgs parsed, cli::parse_args(args, render_flags()));
+  const auto line = render_command_line();
+  const RenderFlags flags(*line);
+  SINEW_ASSIGN_OR_RETURN(const cli::ParseResult result, line->parse(args));
   RenderOptions o;
-  if (parsed.has("--help") || parsed.has("-h")) {
+  if (result == cli::ParseResult::kHelp) {
     o.help = true;
     return o;
   }
-  if (parsed.positionals.empty()) return invalid_argument("MODEL", "", "missing: the model file to render");
-  if (parsed.positionals.size() > 1) {
-    return invalid_argument("argument", parsed.positionals[1], "unexpected extra argument (only one MODEL)");
-  }
-  o.model_path = parsed.positionals.front();
-  SINEW_RETURN_IF_ERROR(parse_run(parsed, o));
-  SINEW_RETURN_IF_ERROR(parse_view(parsed, o));
-  SINEW_RETURN_IF_ERROR(parse_pose_space(parsed, o));
+  if (flags.model.empty()) return invalid_argument("MODEL", "", "missing: the model file to render");
+  o.model_path = flags.model.front();
+  SINEW_RETURN_IF_ERROR(parse_run(flags, o));
+  SINEW_RETURN_IF_ERROR(parse_view(flags, o));
+  SINEW_RETURN_IF_ERROR(parse_pose_space(flags, o));
   if (o.out_dir.empty()) return invalid_argument("--out", "", "missing: the output folder is required");
   return o;
 }
@@ -508,8 +540,7 @@ void print_summary(const RenderOptions& options, const RenderOutputs& o, std::os
 int run_render(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
   auto options = parse_render_options(args);
   if (!options.ok()) {
-    err << "sinew-editor render: " << options.status().message() << "\n" << usage_line() << "\n";
-    return 2;
+    return cli::usage_error(kProgram, options.status(), err);
   }
   if (options->help) {
     out << render_usage();

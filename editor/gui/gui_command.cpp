@@ -1,94 +1,88 @@
 // `sinew-editor gui`: argument parsing and the automation loop (frames,
 // screenshot) around EditorApp.
-#include <charconv>
-#include <cmath>
-#include <string_view>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
 
 #include "editor/gui/editor_app.h"
+#include "runtime/cli/command_line.h"
+#include "runtime/cli/option_values.h"
 #include "runtime/image/image_io.h"
 
 namespace sinew::editor::gui {
 namespace {
 
-Expected<int> parse_int(std::string_view flag, std::string_view text, int min_value) {
-  int value = 0;
-  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
-  if (ec != std::errc{} || end != text.data() + text.size() || value < min_value) {
-    return invalid_argument(flag, std::string(text), "expected an integer >= " + std::to_string(min_value));
-  }
-  return value;
-}
+constexpr int kMinWidth = 320;
+constexpr int kMinHeight = 200;
 
-Expected<double> parse_seconds(std::string_view flag, const std::string& text) {
-  char* end = nullptr;
-  const double value = std::strtod(text.c_str(), &end);
-  if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(value) || value < 0.0) {
-    return invalid_argument(flag, text, "expected a finite number of seconds >= 0");
-  }
-  return value;
-}
+struct GuiFlags {
+  explicit GuiFlags(cli::CommandLine& l)
+      : model(l.positionals("MODEL", "the model or pack to open (.gltf, .glb, .cfg, .pack)", 1)),
+        size(l.option("--size", "WxH", "window size (default 1024x768; at least 320x200)")),
+        frames(l.option("--frames", "N", "quit after N frames (0: run until closed)")),
+        screenshot(l.option("--screenshot", "PATH", "write the last frame shown as PNG")),
+        overlay(l.option("--overlay", "none|boxes|heat|escapes",
+                         "viewport overlay: fuzzy boxes of a bone, leaf-size heat map,\n"
+                         "escaped triangles in red")),
+        bone(l.option("--bone", "NAME|INDEX", "the bone of the boxes overlay")),
+        clip(l.option("--clip", "NAME", "the clip to play (name or #index)")),
+        time(l.option("--time", "S", "playback time in seconds; starts paused there")),
+        threads(l.option("--threads", "N", "render threads (default 0: all cores)")) {}
 
-Status parse_size(const std::string& text, GuiOptions& options) {
-  const std::size_t x = text.find('x');
-  if (x == std::string::npos) return invalid_argument("--size", text, "expected WxH");
-  SINEW_ASSIGN_OR_RETURN(options.width, parse_int("--size", std::string_view(text).substr(0, x), 320));
-  SINEW_ASSIGN_OR_RETURN(options.height, parse_int("--size", std::string_view(text).substr(x + 1), 200));
-  return Status{};
-}
+  const std::vector<std::string>& model;
+  const std::optional<std::string>& size;
+  const std::optional<std::string>& frames;
+  const std::optional<std::string>& screenshot;
+  const std::optional<std::string>& overlay;
+  const std::optional<std::string>& bone;
+  const std::optional<std::string>& clip;
+  const std::optional<std::string>& time;
+  const std::optional<std::string>& threads;
+};
+
+const char* const kDescription = "Opens the editor window on MODEL (.gltf, .glb, .cfg, .pack).\n";
 
 }  // namespace
 
 std::string gui_usage() {
-  return "usage: sinew-editor gui [MODEL|PACK] [--size WxH] [--frames N] [--screenshot PATH]\n"
-         "           [--overlay none|boxes|heat|escapes] [--bone NAME|INDEX] [--clip NAME]\n"
-         "           [--time S] [--threads N]\n"
-         "Opens the editor window on MODEL (.gltf, .glb, .cfg, .pack).\n"
-         "  --size WxH        window size (default 1024x768; at least 320x200)\n"
-         "  --frames N        quit after N frames (0: run until closed)\n"
-         "  --screenshot PATH write the last frame shown as PNG\n"
-         "  --overlay MODE    viewport overlay: fuzzy boxes of a bone, leaf-size heat map,\n"
-         "                    escaped triangles in red\n"
-         "  --bone NAME|INDEX the bone of the boxes overlay\n"
-         "  --clip NAME       the clip to play (name or #index)\n"
-         "  --time S          playback time in seconds; starts paused there\n"
-         "  --threads N       render threads (0: all cores)\n";
+  cli::CommandLine line("sinew-editor gui", kDescription);
+  const GuiFlags flags(line);
+  return line.help();
 }
 
 Expected<GuiOptions> parse_gui_options(const std::vector<std::string>& args) {
+  cli::CommandLine line("sinew-editor gui", kDescription);
+  const GuiFlags f(line);
+  SINEW_ASSIGN_OR_RETURN(const cli::ParseResult result, line.parse(args));
   GuiOptions options;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& arg = args[i];
-    if (arg == "--help" || arg == "-h") {
-      options.help = true;
-      continue;
-    }
-    if (arg.rfind("--", 0) != 0) {
-      if (!options.model_path.empty()) return invalid_argument("MODEL", arg, "only one model may be given");
-      options.model_path = arg;
-      continue;
-    }
-    if (i + 1 >= args.size()) return invalid_argument(arg, "", "needs a value");
-    const std::string& value = args[++i];
-    if (arg == "--size") {
-      SINEW_RETURN_IF_ERROR(parse_size(value, options));
-    } else if (arg == "--frames") {
-      SINEW_ASSIGN_OR_RETURN(options.frames, parse_int(arg, value, 0));
-    } else if (arg == "--screenshot") {
-      options.screenshot = value;
-    } else if (arg == "--overlay") {
-      SINEW_ASSIGN_OR_RETURN(options.overlay, parse_overlay(value));
-    } else if (arg == "--bone") {
-      options.bone = value;
-    } else if (arg == "--clip") {
-      options.clip = value;
-    } else if (arg == "--time") {
-      SINEW_ASSIGN_OR_RETURN(const double seconds, parse_seconds(arg, value));
-      options.time = seconds;
-    } else if (arg == "--threads") {
-      SINEW_ASSIGN_OR_RETURN(options.threads, parse_int(arg, value, 0));
-    } else {
-      return invalid_argument("flag", arg, "unknown option (see --help)");
-    }
+  if (result == cli::ParseResult::kHelp) {
+    options.help = true;
+    return options;
+  }
+  if (!f.model.empty()) options.model_path = f.model.front();
+  if (f.size) {
+    SINEW_ASSIGN_OR_RETURN(const cli::Size2 size, cli::parse_size("--size", *f.size, 16384, kMinHeight));
+    if (size.width < kMinWidth) return invalid_argument("--size", *f.size, "expected at least 320x200");
+    options.width = size.width;
+    options.height = size.height;
+  }
+  if (f.frames) {
+    SINEW_ASSIGN_OR_RETURN(const std::int64_t n, cli::parse_int("--frames", *f.frames, 0, 1000000000));
+    options.frames = static_cast<int>(n);
+  }
+  if (f.screenshot) options.screenshot = *f.screenshot;
+  if (f.overlay) {
+    SINEW_ASSIGN_OR_RETURN(options.overlay, parse_overlay(*f.overlay));
+  }
+  if (f.bone) options.bone = *f.bone;
+  if (f.clip) options.clip = *f.clip;
+  if (f.time) {
+    SINEW_ASSIGN_OR_RETURN(const double seconds, cli::parse_double("--time", *f.time, 0.0, 1e9));
+    options.time = seconds;
+  }
+  if (f.threads) {
+    SINEW_ASSIGN_OR_RETURN(options.threads, cli::parse_threads("--threads", *f.threads));
   }
   if (!options.screenshot.empty() && options.frames == 0) options.frames = 1;
   return options;
@@ -121,8 +115,7 @@ Status run_loop(const GuiOptions& options) {
 int run_gui(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
   Expected<GuiOptions> options = parse_gui_options(args);
   if (!options.ok()) {
-    err << "sinew-editor gui: " << options.status().message() << "\n" << gui_usage();
-    return 2;
+    return cli::usage_error("sinew-editor gui", options.status(), err);
   }
   if (options->help) {
     out << gui_usage();

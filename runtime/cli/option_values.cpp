@@ -1,27 +1,15 @@
-#include "editor/cli/cli_args.h"
-
-#include <filesystem>
+#include "runtime/cli/option_values.h"
 
 #include <algorithm>
 #include <charconv>
 #include <cmath>
-#include <limits>
+#include <filesystem>
+#include <optional>
 
 #include "runtime/core/format_number.h"
 
-namespace sinew::editor::cli {
+namespace sinew::cli {
 namespace {
-
-const FlagSpec* find_spec(const std::vector<FlagSpec>& specs, std::string_view name) {
-  for (const FlagSpec& spec : specs) {
-    if (spec.name == name) return &spec;
-  }
-  return nullptr;
-}
-
-bool looks_like_flag(const std::string& arg) {
-  return (arg.size() > 2 && arg.compare(0, 2, "--") == 0) || arg == "-h";
-}
 
 std::vector<std::string> split_commas(const std::string& text) {
   std::vector<std::string> parts;
@@ -46,46 +34,6 @@ std::optional<T> whole_number(std::string_view text) {
 }
 
 }  // namespace
-
-bool ParsedArgs::has(std::string_view name) const { return value(name).has_value(); }
-
-std::optional<std::string> ParsedArgs::value(std::string_view name) const {
-  for (const auto& [flag, text] : flags) {
-    if (flag == name) return text;
-  }
-  return std::nullopt;
-}
-
-Expected<ParsedArgs> parse_args(const std::vector<std::string>& args, const std::vector<FlagSpec>& specs) {
-  ParsedArgs parsed;
-  bool flags_ended = false;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& arg = args[i];
-    if (!flags_ended && arg == "--") {
-      flags_ended = true;
-      continue;
-    }
-    if (flags_ended || !looks_like_flag(arg)) {
-      parsed.positionals.push_back(arg);
-      continue;
-    }
-    const std::size_t equals = arg.find('=');
-    const std::string name = arg.substr(0, equals);
-    const FlagSpec* spec = find_spec(specs, name);
-    if (spec == nullptr) return invalid_argument("option", name, "unknown option (see --help)");
-    if (parsed.has(name)) return invalid_argument(name, arg, "given twice");
-    std::string text;
-    if (equals != std::string::npos) {
-      if (!spec->takes_value) return invalid_argument(name, arg, "takes no value");
-      text = arg.substr(equals + 1);
-    } else if (spec->takes_value) {
-      if (i + 1 >= args.size()) return invalid_argument(name, "", "missing value");
-      text = args[++i];
-    }
-    parsed.flags.emplace_back(name, std::move(text));
-  }
-  return parsed;
-}
 
 Expected<std::int64_t> parse_int(std::string_view flag, const std::string& text, std::int64_t lo,
                                  std::int64_t hi) {
@@ -136,16 +84,27 @@ Expected<std::vector<std::string>> parse_list(std::string_view flag, const std::
   return parts;
 }
 
-Expected<Size2> parse_size(std::string_view flag, const std::string& text, int max_side) {
+Expected<std::vector<int>> parse_int_list(std::string_view flag, const std::string& text, int lo, int hi) {
+  SINEW_ASSIGN_OR_RETURN(const std::vector<std::string> items, parse_list(flag, text));
+  std::vector<int> values;
+  for (const std::string& item : items) {
+    SINEW_ASSIGN_OR_RETURN(const std::int64_t n, parse_int(flag, item, lo, hi));
+    values.push_back(static_cast<int>(n));
+  }
+  return values;
+}
+
+Expected<Size2> parse_size(std::string_view flag, const std::string& text, int max_side, int min_side) {
   const std::size_t x = text.find('x');
   const auto fail = [&] {
     return invalid_argument(flag, text,
-                            "expected WxH with W and H from 1 to " + std::to_string(max_side) + ", e.g. 512x512");
+                            "expected WxH with W and H from " + std::to_string(min_side) + " to " +
+                                std::to_string(max_side) + ", e.g. 512x512");
   };
   if (x == std::string::npos) return fail();
   const auto w = whole_number<int>(std::string_view(text).substr(0, x));
   const auto h = whole_number<int>(std::string_view(text).substr(x + 1));
-  if (!w || !h || *w < 1 || *h < 1 || *w > max_side || *h > max_side) return fail();
+  if (!w || !h || *w < min_side || *h < min_side || *w > max_side || *h > max_side) return fail();
   return Size2{*w, *h};
 }
 
@@ -166,31 +125,6 @@ Expected<bool> parse_on_off(std::string_view flag, const std::string& text) {
   return index == 0;
 }
 
-Status parse_import_limits(const ParsedArgs& args, ImportLimits& limits) {
-  const std::pair<const char*, std::size_t*> options[] = {
-      {"--max-triangles", &limits.max_triangles}, {"--max-clips", &limits.max_clips}, {"--max-keys", &limits.max_keys},
-      {"--max-nodes", &limits.max_nodes},         {"--max-bytes", &limits.max_bytes}};
-  for (const auto& [flag, value] : options) {
-    if (const auto text = args.value(flag)) {
-      SINEW_ASSIGN_OR_RETURN(const std::int64_t n, parse_int(flag, *text, 1, std::int64_t{1} << 40));
-      *value = static_cast<std::size_t>(n);
-    }
-  }
-  return {};
-}
-
-std::string import_limits_usage() {
-  const ImportLimits d;
-  return "  --max-triangles N     glTF import limit on triangles over all mesh instances (default " +
-         std::to_string(d.max_triangles) + ")\n" +
-         "  --max-clips N         glTF import limit on animations (default " + std::to_string(d.max_clips) + ")\n" +
-         "  --max-keys N          glTF import limit on animation keys over all channels (default " +
-         std::to_string(d.max_keys) + ")\n" +
-         "  --max-nodes N         glTF import limit on nodes (default " + std::to_string(d.max_nodes) + ")\n" +
-         "  --max-bytes N         glTF import limit on the bytes read, the file and its external buffers (default " +
-         std::to_string(d.max_bytes) + ")\n";
-}
-
 Expected<std::vector<std::string>> parse_folder_list(std::string_view flag, const std::string& text) {
   std::vector<std::string> folders;
   std::size_t start = 0;
@@ -207,4 +141,9 @@ Expected<std::vector<std::string>> parse_folder_list(std::string_view flag, cons
   return folders;
 }
 
-}  // namespace sinew::editor::cli
+Expected<int> parse_threads(std::string_view flag, const std::string& text) {
+  SINEW_ASSIGN_OR_RETURN(const std::int64_t n, parse_int(flag, text, 0, kMaxThreads));
+  return static_cast<int>(n);
+}
+
+}  // namespace sinew::cli

@@ -13,8 +13,10 @@
 #include "animation/reference_skinning.h"
 #include "content/mannequin/mannequin.h"
 #include "editor/import/cal3d_importer.h"
+#include "runtime/cli/option_values.h"
 #include "runtime/timing/phase_timers.h"
 #include "runtime/timing/stopwatch.h"
+#include "tests/bench/bench_options.h"
 #include "tests/support/cal3d_support.h"
 
 namespace sinew::bench {
@@ -138,6 +140,12 @@ void bench_cal3d(const std::string& dir, int instances, int frames, Row& row) {
   testing_support::free_cal3d_animation_tracks(core);
 }
 
+struct AnimationBenchOptions {
+  int frames = 60;
+  std::string shared = SINEW_SHARED_DIR;
+  bool help = false;
+};
+
 int walk_index(const character::Model& m) {
   for (std::size_t i = 0; i < m.clips.size(); ++i) {
     if (m.clips[i].name() == "walk") return static_cast<int>(i);
@@ -148,18 +156,22 @@ int walk_index(const character::Model& m) {
 }  // namespace
 
 int run_animation_bench(const std::vector<std::string>& args) {
-  int frames = 60;
-  std::string shared = SINEW_SHARED_DIR;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    if (args[i] == "--frames" && i + 1 < args.size()) {
-      frames = std::max(1, std::atoi(args[++i].c_str()));
-    } else if (args[i] == "--shared" && i + 1 < args.size()) {
-      shared = args[++i];
-    } else {
-      std::fprintf(stderr, "sinew-bench animation: unknown option '%s'\n", args[i].c_str());
-      return 2;
+  BenchArgs options("animation", "Animation + skinning vs the Cal3D library.\n",
+                    {frames_flag("frames per character (default 60)"), shared_flag()});
+  const auto parsed = [&]() -> Expected<AnimationBenchOptions> {
+    SINEW_ASSIGN_OR_RETURN(const cli::ParseResult result, options.parse(args));
+    AnimationBenchOptions o;
+    o.help = result == cli::ParseResult::kHelp;
+    if (const auto text = options.value("--frames")) {
+      SINEW_ASSIGN_OR_RETURN(const std::int64_t n, cli::parse_int("--frames", *text, 1, 1000000));
+      o.frames = static_cast<int>(n);
     }
-  }
+    if (const auto text = options.value("--shared")) o.shared = *text;
+    return o;
+  }();
+  if (const std::optional<int> done = usage_exit(options, parsed)) return *done;
+  const int frames = parsed->frames;
+  const std::string& shared = parsed->shared;
   const std::string cally_dir = shared + "/content/cal3d/cally";
   auto cally = editor::import_cal3d(cally_dir + "/cally.cfg");
   if (!cally.ok()) {

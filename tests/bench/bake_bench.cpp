@@ -22,7 +22,8 @@
 
 #include "character/bake.h"
 #include "content/mannequin/mannequin.h"
-#include "editor/cli/cli_args.h"
+#include "runtime/cli/option_values.h"
+#include "tests/bench/bench_options.h"
 #include "editor/import/cal3d_importer.h"
 #include "raytrace/camera/camera.h"
 #include "raytrace/fuzzy/fuzzy_bake.h"
@@ -69,18 +70,25 @@ struct BakeBenchOptions {
   bool help = false;
 };
 
-const std::vector<editor::cli::FlagSpec>& bake_flags() {
-  static const std::vector<editor::cli::FlagSpec> flags = {
-      {"--help", false}, {"-h", false}, {"--models"}, {"--shared"}, {"--threads"}, {"--large"}, {"--json"},
+std::vector<BenchFlag> bake_flags() {
+  return {
+      models_flag("cally and/or mannequin (default cally,mannequin)"),
+      shared_flag(),
+      threads_flag("0: all cores"),
+      {"--large", "on|off",
+       "the memory-bound bakes of a synthetic 300k-triangle x 60-bone\n"
+       "character at 256, 64 and 16 MiB budgets (default on)"},
+      json_flag(),
   };
-  return flags;
 }
 
-Expected<BakeBenchOptions> parse_options(const std::vector<std::string>& args) {
-  namespace cli = editor::cli;
-  SINEW_ASSIGN_OR_RETURN(const cli::ParsedArgs parsed, parse_bench_args(args, bake_flags()));
+const char* const kDescription = "fuzzy bake cost per candidate-bone mode, its trace effect, and its memory bound\n";
+
+Expected<BakeBenchOptions> parse_options(const std::vector<std::string>& args, BenchArgs& parsed) {
+  namespace cli = sinew::cli;
+  SINEW_ASSIGN_OR_RETURN(const cli::ParseResult result, parsed.parse(args));
   BakeBenchOptions o;
-  if (wants_help(parsed)) {
+  if (result == cli::ParseResult::kHelp) {
     o.help = true;
     return o;
   }
@@ -94,7 +102,7 @@ Expected<BakeBenchOptions> parse_options(const std::vector<std::string>& args) {
   }
   if (const auto text = parsed.value("--shared")) o.shared = *text;
   if (const auto text = parsed.value("--threads")) {
-    SINEW_ASSIGN_OR_RETURN(const std::int64_t n, cli::parse_int("--threads", *text, 1, 1024));
+    SINEW_ASSIGN_OR_RETURN(const std::int64_t n, parse_thread_count("--threads", *text));
     o.threads = static_cast<int>(n);
   }
   if (const auto text = parsed.value("--large")) {
@@ -102,18 +110,6 @@ Expected<BakeBenchOptions> parse_options(const std::vector<std::string>& args) {
   }
   if (const auto text = parsed.value("--json")) o.json_path = *text;
   return o;
-}
-
-void print_usage(std::FILE* to) {
-  std::fprintf(to,
-               "usage: sinew-bench bake [--models LIST] [--shared DIR] [--threads N] [--large on|off]\n"
-               "                        [--json FILE]\n"
-               "  --models LIST   cally and/or mannequin (default cally,mannequin)\n"
-               "  --shared DIR    the shared folder holding content/cal3d/cally\n"
-               "  --threads N     threads for the bakes and renders (default: hardware threads)\n"
-               "  --large on|off  the memory-bound bakes of a synthetic 300k-triangle x 60-bone\n"
-               "                  character at 256, 64 and 16 MiB budgets (default on)\n"
-               "  --json FILE     also write the numbers as JSON\n");
 }
 
 // --- machine -------------------------------------------------------------------
@@ -599,8 +595,9 @@ Json large_json(const LargeResult& r) {
 }  // namespace
 
 int run_bake_bench(const std::vector<std::string>& args, const std::string& command_line) {
-  const auto parsed = parse_options(args);
-  if (const std::optional<int> done = usage_exit("bake", parsed, print_usage)) return *done;
+  BenchArgs bench_args("bake", kDescription, bake_flags());
+  const auto parsed = parse_options(args, bench_args);
+  if (const std::optional<int> done = usage_exit(bench_args, parsed)) return *done;
   const BakeBenchOptions& o = *parsed;
 
   const std::string cpu = cpu_model();

@@ -17,7 +17,7 @@
 #include "character/bake.h"
 #include "character/framing.h"
 #include "content/mannequin/mannequin.h"
-#include "editor/cli/cli_args.h"
+#include "runtime/cli/option_values.h"
 #include "editor/import/cal3d_importer.h"
 #include "editor/import/model_loader.h"
 #include "raytrace/render/renderer.h"
@@ -100,36 +100,6 @@ inline void print_bench_header(const char* name, const std::string& command_line
   std::printf("  load:    %s (1, 5, 15 min, at start)\n", load_average().c_str());
 }
 
-inline bool wants_help(const editor::cli::ParsedArgs& parsed) { return parsed.has("--help") || parsed.has("-h"); }
-
-// The start every benchmark's option parser shares: the flags parsed and
-// no positional arguments (unless help was asked for, which ends parsing).
-inline Expected<editor::cli::ParsedArgs> parse_bench_args(const std::vector<std::string>& args,
-                                                          const std::vector<editor::cli::FlagSpec>& flags) {
-  SINEW_ASSIGN_OR_RETURN(editor::cli::ParsedArgs parsed, editor::cli::parse_args(args, flags));
-  if (!wants_help(parsed) && !parsed.positionals.empty()) {
-    return invalid_argument("argument", parsed.positionals.front(), "unexpected argument");
-  }
-  return parsed;
-}
-
-// What every benchmark's entry point does with its parsed options: a usage
-// error is printed with the usage (exit code 2), --help prints the usage
-// (exit code 0); otherwise there is nothing to return and the run goes on.
-template <class Options>
-std::optional<int> usage_exit(const char* bench, const Expected<Options>& parsed, void (*print_usage)(std::FILE*)) {
-  if (!parsed.ok()) {
-    std::fprintf(stderr, "sinew-bench %s: %s\n", bench, parsed.status().message().c_str());
-    print_usage(stderr);
-    return 2;
-  }
-  if (parsed->help) {
-    print_usage(stdout);
-    return 0;
-  }
-  return std::nullopt;
-}
-
 // Writes a benchmark's --json or --markdown output (nothing for an empty
 // path). False, with a message naming the flag and the file, when the file
 // cannot be written.
@@ -158,16 +128,7 @@ inline std::string join_ints(const std::vector<int>& values) {
   return out;
 }
 
-// A comma-separated list of integers in [lo, hi] ("1,6,12").
-inline Expected<std::vector<int>> parse_int_list(std::string_view flag, const std::string& text, int lo, int hi) {
-  SINEW_ASSIGN_OR_RETURN(const std::vector<std::string> items, editor::cli::parse_list(flag, text));
-  std::vector<int> values;
-  for (const std::string& item : items) {
-    SINEW_ASSIGN_OR_RETURN(const std::int64_t n, editor::cli::parse_int(flag, item, lo, hi));
-    values.push_back(static_cast<int>(n));
-  }
-  return values;
-}
+using cli::parse_int_list;  // "1,6,12"
 
 // "mannequin" (procedural) or "cally" (from SHARED/content/cal3d/cally).
 // Cally is optional content: a missing file is a note, not a failure, so a

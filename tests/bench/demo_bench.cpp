@@ -6,7 +6,8 @@
 #include <string>
 
 #include "character/pack.h"
-#include "editor/cli/cli_args.h"
+#include "runtime/cli/option_values.h"
+#include "tests/bench/bench_options.h"
 #include "editor/import/model_loader.h"
 #include "game_demo/demo_session.h"
 #include "game_demo/world.h"
@@ -32,19 +33,26 @@ struct DemoBenchOptions {
   bool help = false;
 };
 
-const std::vector<editor::cli::FlagSpec>& demo_flags() {
-  static const std::vector<editor::cli::FlagSpec> flags = {
-      {"--help", false}, {"-h", false}, {"--characters"}, {"--size"},  {"--threads"},
-      {"--frames"},      {"--warmup"},  {"--shadows"},    {"--model"}, {"--json"},
+std::vector<BenchFlag> demo_flags() {
+  return {
+      {"--characters", "LIST", "character counts to measure (default 1,6,12)"},
+      size_flag("1024x1024"),
+      threads_flag("2"),
+      frames_flag("measured frames per count (default 30), after"),
+      {"--warmup", "N", "unmeasured frames (default 5)"},
+      {"--shadows", "on|off", "shadow rays (default on)"},
+      {"--model", "PATH", "glTF or Cal3D character (default the procedural mannequin)"},
+      json_flag(),
   };
-  return flags;
 }
 
-Expected<DemoBenchOptions> parse_options(const std::vector<std::string>& args) {
-  namespace cli = editor::cli;
-  SINEW_ASSIGN_OR_RETURN(const cli::ParsedArgs parsed, parse_bench_args(args, demo_flags()));
+const char* const kDescription = "the game demo's fps and phases\n";
+
+Expected<DemoBenchOptions> parse_options(const std::vector<std::string>& args, BenchArgs& parsed) {
+  namespace cli = sinew::cli;
+  SINEW_ASSIGN_OR_RETURN(const cli::ParseResult result, parsed.parse(args));
   DemoBenchOptions o;
-  if (wants_help(parsed)) {
+  if (result == cli::ParseResult::kHelp) {
     o.help = true;
     return o;
   }
@@ -57,7 +65,7 @@ Expected<DemoBenchOptions> parse_options(const std::vector<std::string>& args) {
     o.height = size.height;
   }
   if (const auto text = parsed.value("--threads")) {
-    SINEW_ASSIGN_OR_RETURN(const std::int64_t n, cli::parse_int("--threads", *text, 1, 1024));
+    SINEW_ASSIGN_OR_RETURN(const std::int64_t n, parse_thread_count("--threads", *text));
     o.threads = static_cast<int>(n);
   }
   if (const auto text = parsed.value("--frames")) {
@@ -74,20 +82,6 @@ Expected<DemoBenchOptions> parse_options(const std::vector<std::string>& args) {
   if (const auto text = parsed.value("--model")) o.model_path = *text;
   if (const auto text = parsed.value("--json")) o.json_path = *text;
   return o;
-}
-
-void print_usage(std::FILE* to) {
-  std::fprintf(to,
-               "usage: sinew-bench demo [--characters LIST] [--size WxH] [--threads N] [--frames N]\n"
-               "                        [--warmup N] [--shadows on|off] [--model PATH] [--json FILE]\n"
-               "  --characters LIST  character counts to measure (default 1,6,12)\n"
-               "  --size WxH         frame size (default 1024x1024)\n"
-               "  --threads N        worker threads (default 2)\n"
-               "  --frames N         measured frames per count (default 30), after\n"
-               "  --warmup N         unmeasured frames (default 5)\n"
-               "  --shadows on|off   shadow rays (default on)\n"
-               "  --model PATH       glTF or Cal3D character (default the procedural mannequin)\n"
-               "  --json FILE        also write the numbers as JSON\n");
 }
 
 struct CountResult {
@@ -156,8 +150,9 @@ void print_table(const DemoBenchOptions& o, const std::vector<CountResult>& resu
 }  // namespace
 
 int run_demo_bench(const std::vector<std::string>& args, const std::string& command_line) {
-  const auto parsed = parse_options(args);
-  if (const std::optional<int> done = usage_exit("demo", parsed, print_usage)) return *done;
+  BenchArgs bench_args("demo", kDescription, demo_flags());
+  const auto parsed = parse_options(args, bench_args);
+  if (const std::optional<int> done = usage_exit(bench_args, parsed)) return *done;
   const DemoBenchOptions& o = *parsed;
   JobSystem jobs(o.threads);
   std::printf("# sinew-bench demo\n\n`%s`\n\n%s, %d threads, %s, %dx%d, shadows %s\n", command_line.c_str(),

@@ -15,7 +15,8 @@
 
 #include "character/bake.h"
 #include "character/framing.h"
-#include "editor/cli/cli_args.h"
+#include "runtime/cli/option_values.h"
+#include "tests/bench/bench_options.h"
 #include "editor/mesh/subdivide.h"
 #include "raytrace/camera/camera.h"
 #include "raytrace/render/renderer.h"
@@ -89,18 +90,33 @@ struct Options {
   bool help = false;
 };
 
-const std::vector<editor::cli::FlagSpec>& flags() {
-  static const std::vector<editor::cli::FlagSpec> specs = {
-      {"--help", false}, {"-h", false},        {"--quick", false}, {"--size"},   {"--frames"}, {"--threads"},
-      {"--clips"},       {"--clip"},           {"--model"},        {"--instances"}, {"--shared"}, {"--json"},
-      {"--check-stride"}, {"--subdivide"},     {"--embree-modes"}, {"--embree-widths"},
+std::vector<BenchFlag> flags() {
+  return {
+      quick_flag("256x256, 30 frames, 1 thread, Embree refit at widths 1,16 only"),
+      {"--model", "M", "cally (default), mannequin, or a .gltf/.glb/.cfg/.pack path"},
+      {"--instances", "N", "character instances (default 1)"},
+      frames_flag("frames at 30 fps through each clip (default 120)"),
+      {"--clips", "LIST", "clips to animate, e.g. walk,tornado_kick (default walk)"},
+      {"--clip", "NAME", "one clip to animate (instead of --clips)"},
+      size_flag("1024x1024"),
+      thread_list_flag("1,2"),
+      {"--embree-modes", "LIST",
+       "Embree modes: low (LOW rebuild), refit, medium (MEDIUM rebuild)\n(default low,refit,medium)"},
+      {"--embree-widths", "LIST",
+       "rays per Embree call: 1 (rtcIntersect1/rtcOccluded1) or 4, 8, 16\n"
+       "(coherent packets); every mode runs at every width (default 1,4,8,16)"},
+      {"--subdivide", "L", "subdivide the model L times first (each level: 4x the triangles)"},
+      {"--check-stride", "N", "brute-force check every Nth pixel of the first frame (default 7)"},
+      shared_flag(),
+      json_flag(),
   };
-  return specs;
 }
+
+const char* const kDescription = "Sinew vs Embree 3 (rebuild LOW/MEDIUM, refit) vs exact kd\n";
 
 // "low,refit,medium": each mode once.
 Expected<std::vector<EmbreeMode>> parse_modes(const std::string& text) {
-  namespace cli = editor::cli;
+  namespace cli = sinew::cli;
   SINEW_ASSIGN_OR_RETURN(const std::vector<std::string> items, cli::parse_list("--embree-modes", text));
   std::vector<EmbreeMode> modes;
   for (const std::string& item : items) {
@@ -132,11 +148,11 @@ Expected<std::vector<EmbreeWidth>> parse_widths(const std::string& text) {
   return widths;
 }
 
-Expected<Options> parse_options(const std::vector<std::string>& args) {
-  namespace cli = editor::cli;
-  SINEW_ASSIGN_OR_RETURN(const cli::ParsedArgs parsed, parse_bench_args(args, flags()));
+Expected<Options> parse_options(const std::vector<std::string>& args, BenchArgs& parsed) {
+  namespace cli = sinew::cli;
+  SINEW_ASSIGN_OR_RETURN(const cli::ParseResult result, parsed.parse(args));
   Options o;
-  if (wants_help(parsed)) {
+  if (result == cli::ParseResult::kHelp) {
     o.help = true;
     return o;
   }
@@ -159,7 +175,7 @@ Expected<Options> parse_options(const std::vector<std::string>& args) {
     o.frames = static_cast<int>(n);
   }
   if (const auto text = parsed.value("--threads")) {
-    SINEW_ASSIGN_OR_RETURN(o.threads, parse_int_list("--threads", *text, 1, 1024));
+    SINEW_ASSIGN_OR_RETURN(o.threads, parse_thread_counts("--threads", *text));
   }
   if (parsed.has("--clip") && parsed.has("--clips")) {
     return invalid_argument("--clip", *parsed.value("--clip"), "give --clip or --clips, not both");
@@ -191,32 +207,6 @@ Expected<Options> parse_options(const std::vector<std::string>& args) {
   if (const auto text = parsed.value("--shared")) o.shared = *text;
   if (const auto text = parsed.value("--json")) o.json_path = *text;
   return o;
-}
-
-void print_usage(std::FILE* to) {
-  std::fprintf(to,
-               "usage: sinew-bench embree [--quick] [--model NAME|PATH] [--instances N] [--frames N]\n"
-               "                          [--clips LIST | --clip NAME] [--size WxH] [--threads LIST]\n"
-               "                          [--embree-modes LIST] [--embree-widths LIST]\n"
-               "                          [--subdivide LEVELS] [--check-stride N] [--shared DIR] [--json FILE]\n"
-               "  --quick             256x256, 30 frames, 1 thread, Embree refit at widths 1,16 only\n"
-               "                      (later flags override)\n"
-               "  --model M           cally (default), mannequin, or a .gltf/.glb/.cfg/.pack path\n"
-               "  --instances N       character instances (default 1)\n"
-               "  --frames N          frames at 30 fps through each clip (default 120)\n"
-               "  --clips LIST        clips to animate, e.g. walk,tornado_kick (default walk)\n"
-               "  --size WxH          image size (default 1024x1024)\n"
-               "  --threads LIST      thread counts (default 1,2)\n"
-               "  --embree-modes LIST\n"
-               "                      Embree modes: low (LOW rebuild), refit, medium (MEDIUM rebuild)\n"
-               "                      (default low,refit,medium)\n"
-               "  --embree-widths LIST\n"
-               "                      rays per Embree call: 1 (rtcIntersect1/rtcOccluded1) or 4, 8, 16\n"
-               "                      (coherent packets); every mode runs at every width (default 1,4,8,16)\n"
-               "  --subdivide L       subdivide the model L times first (each level: 4x the triangles)\n"
-               "  --check-stride N    brute-force check every Nth pixel of the first frame (default 7)\n"
-               "  --shared DIR        the shared folder holding content/cal3d/cally\n"
-               "  --json FILE         also write the numbers as JSON\n");
 }
 
 // --- contenders ----------------------------------------------------------------
@@ -706,8 +696,9 @@ std::string join_modes(const std::vector<EmbreeMode>& modes) {
 }  // namespace
 
 int run_embree_bench(const std::vector<std::string>& args, const std::string& command_line) {
-  const auto parsed = parse_options(args);
-  if (const std::optional<int> done = usage_exit("embree", parsed, print_usage)) return *done;
+  BenchArgs bench_args("embree", kDescription, flags());
+  const auto parsed = parse_options(args, bench_args);
+  if (const std::optional<int> done = usage_exit(bench_args, parsed)) return *done;
   const Options& o = *parsed;
   const std::string cpu = cpu_model();
   const std::string date = utc_date();

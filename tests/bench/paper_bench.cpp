@@ -37,7 +37,8 @@
 #include "character/bake.h"
 #include "character/framing.h"
 #include "content/mannequin/mannequin.h"
-#include "editor/cli/cli_args.h"
+#include "runtime/cli/option_values.h"
+#include "tests/bench/bench_options.h"
 #include "editor/mesh/subdivide.h"
 #include "raytrace/camera/camera.h"
 #include "raytrace/render/renderer.h"
@@ -106,20 +107,31 @@ struct Options {
   bool help = false;
 };
 
-const std::vector<editor::cli::FlagSpec>& flags() {
-  static const std::vector<editor::cli::FlagSpec> specs = {
-      {"--help", false}, {"-h", false},   {"--quick", false},     {"--tables"}, {"--levels"},
-      {"--threads"},     {"--frames"},    {"--size"},             {"--samples"}, {"--check-stride"},
-      {"--shared"},      {"--limits"},    {"--json"},             {"--markdown"}, {"--clip-ranges", false},
+std::vector<BenchFlag> flags() {
+  return {
+      quick_flag("levels 0,1,2, 3 frames, 1 thread"),
+      {"--tables", "LIST", "which of the paper's tables to measure (default 1,2)"},
+      {"--levels", "LIST", "Table 2's subdivision levels of Cally (default 0,1,2,3,4)"},
+      thread_list_flag("1,2"),
+      frames_flag("frames timed per configuration, median taken (default 8)"),
+      size_flag("1024x1024"),
+      {"--samples", "N", "Table 2's pose samples (default: all clips, key times + 30 Hz)"},
+      {"--check-stride", "N", "brute-force check every Nth pixel of each first frame (default 7)"},
+      shared_flag(),
+      {"--limits", "FILE", "Cally's joint limits (default content/limits/cally.json)"},
+      json_flag(),
+      markdown_flag(),
+      {"--clip-ranges", "", "print the Euler ranges of Cally's clip key poses per joint, then exit"},
   };
-  return specs;
 }
 
-Expected<Options> parse_options(const std::vector<std::string>& args) {
-  namespace cli = editor::cli;
-  SINEW_ASSIGN_OR_RETURN(const cli::ParsedArgs parsed, parse_bench_args(args, flags()));
+const char* const kDescription = "the paper's Tables 1 and 2 on Cally\n";
+
+Expected<Options> parse_options(const std::vector<std::string>& args, BenchArgs& parsed) {
+  namespace cli = sinew::cli;
+  SINEW_ASSIGN_OR_RETURN(const cli::ParseResult result, parsed.parse(args));
   Options o;
-  if (wants_help(parsed)) {
+  if (result == cli::ParseResult::kHelp) {
     o.help = true;
     return o;
   }
@@ -136,7 +148,7 @@ Expected<Options> parse_options(const std::vector<std::string>& args) {
     SINEW_ASSIGN_OR_RETURN(o.levels, parse_int_list("--levels", *text, 0, editor::kMaxSubdivisionLevels));
   }
   if (const auto text = parsed.value("--threads")) {
-    SINEW_ASSIGN_OR_RETURN(o.threads, parse_int_list("--threads", *text, 1, 1024));
+    SINEW_ASSIGN_OR_RETURN(o.threads, parse_thread_counts("--threads", *text));
   }
   if (const auto text = parsed.value("--frames")) {
     SINEW_ASSIGN_OR_RETURN(const std::int64_t n, cli::parse_int("--frames", *text, 1, 100000));
@@ -163,26 +175,6 @@ Expected<Options> parse_options(const std::vector<std::string>& args) {
   std::sort(o.levels.begin(), o.levels.end());
   o.levels.erase(std::unique(o.levels.begin(), o.levels.end()), o.levels.end());
   return o;
-}
-
-void print_usage(std::FILE* to) {
-  std::fprintf(to,
-               "usage: sinew-bench paper [--quick] [--tables 1,2] [--levels LIST] [--threads LIST] [--frames N]\n"
-               "                         [--size WxH] [--samples N] [--check-stride N] [--shared DIR]\n"
-               "                         [--limits FILE] [--json FILE] [--markdown FILE] [--clip-ranges]\n"
-               "  --quick            levels 0,1,2, 3 frames, 1 thread (later flags override)\n"
-               "  --tables LIST      which of the paper's tables to measure (default 1,2)\n"
-               "  --levels LIST      Table 2's subdivision levels of Cally (default 0,1,2,3,4)\n"
-               "  --threads LIST     render thread counts (default 1,2)\n"
-               "  --frames N         frames timed per configuration, median taken (default 8)\n"
-               "  --size WxH         image size (default 1024x1024)\n"
-               "  --samples N        Table 2's pose samples (default: all clips, key times + 30 Hz)\n"
-               "  --check-stride N   brute-force check every Nth pixel of each first frame (default 7)\n"
-               "  --shared DIR       the shared folder holding content/cal3d/cally\n"
-               "  --limits FILE      Cally's joint limits (default content/limits/cally.json)\n"
-               "  --json FILE        also write the numbers as JSON\n"
-               "  --markdown FILE    also write the tables as a Markdown section\n"
-               "  --clip-ranges      print the Euler ranges of Cally's clip key poses per joint, then exit\n");
 }
 
 // --- measuring one scene ----------------------------------------------------------
@@ -934,8 +926,9 @@ bool wants(const Options& o, int table) {
 }  // namespace
 
 int run_paper_bench(const std::vector<std::string>& args, const std::string& command_line) {
-  const auto parsed = parse_options(args);
-  if (const std::optional<int> done = usage_exit("paper", parsed, print_usage)) return *done;
+  BenchArgs bench_args("paper", kDescription, flags());
+  const auto parsed = parse_options(args, bench_args);
+  if (const std::optional<int> done = usage_exit(bench_args, parsed)) return *done;
   const Options& o = *parsed;
 
   std::string note;

@@ -18,7 +18,8 @@
 
 #include "character/bake.h"
 #include "content/mannequin/mannequin.h"
-#include "editor/cli/cli_args.h"
+#include "runtime/cli/option_values.h"
+#include "tests/bench/bench_options.h"
 #include "editor/import/cal3d_importer.h"
 #include "raytrace/camera/camera.h"
 #include "raytrace/render/renderer.h"
@@ -53,19 +54,27 @@ struct BenchOptions {
   bool help = false;
 };
 
-const std::vector<editor::cli::FlagSpec>& bench_flags() {
-  static const std::vector<editor::cli::FlagSpec> flags = {
-      {"--help", false}, {"-h", false},  {"--size"},          {"--frames"},     {"--threads"}, {"--models"},
-      {"--instances"},   {"--shared"},   {"--triangle-test"}, {"--bone-boxes"}, {"--json"},
+std::vector<BenchFlag> bench_flags() {
+  return {
+      size_flag("1024x1024"),
+      frames_flag("frames at 30 fps through the walk clip (default 30)"),
+      thread_list_flag("1,2"),
+      models_flag("cally and/or mannequin (default cally,mannequin)"),
+      {"--instances", "LIST", "instance counts (default 1,4)"},
+      shared_flag(),
+      {"--triangle-test", "fast|watertight", "ray-triangle test (default fast)"},
+      {"--bone-boxes", "exact|cheap", "per-frame bone boxes (default exact)"},
+      json_flag(),
   };
-  return flags;
 }
 
-Expected<BenchOptions> parse_options(const std::vector<std::string>& args) {
-  namespace cli = editor::cli;
-  SINEW_ASSIGN_OR_RETURN(const cli::ParsedArgs parsed, parse_bench_args(args, bench_flags()));
+const char* const kDescription = "ray tracer frame phases, and fuzzy vs exact kd-tree trace time\n";
+
+Expected<BenchOptions> parse_options(const std::vector<std::string>& args, BenchArgs& parsed) {
+  namespace cli = sinew::cli;
+  SINEW_ASSIGN_OR_RETURN(const cli::ParseResult result, parsed.parse(args));
   BenchOptions o;
-  if (wants_help(parsed)) {
+  if (result == cli::ParseResult::kHelp) {
     o.help = true;
     return o;
   }
@@ -79,7 +88,7 @@ Expected<BenchOptions> parse_options(const std::vector<std::string>& args) {
     o.frames = static_cast<int>(n);
   }
   if (const auto text = parsed.value("--threads")) {
-    SINEW_ASSIGN_OR_RETURN(o.threads, parse_int_list("--threads", *text, 1, 1024));
+    SINEW_ASSIGN_OR_RETURN(o.threads, parse_thread_counts("--threads", *text));
   }
   if (const auto text = parsed.value("--instances")) {
     SINEW_ASSIGN_OR_RETURN(o.instances, parse_int_list("--instances", *text, 1, 256));
@@ -103,22 +112,6 @@ Expected<BenchOptions> parse_options(const std::vector<std::string>& args) {
   }
   if (const auto text = parsed.value("--json")) o.json_path = *text;
   return o;
-}
-
-void print_usage(std::FILE* to) {
-  std::fprintf(to,
-               "usage: sinew-bench raytrace [--size WxH] [--frames N] [--threads LIST] [--models LIST]\n"
-               "                            [--instances LIST] [--shared DIR] [--triangle-test fast|watertight]\n"
-               "                            [--bone-boxes exact|cheap] [--json FILE]\n"
-               "  --size WxH            image size (default 1024x1024)\n"
-               "  --frames N            frames at 30 fps through the walk clip (default 30)\n"
-               "  --threads LIST        thread counts, e.g. 1,2 (default 1,2)\n"
-               "  --models LIST         cally and/or mannequin (default cally,mannequin)\n"
-               "  --instances LIST      instance counts (default 1,4)\n"
-               "  --shared DIR          the shared folder holding content/cal3d/cally\n"
-               "  --triangle-test T     fast|watertight (default fast)\n"
-               "  --bone-boxes B        exact|cheap (default exact)\n"
-               "  --json FILE           also write the numbers as JSON\n");
 }
 
 // --- machine -------------------------------------------------------------------
@@ -370,8 +363,9 @@ const char* bone_boxes_name(rt::BoneBoxMode b) { return b == rt::BoneBoxMode::kE
 }  // namespace
 
 int run_raytrace_bench(const std::vector<std::string>& args, const std::string& command_line) {
-  const auto parsed = parse_options(args);
-  if (const std::optional<int> done = usage_exit("raytrace", parsed, print_usage)) return *done;
+  BenchArgs bench_args("raytrace", kDescription, bench_flags());
+  const auto parsed = parse_options(args, bench_args);
+  if (const std::optional<int> done = usage_exit(bench_args, parsed)) return *done;
   const BenchOptions& o = *parsed;
 
   const std::string cpu = cpu_model();

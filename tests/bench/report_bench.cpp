@@ -14,7 +14,8 @@
 #include <string>
 #include <vector>
 
-#include "editor/cli/cli_args.h"
+#include "runtime/cli/option_values.h"
+#include "tests/bench/bench_options.h"
 #include "runtime/cpu/cpu_features.h"
 #include "runtime/jobs/job_system.h"
 #include "tests/bench/bench_support.h"
@@ -42,14 +43,24 @@ struct Options {
   std::string shared = SINEW_SHARED_DIR;
 };
 
-Expected<Options> parse_options(const std::vector<std::string>& args) {
-  namespace cli = editor::cli;
-  static const std::vector<cli::FlagSpec> flags = {
-      {"--help", false}, {"-h", false}, {"--quick", false}, {"--out"}, {"--sections"}, {"--shared"},
+std::vector<BenchFlag> bench_flags() {
+  return {
+      {"--quick", "", "a smoke run under 5 minutes on 2 cores (default --out build/report-quick)"},
+      {"--out", "DIR", "where BENCHMARKS.md, img/ and bench-data/ go (default: the source tree's docs/)"},
+      {"--sections", "LIST",
+       "paper,embree,tradeoff,scaling (default all); the other sections are kept\n"
+       "from the last report written to the same --out"},
+      shared_flag(),
   };
-  SINEW_ASSIGN_OR_RETURN(const cli::ParsedArgs parsed, parse_bench_args(args, flags));
+}
+
+const char* const kDescription = "every issue-7 benchmark; writes docs/BENCHMARKS.md\n";
+
+Expected<Options> parse_options(const std::vector<std::string>& args, BenchArgs& parsed) {
+  namespace cli = sinew::cli;
+  SINEW_ASSIGN_OR_RETURN(const cli::ParseResult result, parsed.parse(args));
   Options o;
-  if (wants_help(parsed)) {
+  if (result == cli::ParseResult::kHelp) {
     o.help = true;
     return o;
   }
@@ -68,16 +79,6 @@ Expected<Options> parse_options(const std::vector<std::string>& args) {
     o.out_dir = o.quick ? std::string(SINEW_SOURCE_DIR) + "/build/report-quick" : std::string(SINEW_SOURCE_DIR) + "/docs";
   }
   return o;
-}
-
-void print_usage(std::FILE* to) {
-  std::fprintf(to,
-               "usage: sinew-bench report [--quick] [--out DIR] [--sections LIST] [--shared DIR]\n"
-               "  --quick           a smoke run under 5 minutes on 2 cores (default --out build/report-quick)\n"
-               "  --out DIR         where BENCHMARKS.md, img/ and bench-data/ go (default: the source tree's docs/)\n"
-               "  --sections LIST   paper,embree,tradeoff,scaling (default all); the other sections are kept\n"
-               "                    from the last report written to the same --out\n"
-               "  --shared DIR      the shared folder holding content/cal3d/cally\n");
 }
 
 bool wanted(const Options& o, const std::string& section) {
@@ -710,8 +711,9 @@ void run_all(const Options& o, const std::string& data_dir, Report& report) {
 }  // namespace
 
 int run_report_bench(const std::vector<std::string>& args, const std::string& command_line) {
-  const auto parsed = parse_options(args);
-  if (const std::optional<int> done = usage_exit("report", parsed, print_usage)) return *done;
+  BenchArgs bench_args("report", kDescription, bench_flags());
+  const auto parsed = parse_options(args, bench_args);
+  if (const std::optional<int> done = usage_exit(bench_args, parsed)) return *done;
   const Options& o = *parsed;
   const std::string data_dir = o.out_dir + "/bench-data";
   const std::string image_dir = o.out_dir + "/img";

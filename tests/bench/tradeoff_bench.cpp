@@ -25,7 +25,8 @@
 #include "character/framing.h"
 #include "character/pack.h"
 #include "content/mannequin/mannequin.h"
-#include "editor/cli/cli_args.h"
+#include "runtime/cli/option_values.h"
+#include "tests/bench/bench_options.h"
 #include "raytrace/camera/camera.h"
 #include "raytrace/render/renderer.h"
 #include "raytrace/scene/scene.h"
@@ -73,20 +74,30 @@ struct Options {
   bool help = false;
 };
 
-const std::vector<editor::cli::FlagSpec>& flags() {
-  static const std::vector<editor::cli::FlagSpec> specs = {
-      {"--help", false}, {"-h", false},   {"--quick", false}, {"--model"},   {"--samples"},  {"--modes"},
-      {"--padding"},     {"--held-out"}, {"--size"},         {"--threads"}, {"--shared"},   {"--json"},
-      {"--markdown"},
+std::vector<BenchFlag> flags() {
+  return {
+      quick_flag("samples 4,16,62,250, modes arbitrary,clips, padding 0,0.05, 256x256,\n"
+                 "32x32 hole image, 3 walk frames"),
+      {"--model", "M", "cally (default; the mannequin when Cally is absent) or mannequin"},
+      {"--samples", "LIST", "pose samples per bake (default 4,8,16,32,62,124,250,500,1000)"},
+      {"--modes", "LIST", "arbitrary,limits,clips,clip (default all four; clip = the walk alone)"},
+      {"--padding", "LIST", "fuzzy box padding, a fraction of the rest-pose box diagonal\n(default 0,0.01,0.05)"},
+      {"--held-out", "N", "held-out poses per mode for escapes and holes (default 500)"},
+      size_flag("512x512"),
+      threads_flag("2"),
+      shared_flag(),
+      json_flag(),
+      markdown_flag(),
   };
-  return specs;
 }
 
-Expected<Options> parse_options(const std::vector<std::string>& args) {
-  namespace cli = editor::cli;
-  SINEW_ASSIGN_OR_RETURN(const cli::ParsedArgs parsed, parse_bench_args(args, flags()));
+const char* const kDescription = "speed against accuracy: samples, pose spaces, padding, held-out escapes and holes,\nfallback cost, fast vs watertight, exact vs cheap boxes\n";
+
+Expected<Options> parse_options(const std::vector<std::string>& args, BenchArgs& parsed) {
+  namespace cli = sinew::cli;
+  SINEW_ASSIGN_OR_RETURN(const cli::ParseResult result, parsed.parse(args));
   Options o;
-  if (wants_help(parsed)) {
+  if (result == cli::ParseResult::kHelp) {
     o.help = true;
     return o;
   }
@@ -136,33 +147,13 @@ Expected<Options> parse_options(const std::vector<std::string>& args) {
     o.height = size.height;
   }
   if (const auto text = parsed.value("--threads")) {
-    SINEW_ASSIGN_OR_RETURN(const std::int64_t n, cli::parse_int("--threads", *text, 1, 1024));
+    SINEW_ASSIGN_OR_RETURN(const std::int64_t n, parse_thread_count("--threads", *text));
     o.threads = static_cast<int>(n);
   }
   if (const auto text = parsed.value("--shared")) o.shared = *text;
   if (const auto text = parsed.value("--json")) o.json_path = *text;
   if (const auto text = parsed.value("--markdown")) o.markdown_path = *text;
   return o;
-}
-
-void print_usage(std::FILE* to) {
-  std::fprintf(to,
-               "usage: sinew-bench tradeoff [--quick] [--model cally|mannequin] [--samples LIST] [--modes LIST]\n"
-               "                            [--padding LIST] [--held-out N] [--size WxH] [--threads N]\n"
-               "                            [--shared DIR] [--json FILE] [--markdown FILE]\n"
-               "  --quick           samples 4,16,62,250, modes arbitrary,clips, padding 0,0.05, 256x256,\n"
-               "                    32x32 hole image, 3 walk frames (later flags override)\n"
-               "  --model M         cally (default; the mannequin when Cally is absent) or mannequin\n"
-               "  --samples LIST    pose samples per bake (default 4,8,16,32,62,124,250,500,1000)\n"
-               "  --modes LIST      arbitrary,limits,clips,clip (default all four; clip = the walk alone)\n"
-               "  --padding LIST    fuzzy box padding, a fraction of the rest-pose box diagonal\n"
-               "                    (default 0,0.01,0.05)\n"
-               "  --held-out N      held-out poses per mode for escapes and holes (default 500)\n"
-               "  --size WxH        fps image size (default 512x512)\n"
-               "  --threads N       worker threads (default 2)\n"
-               "  --shared DIR      the shared folder holding content/cal3d/cally\n"
-               "  --json FILE       also write the numbers as JSON\n"
-               "  --markdown FILE   also write the tables as a Markdown section\n");
 }
 
 // --- model ---------------------------------------------------------------------
@@ -842,8 +833,9 @@ CrackResult crack_test(bool watertight, int subdivisions, std::uint64_t seed) {
 
 int run_tradeoff_bench(const std::vector<std::string>& args, const std::string& command_line) {
   const Clock::time_point run_start = Clock::now();
-  const auto parsed = parse_options(args);
-  if (const std::optional<int> done = usage_exit("tradeoff", parsed, print_usage)) return *done;
+  BenchArgs bench_args("tradeoff", kDescription, flags());
+  const auto parsed = parse_options(args, bench_args);
+  if (const std::optional<int> done = usage_exit(bench_args, parsed)) return *done;
   const Options& o = *parsed;
 
   Report rep;

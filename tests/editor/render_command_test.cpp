@@ -18,7 +18,8 @@
 
 #include "character/bake.h"
 #include "character/framing.h"
-#include "editor/cli/cli_args.h"
+#include "runtime/cli/command_line.h"
+#include "runtime/cli/option_values.h"
 #include "editor/cli/render_command.h"
 #include "editor/import/gltf_importer.h"
 #include "raytrace/camera/camera.h"
@@ -373,7 +374,8 @@ TEST(RenderCommand, UsageErrorsNameTheFlagAndValue) {
     const RunResult r = run(c.args);
     EXPECT_EQ(r.code, 2) << c.message;
     EXPECT_NE(r.err.find(c.message), std::string::npos) << "expected '" << c.message << "' in: " << r.err;
-    EXPECT_NE(r.err.find("usage: sinew-editor render"), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.rfind("sinew-editor render: ", 0), 0u) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << "one line: " << r.err;
     EXPECT_TRUE(r.out.empty()) << r.out;
   }
   EXPECT_FALSE(std::filesystem::exists(dir)) << "nothing runs on a usage error";
@@ -408,7 +410,7 @@ TEST(RenderCommand, UserErrorsAreOneClearLine) {
 TEST(RenderCommand, HelpPrintsUsageAndSucceeds) {
   const RunResult r = run({"--help"});
   EXPECT_EQ(r.code, 0);
-  EXPECT_EQ(r.out.rfind("usage: sinew-editor render MODEL", 0), 0u) << r.out;
+  EXPECT_EQ(r.out.rfind("usage: sinew-editor render [OPTIONS] [MODEL]", 0), 0u) << r.out;
   EXPECT_NE(r.out.find("--triangle-test fast|watertight"), std::string::npos);
   EXPECT_TRUE(r.err.empty());
 }
@@ -474,8 +476,8 @@ TEST(RenderCommand, OptionsMapToTheirSettings) {
   EXPECT_NE(zero.status().message().find("--max-bytes = 0"), std::string::npos) << zero.status().message();
 }
 
-TEST(CliArgs, ParsesTypedValuesAndRejectsBadOnes) {
-  using namespace cli;
+TEST(OptionValues, ParseTypedValuesAndRejectBadOnes) {
+  using namespace sinew::cli;
   const auto f = parse_floats("--v", "1,-2.5,3e2", 3);
   ASSERT_TRUE(f.ok());
   EXPECT_EQ(*f, (std::vector<float>{1.0f, -2.5f, 300.0f}));
@@ -502,16 +504,57 @@ TEST(CliArgs, ParsesTypedValuesAndRejectsBadOnes) {
   EXPECT_EQ(*parse_list("--l", "a,b"), (std::vector<std::string>{"a", "b"}));
   EXPECT_FALSE(parse_list("--l", "a,,b").ok());
 
-  const std::vector<FlagSpec> specs = {{"--x"}, {"--on", false}};
-  const auto p = parse_args({"pos", "--x=1", "--on", "--", "--not-a-flag"}, specs);
-  ASSERT_TRUE(p.ok()) << p.status().message();
-  EXPECT_EQ(p->value("--x"), "1");
-  EXPECT_TRUE(p->has("--on"));
-  EXPECT_EQ(p->positionals, (std::vector<std::string>{"pos", "--not-a-flag"}));
-  EXPECT_EQ(parse_args({"--x", "1", "--x", "2"}, specs).status().message(), "--x = --x: given twice");
-  EXPECT_EQ(parse_args({"--on=1"}, specs).status().message(), "--on = --on=1: takes no value");
-  EXPECT_EQ(parse_args({"--y"}, specs).status().message(), "option = --y: unknown option (see --help)");
-  EXPECT_EQ(parse_args({"--x"}, specs).status().message(), "--x: missing value");
+}
+
+// The convention every program shares (runtime/cli/command_line.h).
+TEST(CommandLine, TakesBothFlagFormsAndNamesWhatIsWrong) {
+  const auto parse = [](const std::vector<std::string>& args, std::string* x_out = nullptr) {
+    cli::CommandLine line("tool", "what it does");
+    const auto& positionals = line.positionals("FILE", "a file", 1);
+    const auto& x = line.option("--x", "N", "a value");
+    const bool& on = line.flag("--on", "a switch");
+    auto result = line.parse(args);
+    if (result.ok() && x_out != nullptr) *x_out = x.value_or("") + (on ? "+on" : "") + "|" +
+                                                  (positionals.empty() ? "" : positionals.front());
+    return result;
+  };
+  for (const std::vector<std::string>& form :
+       {std::vector<std::string>{"pos", "--x=1", "--on"}, std::vector<std::string>{"--x", "1", "pos", "--on"}}) {
+    std::string seen;
+    const auto r = parse(form, &seen);
+    ASSERT_TRUE(r.ok()) << r.status().message();
+    EXPECT_EQ(*r, cli::ParseResult::kRun);
+    EXPECT_EQ(seen, "1+on|pos");
+  }
+  std::string seen;
+  ASSERT_TRUE(parse({"--", "--not-a-flag"}, &seen).ok());
+  EXPECT_EQ(seen, "|--not-a-flag");
+  EXPECT_EQ(*parse({"--help"}), cli::ParseResult::kHelp);
+  EXPECT_EQ(*parse({"-h", "--bogus"}), cli::ParseResult::kHelp);
+  EXPECT_EQ(parse({"--x", "1", "--x", "2"}).status().message(), "--x: given more than once");
+  EXPECT_EQ(parse({"--y"}).status().message(), "option = --y: unknown option (see --help)");
+  EXPECT_EQ(parse({"--x"}).status().message(), "--x: missing value");
+  EXPECT_EQ(parse({"a", "b"}).status().message(), "argument = b: unexpected argument (at most 1)");
+
+  cli::CommandLine line("tool", "what it does");
+  line.option("--x", "N", "a value");
+  const std::string help = line.help();
+  EXPECT_EQ(help.rfind("usage: tool [OPTIONS]", 0), 0u) << help;
+  EXPECT_NE(help.find("--x N"), std::string::npos) << help;
+  EXPECT_NE(help.find("what it does"), std::string::npos) << help;
+}
+
+TEST(CommandLine, UsageErrorsAreOneLineAndExitCode2) {
+  cli::CommandLine line("tool", "");
+  std::ostringstream out, err;
+  const auto done = cli::help_or_usage_error(line, line.parse({"--bogus"}), out, err);
+  ASSERT_TRUE(done.has_value());
+  EXPECT_EQ(*done, 2);
+  EXPECT_EQ(err.str(), "tool: option = --bogus: unknown option (see --help)\n");
+  EXPECT_TRUE(out.str().empty());
+  std::ostringstream help_out, help_err;
+  EXPECT_EQ(cli::help_or_usage_error(line, line.parse({"--help"}), help_out, help_err), 0);
+  EXPECT_EQ(help_out.str(), line.help());
 }
 
 }  // namespace

@@ -20,7 +20,7 @@ endif()
 # The installed package from a separate project (label "package"). Not in
 # sanitizer builds: an instrumented libsinew needs an instrumented host.
 add_executable(sinew-image-diff ${CMAKE_CURRENT_LIST_DIR}/image_diff.cpp)
-target_link_libraries(sinew-image-diff PRIVATE sinew::runtime)
+target_link_libraries(sinew-image-diff PRIVATE sinew::runtime sinew::cli)
 set(consumer_model ${PROJECT_SOURCE_DIR}/../shared/content/gltf/CesiumMan/CesiumMan.glb)
 if(NOT CMAKE_CXX_FLAGS MATCHES "-fsanitize" AND EXISTS ${consumer_model})
   add_test(NAME package.consumer

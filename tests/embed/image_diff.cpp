@@ -5,30 +5,46 @@
 // the example host's output with sinew-editor render.
 #include <cstdio>
 #include <cstdlib>
+#include <iostream>
 #include <string>
+#include <vector>
 
+#include "runtime/cli/command_line.h"
+#include "runtime/cli/option_values.h"
 #include "runtime/image/image_io.h"
 
 int main(int argc, char** argv) {
-  if (argc < 3) {
-    std::fprintf(stderr, "usage: sinew-image-diff A B [--max-channel-diff N] [--max-differing-pixels N]\n");
-    return 2;
+  namespace cli = sinew::cli;
+  cli::CommandLine line("sinew-image-diff",
+                        "Compares the RGB channels of two 8-bit images (PNG, PPM, any format OpenImageIO\n"
+                        "reads). Exit 0 when within the limits, 1 otherwise, 2 on usage or read errors.\n");
+  const auto& images = line.positionals("IMAGE", "the two images A and B", 2);
+  const auto& channel_text = line.option("--max-channel-diff", "N",
+                                         "a pixel differs when a channel differs by more than N (default 0)");
+  const auto& differing_text = line.option("--max-differing-pixels", "N", "pixels allowed to differ (default 0)");
+  if (const auto done = cli::help_or_usage_error(line, line.parse({argv + 1, argv + argc}), std::cout, std::cerr)) {
+    return *done;
+  }
+  if (images.size() != 2) {
+    return cli::usage_error(line.program(),
+                            sinew::invalid_argument("IMAGE", std::to_string(images.size()) + " given",
+                                                    "expected two images, A and B"),
+                            std::cerr);
   }
   int max_channel_diff = 0;
   long max_differing = 0;
-  for (int i = 3; i + 1 < argc; i += 2) {
-    const std::string flag = argv[i];
-    if (flag == "--max-channel-diff") {
-      max_channel_diff = std::atoi(argv[i + 1]);
-    } else if (flag == "--max-differing-pixels") {
-      max_differing = std::atol(argv[i + 1]);
-    } else {
-      std::fprintf(stderr, "sinew-image-diff: unknown option %s\n", argv[i]);
-      return 2;
-    }
+  if (channel_text) {
+    const auto n = cli::parse_int("--max-channel-diff", *channel_text, 0, 255);
+    if (!n.ok()) return cli::usage_error(line.program(), n.status(), std::cerr);
+    max_channel_diff = static_cast<int>(*n);
   }
-  const auto a = sinew::read_image(argv[1]);
-  const auto b = sinew::read_image(argv[2]);
+  if (differing_text) {
+    const auto n = cli::parse_int("--max-differing-pixels", *differing_text, 0, std::int64_t{1} << 40);
+    if (!n.ok()) return cli::usage_error(line.program(), n.status(), std::cerr);
+    max_differing = static_cast<long>(*n);
+  }
+  const auto a = sinew::read_image(images[0]);
+  const auto b = sinew::read_image(images[1]);
   for (const auto* image : {&a, &b}) {
     if (!image->ok()) {
       std::fprintf(stderr, "sinew-image-diff: %s\n", image->status().message().c_str());

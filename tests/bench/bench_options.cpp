@@ -1,0 +1,67 @@
+#include "tests/bench/bench_options.h"
+
+#include <cstdlib>
+
+#include "runtime/cli/option_values.h"
+#include "runtime/jobs/job_system.h"
+
+namespace sinew::bench {
+
+BenchFlag threads_flag(const std::string& defaults) {
+  return {"--threads", "N", "worker threads, 0 = all cores (default " + defaults + ")"};
+}
+BenchFlag thread_list_flag(const std::string& defaults) {
+  return {"--threads", "LIST", "thread counts, e.g. 1,2; 0 = all cores (default " + defaults + ")"};
+}
+BenchFlag size_flag(const std::string& defaults) { return {"--size", "WxH", "image size (default " + defaults + ")"}; }
+BenchFlag frames_flag(const std::string& help) { return {"--frames", "N", help}; }
+BenchFlag models_flag(const std::string& help) { return {"--models", "LIST", help}; }
+BenchFlag quick_flag(const std::string& what) { return {"--quick", "", what + " (later flags override)"}; }
+BenchFlag shared_flag() { return {"--shared", "DIR", "the shared folder holding content/cal3d/cally"}; }
+BenchFlag json_flag() { return {"--json", "FILE", "also write the numbers as JSON"}; }
+BenchFlag markdown_flag() { return {"--markdown", "FILE", "also write the tables as a Markdown section"}; }
+
+BenchArgs::BenchArgs(const std::string& bench, const std::string& description, const std::vector<BenchFlag>& flags)
+    : line_("sinew-bench " + bench, description) {
+  for (const BenchFlag& flag : flags) {
+    if (flag.value_form.empty()) {
+      switches_.emplace_back(flag.name, &line_.flag(flag.name, flag.help));
+    } else {
+      values_.emplace_back(flag.name, &line_.option(flag.name, flag.value_form, flag.help));
+    }
+  }
+}
+
+Expected<cli::ParseResult> BenchArgs::parse(const std::vector<std::string>& args) { return line_.parse(args); }
+
+std::optional<std::string> BenchArgs::value(std::string_view name) const {
+  for (const auto& [declared, text] : values_) {
+    if (declared == name) return *text;
+  }
+  std::abort();  // a benchmark reads an option it did not declare
+}
+
+bool BenchArgs::has(std::string_view name) const {
+  for (const auto& [declared, given] : switches_) {
+    if (declared == name) return *given;
+  }
+  for (const auto& [declared, text] : values_) {
+    if (declared == name) return text->has_value();
+  }
+  std::abort();  // a benchmark reads an option it did not declare
+}
+
+Expected<int> parse_thread_count(std::string_view flag, const std::string& text) {
+  SINEW_ASSIGN_OR_RETURN(const int threads, cli::parse_threads(flag, text));
+  return threads == 0 ? JobSystem::hardware_threads() : threads;
+}
+
+Expected<std::vector<int>> parse_thread_counts(std::string_view flag, const std::string& text) {
+  SINEW_ASSIGN_OR_RETURN(std::vector<int> counts, cli::parse_int_list(flag, text, 0, cli::kMaxThreads));
+  for (int& threads : counts) {
+    if (threads == 0) threads = JobSystem::hardware_threads();
+  }
+  return counts;
+}
+
+}  // namespace sinew::bench
