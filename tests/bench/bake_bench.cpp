@@ -1,6 +1,5 @@
-#include "character/framing.h"
 #include "tests/bench/bake_bench.h"
-#include "tests/bench/bench_support.h"
+#include "tests/bench/bench_record.h"
 
 #include <sys/resource.h>
 
@@ -21,24 +20,24 @@
 #include <string_view>
 
 #include "character/bake.h"
+#include "character/framing.h"
 #include "content/mannequin/mannequin.h"
-#include "runtime/cli/option_values.h"
-#include "tests/bench/bench_options.h"
 #include "editor/import/cal3d_importer.h"
 #include "raytrace/camera/camera.h"
 #include "raytrace/fuzzy/fuzzy_bake.h"
 #include "raytrace/render/renderer.h"
 #include "raytrace/scene/scene.h"
+#include "runtime/cli/option_values.h"
 #include "runtime/cpu/cpu_features.h"
 #include "runtime/jobs/job_system.h"
 #include "runtime/timing/phase_timers.h"
 #include "runtime/timing/stopwatch.h"
+#include "tests/bench/bench_options.h"
 
 namespace sinew::bench {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-using Json = nlohmann::ordered_json;
 
 // The machine is noisy: every time printed is a median of this many runs.
 constexpr int kBakeRepeats = 3;
@@ -600,50 +599,21 @@ int run_bake_bench(const std::vector<std::string>& args, const std::string& comm
   if (const std::optional<int> done = usage_exit(bench_args, parsed)) return *done;
   const BakeBenchOptions& o = *parsed;
 
-  const std::string cpu = cpu_model();
-  const std::string date = utc_date();
-  print_bench_header("bake", command_line, std::to_string(o.threads), cpu, date);
+  BenchRecord record("bake", command_line, o.threads);
   std::fflush(stdout);
-
-  Json doc;
-  doc["command"] = command_line;
-  doc["cpu"] = cpu;
-  doc["hardware_threads"] = JobSystem::hardware_threads();
-  doc["isa"] = std::string(build_isa());
-  doc["date"] = date;
-  doc["threads"] = o.threads;
+  Json& doc = record.doc();
   doc["bake_repeats"] = kBakeRepeats;
   doc["render_repeats"] = kRenderRepeats;
   doc["models"] = Json::array();
-  doc["notes"] = Json::array();
 
   JobSystem jobs(o.threads);
-  int exit_code = 0;
-  for (const std::string& name : o.models) {
-    const auto fail = [&](const Status& s) {
-      std::fprintf(stderr, "sinew-bench bake: %s: %s\n", name.c_str(), s.message().c_str());
-      exit_code = 1;
-    };
-    std::string note;
-    auto loaded = load_model(name, o.shared, note);
-    if (!loaded.ok()) {
-      fail(loaded.status());
-      continue;
-    }
-    if (!loaded->has_value()) {
-      std::printf("\n%s\n", note.c_str());
-      doc["notes"].push_back(note);
-      continue;
-    }
-    const auto result = run_model(name, std::move(**loaded), jobs);
-    if (!result.ok()) {
-      fail(result.status());
-      continue;
-    }
-    print_model(*result);
+  for_each_model(record, o.models, o.shared, [&](const std::string& name, character::Model model) -> Status {
+    SINEW_ASSIGN_OR_RETURN(const auto result, run_model(name, std::move(model), jobs));
+    print_model(result);
     std::fflush(stdout);
-    doc["models"].push_back(model_json(*result));
-  }
+    doc["models"].push_back(model_json(result));
+    return {};
+  });
   if (!o.models.empty()) {
     std::printf("\n  poses = producing the samples' matrices; sampling/assign/build = FuzzyBakeStats phases;\n"
                 "  total = the whole bake_in_memory call; /rest = fuzzy area / bind-pose area; tri/lf = mean\n"
@@ -655,16 +625,14 @@ int run_bake_bench(const std::vector<std::string>& args, const std::string& comm
   if (o.large) {
     const auto large = run_large(jobs);
     if (!large.ok()) {
-      std::fprintf(stderr, "sinew-bench bake: synthetic: %s\n", large.status().message().c_str());
-      exit_code = 1;
+      record.fail("synthetic", large.status());
     } else {
       print_large(*large);
       doc["large"] = large_json(*large);
     }
   }
 
-  if (!write_output("bake", "--json", o.json_path, doc.dump(2) + "\n")) return 1;
-  return exit_code;
+  return record.finish(o.json_path);
 }
 
 }  // namespace sinew::bench

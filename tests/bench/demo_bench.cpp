@@ -6,19 +6,18 @@
 #include <string>
 
 #include "character/pack.h"
-#include "runtime/cli/option_values.h"
-#include "tests/bench/bench_options.h"
 #include "editor/import/model_loader.h"
 #include "game_demo/demo_session.h"
 #include "game_demo/world.h"
+#include "runtime/cli/option_values.h"
 #include "runtime/jobs/job_system.h"
 #include "runtime/timing/phase_timers.h"
-#include "tests/bench/bench_support.h"
+#include "tests/bench/bench_options.h"
+#include "tests/bench/bench_record.h"
 
 namespace sinew::bench {
 namespace {
 
-using Json = nlohmann::ordered_json;
 
 struct DemoBenchOptions {
   std::vector<int> characters{1, 6, 12};
@@ -155,35 +154,33 @@ int run_demo_bench(const std::vector<std::string>& args, const std::string& comm
   if (const std::optional<int> done = usage_exit(bench_args, parsed)) return *done;
   const DemoBenchOptions& o = *parsed;
   JobSystem jobs(o.threads);
-  std::printf("# sinew-bench demo\n\n`%s`\n\n%s, %d threads, %s, %dx%d, shadows %s\n", command_line.c_str(),
-              cpu_model().c_str(), jobs.thread_count(), utc_date().c_str(), o.width, o.height,
-              o.shadows ? "on" : "off");
+  BenchRecord record("demo", command_line, jobs.thread_count());
+  std::printf("  %dx%d, shadows %s\n", o.width, o.height, o.shadows ? "on" : "off");
+  Json& doc = record.doc();
+  doc["size"] = {o.width, o.height};
+  doc["shadows"] = o.shadows;
+  doc["counts"] = Json::array();
   std::vector<CountResult> results;
   for (int characters : o.characters) {
     std::fprintf(stderr, "measuring %d characters...\n", characters);
     auto r = measure(o, characters, jobs);
     if (!r.ok()) {
-      std::fprintf(stderr, "sinew-bench demo: %s\n", r.status().message().c_str());
-      return 1;
+      record.fail(std::to_string(characters) + " characters", r.status());
+      return record.exit_code();
     }
     results.push_back(std::move(*r));
   }
   std::printf("model: %s (%zu triangles)\n", o.model_path.empty() ? "mannequin (procedural)" : o.model_path.c_str(),
               results.empty() ? std::size_t{0} : results.front().triangles);
   print_table(o, results);
-  if (!o.json_path.empty()) {
-    Json out = {{"command", command_line}, {"cpu", cpu_model()}, {"date", utc_date()}, {"threads", jobs.thread_count()},
-                {"size", {o.width, o.height}}, {"shadows", o.shadows}, {"counts", Json::array()}};
-    for (const CountResult& r : results) {
-      Json phases = Json::object();
-      for (const PhaseSummary& p : r.phases) phases[p.name] = p.median_ms;
-      out["counts"].push_back({{"characters", r.characters}, {"fps", r.frame_ms > 0.0 ? 1000.0 / r.frame_ms : 0.0},
-                               {"frame_ms", r.frame_ms}, {"phases_ms", phases},
-                               {"rays_per_frame", r.rays_per_frame}});
-    }
-    std::ofstream(o.json_path) << out.dump(2) << "\n";
+  for (const CountResult& r : results) {
+    Json phases = Json::object();
+    for (const PhaseSummary& p : r.phases) phases[p.name] = p.median_ms;
+    doc["counts"].push_back({{"characters", r.characters}, {"fps", r.frame_ms > 0.0 ? 1000.0 / r.frame_ms : 0.0},
+                             {"frame_ms", r.frame_ms}, {"phases_ms", phases},
+                             {"rays_per_frame", r.rays_per_frame}});
   }
-  return 0;
+  return record.finish(o.json_path);
 }
 
 }  // namespace sinew::bench

@@ -15,15 +15,15 @@
 
 #include "character/bake.h"
 #include "character/framing.h"
-#include "runtime/cli/option_values.h"
-#include "tests/bench/bench_options.h"
 #include "editor/mesh/subdivide.h"
 #include "raytrace/camera/camera.h"
 #include "raytrace/render/renderer.h"
 #include "raytrace/scene/scene.h"
+#include "runtime/cli/option_values.h"
 #include "runtime/jobs/job_system.h"
 #include "runtime/timing/phase_timers.h"
-#include "tests/bench/bench_support.h"
+#include "tests/bench/bench_options.h"
+#include "tests/bench/bench_record.h"
 #include "tests/bench/brute_force_gate.h"
 // Always included for EmbreeMode and EmbreeWidth, which the options name;
 // the tracer itself is only linked (and called) when Embree was found.
@@ -35,7 +35,6 @@ namespace sinew::bench {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-using Json = nlohmann::ordered_json;
 
 constexpr double kFramesPerSecond = 30.0;
 
@@ -700,9 +699,7 @@ int run_embree_bench(const std::vector<std::string>& args, const std::string& co
   const auto parsed = parse_options(args, bench_args);
   if (const std::optional<int> done = usage_exit(bench_args, parsed)) return *done;
   const Options& o = *parsed;
-  const std::string cpu = cpu_model();
-  const std::string date = utc_date();
-  print_bench_header("embree", command_line, join_ints(o.threads), cpu, date);
+  BenchRecord record("embree", command_line, o.threads);
 #ifdef SINEW_HAVE_EMBREE
   const bool have_embree = true;
 #else
@@ -719,27 +716,32 @@ int run_embree_bench(const std::vector<std::string>& args, const std::string& co
   }
   std::fflush(stdout);
 
-  Json doc = {{"command", command_line}, {"cpu", cpu}, {"commit", git_commit()}, {"load_average_start", load_average()},           {"hardware_threads", JobSystem::hardware_threads()},
-              {"date", date},            {"model", o.model},     {"subdivide", o.subdivide}, {"instances", o.instances},
-              {"size", {o.width, o.height}}, {"frames", o.frames}, {"embree", have_embree},
-              {"embree_modes", mode_keys(o.embree_modes)}, {"embree_widths", widths_of(o.embree_widths)},
-              {"configurations", Json::array()}};
+  Json& doc = record.doc();
+  doc.update(Json{{"model", o.model},
+                  {"subdivide", o.subdivide},
+                  {"instances", o.instances},
+                  {"size", {o.width, o.height}},
+                  {"frames", o.frames},
+                  {"embree", have_embree},
+                  {"embree_modes", mode_keys(o.embree_modes)},
+                  {"embree_widths", widths_of(o.embree_widths)},
+                  {"configurations", Json::array()}});
   std::string note;
   auto loaded = load_model_or_path(o.model, o.shared, note);
   if (!loaded.ok()) {
-    std::fprintf(stderr, "sinew-bench embree: %s\n", loaded.status().message().c_str());
-    return 1;
+    record.fail("", loaded.status());
+    return record.exit_code();
   }
   if (!loaded->has_value()) {
-    std::printf("\n%s\n", note.c_str());
-    return 0;
+    record.note(note);
+    return record.finish(o.json_path);
   }
   character::Model loaded_model = std::move(**loaded);
   if (o.subdivide > 0) {
     auto finer = editor::subdivide(loaded_model, o.subdivide);
     if (!finer.ok()) {
-      std::fprintf(stderr, "sinew-bench embree: %s\n", finer.status().message().c_str());
-      return 1;
+      record.fail("--subdivide", finer.status());
+      return record.exit_code();
     }
     loaded_model = std::move(*finer);
   }
@@ -749,8 +751,8 @@ int run_embree_bench(const std::vector<std::string>& args, const std::string& co
     JobSystem jobs(*std::max_element(o.threads.begin(), o.threads.end()));
     auto baked = character::bake_in_memory(model, character::BakeRequest{}, jobs);
     if (!baked.ok()) {
-      std::fprintf(stderr, "sinew-bench embree: %s\n", baked.status().message().c_str());
-      return 1;
+      record.fail("bake", baked.status());
+      return record.exit_code();
     }
     bake = std::move(*baked);
   }
@@ -758,26 +760,23 @@ int run_embree_bench(const std::vector<std::string>& args, const std::string& co
               model.skeleton.joint_count());
   doc["triangles"] = model.mesh.triangle_count();
 
-  int exit_code = 0;
   std::vector<std::string> best_rows;  // the best Embree row of each configuration, for the note
   for (const std::string& clip_name : o.clips) {
     const auto clip = find_clip(model, o.model, clip_name);
     if (!clip.ok()) {
-      std::fprintf(stderr, "sinew-bench embree: %s\n", clip.status().message().c_str());
-      exit_code = 1;
+      record.fail("", clip.status());
       continue;
     }
     for (int threads : o.threads) {
       auto result = run_configuration(model, bake.fuzzy.view(), o, clip_name, *clip, threads);
       if (!result.ok()) {
-        std::fprintf(stderr, "sinew-bench embree: %s: %s\n", clip_name.c_str(), result.status().message().c_str());
-        exit_code = 1;
+        record.fail(clip_name, result.status());
         continue;
       }
       print_config(*result);
       std::fflush(stdout);
       for (const ContenderResult& c : result->contenders) {
-        if (!c.gate.passed()) exit_code = 1;
+        if (!c.gate.passed()) record.mark_failed();
       }
       if (const ContenderResult* best = best_embree(*result)) {
         best_rows.push_back(clip_name + ", " + std::to_string(threads) + " thread" + (threads == 1 ? "" : "s") +
@@ -799,8 +798,7 @@ int run_embree_bench(const std::vector<std::string>& args, const std::string& co
   const std::string load_end = load_average();
   std::printf("  load at the end: %s (1, 5, 15 min)\n", load_end.c_str());
   doc["load_average_end"] = load_end;
-  if (!write_output("embree", "--json", o.json_path, doc.dump(2) + "\n")) return 1;
-  return exit_code;
+  return record.finish(o.json_path);
 }
 
 }  // namespace sinew::bench

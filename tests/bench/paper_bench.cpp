@@ -37,24 +37,23 @@
 #include "character/bake.h"
 #include "character/framing.h"
 #include "content/mannequin/mannequin.h"
-#include "runtime/cli/option_values.h"
-#include "tests/bench/bench_options.h"
 #include "editor/mesh/subdivide.h"
 #include "raytrace/camera/camera.h"
 #include "raytrace/render/renderer.h"
 #include "raytrace/scene/scene.h"
+#include "runtime/cli/option_values.h"
 #include "runtime/jobs/job_system.h"
 #include "runtime/memory/line_aligned.h"
 #include "runtime/timing/phase_timers.h"
 #include "runtime/timing/stopwatch.h"
-#include "tests/bench/bench_support.h"
+#include "tests/bench/bench_options.h"
+#include "tests/bench/bench_record.h"
 #include "tests/bench/brute_force_gate.h"
 
 namespace sinew::bench {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-using Json = nlohmann::ordered_json;
 
 
 // --- the paper's numbers ---------------------------------------------------------
@@ -734,14 +733,11 @@ Json table1_json(const Table1Model& m) {
 struct Run {
   const Options* o = nullptr;
   std::string command_line;
-  int exit_code = 0;
-  Json doc;
+  BenchRecord* record = nullptr;
   std::string markdown;
 
-  void fail(const std::string& what, const Status& s) {
-    std::fprintf(stderr, "sinew-bench paper: %s: %s\n", what.c_str(), s.message().c_str());
-    exit_code = 1;
-  }
+  void fail(const std::string& what, const Status& s) { record->fail(what, s); }
+  Json& doc() { return record->doc(); }
 };
 
 std::string method_threads(const Options& o) {
@@ -759,7 +755,7 @@ void run_table2(const character::Model& cally, Run& run) {
       run.fail("table 2 level " + std::to_string(level), row.status());
       continue;
     }
-    if (row->failed) run.exit_code = 1;
+    if (row->failed) run.record->mark_failed();
     measured.push_back(std::move(*row));
   }
   std::vector<Table2Row> rows = measured;
@@ -817,7 +813,7 @@ void run_table2(const character::Model& cally, Run& run) {
     table["paper"].push_back(
         {{"triangles", p.triangles}, {"sampling_s", p.sampling_s}, {"build_s", p.build_s}, {"fps", p.fps}});
   }
-  run.doc["table2"] = std::move(table);
+  run.doc()["table2"] = std::move(table);
 }
 
 Expected<anim::JointLimits> limits_for(const std::string& name, const character::Model& model,
@@ -884,7 +880,7 @@ void run_table1(std::optional<character::Model>& cally, Run& run) {
         run.fail(name + " " + paper.mode, row.status());
         continue;
       }
-      if (row->failed) run.exit_code = 1;
+      if (row->failed) run.record->mark_failed();
       result.rows.push_back(std::move(*row));
     }
     md += "### " + name + " (" + std::to_string(result.triangles) + " triangles)\n\n";
@@ -906,7 +902,7 @@ void run_table1(std::optional<character::Model>& cally, Run& run) {
   std::printf("\n%s", md.c_str());
   std::fflush(stdout);
   run.markdown += md;
-  run.doc["table1"] = std::move(models);
+  run.doc()["table1"] = std::move(models);
   Json paper = Json::array();
   for (const PaperTable1Row& p : kPaperTable1) {
     paper.push_back({{"model", "ut2003"},
@@ -916,7 +912,7 @@ void run_table1(std::optional<character::Model>& cally, Run& run) {
                      {"tris_per_leaf", p.tris_per_leaf},
                      {"fps", p.fps}});
   }
-  run.doc["paper_table1"] = std::move(paper);
+  run.doc()["paper_table1"] = std::move(paper);
 }
 
 bool wants(const Options& o, int table) {
@@ -949,9 +945,7 @@ int run_paper_bench(const std::vector<std::string>& args, const std::string& com
   }
 
   const Clock::time_point start = Clock::now();
-  const std::string cpu = cpu_model();
-  const std::string date = utc_date();
-  print_bench_header("paper", command_line, join_ints(o.threads), cpu, date);
+  BenchRecord record("paper", command_line, o.threads);
   std::printf("  Günther et al. 2006, Tables 1 and 2; %dx%d, %d frames per configuration, brute-force check of\n"
               "  every %dth pixel of each configuration's first frame\n",
               o.width, o.height, o.frames, o.check_stride);
@@ -960,19 +954,11 @@ int run_paper_bench(const std::vector<std::string>& args, const std::string& com
   Run run;
   run.o = &o;
   run.command_line = command_line;
-  run.doc = {{"command", command_line},
-             {"commit", git_commit()},
-             {"cpu", cpu},
-             {"hardware_threads", JobSystem::hardware_threads()},
-             {"date", date},
-             {"load_average_start", load_average()},
-             {"threads", o.threads},
-             {"notes", Json::array()}};
+  run.record = &record;
   if (!cally) {
     // Table 2 is Cally's; Table 1 still measures the mannequin.
-    std::printf("\n%s\n", note.c_str());
-    run.doc["notes"].push_back(note);
-    run.exit_code = 1;
+    record.note(note);
+    record.mark_failed();
   }
   if (wants(o, 2) && cally) run_table2(*cally, run);
   if (wants(o, 1)) run_table1(cally, run);
@@ -980,11 +966,9 @@ int run_paper_bench(const std::vector<std::string>& args, const std::string& com
   const double wall_s = ms_since(start) / 1000.0;
   const std::string load_end = load_average();
   std::printf("\n  wall time %.1f s; load at the end: %s (1, 5, 15 min)\n", wall_s, load_end.c_str());
-  run.doc["wall_s"] = wall_s;
-  run.doc["load_average_end"] = load_end;
-  if (!write_output("paper", "--json", o.json_path, run.doc.dump(2) + "\n")) return 1;
-  if (!write_output("paper", "--markdown", o.markdown_path, run.markdown)) return 1;
-  return run.exit_code;
+  run.doc()["wall_s"] = wall_s;
+  run.doc()["load_average_end"] = load_end;
+  return record.finish(o.json_path, o.markdown_path, run.markdown);
 }
 
 }  // namespace sinew::bench

@@ -1,5 +1,4 @@
-#include "character/framing.h"
-#include "tests/bench/bench_support.h"
+#include "tests/bench/bench_record.h"
 #include "tests/bench/brute_force_gate.h"
 #include "tests/bench/raytrace_bench.h"
 
@@ -17,22 +16,22 @@
 #include <string_view>
 
 #include "character/bake.h"
+#include "character/framing.h"
 #include "content/mannequin/mannequin.h"
-#include "runtime/cli/option_values.h"
-#include "tests/bench/bench_options.h"
 #include "editor/import/cal3d_importer.h"
 #include "raytrace/camera/camera.h"
 #include "raytrace/render/renderer.h"
 #include "raytrace/scene/scene.h"
+#include "runtime/cli/option_values.h"
 #include "runtime/cpu/cpu_features.h"
 #include "runtime/jobs/job_system.h"
 #include "runtime/memory/line_aligned.h"
 #include "runtime/timing/phase_timers.h"
+#include "tests/bench/bench_options.h"
 
 namespace sinew::bench {
 namespace {
 
-using Json = nlohmann::ordered_json;
 
 constexpr double kFramesPerSecond = 30.0;
 constexpr int kMaxImageSide = 16384;
@@ -368,66 +367,30 @@ int run_raytrace_bench(const std::vector<std::string>& args, const std::string& 
   if (const std::optional<int> done = usage_exit(bench_args, parsed)) return *done;
   const BenchOptions& o = *parsed;
 
-  const std::string cpu = cpu_model();
-  const std::string date = utc_date();
-  print_bench_header("raytrace", command_line, join_ints(o.threads), cpu, date);
+  BenchRecord record("raytrace", command_line, o.threads);
   std::printf("  %dx%d, %d frames at 30 fps through the walk clip (instance i %.2f s later), point light,\n"
               "  shadows on, diffuse shading, triangle test %s, bone boxes %s, fallback on; each\n"
               "  configuration's first frame is checked against brute force (every 7th pixel)\n",
               o.width, o.height, o.frames, character::instance_time_offset(1), triangle_test_name(o.triangle_test),
               bone_boxes_name(o.bone_boxes));
   std::fflush(stdout);
-
-  Json doc;
-  doc["command"] = command_line;
-  doc["cpu"] = cpu;
-  doc["hardware_threads"] = JobSystem::hardware_threads();
-  doc["isa"] = std::string(build_isa());
-  doc["date"] = date;
+  Json& doc = record.doc();
   doc["size"] = {o.width, o.height};
   doc["frames"] = o.frames;
-  doc["threads"] = o.threads;
   doc["triangle_test"] = triangle_test_name(o.triangle_test);
   doc["bone_boxes"] = bone_boxes_name(o.bone_boxes);
   doc["models"] = Json::array();
-  doc["notes"] = Json::array();
 
   // The bake is timed once per model, on the most threads the run uses.
   const int bake_threads = *std::max_element(o.threads.begin(), o.threads.end());
-  int exit_code = 0;
-  for (const std::string& name : o.models) {
-    const auto fail = [&](const Status& s) {
-      std::fprintf(stderr, "sinew-bench raytrace: %s: %s\n", name.c_str(), s.message().c_str());
-      exit_code = 1;
-    };
-    std::string note;
-    auto loaded = load_model(name, o.shared, note);
-    if (!loaded.ok()) {
-      fail(loaded.status());
-      continue;
-    }
-    if (!loaded->has_value()) {
-      std::printf("\n%s\n", note.c_str());
-      doc["notes"].push_back(note);
-      continue;
-    }
+  for_each_model(record, o.models, o.shared, [&](const std::string& name, character::Model model) -> Status {
     BenchModel m;
     m.name = name;
-    m.model = std::move(**loaded);
-    const auto walk = find_walk_clip(m.model, name);
-    if (!walk.ok()) {
-      fail(walk.status());
-      continue;
-    }
-    m.walk_clip = *walk;
+    m.model = std::move(model);
+    SINEW_ASSIGN_OR_RETURN(m.walk_clip, find_walk_clip(m.model, name));
     {
       JobSystem jobs(bake_threads);
-      auto bake = character::bake_in_memory(m.model, character::BakeRequest{}, jobs);
-      if (!bake.ok()) {
-        fail(bake.status());
-        continue;
-      }
-      m.bake = std::move(*bake);
+      SINEW_ASSIGN_OR_RETURN(m.bake, character::bake_in_memory(m.model, character::BakeRequest{}, jobs));
       m.bake_threads = bake_threads;
     }
     print_model_header(m);
@@ -438,7 +401,7 @@ int run_raytrace_bench(const std::vector<std::string>& args, const std::string& 
       for (int threads : o.threads) {
         auto run = run_configuration(m, o, instances, threads);
         if (!run.ok()) {
-          fail(run.status());
+          record.fail(name, run.status());
           continue;
         }
         if (!run->gate.passed()) {
@@ -446,7 +409,7 @@ int run_raytrace_bench(const std::vector<std::string>& args, const std::string& 
                       "not reported\n",
                       instances, threads, static_cast<unsigned long long>(run->gate.mismatched),
                       static_cast<unsigned long long>(run->gate.checked));
-          exit_code = 1;
+          record.mark_failed();
           continue;
         }
         runs.push_back(std::move(*run));
@@ -462,15 +425,15 @@ int run_raytrace_bench(const std::vector<std::string>& args, const std::string& 
                       {"runs", Json::array()}};
     for (const RunResult& r : runs) model_doc["runs"].push_back(run_json(r));
     doc["models"].push_back(std::move(model_doc));
-  }
+    return {};
+  });
 
   std::printf("\n  anim = clip_skinning + set_bones for all instances; top+fb = top-level build + fallback;\n"
               "  Mrays/s = (primary + shadow rays) / (primary + shadow trace time); fps = 1000 / median total.\n"
               "  The exact tree is rebuilt on the listed frames over the posed triangles (Wald-Havran SAH\n"
               "  sweep over triangle boxes, the static-mesh builder); fuzzy/exact is the median ratio of trace\n"
               "  times on those frames; hits = both found the same number of primary hits.\n");
-  if (!write_output("raytrace", "--json", o.json_path, doc.dump(2) + "\n")) return 1;
-  return exit_code;
+  return record.finish(o.json_path);
 }
 
 }  // namespace sinew::bench

@@ -15,9 +15,9 @@
 #include <vector>
 
 #include "runtime/cli/option_values.h"
-#include "tests/bench/bench_options.h"
 #include "runtime/cpu/cpu_features.h"
 #include "runtime/jobs/job_system.h"
+#include "tests/bench/bench_options.h"
 #include "tests/bench/bench_support.h"
 #include "tests/bench/embree_bench.h"
 #include "tests/bench/paper_bench.h"
