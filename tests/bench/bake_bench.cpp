@@ -83,32 +83,13 @@ std::vector<BenchFlag> bake_flags() {
 
 const char* const kDescription = "fuzzy bake cost per candidate-bone mode, its trace effect, and its memory bound\n";
 
-Expected<BakeBenchOptions> parse_options(const std::vector<std::string>& args, BenchArgs& parsed) {
-  namespace cli = sinew::cli;
-  SINEW_ASSIGN_OR_RETURN(const cli::ParseResult result, parsed.parse(args));
-  BakeBenchOptions o;
-  if (result == cli::ParseResult::kHelp) {
-    o.help = true;
-    return o;
-  }
-  if (const auto text = parsed.value("--models")) {
-    SINEW_ASSIGN_OR_RETURN(o.models, cli::parse_list("--models", *text));
-    for (const std::string& name : o.models) {
-      if (name != "cally" && name != "mannequin") {
-        return invalid_argument("--models", name, "unknown model (expected cally or mannequin)");
-      }
-    }
-  }
-  if (const auto text = parsed.value("--shared")) o.shared = *text;
-  if (const auto text = parsed.value("--threads")) {
-    SINEW_ASSIGN_OR_RETURN(const std::int64_t n, parse_thread_count("--threads", *text));
-    o.threads = static_cast<int>(n);
-  }
-  if (const auto text = parsed.value("--large")) {
-    SINEW_ASSIGN_OR_RETURN(o.large, cli::parse_on_off("--large", *text));
-  }
-  if (const auto text = parsed.value("--json")) o.json_path = *text;
-  return o;
+Status read_options(const BenchArgs& parsed, BakeBenchOptions& o) {
+  SINEW_RETURN_IF_ERROR(parsed.read_models(o.models));
+  SINEW_RETURN_IF_ERROR(parsed.read("--shared", o.shared));
+  SINEW_RETURN_IF_ERROR(parsed.read_threads(o.threads));
+  SINEW_RETURN_IF_ERROR(parsed.read("--large", o.large));
+  SINEW_RETURN_IF_ERROR(parsed.read("--json", o.json_path));
+  return {};
 }
 
 // --- machine -------------------------------------------------------------------
@@ -595,7 +576,7 @@ Json large_json(const LargeResult& r) {
 
 int run_bake_bench(const std::vector<std::string>& args, const std::string& command_line) {
   BenchArgs bench_args("bake", kDescription, bake_flags());
-  const auto parsed = parse_options(args, bench_args);
+  const auto parsed = parse_bench_options(bench_args, args, read_options);
   if (const std::optional<int> done = usage_exit(bench_args, parsed)) return *done;
   const BakeBenchOptions& o = *parsed;
 

@@ -51,6 +51,68 @@ bool BenchArgs::has(std::string_view name) const {
   std::abort();  // a benchmark reads an option it did not declare
 }
 
+Status BenchArgs::read(std::string_view name, std::int64_t lo, std::int64_t hi, int& out) const {
+  if (const auto text = value(name)) {
+    SINEW_ASSIGN_OR_RETURN(const std::int64_t n, cli::parse_int(name, *text, lo, hi));
+    out = static_cast<int>(n);
+  }
+  return {};
+}
+
+Status BenchArgs::read(std::string_view name, int lo, int hi, std::vector<int>& out) const {
+  if (const auto text = value(name)) {
+    SINEW_ASSIGN_OR_RETURN(out, cli::parse_int_list(name, *text, lo, hi));
+  }
+  return {};
+}
+
+Status BenchArgs::read(std::string_view name, bool& out) const {
+  if (const auto text = value(name)) {
+    SINEW_ASSIGN_OR_RETURN(out, cli::parse_on_off(name, *text));
+  }
+  return {};
+}
+
+Status BenchArgs::read(std::string_view name, std::string& out) const {
+  if (const auto text = value(name)) out = *text;
+  return {};
+}
+
+Status BenchArgs::read_size(int max_side, int& width, int& height) const {
+  if (const auto text = value("--size")) {
+    SINEW_ASSIGN_OR_RETURN(const cli::Size2 size, cli::parse_size("--size", *text, max_side));
+    width = size.width;
+    height = size.height;
+  }
+  return {};
+}
+
+Status BenchArgs::read_threads(int& out) const {
+  if (const auto text = value("--threads")) {
+    SINEW_ASSIGN_OR_RETURN(out, parse_thread_count("--threads", *text));
+  }
+  return {};
+}
+
+Status BenchArgs::read_threads(std::vector<int>& out) const {
+  if (const auto text = value("--threads")) {
+    SINEW_ASSIGN_OR_RETURN(out, parse_thread_counts("--threads", *text));
+  }
+  return {};
+}
+
+Status BenchArgs::read_models(std::vector<std::string>& out) const {
+  if (const auto text = value("--models")) {
+    SINEW_ASSIGN_OR_RETURN(out, cli::parse_list("--models", *text));
+    for (const std::string& name : out) {
+      if (name != "cally" && name != "mannequin") {
+        return invalid_argument("--models", name, "unknown model (expected cally or mannequin)");
+      }
+    }
+  }
+  return {};
+}
+
 Expected<int> parse_thread_count(std::string_view flag, const std::string& text) {
   SINEW_ASSIGN_OR_RETURN(const int threads, cli::parse_threads(flag, text));
   return threads == 0 ? JobSystem::hardware_threads() : threads;

@@ -4,6 +4,7 @@
 // one reading of their values (--threads 0 = every core, as everywhere).
 #pragma once
 
+#include <cstdint>
 #include <iostream>
 #include <optional>
 #include <string>
@@ -44,6 +45,18 @@ class BenchArgs {
   std::optional<std::string> value(std::string_view name) const;
   bool has(std::string_view name) const;
 
+  // Typed reads of a declared option: `out` takes the value when the option
+  // was given and keeps its default otherwise; errors name the option and
+  // the text ("--frames = 0: ...").
+  Status read(std::string_view name, std::int64_t lo, std::int64_t hi, int& out) const;  // an integer
+  Status read(std::string_view name, int lo, int hi, std::vector<int>& out) const;       // "1,4,16"
+  Status read(std::string_view name, bool& out) const;                                 // on|off
+  Status read(std::string_view name, std::string& out) const;                          // text
+  Status read_size(int max_side, int& width, int& height) const;                       // --size WxH
+  Status read_threads(int& out) const;                                                 // --threads N
+  Status read_threads(std::vector<int>& out) const;                                    // --threads LIST
+  Status read_models(std::vector<std::string>& out) const;                             // --models cally,mannequin
+
   const cli::CommandLine& line() const { return line_; }
 
  private:
@@ -56,6 +69,21 @@ class BenchArgs {
 // headers print what ran.
 Expected<int> parse_thread_count(std::string_view flag, const std::string& text);
 Expected<std::vector<int>> parse_thread_counts(std::string_view flag, const std::string& text);
+
+// Parses `args` and reads them into a benchmark's Options with `read`
+// (nothing is read when --help was given: Options::help is set instead).
+template <class Options>
+Expected<Options> parse_bench_options(BenchArgs& bench_args, const std::vector<std::string>& args,
+                                      Status (*read)(const BenchArgs&, Options&)) {
+  SINEW_ASSIGN_OR_RETURN(const cli::ParseResult result, bench_args.parse(args));
+  Options o;
+  if (result == cli::ParseResult::kHelp) {
+    o.help = true;
+    return o;
+  }
+  SINEW_RETURN_IF_ERROR(read(bench_args, o));
+  return o;
+}
 
 // What every benchmark's entry point does with its parsed options: help on
 // stdout (exit 0), a usage error as one line on stderr (exit 2); nothing

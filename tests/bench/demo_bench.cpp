@@ -47,40 +47,16 @@ std::vector<BenchFlag> demo_flags() {
 
 const char* const kDescription = "the game demo's fps and phases\n";
 
-Expected<DemoBenchOptions> parse_options(const std::vector<std::string>& args, BenchArgs& parsed) {
-  namespace cli = sinew::cli;
-  SINEW_ASSIGN_OR_RETURN(const cli::ParseResult result, parsed.parse(args));
-  DemoBenchOptions o;
-  if (result == cli::ParseResult::kHelp) {
-    o.help = true;
-    return o;
-  }
-  if (const auto text = parsed.value("--characters")) {
-    SINEW_ASSIGN_OR_RETURN(o.characters, parse_int_list("--characters", *text, 1, 256));
-  }
-  if (const auto text = parsed.value("--size")) {
-    SINEW_ASSIGN_OR_RETURN(const cli::Size2 size, cli::parse_size("--size", *text, 8192));
-    o.width = size.width;
-    o.height = size.height;
-  }
-  if (const auto text = parsed.value("--threads")) {
-    SINEW_ASSIGN_OR_RETURN(const std::int64_t n, parse_thread_count("--threads", *text));
-    o.threads = static_cast<int>(n);
-  }
-  if (const auto text = parsed.value("--frames")) {
-    SINEW_ASSIGN_OR_RETURN(const std::int64_t n, cli::parse_int("--frames", *text, 1, 100000));
-    o.frames = static_cast<int>(n);
-  }
-  if (const auto text = parsed.value("--warmup")) {
-    SINEW_ASSIGN_OR_RETURN(const std::int64_t n, cli::parse_int("--warmup", *text, 0, 100000));
-    o.warmup = static_cast<int>(n);
-  }
-  if (const auto text = parsed.value("--shadows")) {
-    SINEW_ASSIGN_OR_RETURN(o.shadows, cli::parse_on_off("--shadows", *text));
-  }
-  if (const auto text = parsed.value("--model")) o.model_path = *text;
-  if (const auto text = parsed.value("--json")) o.json_path = *text;
-  return o;
+Status read_options(const BenchArgs& parsed, DemoBenchOptions& o) {
+  SINEW_RETURN_IF_ERROR(parsed.read("--characters", 1, 256, o.characters));
+  SINEW_RETURN_IF_ERROR(parsed.read_size(8192, o.width, o.height));
+  SINEW_RETURN_IF_ERROR(parsed.read_threads(o.threads));
+  SINEW_RETURN_IF_ERROR(parsed.read("--frames", 1, 100000, o.frames));
+  SINEW_RETURN_IF_ERROR(parsed.read("--warmup", 0, 100000, o.warmup));
+  SINEW_RETURN_IF_ERROR(parsed.read("--shadows", o.shadows));
+  SINEW_RETURN_IF_ERROR(parsed.read("--model", o.model_path));
+  SINEW_RETURN_IF_ERROR(parsed.read("--json", o.json_path));
+  return {};
 }
 
 struct CountResult {
@@ -150,7 +126,7 @@ void print_table(const DemoBenchOptions& o, const std::vector<CountResult>& resu
 
 int run_demo_bench(const std::vector<std::string>& args, const std::string& command_line) {
   BenchArgs bench_args("demo", kDescription, demo_flags());
-  const auto parsed = parse_options(args, bench_args);
+  const auto parsed = parse_bench_options(bench_args, args, read_options);
   if (const std::optional<int> done = usage_exit(bench_args, parsed)) return *done;
   const DemoBenchOptions& o = *parsed;
   JobSystem jobs(o.threads);

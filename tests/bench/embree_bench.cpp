@@ -147,14 +147,8 @@ Expected<std::vector<EmbreeWidth>> parse_widths(const std::string& text) {
   return widths;
 }
 
-Expected<Options> parse_options(const std::vector<std::string>& args, BenchArgs& parsed) {
+Status read_options(const BenchArgs& parsed, Options& o) {
   namespace cli = sinew::cli;
-  SINEW_ASSIGN_OR_RETURN(const cli::ParseResult result, parsed.parse(args));
-  Options o;
-  if (result == cli::ParseResult::kHelp) {
-    o.help = true;
-    return o;
-  }
   if (parsed.has("--quick")) {  // explicit flags below still override
     o.width = o.height = 256;
     o.frames = 30;
@@ -164,18 +158,9 @@ Expected<Options> parse_options(const std::vector<std::string>& args, BenchArgs&
     o.embree_modes = {EmbreeMode::kRefit};
     o.embree_widths = {EmbreeWidth::k1, EmbreeWidth::k16};
   }
-  if (const auto text = parsed.value("--size")) {
-    SINEW_ASSIGN_OR_RETURN(const cli::Size2 size, cli::parse_size("--size", *text, 16384));
-    o.width = size.width;
-    o.height = size.height;
-  }
-  if (const auto text = parsed.value("--frames")) {
-    SINEW_ASSIGN_OR_RETURN(const std::int64_t n, cli::parse_int("--frames", *text, 1, 100000));
-    o.frames = static_cast<int>(n);
-  }
-  if (const auto text = parsed.value("--threads")) {
-    SINEW_ASSIGN_OR_RETURN(o.threads, parse_thread_counts("--threads", *text));
-  }
+  SINEW_RETURN_IF_ERROR(parsed.read_size(16384, o.width, o.height));
+  SINEW_RETURN_IF_ERROR(parsed.read("--frames", 1, 100000, o.frames));
+  SINEW_RETURN_IF_ERROR(parsed.read_threads(o.threads));
   if (parsed.has("--clip") && parsed.has("--clips")) {
     return invalid_argument("--clip", *parsed.value("--clip"), "give --clip or --clips, not both");
   }
@@ -183,29 +168,19 @@ Expected<Options> parse_options(const std::vector<std::string>& args, BenchArgs&
   if (const auto text = parsed.value("--clips")) {
     SINEW_ASSIGN_OR_RETURN(o.clips, cli::parse_list("--clips", *text));
   }
-  if (const auto text = parsed.value("--model")) o.model = *text;
-  if (const auto text = parsed.value("--instances")) {
-    SINEW_ASSIGN_OR_RETURN(const std::int64_t n, cli::parse_int("--instances", *text, 1, 256));
-    o.instances = static_cast<int>(n);
-  }
-  if (const auto text = parsed.value("--subdivide")) {
-    SINEW_ASSIGN_OR_RETURN(const std::int64_t n,
-                           cli::parse_int("--subdivide", *text, 0, editor::kMaxSubdivisionLevels));
-    o.subdivide = static_cast<int>(n);
-  }
-  if (const auto text = parsed.value("--check-stride")) {
-    SINEW_ASSIGN_OR_RETURN(const std::int64_t n, cli::parse_int("--check-stride", *text, 1, 1 << 20));
-    o.check_stride = static_cast<int>(n);
-  }
+  SINEW_RETURN_IF_ERROR(parsed.read("--model", o.model));
+  SINEW_RETURN_IF_ERROR(parsed.read("--instances", 1, 256, o.instances));
+  SINEW_RETURN_IF_ERROR(parsed.read("--subdivide", 0, editor::kMaxSubdivisionLevels, o.subdivide));
+  SINEW_RETURN_IF_ERROR(parsed.read("--check-stride", 1, 1 << 20, o.check_stride));
   if (const auto text = parsed.value("--embree-modes")) {
     SINEW_ASSIGN_OR_RETURN(o.embree_modes, parse_modes(*text));
   }
   if (const auto text = parsed.value("--embree-widths")) {
     SINEW_ASSIGN_OR_RETURN(o.embree_widths, parse_widths(*text));
   }
-  if (const auto text = parsed.value("--shared")) o.shared = *text;
-  if (const auto text = parsed.value("--json")) o.json_path = *text;
-  return o;
+  SINEW_RETURN_IF_ERROR(parsed.read("--shared", o.shared));
+  SINEW_RETURN_IF_ERROR(parsed.read("--json", o.json_path));
+  return {};
 }
 
 // --- contenders ----------------------------------------------------------------
@@ -696,7 +671,7 @@ std::string join_modes(const std::vector<EmbreeMode>& modes) {
 
 int run_embree_bench(const std::vector<std::string>& args, const std::string& command_line) {
   BenchArgs bench_args("embree", kDescription, flags());
-  const auto parsed = parse_options(args, bench_args);
+  const auto parsed = parse_bench_options(bench_args, args, read_options);
   if (const std::optional<int> done = usage_exit(bench_args, parsed)) return *done;
   const Options& o = *parsed;
   BenchRecord record("embree", command_line, o.threads);

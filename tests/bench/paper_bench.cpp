@@ -49,6 +49,7 @@
 #include "tests/bench/bench_options.h"
 #include "tests/bench/bench_record.h"
 #include "tests/bench/brute_force_gate.h"
+#include "tests/bench/table_numbers.h"
 
 namespace sinew::bench {
 namespace {
@@ -126,54 +127,28 @@ std::vector<BenchFlag> flags() {
 
 const char* const kDescription = "the paper's Tables 1 and 2 on Cally\n";
 
-Expected<Options> parse_options(const std::vector<std::string>& args, BenchArgs& parsed) {
-  namespace cli = sinew::cli;
-  SINEW_ASSIGN_OR_RETURN(const cli::ParseResult result, parsed.parse(args));
-  Options o;
-  if (result == cli::ParseResult::kHelp) {
-    o.help = true;
-    return o;
-  }
+Status read_options(const BenchArgs& parsed, Options& o) {
   if (parsed.has("--quick")) {  // explicit flags below still override
     o.quick = true;
     o.levels = {0, 1, 2};
     o.frames = 3;
     o.threads = {1};  // the paper's single core
   }
-  if (const auto text = parsed.value("--tables")) {
-    SINEW_ASSIGN_OR_RETURN(o.tables, parse_int_list("--tables", *text, 1, 2));
-  }
-  if (const auto text = parsed.value("--levels")) {
-    SINEW_ASSIGN_OR_RETURN(o.levels, parse_int_list("--levels", *text, 0, editor::kMaxSubdivisionLevels));
-  }
-  if (const auto text = parsed.value("--threads")) {
-    SINEW_ASSIGN_OR_RETURN(o.threads, parse_thread_counts("--threads", *text));
-  }
-  if (const auto text = parsed.value("--frames")) {
-    SINEW_ASSIGN_OR_RETURN(const std::int64_t n, cli::parse_int("--frames", *text, 1, 100000));
-    o.frames = static_cast<int>(n);
-  }
-  if (const auto text = parsed.value("--size")) {
-    SINEW_ASSIGN_OR_RETURN(const cli::Size2 size, cli::parse_size("--size", *text, 16384));
-    o.width = size.width;
-    o.height = size.height;
-  }
-  if (const auto text = parsed.value("--samples")) {
-    SINEW_ASSIGN_OR_RETURN(const std::int64_t n, cli::parse_int("--samples", *text, 1, anim::kMaxPoseSamples));
-    o.samples = static_cast<int>(n);
-  }
-  if (const auto text = parsed.value("--check-stride")) {
-    SINEW_ASSIGN_OR_RETURN(const std::int64_t n, cli::parse_int("--check-stride", *text, 1, 1 << 20));
-    o.check_stride = static_cast<int>(n);
-  }
-  if (const auto text = parsed.value("--shared")) o.shared = *text;
-  if (const auto text = parsed.value("--limits")) o.cally_limits = *text;
-  if (const auto text = parsed.value("--json")) o.json_path = *text;
-  if (const auto text = parsed.value("--markdown")) o.markdown_path = *text;
+  SINEW_RETURN_IF_ERROR(parsed.read("--tables", 1, 2, o.tables));
+  SINEW_RETURN_IF_ERROR(parsed.read("--levels", 0, editor::kMaxSubdivisionLevels, o.levels));
+  SINEW_RETURN_IF_ERROR(parsed.read_threads(o.threads));
+  SINEW_RETURN_IF_ERROR(parsed.read("--frames", 1, 100000, o.frames));
+  SINEW_RETURN_IF_ERROR(parsed.read_size(16384, o.width, o.height));
+  SINEW_RETURN_IF_ERROR(parsed.read("--samples", 1, anim::kMaxPoseSamples, o.samples));
+  SINEW_RETURN_IF_ERROR(parsed.read("--check-stride", 1, 1 << 20, o.check_stride));
+  SINEW_RETURN_IF_ERROR(parsed.read("--shared", o.shared));
+  SINEW_RETURN_IF_ERROR(parsed.read("--limits", o.cally_limits));
+  SINEW_RETURN_IF_ERROR(parsed.read("--json", o.json_path));
+  SINEW_RETURN_IF_ERROR(parsed.read("--markdown", o.markdown_path));
   o.clip_ranges = parsed.has("--clip-ranges");
   std::sort(o.levels.begin(), o.levels.end());
   o.levels.erase(std::unique(o.levels.begin(), o.levels.end()), o.levels.end());
-  return o;
+  return {};
 }
 
 // --- measuring one scene ----------------------------------------------------------
@@ -395,18 +370,6 @@ const PaperTable2Row* paper_row_for(std::size_t triangles) {
   return nullptr;
 }
 
-std::string fmt(int decimals, double value) {
-  char text[64];
-  std::snprintf(text, sizeof text, "%.*f", decimals, value);
-  return text;
-}
-
-std::string fmt_general(double value) {
-  char text[64];
-  std::snprintf(text, sizeof text, "%.4g", value);
-  return text;
-}
-
 std::string gate_text(const GateReport& g) {
   if (!g.result.passed()) {
     return "FAILED brute-force check (" + std::to_string(g.result.mismatched) + " of " +
@@ -444,20 +407,20 @@ std::string table2_markdown(const std::vector<Table2Row>& rows, const std::vecto
       for (std::size_t k = 0; k < threads.size(); ++k) md += " | |";
       md += " FAILED |";
     } else {
-      md += fmt(2, r.sampling_s) + " | " + fmt(2, r.build_s) + " | " + fmt(2, r.tris_per_leaf) + " |";
+      md += fixed(r.sampling_s, 2) + " | " + fixed(r.build_s, 2) + " | " + fixed(r.tris_per_leaf, 2) + " |";
       for (int t : threads) {
         const auto it = std::find_if(r.fps.begin(), r.fps.end(), [&](const auto& p) { return p.first == t; });
         if (it == r.fps.end()) {
           md += " - | - |";
         } else {
-          md += " " + fmt(2, it->second.primary) + " | " + fmt(2, it->second.primary_shadows) + " |";
+          md += " " + fixed(it->second.primary, 2) + " | " + fixed(it->second.primary_shadows, 2) + " |";
         }
       }
       md += " " + (r.interpolated ? std::string("(log-log between levels)") : gate_text(r.gate)) + " |";
     }
     if (const PaperTable2Row* p = paper_row_for(r.triangles)) {
-      md += " " + std::to_string(p->triangles / 1000) + "k | " + fmt(2, p->sampling_s) + " | " +
-            fmt(2, p->build_s) + " | " + fmt(1, p->fps) + " |\n";
+      md += " " + std::to_string(p->triangles / 1000) + "k | " + fixed(p->sampling_s, 2) + " | " +
+            fixed(p->build_s, 2) + " | " + fixed(p->fps, 1) + " |\n";
     } else {
       md += " | | | |\n";
     }
@@ -685,15 +648,15 @@ std::string table1_markdown(const Table1Model& m, const std::vector<int>& thread
       for (std::size_t k = 0; k < threads.size(); ++k) md += " | |";
       md += " FAILED |";
     } else {
-      md += " " + fmt_general(r.fuzzy_area) + " | " + fmt(2, r.rest_area > 0.0 ? r.fuzzy_area / r.rest_area : 0.0) +
-            " | " + fmt(2, r.tris_per_leaf) + " | " + std::to_string(r.escaped_triangles) + " | " +
-            fmt(1, r.fps.empty() ? 0.0 : r.fps.front().second.triangle_tests_per_ray) + " |";
-      for (const auto& [t, f] : r.fps) md += " " + fmt(2, f.primary) + " | " + fmt(2, f.primary_shadows) + " |";
+      md += " " + general(r.fuzzy_area, 4) + " | " + fixed(r.rest_area > 0.0 ? r.fuzzy_area / r.rest_area : 0.0, 2) +
+            " | " + fixed(r.tris_per_leaf, 2) + " | " + std::to_string(r.escaped_triangles) + " | " +
+            fixed(r.fps.empty() ? 0.0 : r.fps.front().second.triangle_tests_per_ray, 1) + " |";
+      for (const auto& [t, f] : r.fps) md += " " + fixed(f.primary, 2) + " | " + fixed(f.primary_shadows, 2) + " |";
       md += " " + gate_text(r.gate) + " |";
     }
     if (paper) {
-      md += " " + std::to_string(paper->samples) + " | " + fmt(0, paper->fuzzy_area / 1000.0) + "k" + " | " +
-            fmt(1, paper->tris_per_leaf) + " | " + fmt(1, paper->fps) + " |\n";
+      md += " " + std::to_string(paper->samples) + " | " + fixed(paper->fuzzy_area / 1000.0, 0) + "k" + " | " +
+            fixed(paper->tris_per_leaf, 1) + " | " + fixed(paper->fps, 1) + " |\n";
     } else {
       md += " | | | |\n";
     }
@@ -923,7 +886,7 @@ bool wants(const Options& o, int table) {
 
 int run_paper_bench(const std::vector<std::string>& args, const std::string& command_line) {
   BenchArgs bench_args("paper", kDescription, flags());
-  const auto parsed = parse_options(args, bench_args);
+  const auto parsed = parse_bench_options(bench_args, args, read_options);
   if (const std::optional<int> done = usage_exit(bench_args, parsed)) return *done;
   const Options& o = *parsed;
 

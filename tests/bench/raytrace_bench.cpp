@@ -69,38 +69,14 @@ std::vector<BenchFlag> bench_flags() {
 
 const char* const kDescription = "ray tracer frame phases, and fuzzy vs exact kd-tree trace time\n";
 
-Expected<BenchOptions> parse_options(const std::vector<std::string>& args, BenchArgs& parsed) {
+Status read_options(const BenchArgs& parsed, BenchOptions& o) {
   namespace cli = sinew::cli;
-  SINEW_ASSIGN_OR_RETURN(const cli::ParseResult result, parsed.parse(args));
-  BenchOptions o;
-  if (result == cli::ParseResult::kHelp) {
-    o.help = true;
-    return o;
-  }
-  if (const auto text = parsed.value("--size")) {
-    SINEW_ASSIGN_OR_RETURN(const cli::Size2 size, cli::parse_size("--size", *text, kMaxImageSide));
-    o.width = size.width;
-    o.height = size.height;
-  }
-  if (const auto text = parsed.value("--frames")) {
-    SINEW_ASSIGN_OR_RETURN(const std::int64_t n, cli::parse_int("--frames", *text, 1, 100000));
-    o.frames = static_cast<int>(n);
-  }
-  if (const auto text = parsed.value("--threads")) {
-    SINEW_ASSIGN_OR_RETURN(o.threads, parse_thread_counts("--threads", *text));
-  }
-  if (const auto text = parsed.value("--instances")) {
-    SINEW_ASSIGN_OR_RETURN(o.instances, parse_int_list("--instances", *text, 1, 256));
-  }
-  if (const auto text = parsed.value("--models")) {
-    SINEW_ASSIGN_OR_RETURN(o.models, cli::parse_list("--models", *text));
-    for (const std::string& name : o.models) {
-      if (name != "cally" && name != "mannequin") {
-        return invalid_argument("--models", name, "unknown model (expected cally or mannequin)");
-      }
-    }
-  }
-  if (const auto text = parsed.value("--shared")) o.shared = *text;
+  SINEW_RETURN_IF_ERROR(parsed.read_size(kMaxImageSide, o.width, o.height));
+  SINEW_RETURN_IF_ERROR(parsed.read("--frames", 1, 100000, o.frames));
+  SINEW_RETURN_IF_ERROR(parsed.read_threads(o.threads));
+  SINEW_RETURN_IF_ERROR(parsed.read("--instances", 1, 256, o.instances));
+  SINEW_RETURN_IF_ERROR(parsed.read_models(o.models));
+  SINEW_RETURN_IF_ERROR(parsed.read("--shared", o.shared));
   if (const auto text = parsed.value("--triangle-test")) {
     SINEW_ASSIGN_OR_RETURN(const int i, cli::parse_choice("--triangle-test", *text, {"fast", "watertight"}));
     o.triangle_test = i == 0 ? rt::TriangleTest::kFast : rt::TriangleTest::kWatertight;
@@ -109,8 +85,8 @@ Expected<BenchOptions> parse_options(const std::vector<std::string>& args, Bench
     SINEW_ASSIGN_OR_RETURN(const int i, cli::parse_choice("--bone-boxes", *text, {"exact", "cheap"}));
     o.bone_boxes = i == 0 ? rt::BoneBoxMode::kExact : rt::BoneBoxMode::kCheap;
   }
-  if (const auto text = parsed.value("--json")) o.json_path = *text;
-  return o;
+  SINEW_RETURN_IF_ERROR(parsed.read("--json", o.json_path));
+  return {};
 }
 
 // --- machine -------------------------------------------------------------------
@@ -363,7 +339,7 @@ const char* bone_boxes_name(rt::BoneBoxMode b) { return b == rt::BoneBoxMode::kE
 
 int run_raytrace_bench(const std::vector<std::string>& args, const std::string& command_line) {
   BenchArgs bench_args("raytrace", kDescription, bench_flags());
-  const auto parsed = parse_options(args, bench_args);
+  const auto parsed = parse_bench_options(bench_args, args, read_options);
   if (const std::optional<int> done = usage_exit(bench_args, parsed)) return *done;
   const BenchOptions& o = *parsed;
 

@@ -56,17 +56,11 @@ std::vector<BenchFlag> bench_flags() {
 
 const char* const kDescription = "every issue-7 benchmark; writes docs/BENCHMARKS.md\n";
 
-Expected<Options> parse_options(const std::vector<std::string>& args, BenchArgs& parsed) {
+Status read_options(const BenchArgs& parsed, Options& o) {
   namespace cli = sinew::cli;
-  SINEW_ASSIGN_OR_RETURN(const cli::ParseResult result, parsed.parse(args));
-  Options o;
-  if (result == cli::ParseResult::kHelp) {
-    o.help = true;
-    return o;
-  }
   o.quick = parsed.has("--quick");
-  if (const auto text = parsed.value("--out")) o.out_dir = *text;
-  if (const auto text = parsed.value("--shared")) o.shared = *text;
+  SINEW_RETURN_IF_ERROR(parsed.read("--out", o.out_dir));
+  SINEW_RETURN_IF_ERROR(parsed.read("--shared", o.shared));
   if (const auto text = parsed.value("--sections")) {
     SINEW_ASSIGN_OR_RETURN(o.sections, cli::parse_list("--sections", *text));
     for (const std::string& s : o.sections) {
@@ -78,7 +72,7 @@ Expected<Options> parse_options(const std::vector<std::string>& args, BenchArgs&
   if (o.out_dir.empty()) {
     o.out_dir = o.quick ? std::string(SINEW_SOURCE_DIR) + "/build/report-quick" : std::string(SINEW_SOURCE_DIR) + "/docs";
   }
-  return o;
+  return {};
 }
 
 bool wanted(const Options& o, const std::string& section) {
@@ -712,7 +706,7 @@ void run_all(const Options& o, const std::string& data_dir, Report& report) {
 
 int run_report_bench(const std::vector<std::string>& args, const std::string& command_line) {
   BenchArgs bench_args("report", kDescription, bench_flags());
-  const auto parsed = parse_options(args, bench_args);
+  const auto parsed = parse_bench_options(bench_args, args, read_options);
   if (const std::optional<int> done = usage_exit(bench_args, parsed)) return *done;
   const Options& o = *parsed;
   const std::string data_dir = o.out_dir + "/bench-data";

@@ -35,6 +35,7 @@
 #include "tests/bench/bench_options.h"
 #include "tests/bench/bench_support.h"
 #include "tests/bench/brute_force_gate.h"
+#include "tests/bench/table_numbers.h"
 #include "tests/support/brute_force.h"
 
 namespace sinew::bench {
@@ -93,14 +94,8 @@ std::vector<BenchFlag> flags() {
 
 const char* const kDescription = "speed against accuracy: samples, pose spaces, padding, held-out escapes and holes,\nfallback cost, fast vs watertight, exact vs cheap boxes\n";
 
-Expected<Options> parse_options(const std::vector<std::string>& args, BenchArgs& parsed) {
+Status read_options(const BenchArgs& parsed, Options& o) {
   namespace cli = sinew::cli;
-  SINEW_ASSIGN_OR_RETURN(const cli::ParseResult result, parsed.parse(args));
-  Options o;
-  if (result == cli::ParseResult::kHelp) {
-    o.help = true;
-    return o;
-  }
   if (parsed.has("--quick")) {  // explicit flags below still override
     o.quick = true;
     o.samples = {4, 16, 62, 250};
@@ -137,23 +132,13 @@ Expected<Options> parse_options(const std::vector<std::string>& args, BenchArgs&
     }
     std::sort(o.paddings.begin(), o.paddings.end());
   }
-  if (const auto text = parsed.value("--held-out")) {
-    SINEW_ASSIGN_OR_RETURN(const std::int64_t n, cli::parse_int("--held-out", *text, 1, 1000000));
-    o.held_out = static_cast<int>(n);
-  }
-  if (const auto text = parsed.value("--size")) {
-    SINEW_ASSIGN_OR_RETURN(const cli::Size2 size, cli::parse_size("--size", *text, 16384));
-    o.width = size.width;
-    o.height = size.height;
-  }
-  if (const auto text = parsed.value("--threads")) {
-    SINEW_ASSIGN_OR_RETURN(const std::int64_t n, parse_thread_count("--threads", *text));
-    o.threads = static_cast<int>(n);
-  }
-  if (const auto text = parsed.value("--shared")) o.shared = *text;
-  if (const auto text = parsed.value("--json")) o.json_path = *text;
-  if (const auto text = parsed.value("--markdown")) o.markdown_path = *text;
-  return o;
+  SINEW_RETURN_IF_ERROR(parsed.read("--held-out", 1, 1000000, o.held_out));
+  SINEW_RETURN_IF_ERROR(parsed.read_size(16384, o.width, o.height));
+  SINEW_RETURN_IF_ERROR(parsed.read_threads(o.threads));
+  SINEW_RETURN_IF_ERROR(parsed.read("--shared", o.shared));
+  SINEW_RETURN_IF_ERROR(parsed.read("--json", o.json_path));
+  SINEW_RETURN_IF_ERROR(parsed.read("--markdown", o.markdown_path));
+  return {};
 }
 
 // --- model ---------------------------------------------------------------------
@@ -482,23 +467,6 @@ struct SideRow {
 };
 
 // --- report --------------------------------------------------------------------
-
-// Numbers for the Markdown: fixed with `digits` decimals, or %.2e ("sci").
-std::string fixed(double value, int digits) {
-  char text[64];
-  std::snprintf(text, sizeof text, "%.*f", digits, value);
-  return text;
-}
-std::string sci(double value) {
-  char text[64];
-  std::snprintf(text, sizeof text, "%.2e", value);
-  return text;
-}
-std::string general(double value) {
-  char text[64];
-  std::snprintf(text, sizeof text, "%g", value);
-  return text;
-}
 
 std::string padding_text(double padding) { return general(padding); }
 
@@ -834,7 +802,7 @@ CrackResult crack_test(bool watertight, int subdivisions, std::uint64_t seed) {
 int run_tradeoff_bench(const std::vector<std::string>& args, const std::string& command_line) {
   const Clock::time_point run_start = Clock::now();
   BenchArgs bench_args("tradeoff", kDescription, flags());
-  const auto parsed = parse_options(args, bench_args);
+  const auto parsed = parse_bench_options(bench_args, args, read_options);
   if (const std::optional<int> done = usage_exit(bench_args, parsed)) return *done;
   const Options& o = *parsed;
 

@@ -17,6 +17,7 @@
 #include "raytrace/render/renderer.h"
 #include "raytrace/scene/scene.h"
 #include "runtime/jobs/job_system.h"
+#include "tests/support/aov_frame.h"
 #include "tests/support/brute_force.h"
 #include "tests/support/idle_mannequin.h"
 
@@ -70,20 +71,16 @@ inline ImageCheck render_and_compare(const rt::Scene& scene, const rt::CameraDes
   if (!camera.ok()) return check;
   const std::vector<SoupTriangle> soup = testing_support::world_triangles(scene);
   const testing_support::ScreenBinner binner(soup, *camera);
-  const std::size_t n = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
-  std::vector<float> color(4 * n), depth(n);
-  std::vector<Vec3> normal(n);
-  std::vector<std::uint32_t> triangle(n), instance(n);
+  testing_support::AovFrame frame(width, height);
+  const auto& color = frame.rgba32f;
+  const auto& depth = frame.depth;
+  const auto& normal = frame.normal;
+  const auto& triangle = frame.triangle_id;
+  const auto& instance = frame.instance_id;
   JobSystem jobs(2);
   for (const rt::TriangleTest test : {rt::TriangleTest::kFast, rt::TriangleTest::kWatertight}) {
-    rt::FrameBuffers buffers;
-    buffers.width = width;
-    buffers.height = height;
-    buffers.color_rgba32f = color;
-    buffers.depth = depth;
-    buffers.normal = normal;
-    buffers.triangle_id = triangle;
-    buffers.instance_id = instance;
+    frame.poison();
+    const rt::FrameBuffers buffers = frame.buffers();
     rt::RenderSettings settings;
     settings.triangle_test = test;
     settings.light.position = camera->eye() + Vec3(1.0f, 3.0f, 2.0f) * glm::length(desc.target - desc.eye);
