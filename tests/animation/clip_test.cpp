@@ -7,22 +7,14 @@
 
 #include "animation/clip.h"
 #include "animation/skeleton.h"
+#include "tests/support/joint_chain.h"
 
 namespace sinew::anim {
 namespace {
 
 constexpr float kPi = 3.14159265358979f;
 
-Skeleton three_joints() {
-  RawSkeleton raw;
-  raw.joints.resize(3);
-  raw.joints[0].name = "root";
-  raw.joints[1].name = "a";
-  raw.joints[1].parent = 0;
-  raw.joints[2].name = "b";
-  raw.joints[2].parent = 1;
-  return *Skeleton::build(raw, "test");
-}
+Skeleton three_joints() { return *Skeleton::build(testing_support::joint_chain({"root", "a", "b"}), "test"); }
 
 Clip build(RawClip raw) {
   auto c = Clip::build(std::move(raw), three_joints(), "test");

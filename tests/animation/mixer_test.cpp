@@ -12,6 +12,7 @@
 #include "animation/clip.h"
 #include "animation/mixer.h"
 #include "animation/skeleton.h"
+#include "tests/support/joint_chain.h"
 
 namespace sinew::anim {
 namespace {
@@ -23,13 +24,7 @@ constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 // root -> a -> b, with rest translations that no clip below uses, so a
 // joint falling back to its rest pose is recognisable.
 Skeleton three_joints() {
-  RawSkeleton raw;
-  raw.joints.resize(3);
-  raw.joints[0].name = "root";
-  raw.joints[1].name = "a";
-  raw.joints[1].parent = 0;
-  raw.joints[2].name = "b";
-  raw.joints[2].parent = 1;
+  RawSkeleton raw = testing_support::joint_chain({"root", "a", "b"});
   for (std::size_t j = 0; j < 3; ++j) {
     raw.joints[j].rest.translation = Vec3(100.0f + static_cast<float>(j), 0.0f, 0.0f);
   }

@@ -11,6 +11,7 @@
 #include "animation/clip.h"
 #include "animation/joint_limits.h"
 #include "animation/skeleton.h"
+#include "tests/support/joint_chain.h"
 
 namespace sinew::anim {
 namespace {
@@ -19,18 +20,10 @@ constexpr float kPi = 3.14159265358979f;
 constexpr float kDeg = kPi / 180.0f;
 
 Skeleton skeleton_with_rest() {
-  RawSkeleton raw;
-  raw.joints.resize(4);
-  raw.joints[0].name = "root";
-  raw.joints[1].name = "a";
-  raw.joints[1].parent = 0;
+  RawSkeleton raw = testing_support::joint_chain({"root", "a", "b", "c"});
   raw.joints[1].rest.translation = Vec3(0, 1, 0);
   raw.joints[1].rest.rotation = glm::angleAxis(0.7f, glm::normalize(Vec3(1, 2, 3)));
-  raw.joints[2].name = "b";
-  raw.joints[2].parent = 1;
   raw.joints[2].rest.rotation = glm::angleAxis(-1.2f, Vec3(0, 0, 1));
-  raw.joints[3].name = "c";
-  raw.joints[3].parent = 2;
   raw.joints[3].rest.scale = Vec3(2.0f);
   return *Skeleton::build(raw, "test");
 }

@@ -2,6 +2,7 @@
 
 #include "animation/pose.h"
 #include "animation/reference_skinning.h"
+#include "tests/support/joint_chain.h"
 
 namespace sinew::anim {
 namespace {
@@ -16,11 +17,7 @@ void expect_near(const Vec3& a, const Vec3& b, float tol = 1e-5f) {
 
 // A two-bone arm along +x: shoulder at the origin, elbow at x = 2.
 Skeleton arm() {
-  RawSkeleton raw;
-  raw.joints.resize(2);
-  raw.joints[0].name = "shoulder";
-  raw.joints[1].name = "elbow";
-  raw.joints[1].parent = 0;
+  RawSkeleton raw = testing_support::joint_chain({"shoulder", "elbow"});
   raw.joints[1].rest.translation = Vec3(2, 0, 0);
   raw.joints[1].inverse_bind = Affine3::translation({-2, 0, 0});
   return *Skeleton::build(raw, "arm");
