@@ -158,7 +158,9 @@ struct FuzzyHeader {
   std::uint32_t node_count;
   std::int32_t max_depth;
   std::uint8_t candidates;
-  std::uint8_t reserved[7];
+  std::uint8_t merge_rigid_bones;  // 0 or 1; 0 in packs from before the option (then merged_bones is 0)
+  std::uint16_t merged_bones;      // bones that stood for their parent (FuzzyBakeStats::merged_bones)
+  std::uint8_t reserved[4];
   double fuzzy_area;
   double rest_area;
   double mean_items_per_leaf;
@@ -443,6 +445,8 @@ Expected<PackWriter> character_pack_writer(const PackContents& c) {
     h.node_count = f.stats.node_count;
     h.max_depth = f.stats.max_depth;
     h.candidates = static_cast<std::uint8_t>(f.stats.candidates);
+    h.merge_rigid_bones = f.stats.merge_rigid_bones ? 1 : 0;
+    h.merged_bones = static_cast<std::uint16_t>(f.stats.merged_bones);
     h.fuzzy_area = f.stats.fuzzy_area;
     h.rest_area = f.stats.rest_area;
     h.mean_items_per_leaf = f.stats.mean_items_per_leaf;
@@ -552,6 +556,19 @@ Expected<Pack> Pack::load(PackReader reader) {
     return make_error(ErrorCode::kInvalidData, r.name(), "FZHD.candidates", std::to_string(h.candidates),
                       "unknown candidate-bone mode");
   }
+  if (h.merge_rigid_bones > 1) {
+    return make_error(ErrorCode::kInvalidData, r.name(), "FZHD.merge_rigid_bones", std::to_string(h.merge_rigid_bones),
+                      "not 0 or 1");
+  }
+  if (h.merged_bones > (h.merge_rigid_bones ? h.bone_count : 0u)) {
+    return make_error(ErrorCode::kInvalidData, r.name(), "FZHD.merged_bones", std::to_string(h.merged_bones),
+                      h.merge_rigid_bones ? "more than the bones" : "not 0 in a bake that merged no bones");
+  }
+  for (const std::uint8_t byte : h.reserved) {
+    if (byte != 0) {
+      return make_error(ErrorCode::kInvalidData, r.name(), "FZHD.reserved", std::to_string(byte), "not 0");
+    }
+  }
   rt::FuzzyCharacterView& v = pack.fuzzy_;
   v.bone_count = h.bone_count;
   SINEW_ASSIGN_OR_RETURN(v.triangle_bone, view_section<std::uint16_t>(r, kTriangleBone));
@@ -571,6 +588,8 @@ Expected<Pack> Pack::load(PackReader reader) {
   st.triangle_count = h.triangle_count;
   st.bone_count = h.bone_count;
   st.candidates = static_cast<rt::CandidateBones>(h.candidates);
+  st.merge_rigid_bones = h.merge_rigid_bones != 0;
+  st.merged_bones = h.merged_bones;
   st.fuzzy_area = h.fuzzy_area;
   st.rest_area = h.rest_area;
   st.mean_items_per_leaf = h.mean_items_per_leaf;

@@ -37,6 +37,13 @@ namespace {
 using Clock = std::chrono::steady_clock;
 using Json = nlohmann::ordered_json;
 
+// "17 of 37 bones merged into their parents' trees" / "rigid bones kept".
+std::string rigid_bones_text(const rt::FuzzyBakeStats& st) {
+  if (!st.merge_rigid_bones) return "rigid bones kept";
+  return std::to_string(st.merged_bones) + " of " + std::to_string(st.bone_count) +
+         " bones merged into their parents' trees";
+}
+
 // --- bake options ---------------------------------------------------------------
 
 struct BakeOptions {
@@ -47,6 +54,7 @@ struct BakeOptions {
   std::string limits_path;
   float padding = 0.0f;
   rt::CandidateBones candidates = rt::CandidateBones::kAll;
+  bool merge_rigid_bones = rt::FuzzyBakeOptions{}.merge_rigid_bones;
   float sah_intersection_cost = rt::FuzzyBakeOptions{}.kd.intersection_cost;
   int threads = 0;
   std::size_t max_memory_bytes = character::BakeRequest{}.max_memory_bytes;
@@ -78,6 +86,10 @@ struct BakeFlags {
         limits(l.option("--limits", "FILE.json", "joint limits (needed by --pose-space limits; stored in the pack)")),
         pad(l.option("--pad", "FRACTION", "grow every fuzzy box by this fraction of the model's size (default 0)")),
         candidates(l.option("--candidates", "MODE", "all (the paper's) | influencing (faster; default all)")),
+        rigid_bones(l.option("--rigid-bones", "merge|keep",
+                             "a bone that never moves relative to its parent in the pose\n"
+                             "space gives its triangles to the parent's tree (merge: fewer\n"
+                             "top-level objects per frame; default) or keeps its own (keep)")),
         sah_intersection_cost(l.option("--sah-intersection-cost", "C",
                                        "the bone trees' triangle cost against a cell visit's 1\n"
                                        "(default 0.5, tuned for 64-ray packets; 1.5\n"
@@ -100,6 +112,7 @@ struct BakeFlags {
   const std::optional<std::string>& limits;
   const std::optional<std::string>& pad;
   const std::optional<std::string>& candidates;
+  const std::optional<std::string>& rigid_bones;
   const std::optional<std::string>& sah_intersection_cost;
   const std::optional<std::string>& threads;
   const std::optional<std::string>& max_memory_mib;
@@ -197,6 +210,10 @@ Expected<BakeOptions> parse_bake_options(const std::vector<std::string>& args, c
   if (const std::optional<std::string>& v = f.candidates) {
     SINEW_ASSIGN_OR_RETURN(const int c, cli::parse_choice("--candidates", *v, {"all", "influencing"}));
     o.candidates = c == 0 ? rt::CandidateBones::kAll : rt::CandidateBones::kInfluencing;
+  }
+  if (const std::optional<std::string>& v = f.rigid_bones) {
+    SINEW_ASSIGN_OR_RETURN(const int c, cli::parse_choice("--rigid-bones", *v, {"merge", "keep"}));
+    o.merge_rigid_bones = c == 0;
   }
   if (const std::optional<std::string>& v = f.sah_intersection_cost) {
     SINEW_ASSIGN_OR_RETURN(const double cost, cli::parse_double("--sah-intersection-cost", *v, 0.01, 100.0));
@@ -404,6 +421,8 @@ Json inspect_json(const character::Pack& pack) {
                   {"leaf_items", f.items.size()},
                   {"max_depth", max_depth},
                   {"mean_leaf_depth", leaves ? depth_sum / static_cast<double>(leaves) : 0.0},
+                  {"merge_rigid_bones", st.merge_rigid_bones},
+                  {"merged_bones", st.merged_bones},
                   {"bones", bones}};
   return out;
 }
@@ -438,7 +457,11 @@ void print_inspect(const Json& j, std::ostream& out) {
   const Json& f = j["fuzzy"];
   out << "fuzzy trees: " << f["pose_samples"] << " pose samples, fuzzy area " << f["fuzzy_area_ratio"]
       << "x the rest pose's, " << f["triangles_per_leaf"] << " triangles per leaf, " << f["nodes"] << " nodes, depth "
-      << f["max_depth"] << " max / " << f["mean_leaf_depth"] << " mean leaf\n";
+      << f["max_depth"] << " max / " << f["mean_leaf_depth"] << " mean leaf; "
+      << (f["merge_rigid_bones"].get<bool>() ? std::to_string(f["merged_bones"].get<std::uint32_t>()) +
+                                                   " bones merged into their parents' trees"
+                                             : std::string("rigid bones kept"))
+      << "\n";
 }
 
 // The process's peak resident set so far (getrusage), in KiB; 0 if unknown.
@@ -491,6 +514,7 @@ int run_bake(const std::vector<std::string>& args, std::ostream& out, std::ostre
   request.pose_space = o.pose_space;
   request.fuzzy.padding = o.padding;
   request.fuzzy.candidates = o.candidates;
+  request.fuzzy.merge_rigid_bones = o.merge_rigid_bones;
   request.fuzzy.kd.intersection_cost = o.sah_intersection_cost;
   request.max_memory_bytes = o.max_memory_bytes;
   request.fuzzy.memory_budget_bytes = std::min(request.fuzzy.memory_budget_bytes, o.max_memory_bytes / 4);
@@ -542,7 +566,8 @@ int run_bake(const std::vector<std::string>& args, std::ostream& out, std::ostre
   out << "wrote " << o.out_path << ": " << std::filesystem::file_size(o.out_path) << " bytes, " << st.sample_count
       << " pose samples, fuzzy area " << std::fixed << std::setprecision(3)
       << (st.rest_area > 0.0 ? st.fuzzy_area / st.rest_area : 0.0) << "x rest, " << std::setprecision(2)
-      << st.mean_items_per_leaf << " triangles per leaf, " << std::setprecision(0) << ms_since(start) << " ms\n";
+      << st.mean_items_per_leaf << " triangles per leaf, " << rigid_bones_text(st) << ", " << std::setprecision(0)
+      << ms_since(start) << " ms\n";
   return 0;
 }
 

@@ -5,7 +5,7 @@
 //
 //   bake MODEL -o OUT.pack [--pose-space arbitrary|limits|clips|clip:NAME]
 //        [--clips a,b,c] [--samples N] [--seed S] [--limits FILE.json]
-//        [--pad FRACTION] [--candidates all|influencing] [--threads N]
+//        [--pad FRACTION] [--candidates all|influencing] [--rigid-bones merge|keep] [--threads N]
 //   subdivide MODEL --levels L -o OUT.pack
 //   inspect PACK [--json]
 //   validate PACK

@@ -224,10 +224,20 @@ VertexTriangles vertex_triangles(const SkinnedMesh& mesh) {
   return adj;
 }
 
+// The bones standing for themselves (see moving_representatives).
+std::vector<std::uint16_t> represented_bones(std::span<const std::uint16_t> rep) {
+  std::vector<std::uint16_t> bones;
+  for (std::size_t b = 0; b < rep.size(); ++b) {
+    if (rep[b] == b) bones.push_back(static_cast<std::uint16_t>(b));
+  }
+  return bones;
+}
+
 // CandidateBones::kInfluencing: the bones weighting any corner, with their
-// parents and children.
+// parents and children, each replaced by its representative.
 BoneLists influencing_candidates(const SkinnedMesh& mesh, std::span<const int> parents,
-                                 std::uint32_t bone_count) {
+                                 std::span<const std::uint16_t> rep) {
+  const std::uint32_t bone_count = static_cast<std::uint32_t>(rep.size());
   BoneLists children;  // per bone its children
   {
     std::vector<std::vector<std::uint16_t>> lists(bone_count);
@@ -247,14 +257,14 @@ BoneLists influencing_candidates(const SkinnedMesh& mesh, std::span<const int> p
       for (std::size_t k = 0; k < static_cast<std::size_t>(kMaxInfluences); ++k) {
         if (mesh.weights[v][k] == 0.0f) continue;
         const std::uint16_t bone = mesh.joints[v][k];
-        scratch.push_back(bone);
-        if (parents[bone] >= 0) scratch.push_back(static_cast<std::uint16_t>(parents[bone]));
-        for (std::uint16_t child : children.of(bone)) scratch.push_back(child);
+        scratch.push_back(rep[bone]);
+        if (parents[bone] >= 0) scratch.push_back(rep[static_cast<std::size_t>(parents[bone])]);
+        for (std::uint16_t child : children.of(bone)) scratch.push_back(rep[child]);
       }
     }
     // Corners without any weight skin to the origin in every pose: no bone
     // is related to them, so let every bone compete.
-    if (scratch.empty()) scratch = all_bones(bone_count);
+    if (scratch.empty()) scratch = represented_bones(rep);
     candidates.append(scratch);
   }
   return candidates;
@@ -323,6 +333,56 @@ struct Samples {
   }
   const Affine3* bone_from_pose(std::size_t s) const { return inverses.data() + s * bone_count; }
 };
+
+// A bone that moves rigidly with its parent in every sample bounds its
+// triangles no more tightly than the parent's frame does (up to the turn of
+// its axes), yet costs a tree, a top-level object and a ray transform per
+// instance and frame. Each bone's representative is itself, or, for such a
+// bone, its parent's representative. "Rigidly": the relative transform
+// (parent's bind-to-pose inverse times the bone's) moves no corner of the
+// bind-pose bounds by more than kRigidTolerance of their diagonal from where
+// the first sample puts it. Only tightness hangs on the tolerance: whichever
+// bone a triangle gets, its boxes come from every sample in that frame.
+constexpr double kRigidTolerance = 1e-4;
+
+std::vector<std::uint16_t> moving_representatives(const Samples& samples, std::span<const int> parents) {
+  const std::uint32_t bones = samples.bone_count;
+  std::vector<std::uint16_t> rep(bones);
+  Aabb bind;
+  for (const Vec3& p : samples.mesh.positions) bind.extend(p);
+  std::array<Vec3, 8> corners{};
+  double tolerance = 0.0;
+  if (!bind.is_empty()) {
+    for (int c = 0; c < 8; ++c) {
+      corners[static_cast<std::size_t>(c)] = Vec3((c & 1) ? bind.upper.x : bind.lower.x,
+                                                  (c & 2) ? bind.upper.y : bind.lower.y,
+                                                  (c & 4) ? bind.upper.z : bind.lower.z);
+    }
+    tolerance = kRigidTolerance * static_cast<double>(glm::length(bind.extent()));
+  }
+  // Parents come before their children (the skeleton's sorted order), so a
+  // parent's representative is known when its child is reached.
+  for (std::uint32_t b = 0; b < bones; ++b) {
+    rep[b] = static_cast<std::uint16_t>(b);
+    const int parent = parents[b];
+    if (parent < 0 || static_cast<std::uint32_t>(parent) >= b || bind.is_empty()) continue;
+    bool rigid = true;
+    std::array<Vec3, 8> first{};
+    for (std::size_t s = 0; s < samples.count() && rigid; ++s) {
+      const Affine3 relative = samples.bone_from_pose(s)[parent] * samples.pose(s)[b];
+      for (std::size_t c = 0; c < corners.size() && rigid; ++c) {
+        const Vec3 moved = relative.transform_point(corners[c]);
+        if (s == 0) {
+          first[c] = moved;
+        } else {
+          rigid = static_cast<double>(glm::length(moved - first[c])) <= tolerance;
+        }
+      }
+    }
+    if (rigid) rep[b] = rep[static_cast<std::size_t>(parent)];
+  }
+  return rep;
+}
 
 // Calls grow(vertices, first_sample, last_sample) over all vertices for
 // batches of samples, reporting progress between batches.
@@ -578,13 +638,17 @@ Expected<FuzzyCharacterData> bake_fuzzy_character(const FuzzyBakeInput& input,
   memory.hold(adj.bytes());
   BoneLists candidates;
   BoneLists needs;
+  std::vector<std::uint16_t> rep = all_bones(bone_count);
+  if (options.merge_rigid_bones) rep = moving_representatives(samples, input.bone_parents);
   if (options.candidates == CandidateBones::kInfluencing) {
-    candidates = influencing_candidates(mesh, input.bone_parents, bone_count);
+    candidates = influencing_candidates(mesh, input.bone_parents, rep);
     needs = vertex_needs(adj, candidates, vertex_count);
   } else {
-    candidates.every_bone = all_bones(bone_count);
+    candidates.every_bone = represented_bones(rep);
     needs.every_bone = candidates.every_bone;
   }
+  stats.merge_rigid_bones = options.merge_rigid_bones;
+  stats.merged_bones = bone_count - static_cast<std::uint32_t>(represented_bones(rep).size());
   memory.hold(candidates.bytes() + needs.bytes());
   Assignment best;
   best.area.assign(triangle_count, std::numeric_limits<double>::infinity());

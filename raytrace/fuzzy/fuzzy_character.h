@@ -77,6 +77,8 @@ struct FuzzyBakeStats {
   std::uint32_t triangle_count = 0;
   std::uint32_t bone_count = 0;
   CandidateBones candidates = CandidateBones::kAll;
+  bool merge_rigid_bones = false;  // FuzzyBakeOptions::merge_rigid_bones
+  std::uint32_t merged_bones = 0;  // bones that moved rigidly with their parent and stood for it
   double fuzzy_area = 0.0;          // sum over triangles of their fuzzy box surface areas
   double rest_area = 0.0;           // the same sum for the bind-pose triangle boxes (a lower bound)
   double mean_items_per_leaf = 0.0; // over all bones' non-empty leaves

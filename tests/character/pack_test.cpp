@@ -317,6 +317,34 @@ TEST_F(CorruptPack, AFlippedByteInEverySectionIsRefusedByItsChecksum) {
   }
 }
 
+// FZHD bytes 25 (merge_rigid_bones), 26-27 (merged_bones) and 28-31
+// (reserved): docs/PACK_FORMAT.md.
+TEST_F(CorruptPack, TheRigidBoneFieldsRoundTripAndAreValidated) {
+  const SectionId header = make_section_id("FZHD");
+  auto pack = character::Pack::from_bytes(*bytes_, "pristine.pack");
+  ASSERT_TRUE(pack.ok()) << pack.status().message();
+  EXPECT_TRUE(pack->fuzzy_stats().merge_rigid_bones);
+  EXPECT_EQ(pack->fuzzy_stats().merged_bones, baked_->fuzzy.stats.merged_bones);
+  // A pack from before the option (both 0) still loads, as a bake that merged nothing.
+  auto old = character::Pack::from_bytes(repack(header, [](auto& p) {
+                                           overwrite(p, 25, std::uint8_t{0});
+                                           overwrite(p, 13, std::uint16_t{0});
+                                         }),
+                                         "old.pack");
+  ASSERT_TRUE(old.ok()) << old.status().message();
+  EXPECT_FALSE(old->fuzzy_stats().merge_rigid_bones);
+  EXPECT_EQ(old->fuzzy_stats().merged_bones, 0u);
+  expect_rejected(repack(header, [](auto& p) { overwrite(p, 25, std::uint8_t{2}); }), "FZHD.merge_rigid_bones");
+  expect_rejected(repack(header, [](auto& p) { overwrite(p, 13, std::uint16_t{60000}); }), "FZHD.merged_bones");
+  expect_rejected(repack(header,
+                         [](auto& p) {
+                           overwrite(p, 25, std::uint8_t{0});
+                           overwrite(p, 13, std::uint16_t{1});
+                         }),
+                  "FZHD.merged_bones");
+  expect_rejected(repack(header, [](auto& p) { overwrite(p, 29, std::uint8_t{1}); }), "FZHD.reserved");
+}
+
 TEST_F(CorruptPack, KdNodeLinksOutsideTheTreeAreRefused) {
   // An inner node whose above child points past the bone's slice.
   std::size_t inner = 0;

@@ -272,9 +272,12 @@ FuzzyCharacterData bake_ok(const Rig& rig, const FuzzyBakeOptions& options = {},
   return std::move(result).value();
 }
 
+// The candidate search alone: rigid bones are not merged (the rigs below
+// tie bones together on purpose).
 FuzzyBakeOptions with_candidates(CandidateBones mode) {
   FuzzyBakeOptions options;
   options.candidates = mode;
+  options.merge_rigid_bones = false;
   return options;
 }
 
@@ -427,6 +430,88 @@ TEST(FuzzyBakeCandidates, InfluencingSearchesTheBoneItsParentAndItsChildrenOnly)
     EXPECT_EQ(bake_ok(rig, with_candidates(CandidateBones::kAll)).triangle_bone[0], 4);
     EXPECT_EQ(bake_ok(rig, with_candidates(CandidateBones::kInfluencing)).triangle_bone[0], 2);  // itself
   }
+}
+
+// A chain whose bones in `still` keep one fixed turn about their pivot
+// relative to their parent in every sample (plus `wobble` radians of
+// random turn, when given); the others move at random as in arm_rig.
+Rig arm_rig_with_still_bones(int bones, int sample_count, std::uint32_t seed, const std::set<int>& still,
+                             double wobble = 0.0) {
+  Rig rig;
+  rig.mesh = arm_mesh(bones, 8, 0.25);
+  rig.parents = chain_parents(bones);
+  Rng rng(seed);
+  for (int s = 0; s < sample_count; ++s) {
+    std::vector<glm::dmat4> global(rig.parents.size());
+    for (std::size_t b = 0; b < rig.parents.size(); ++b) {
+      const glm::dvec3 pivot(static_cast<double>(b), 0, 0);
+      glm::dmat4 local;
+      if (still.count(static_cast<int>(b))) {
+        local = rotation_about(pivot, glm::normalize(glm::dvec3(0.3, 1.0, 0.2)), 0.4 + 0.1 * static_cast<double>(b));
+        if (wobble > 0.0) local = rotation_about(pivot, rng.unit_vector(), rng.uniform(-wobble, wobble)) * local;
+      } else {
+        local = rotation_about(pivot, rng.unit_vector(), rng.uniform(-1.0, 1.0));
+      }
+      global[b] = rig.parents[b] < 0 ? local : global[static_cast<std::size_t>(rig.parents[b])] * local;
+      rig.samples.push_back(to_affine(global[b]));
+    }
+  }
+  return rig;
+}
+
+std::set<std::uint32_t> bones_with_triangles(const FuzzyCharacterData& data) {
+  return std::set<std::uint32_t>(data.triangle_bone.begin(), data.triangle_bone.end());
+}
+
+TEST_P(FuzzyBakeModes, BonesRigidWithTheirParentGiveTheirTrianglesToTheMovingAncestor) {
+  // 0 <- 1 <- 2 <- 3 <- 4 <- 5: bones 2 and 3 never move relative to their
+  // parents, so both stand for bone 1; 4 and 5 move again.
+  const Rig rig = arm_rig_with_still_bones(6, 20, 31, {2, 3});
+  FuzzyBakeOptions options = with_candidates(GetParam());
+  options.merge_rigid_bones = true;
+  const FuzzyCharacterData merged = bake_ok(rig, options);
+  EXPECT_TRUE(merged.stats.merge_rigid_bones);
+  EXPECT_EQ(merged.stats.merged_bones, 2u);
+  const std::set<std::uint32_t> used = bones_with_triangles(merged);
+  EXPECT_EQ(used.count(2) + used.count(3), 0u);
+  EXPECT_TRUE(used.count(1)) << "bone 1 takes the still bones' triangles";
+  EXPECT_EQ(merged.bone_trees[2].triangle_count + merged.bone_trees[3].triangle_count, 0u);
+  // Still conservative: every sampled vertex inside its checks.
+  const RefSamples ref = reference_samples(rig);
+  for (std::size_t v = 0; v < rig.mesh.vertex_count(); ++v) {
+    for (std::uint32_t c = merged.vertex_check_begin[v]; c < merged.vertex_check_begin[v + 1]; ++c) {
+      const VertexCheck& check = merged.vertex_checks[c];
+      for (std::size_t s = 0; s < rig.sample_count(); ++s) {
+        ASSERT_TRUE(box_contains(check.box, apply(ref.bone_from_pose[s][check.bone], ref.skinned[s][v])))
+            << "vertex " << v << " bone " << check.bone << " sample " << s;
+      }
+    }
+  }
+  // Without merging the still bones keep triangles of their own.
+  const FuzzyCharacterData kept = bake_ok(rig, with_candidates(GetParam()));
+  EXPECT_FALSE(kept.stats.merge_rigid_bones);
+  EXPECT_EQ(kept.stats.merged_bones, 0u);
+  const std::set<std::uint32_t> kept_used = bones_with_triangles(kept);
+  EXPECT_GT(kept_used.count(2) + kept_used.count(3), 0u);
+}
+
+TEST(FuzzyBakeMerge, ABoneThatMovesALittleIsNotMerged) {
+  // A hundredth of a radian of play is far above the tolerance (1e-4 of the
+  // bind diagonal), so bone 2 stays a bone of its own.
+  const Rig rig = arm_rig_with_still_bones(4, 20, 32, {2}, 0.01);
+  EXPECT_EQ(bake_ok(rig).stats.merged_bones, 0u);
+  const Rig still = arm_rig_with_still_bones(4, 20, 32, {2});
+  EXPECT_EQ(bake_ok(still).stats.merged_bones, 1u);
+}
+
+TEST(FuzzyBakeMerge, OneSampleMergesEveryBoneIntoTheRoot) {
+  // A static model (the rest pose alone): nothing moves relative to
+  // anything, so one tree holds every triangle.
+  const Rig rig = arm_rig(5, 1, 33);
+  const FuzzyCharacterData data = bake_ok(rig);
+  EXPECT_EQ(data.stats.merged_bones, 4u);
+  EXPECT_EQ(bones_with_triangles(data), std::set<std::uint32_t>{0});
+  EXPECT_EQ(data.bone_trees[0].triangle_count, rig.mesh.triangle_count());
 }
 
 TEST(FuzzyBakeRigid, RigidVerticesHavePointBoxesAtTheirRestPosition) {
