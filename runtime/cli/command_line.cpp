@@ -96,7 +96,10 @@ const std::vector<std::string>& CommandLine::positionals(const std::string& name
 
 void CommandLine::command(const std::string& name, const std::string& help) {
   CLI::App* sub = app_->add_subcommand(name, help);
-  // The command parses its own arguments, --help included.
+  // The command parses its own arguments, --help included. One command per
+  // line: without the bound, an argument of the first that names another
+  // command ("report --sections tradeoff") would start that one instead.
+  app_->require_subcommand(0, 1);
   sub->prefix_command();
   sub->set_help_flag();
   commands_.push_back(name);

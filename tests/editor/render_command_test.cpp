@@ -544,6 +544,16 @@ TEST(CommandLine, TakesBothFlagFormsAndNamesWhatIsWrong) {
   EXPECT_NE(help.find("what it does"), std::string::npos) << help;
 }
 
+TEST(CommandLine, ACommandsArgumentsNeverStartAnotherCommand) {
+  cli::CommandLine line("tool", "");
+  line.command("report", "runs the others");
+  line.command("tradeoff", "one of them");
+  const auto parsed = line.parse({"report", "--sections", "tradeoff", "--quick"});
+  ASSERT_TRUE(parsed.ok()) << parsed.status().message();
+  EXPECT_EQ(line.chosen_command(), "report");
+  EXPECT_EQ(line.command_arguments(), (std::vector<std::string>{"--sections", "tradeoff", "--quick"}));
+}
+
 TEST(CommandLine, UsageErrorsAreOneLineAndExitCode2) {
   cli::CommandLine line("tool", "");
   std::ostringstream out, err;
