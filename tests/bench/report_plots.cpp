@@ -178,23 +178,43 @@ std::string embree_panel(const std::string& dat, const std::vector<std::string>&
 
 // --- the speed/accuracy trade -------------------------------------------------------
 
+// Per mode two blocks: every sample count at padding 0 (holes, work per
+// ray, samples, fps), and the mode's Pareto front among them (no other point
+// of the mode has fewer holes and no more work, or less work and no more
+// holes), sorted by holes.
 std::vector<std::string> tradeoff_data(const Json& doc, std::string& data) {
   std::vector<std::string> modes;
   for (const Json& row : doc.value("sweep", Json::array())) {
     const std::string mode = row.value("mode", "?");
     if (std::find(modes.begin(), modes.end(), mode) == modes.end()) modes.push_back(mode);
   }
+  struct TradePoint {
+    double holes, work, samples, fps;
+  };
   std::vector<std::string> drawn;
   for (const std::string& mode : modes) {
-    std::string block;
+    std::vector<TradePoint> points;
     for (const Json& row : doc["sweep"]) {
       if (row.value("mode", "") != mode || number(row, "padding") != 0.0) continue;
-      const double holes = number(row, "hole_fraction"), fps = number(row, "fps");
-      if (!std::isfinite(holes) || !std::isfinite(fps)) continue;
-      block += value(std::max(holes, kZeroHoles)) + " " + value(fps) + " " + value(number(row, "samples")) + "\n";
+      const TradePoint p{std::max(number(row, "hole_fraction"), kZeroHoles), number(row, "work_per_ray"),
+                         number(row, "samples"), number(row, "fps")};
+      if (std::isfinite(p.holes) && std::isfinite(p.work) && std::isfinite(p.fps)) points.push_back(p);
     }
-    if (block.empty()) continue;
-    data += block + "\n\n";
+    if (points.empty()) continue;
+    std::vector<TradePoint> front;
+    for (const TradePoint& p : points) {
+      const bool dominated = std::any_of(points.begin(), points.end(), [&](const TradePoint& q) {
+        return q.holes <= p.holes && q.work <= p.work && (q.holes < p.holes || q.work < p.work);
+      });
+      if (!dominated) front.push_back(p);
+    }
+    std::sort(front.begin(), front.end(), [](const TradePoint& a, const TradePoint& b) { return a.holes < b.holes; });
+    for (const std::vector<TradePoint>* block : {&points, &front}) {
+      for (const TradePoint& p : *block) {
+        data += value(p.holes) + " " + value(p.work) + " " + value(p.samples) + " " + value(p.fps) + "\n";
+      }
+      data += "\n\n";
+    }
     drawn.push_back(mode);
   }
   return drawn;
@@ -202,15 +222,18 @@ std::vector<std::string> tradeoff_data(const Json& doc, std::string& data) {
 
 std::string tradeoff_script(const std::string& dat, const std::string& png, const std::vector<std::string>& modes) {
   std::string s = std::string(kTerminal) + "set output '" + png + "'\n" +
-                  "set title 'Speed against accuracy: each point a sample count (padding 0)'\n"
+                  "set title \"Work against accuracy (padding 0): each point a sample count, labelled samples / fps;\\n"
+                  "rings and lines: each mode's Pareto front\"\n"
                   "set logscale x\nset grid\nset key outside below\n"
                   "set xlabel 'fraction of pixels whose hit differs from brute force, fallback off (0 drawn at 1e-6)'\n"
-                  "set ylabel 'frames per second, fallback on'\nplot ";
+                  "set ylabel 'triangle tests + kd-tree node visits per ray (deterministic)'\nplot ";
   for (std::size_t i = 0; i < modes.size(); ++i) {
-    const std::string index = " index " + std::to_string(i);
-    s += std::string(i == 0 ? "" : ", \\\n     ") + "'" + dat + "'" + index +
-         " using 1:2 with linespoints lw 2 pt 7 title '" + modes[i] + "', ''" + index +
-         " using 1:2:(sprintf('%d', $3)) with labels offset char 0.8,0.6 font ',8' notitle";
+    const std::string points = " index " + std::to_string(2 * i);
+    const std::string front = " index " + std::to_string(2 * i + 1);
+    s += std::string(i == 0 ? "" : ", \\\n     ") + "'" + dat + "'" + front + " using 1:2 with linespoints lw 2 pt 6 ps 2 lc " +
+         std::to_string(i + 1) + " title '" + modes[i] + "', ''" + points + " using 1:2 with points pt 7 lc " +
+         std::to_string(i + 1) + " notitle, ''" + points +
+         " using 1:2:(sprintf('%d / %.0f', $3, $4)) with labels offset char 0.8,0.6 font ',7' notitle";
   }
   return s + "\n";
 }

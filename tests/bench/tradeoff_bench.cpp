@@ -257,6 +257,9 @@ struct WalkResult {
   // the work the fuzzy boxes cost, free of the timing noise of a shared
   // machine (and, tile order fixed, the same on every run).
   double tests_per_ray = 0.0;
+  // Triangle tests plus kd-tree node visits per traced ray: the whole
+  // deterministic cost the trees leave, the trade plot's speed axis.
+  double work_per_ray = 0.0;
   GateResult gate;
 };
 
@@ -281,7 +284,7 @@ Expected<WalkResult> measure_walk(const BenchModel& m, const rt::FuzzyCharacterV
   WalkResult result;
   std::vector<double> frame_ms;
   PhaseTimers timers;
-  std::uint64_t rays = 0, triangle_tests = 0;
+  std::uint64_t rays = 0, triangle_tests = 0, node_visits = 0;
   for (int f = 0; f < o.frames; ++f) {
     SINEW_RETURN_IF_ERROR(pose_instances(m.model, walk, f / kFramesPerSecond, stage));
     const Clock::time_point prepare_start = Clock::now();
@@ -301,6 +304,7 @@ Expected<WalkResult> measure_walk(const BenchModel& m, const rt::FuzzyCharacterV
     frame_ms.push_back(prepare_ms + ms_since(render_start));
     rays += stats.primary.rays + stats.shadow.rays;
     triangle_tests += stats.primary.triangle_tests + stats.shadow.triangle_tests;
+    node_visits += stats.primary.node_visits + stats.shadow.node_visits;
     if (f == 0) {
       if (!shared.gate) shared.gate = std::make_unique<BruteForceGate>(stage.scene, *shared.camera, kWalkGateStride);
       SINEW_ASSIGN_OR_RETURN(const std::span<const Hit> primary, hits.render(stage.scene, *shared.camera, settings, jobs));
@@ -310,6 +314,7 @@ Expected<WalkResult> measure_walk(const BenchModel& m, const rt::FuzzyCharacterV
   result.frame_ms = median_of(frame_ms);
   result.boxes_ms = phase_ms(timers, "boxes");
   result.tests_per_ray = rays > 0 ? static_cast<double>(triangle_tests) / static_cast<double>(rays) : 0.0;
+  result.work_per_ray = rays > 0 ? static_cast<double>(triangle_tests + node_visits) / static_cast<double>(rays) : 0.0;
   return result;
 }
 
@@ -410,6 +415,7 @@ struct SweepRow {
   double tris_per_leaf = 0.0;
   double fps = 0.0;
   double tests_per_ray = 0.0;
+  double work_per_ray = 0.0;
   GateResult gate;
   HeldOutResult held_out;
 };
@@ -450,6 +456,7 @@ Expected<SweepRow> run_configuration(const BenchModel& m, const Options& o, Mode
                                                                rt::TriangleTest::kFast, jobs, walk));
   row.fps = walked.frame_ms > 0.0 ? 1000.0 / walked.frame_ms : 0.0;
   row.tests_per_ray = walked.tests_per_ray;
+  row.work_per_ray = walked.work_per_ray;
   row.gate = walked.gate;
   if (!row.gate.passed()) return row;  // not reported: its numbers would describe a wrong image
   SINEW_ASSIGN_OR_RETURN(row.held_out, measure_held_out(m, bake.fuzzy.view(), o, jobs, state));
@@ -471,9 +478,9 @@ struct SideRow {
 std::string padding_text(double padding) { return general(padding); }
 
 void print_sweep_header() {
-  std::printf("  %-9s %7s %5s %7s %9s %10s %6s %6s %7s %6s %10s %10s %9s %8s %8s\n", "mode", "samples", "used",
-              "padding", "bake ms", "pack bytes", "area", "tri/lf", "fps", "tst/ry", "escaped", "holes", "pixels",
-              "fb ms", "fb +ms");
+  std::printf("  %-9s %7s %5s %7s %9s %10s %6s %6s %7s %6s %7s %10s %10s %9s %8s %8s\n", "mode", "samples", "used",
+              "padding", "bake ms", "pack bytes", "area", "tri/lf", "fps", "tst/ry", "work/ry", "escaped", "holes",
+              "pixels", "fb ms", "fb +ms");
 }
 
 void print_sweep_row(const SweepRow& r) {
@@ -484,9 +491,10 @@ void print_sweep_row(const SweepRow& r) {
     return;
   }
   const HeldOutResult& h = r.held_out;
-  std::printf("  %-9s %7d %5d %7s %9.1f %10zu %6.2f %6.2f %7.1f %6.2f %10.3e %10.3e %9llu %8.3f %8.3f\n",
+  std::printf("  %-9s %7d %5d %7s %9.1f %10zu %6.2f %6.2f %7.1f %6.2f %7.2f %10.3e %10.3e %9llu %8.3f %8.3f\n",
               r.mode.c_str(), r.samples, r.samples_used, padding_text(r.padding).c_str(), r.bake_ms, r.pack_bytes,
-              r.fuzzy_area_ratio, r.tris_per_leaf, r.fps, r.tests_per_ray, h.escaped_fraction, h.hole_fraction(),
+              r.fuzzy_area_ratio, r.tris_per_leaf, r.fps, r.tests_per_ray, r.work_per_ray, h.escaped_fraction,
+              h.hole_fraction(),
               static_cast<unsigned long long>(h.pixels_compared), h.fallback_ms, h.frame_on_ms - h.frame_off_ms);
   std::fflush(stdout);
 }
@@ -512,6 +520,7 @@ Json sweep_json(const SweepRow& r) {
           {"tris_per_leaf", r.tris_per_leaf},
           {"fps", r.fps},
           {"triangle_tests_per_ray", r.tests_per_ray},
+          {"work_per_ray", r.work_per_ray},
           {"escaped_fraction", h.escaped_fraction},
           {"hole_fraction", h.hole_fraction()},
           {"hole_pixels", h.hole_pixels},
@@ -557,7 +566,7 @@ std::string markdown(const Report& rep) {
        "box area; `fps` is 1000 / the median of prepare_frame + render over " + std::to_string(o.frames) +
        " frames of the walk at 30 Hz, " + std::to_string(o.width) + "x" + std::to_string(o.height) +
        ", fallback on, shadows on, point light, fast triangle test; `tests/ray` is the triangle tests per traced "
-       "ray (primary and shadow) over those frames, the speed side of the trade without the timing noise; the "
+       "ray (primary and shadow) over those frames, the speed side of the trade without the timing noise; `work/ray` adds the kd-tree node visits (inner and leaf, every tree) to those tests, the cost the plot draws; the "
        "first frame is checked against brute force (every " + std::to_string(kWalkGateStride) + "th pixel) and a configuration that fails is FAILED and not "
        "reported. Accuracy is measured on " + std::to_string(o.held_out) + " held-out poses per mode that the bake "
        "never sampled: arbitrary/limits draw the same mode with another seed, clips/clip take uniform random times "
@@ -571,20 +580,20 @@ std::string markdown(const Report& rep) {
        "rest-pose bounding box diagonal added to every vertex box on each side. Clip modes sample every key and every "
        "1/30 s and pick N evenly; `used` is the real pose count, and a count the clips cannot reach is not repeated.");
   line("");
-  line("| mode | samples | used | padding | bake ms | pack bytes | area | tri/leaf | fps | tests/ray | escaped | holes | "
-       "pixels | fb ms | fb +ms |");
-  line("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+  line("| mode | samples | used | padding | bake ms | pack bytes | area | tri/leaf | fps | tests/ray | work/ray | "
+       "escaped | holes | pixels | fb ms | fb +ms |");
+  line("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
   for (const SweepRow& r : rep.rows) {
     if (!r.gate.passed()) {
       line("| " + r.mode + " | " + std::to_string(r.samples) + " | " + std::to_string(r.samples_used) + " | " +
-           padding_text(r.padding) + " | FAILED | | | | | | | | | | |");
+           padding_text(r.padding) + " | FAILED | | | | | | | | | | | |");
       continue;
     }
     const HeldOutResult& h = r.held_out;
     line("| " + r.mode + " | " + std::to_string(r.samples) + " | " + std::to_string(r.samples_used) + " | " +
          padding_text(r.padding) + " | " + fixed(r.bake_ms, 1) + " | " + std::to_string(r.pack_bytes) + " | " +
          fixed(r.fuzzy_area_ratio, 2) + " | " + fixed(r.tris_per_leaf, 2) + " | " + fixed(r.fps, 1) + " | " +
-         fixed(r.tests_per_ray, 2) + " | " + sci(h.escaped_fraction) + " | " + sci(h.hole_fraction()) + " | " +
+         fixed(r.tests_per_ray, 2) + " | " + fixed(r.work_per_ray, 2) + " | " + sci(h.escaped_fraction) + " | " + sci(h.hole_fraction()) + " | " +
          std::to_string(h.pixels_compared) + " | " + fixed(h.fallback_ms, 3) + " | " +
          fixed(h.frame_on_ms - h.frame_off_ms, 3) + " |");
   }
