@@ -566,7 +566,11 @@ std::string document(const Options& o, const Report& report, const std::string& 
   if (const Run* trade = report.find("tradeoff")) {
     md += pasted_markdown(*trade);
     md += failure_line(*trade);
-    if (!plots.tradeoff.empty()) md += "\n![fps against holes per sample count](" + plots.tradeoff + ")\n";
+    if (!plots.tradeoff.empty()) {
+      md += "\n![triangle tests and node visits per ray against holes, each sample count labelled with its fps; each "
+            "mode's Pareto front](" +
+            plots.tradeoff + ")\n";
+    }
     md += "\n";
   }
   const Run* instances = report.find("scaling-instances");
