@@ -251,6 +251,7 @@ BoneLists influencing_candidates(const SkinnedMesh& mesh, std::span<const int> p
   candidates.begin.reserve(mesh.triangle_count() + 1);
   candidates.begin.push_back(0);
   std::vector<std::uint16_t> scratch;
+  const std::vector<std::uint16_t> every_candidate = represented_bones(rep);
   for (const auto& tri : mesh.triangles) {
     scratch.clear();
     for (std::uint32_t v : tri) {
@@ -264,7 +265,7 @@ BoneLists influencing_candidates(const SkinnedMesh& mesh, std::span<const int> p
     }
     // Corners without any weight skin to the origin in every pose: no bone
     // is related to them, so let every bone compete.
-    if (scratch.empty()) scratch = represented_bones(rep);
+    if (scratch.empty()) scratch = every_candidate;
     candidates.append(scratch);
   }
   return candidates;
@@ -640,15 +641,16 @@ Expected<FuzzyCharacterData> bake_fuzzy_character(const FuzzyBakeInput& input,
   BoneLists needs;
   std::vector<std::uint16_t> rep = all_bones(bone_count);
   if (options.merge_rigid_bones) rep = moving_representatives(samples, input.bone_parents);
+  const std::vector<std::uint16_t> represented = represented_bones(rep);
   if (options.candidates == CandidateBones::kInfluencing) {
     candidates = influencing_candidates(mesh, input.bone_parents, rep);
     needs = vertex_needs(adj, candidates, vertex_count);
   } else {
-    candidates.every_bone = represented_bones(rep);
+    candidates.every_bone = represented;
     needs.every_bone = candidates.every_bone;
   }
   stats.merge_rigid_bones = options.merge_rigid_bones;
-  stats.merged_bones = bone_count - static_cast<std::uint32_t>(represented_bones(rep).size());
+  stats.merged_bones = bone_count - static_cast<std::uint32_t>(represented.size());
   memory.hold(candidates.bytes() + needs.bytes());
   Assignment best;
   best.area.assign(triangle_count, std::numeric_limits<double>::infinity());
