@@ -174,7 +174,7 @@ void render_tile(const Scene& scene, const PinholeCamera& camera, const RenderSe
   if (out.want_color() && settings.shadows) {
     const auto shadow_start = Clock::now();
     for (std::size_t l = 0; l < lights.size(); ++l) {
-      place_shadow_rays(lights[l], static_cast<int>(l), s);
+      aim_shadow_rays(lights[l], static_cast<int>(l), s);
       record.shadowed +=
           trace_shadow_rays(scene, settings.triangle_test, settings.packet_rays, static_cast<int>(l), s,
                             record.shadow);

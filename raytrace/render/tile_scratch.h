@@ -17,6 +17,7 @@
 
 #include "raytrace/render/output_staging.h"
 #include "runtime/jobs/job_system.h"
+#include "runtime/math/aabb.h"
 #include "runtime/math/ray.h"
 
 namespace sinew::rt {
@@ -59,6 +60,11 @@ struct TileScratch {
   std::vector<std::uint8_t> shadow_lanes;
   std::vector<float> shadow_lane_x, shadow_lane_y, shadow_lane_z;
   Vec3 shadow_direction{0.0f};
+  // Aimed but not placed yet (render/tile_stages.h aim_shadow_rays): the
+  // lanes are chosen and shadow_ends bounds every ray's offset surface
+  // point, but shadow_lane_* are not written.
+  bool shadows_aimed_only = false;
+  Aabb shadow_ends;
   bool shadows_compacted = true;  // shadow_* below hold the placed rays
   // This light's shadow rays, compacted in block order (render/tile_stages.h
   // compact_shadow_rays).

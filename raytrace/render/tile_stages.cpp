@@ -288,6 +288,7 @@ void TileScratch::prepare(const Tile& area, int region_blocks_x, int region_bloc
   shadow_count = 0;
   shadow_region_begin.clear();
   shadows_from_point = false;
+  shadows_aimed_only = false;
   const int width = area.x1 - area.x0, height = area.y1 - area.y0;
   const int rx = std::max(1, region_blocks_x), ry = std::max(1, region_blocks_y);
   if (width == layout_width_ && height == layout_height_ && rx == layout_region_x_ && ry == layout_region_y_) {
@@ -669,7 +670,20 @@ void reconstruct_surfaces(const Scene& scene, const Vec3& default_albedo, TileSc
   }
 }
 
-void place_shadow_rays(const Light& light, int l, TileScratch& s) {
+namespace {
+
+// The rounding bound a hit's shadow ray is pushed off its surface by:
+// offset_origin's, for a point light shadow_ray_from_light's wider one.
+Float8 shadow_offset_error(bool point, const Vec3x8& to_light, float light_magnitude, Float8 error) {
+  if (!point) return error;
+  const Float8 reach =
+      Float8(light_magnitude) + Float8(2.0f) * max(max(abs(to_light.x), abs(to_light.y)), abs(to_light.z));
+  return error + Float8(gamma(32)) * reach;
+}
+
+}  // namespace
+
+void aim_shadow_rays(const Light& light, int l, TileScratch& s) {
   const std::uint8_t dark = static_cast<std::uint8_t>(~(1u << l));
   const bool point = light.kind == Light::Kind::kPoint;
   const Vec3x8 light_at{Float8(light.position.x), Float8(light.position.y), Float8(light.position.z)};
@@ -677,11 +691,13 @@ void place_shadow_rays(const Light& light, int l, TileScratch& s) {
   const float light_magnitude = detail::max_abs(light.position);
   s.shadow_placed = 0;
   s.shadows_compacted = false;
+  s.shadows_aimed_only = true;
   s.shadow_count = 0;
   s.shadow_region_begin.clear();
   s.shadows_from_point = point;
   s.shadow_origin = light.position;
   s.shadow_direction = light.direction;
+  Vec3x8 lo{Float8(kInf), Float8(kInf), Float8(kInf)}, hi{Float8(-kInf), Float8(-kInf), Float8(-kInf)};
   for (std::size_t b = 0; b < s.blocks(); ++b) {
     s.shadow_lanes[b] = 0;
     const std::uint32_t lanes = s.block_hits[b];
@@ -695,24 +711,58 @@ void place_shadow_rays(const Light& light, int l, TileScratch& s) {
       s.lit[k0 + static_cast<std::size_t>(std::countr_zero(away))] &= dark;  // no ray needed
     }
     if (toward == 0) continue;
+    // The moved points of offset_shadow_rays, bit for bit (the last step,
+    // one float on, is left to the bound's growth).
+    const Float8 e = shadow_offset_error(point, to_light, light_magnitude, Float8::load(&s.error[k0]));
+    const Float8 distance = abs(facing.x) * e + abs(facing.y) * e + abs(facing.z) * e;
+    const Vec3x8 moved = position + distance * facing;
+    const Mask8 m = Mask8::from_bits(toward);
+    lo = select(m, Vec3x8{min(lo.x, moved.x), min(lo.y, moved.y), min(lo.z, moved.z)}, lo);
+    hi = select(m, Vec3x8{max(hi.x, moved.x), max(hi.y, moved.y), max(hi.z, moved.z)}, hi);
+    s.shadow_lanes[b] = static_cast<std::uint8_t>(toward);
+    s.shadow_placed += static_cast<std::size_t>(std::popcount(toward));
+  }
+  if (s.shadow_placed == 0) return;
+  // A ray ends one float on from its moved point (at most 2^-22 of the
+  // coordinate, or a denormal step from zero): growing the box by 2^-21 of
+  // the coordinates and the smallest normal float holds every end and its
+  // rounding, and keeps the box on the light's side of a receiver the
+  // offset cleared by far more.
+  const Vec3 low(reduce_min(lo.x), reduce_min(lo.y), reduce_min(lo.z));
+  const Vec3 high(reduce_max(hi.x), reduce_max(hi.y), reduce_max(hi.z));
+  const float magnitude = std::max(detail::max_abs(low), detail::max_abs(high));
+  const float grow = 0x1.0p-21f * magnitude + std::numeric_limits<float>::min();
+  s.shadow_ends = {low - Vec3(grow), high + Vec3(grow)};
+}
+
+void offset_shadow_rays(TileScratch& s) {
+  if (!s.shadows_aimed_only) return;
+  s.shadows_aimed_only = false;
+  const bool point = s.shadows_from_point;
+  const Vec3x8 light_at{Float8(s.shadow_origin.x), Float8(s.shadow_origin.y), Float8(s.shadow_origin.z)};
+  const Vec3x8 light_dir{Float8(s.shadow_direction.x), Float8(s.shadow_direction.y), Float8(s.shadow_direction.z)};
+  const float light_magnitude = detail::max_abs(s.shadow_origin);
+  for (std::size_t b = 0; b < s.blocks(); ++b) {
+    if (s.shadow_lanes[b] == 0) continue;
+    const std::size_t k0 = b * kBlockLanes;
+    const Vec3x8 position = load3(s.px, s.py, s.pz, k0);
+    const Vec3x8 facing = load3(s.gx, s.gy, s.gz, k0);
+    const Vec3x8 to_light = point ? light_at - position : light_dir;
     // offset_origin: pushed off along the camera-facing normal by the
-    // rounding bound (for a point light, shadow_ray_from_light's wider
-    // one), then one float further on every axis it moved.
-    Float8 e = Float8::load(&s.error[k0]);
-    if (point) {
-      const Float8 reach = Float8(light_magnitude) +
-                           Float8(2.0f) * max(max(abs(to_light.x), abs(to_light.y)), abs(to_light.z));
-      e = e + Float8(gamma(32)) * reach;
-    }
+    // rounding bound, then one float further on every axis it moved.
+    const Float8 e = shadow_offset_error(point, to_light, light_magnitude, Float8::load(&s.error[k0]));
     const Float8 distance = abs(facing.x) * e + abs(facing.y) * e + abs(facing.z) * e;
     const Vec3x8 offset = distance * facing;
     const Vec3x8 moved = position + offset;
     const Vec3x8 end{step_away(moved.x, offset.x), step_away(moved.y, offset.y), step_away(moved.z, offset.z)};
     // A point light's rays run from the light to the offset points.
     store3(point ? end - light_at : end, s.shadow_lane_x, s.shadow_lane_y, s.shadow_lane_z, k0);
-    s.shadow_lanes[b] = static_cast<std::uint8_t>(toward);
-    s.shadow_placed += static_cast<std::size_t>(std::popcount(toward));
   }
+}
+
+void place_shadow_rays(const Light& light, int l, TileScratch& s) {
+  aim_shadow_rays(light, l, s);
+  offset_shadow_rays(s);
 }
 
 void compact_shadow_rays(TileScratch& s) {
@@ -784,6 +834,7 @@ std::uint64_t trace_shadow_rays(const Scene& scene, TriangleTest test, int packe
     ++blocked_count;
   };
   if (packet_rays <= 1) {
+    offset_shadow_rays(s);
     compact_shadow_rays(s);
     for (std::size_t i = 0; i < s.shadow_count; ++i) {
       if (occluded(scene, s.shadow_ray(i), test, &counters)) block(i);
@@ -792,34 +843,58 @@ std::uint64_t trace_shadow_rays(const Scene& scene, TriangleTest test, int packe
   }
   if (s.shadow_placed == 0) return 0;
   static const float kZeros[kPacketSize] = {};
-  // The tile's rays bounded and culled as placed, lane by lane (the same
-  // rays, so the same bound as over the compacted ones): a tile whose rays
-  // can reach nothing (a ground in the open, mostly) compacts none.
   CullLists& lists = cull_lists();
   lists.tile.clear();
   RayBound tile_bound;
-  const float* const placed[3] = {s.shadow_lane_x.data(), s.shadow_lane_y.data(), s.shadow_lane_z.data()};
-  if (s.shadows_from_point) {
-    tile_bound.add_groups(s.shadow_origin, placed, 0.0f, 1.0f, std::span(s.shadow_lanes.data(), s.blocks()));
-  } else {
-    alignas(32) float d[3][kPacketSize], t_max[kPacketSize];
-    for (int lane = 0; lane < kPacketSize; ++lane) {
-      for (int a = 0; a < 3; ++a) d[a][lane] = s.shadow_direction[a];
-      t_max[lane] = kInf;
+  if (s.shadows_aimed_only) {
+    // Every ray the ends' box allows, as one bound: from the light to the
+    // box, or from the box along the light. Per axis that is the same
+    // range of directions (or origins) as the placed rays' own (the box's
+    // faces are their extreme ends, grown, and rounded differences keep
+    // their order), so the rays are placed only when it reaches an object:
+    // a tile in the open places none.
+    alignas(32) float o[3][kPacketSize] = {}, d[3][kPacketSize] = {};
+    alignas(32) float t_min[kPacketSize] = {}, t_max[kPacketSize] = {};
+    const Vec3 corners[2] = {s.shadow_ends.lower, s.shadow_ends.upper};
+    for (int c = 0; c < 2; ++c) {
+      for (int a = 0; a < 3; ++a) {
+        o[a][c] = s.shadows_from_point ? s.shadow_origin[a] : corners[c][a];
+        d[a][c] = s.shadows_from_point ? corners[c][a] - s.shadow_origin[a] : s.shadow_direction[a];
+      }
+      t_max[c] = s.shadows_from_point ? 1.0f : kInf;
     }
+    const float* const origins[3] = {o[0], o[1], o[2]};
     const float* const directions[3] = {d[0], d[1], d[2]};
-    for (std::size_t b = 0; b < s.blocks(); ++b) {
-      if (s.shadow_lanes[b] == 0) continue;
-      const std::size_t k0 = b * kBlockLanes;
-      const float* const o[3] = {placed[0] + k0, placed[1] + k0, placed[2] + k0};
-      tile_bound.add_lanes(o, directions, kZeros, t_max, s.shadow_lanes[b]);
+    tile_bound.add_lanes(origins, directions, t_min, t_max, 0b11u);
+  } else {
+    // The tile's rays bounded as placed, lane by lane (the same rays, so
+    // the same bound as over the compacted ones).
+    const float* const placed[3] = {s.shadow_lane_x.data(), s.shadow_lane_y.data(), s.shadow_lane_z.data()};
+    if (s.shadows_from_point) {
+      tile_bound.add_groups(s.shadow_origin, placed, 0.0f, 1.0f, std::span(s.shadow_lanes.data(), s.blocks()));
+    } else {
+      alignas(32) float d[3][kPacketSize], t_max[kPacketSize];
+      for (int lane = 0; lane < kPacketSize; ++lane) {
+        for (int a = 0; a < 3; ++a) d[a][lane] = s.shadow_direction[a];
+        t_max[lane] = kInf;
+      }
+      const float* const directions[3] = {d[0], d[1], d[2]};
+      for (std::size_t b = 0; b < s.blocks(); ++b) {
+        if (s.shadow_lanes[b] == 0) continue;
+        const std::size_t k0 = b * kBlockLanes;
+        const float* const o[3] = {placed[0] + k0, placed[1] + k0, placed[2] + k0};
+        tile_bound.add_lanes(o, directions, kZeros, t_max, s.shadow_lanes[b]);
+      }
     }
   }
+  // A tile whose rays can reach nothing (a ground in the open, mostly)
+  // places and compacts none.
   cull_objects(scene, tile_bound, lists.tile);
   if (lists.tile.empty()) {
     counters.rays += s.shadow_placed;
     return 0;
   }
+  offset_shadow_rays(s);
   compact_shadow_rays(s);
   // Pad a group past the last ray (inactive lanes, but the arithmetic
   // reads them; a large packet's groups start anywhere).

@@ -2,7 +2,7 @@
 // structure-of-arrays form (render/tile_scratch.h), eight lanes at a time:
 //
 //   generate_camera_rays -> trace_primary -> reconstruct_surfaces
-//   -> per light: place_shadow_rays -> trace_shadow_rays -> shade_and_write
+//   -> per light: aim_shadow_rays -> trace_shadow_rays -> shade_and_write
 //
 // Renderer::render runs them per tile; the Embree peer of the benchmarks
 // runs the same stages with its own two trace stages, so camera rays,
@@ -50,6 +50,15 @@ void reconstruct_surfaces(const Scene& scene, const Vec3& default_albedo, TileSc
 // light (t_max inf).
 void place_shadow_rays(const Light& light, int l, TileScratch& s);
 
+// place_shadow_rays in two steps. aim_shadow_rays picks the lanes (and
+// clears bit l of s.lit for hits facing away) and bounds where every ray
+// meets its surface (s.shadow_ends: each offset point lies inside), without
+// computing the rays; offset_shadow_rays then places them. trace_shadow_rays
+// places aimed rays itself, and only when the bound of every ray the box
+// allows reaches some object: a tile in the open pays for no ray.
+void aim_shadow_rays(const Light& light, int l, TileScratch& s);
+void offset_shadow_rays(TileScratch& s);
+
 // The placed rays compacted into s.shadow_* in runs (s.shadow_region_begin):
 // per region, the rays of its hits on characters, then those on static
 // meshes, each in block order. Does nothing when they already are.
@@ -59,11 +68,13 @@ void compact_shadow_rays(TileScratch& s);
 // as the Embree peer of the benchmarks does).
 void make_shadow_rays(const Light& light, int l, TileScratch& s);
 
-// Traces the placed shadow rays one by one, as packets of eight, or as one
-// large packet per region; blocked rays clear bit l of s.lit. Returns how
-// many were blocked. Packets are culled like the primary rays, first the
-// tile's placed rays as one bound: when that reaches no object, nothing is
-// compacted or traced. Single rays (packet_rays 1) are all traced.
+// Traces the placed (or aimed) shadow rays one by one, as packets of eight,
+// or as one large packet per region; blocked rays clear bit l of s.lit.
+// Returns how many were blocked. Packets are culled like the primary rays,
+// first the tile's rays as one bound (from their ends' box when they are
+// only aimed, then from the placed rays): when that reaches no object,
+// nothing is placed, compacted or traced. Single rays (packet_rays 1) are
+// all traced.
 std::uint64_t trace_shadow_rays(const Scene& scene, TriangleTest test, int packet_rays, int l, TileScratch& s,
                                 TraversalCounters& counters);
 

@@ -948,6 +948,86 @@ TEST(TileStages, SurfacesAndShadowOriginsAreTheScalarOnes) {
   EXPECT_GT(split_regions, 4u) << "regions with rays on both kinds of mesh";
 }
 
+// aim_shadow_rays bounds where the rays of offset_shadow_rays end without
+// computing them: every end (a directional light's ray origin; for a point
+// light the rounded direction from the light, which the bound's corner
+// directions must hold) lies inside s.shadow_ends, at coordinates from
+// 1e-3 to 1e6, with surfaces at zero too. The bound stays on the lit side
+// of a flat receiver, so a ground in the open is culled.
+TEST(TileStages, AimedShadowRaysEndInsideTheirBound) {
+  std::mt19937 g(7);
+  std::size_t checked = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    const float scale = std::pow(10.0f, -3.0f + 9.0f * unit(g));
+    rt::TileScratch s;
+    s.prepare(Tile{0, 0, 8, 4, 0});
+    const Vec3 centre = scale * Vec3(unit(g) - 0.5f, unit(g) - 0.5f, unit(g) - 0.5f);
+    for (std::size_t b = 0; b < s.blocks(); ++b) s.block_hits[b] = static_cast<std::uint8_t>(g());
+    for (std::size_t k = 0; k < s.lanes; ++k) {
+      const Vec3 p = trial % 10 == 0 ? Vec3(0.0f) : centre + 0.1f * scale * Vec3(unit(g), unit(g), unit(g));
+      const Vec3 n = glm::normalize(Vec3(unit(g) - 0.5f, unit(g) - 0.5f, unit(g) - 0.5f) + Vec3(0.0f, 0.0f, 1e-3f));
+      s.px[k] = p.x;
+      s.py[k] = p.y;
+      s.pz[k] = p.z;
+      s.gx[k] = n.x;
+      s.gy[k] = n.y;
+      s.gz[k] = n.z;
+      s.error[k] = 4.2e-7f * std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
+      s.lit[k] = 1;
+    }
+    rt::Light light;
+    light.kind = trial % 2 == 0 ? rt::Light::Kind::kPoint : rt::Light::Kind::kDirectional;
+    light.position = centre + 3.0f * scale * Vec3(unit(g) - 0.5f, unit(g) - 0.5f, 1.0f);
+    light.direction = glm::normalize(Vec3(unit(g) - 0.5f, unit(g) - 0.5f, 1.0f));
+    rt::aim_shadow_rays(light, 0, s);
+    ASSERT_TRUE(s.shadows_aimed_only);
+    const std::vector<std::uint8_t> aimed(s.shadow_lanes.begin(), s.shadow_lanes.begin() + static_cast<long>(s.blocks()));
+    const Aabb ends = s.shadow_ends;
+    rt::offset_shadow_rays(s);
+    ASSERT_FALSE(s.shadows_aimed_only);
+    // The same lanes as place_shadow_rays picks.
+    rt::TileScratch placed = s;
+    rt::place_shadow_rays(light, 0, placed);
+    for (std::size_t b = 0; b < s.blocks(); ++b) ASSERT_EQ(aimed[b], placed.shadow_lanes[b]) << b;
+    for (std::size_t b = 0; b < s.blocks(); ++b) {
+      for (std::uint32_t m = aimed[b]; m != 0; m &= m - 1) {
+        const std::size_t k = b * rt::kBlockLanes + static_cast<std::size_t>(std::countr_zero(m));
+        const Vec3 lane(s.shadow_lane_x[k], s.shadow_lane_y[k], s.shadow_lane_z[k]);
+        ASSERT_EQ(lane, Vec3(placed.shadow_lane_x[k], placed.shadow_lane_y[k], placed.shadow_lane_z[k])) << k;
+        for (int a = 0; a < 3; ++a) {
+          if (light.kind == rt::Light::Kind::kDirectional) {
+            ASSERT_GE(lane[a], ends.lower[a]) << trial << " " << k;
+            ASSERT_LE(lane[a], ends.upper[a]) << trial << " " << k;
+          } else {
+            ASSERT_GE(lane[a], ends.lower[a] - light.position[a]) << trial << " " << k;
+            ASSERT_LE(lane[a], ends.upper[a] - light.position[a]) << trial << " " << k;
+          }
+        }
+        ++checked;
+      }
+    }
+  }
+  EXPECT_GT(checked, 2000u);
+
+  // A flat receiver lit from above: the bound lies above it.
+  rt::TileScratch s;
+  s.prepare(Tile{0, 0, 8, 4, 0});
+  for (std::size_t k = 0; k < s.lanes; ++k) {
+    s.px[k] = 100.0f + static_cast<float>(k);
+    s.py[k] = -50.0f;
+    s.pz[k] = 0.0f;
+    s.gx[k] = s.gy[k] = 0.0f;
+    s.gz[k] = 1.0f;
+    s.error[k] = 4.2e-7f * 132.0f;
+  }
+  std::fill(s.block_hits.begin(), s.block_hits.end(), std::uint8_t{0xFF});
+  rt::Light light;
+  light.position = Vec3(0.0f, 0.0f, 400.0f);
+  rt::aim_shadow_rays(light, 0, s);
+  EXPECT_EQ(s.shadow_placed, s.lanes);
+  EXPECT_GT(s.shadow_ends.lower.z, 0.0f) << "the ends are off the receiver, and so is their bound";
+}
+
 struct Frame {
   std::vector<std::uint8_t> color;
   std::vector<float> depth;
