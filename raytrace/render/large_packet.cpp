@@ -394,14 +394,18 @@ class LargeQuery {
     const std::uint32_t unbuilt = alive_groups_ & ~frusta_built_;
     const auto directions = [&](int g) -> const float (&)[3][kLanes] { return group_[g].d; };
     const auto lanes = [&](int g) { return live_[g]; };
+    // The packet's own frustum over every group built so far.
+    const std::uint32_t built = frusta_built_ | unbuilt;
     if constexpr (!kAnyHit) {
       frusta_.template set_groups<false>(unbuilt, 1.0f, directions, lanes, [](int, float*) {});
+      frusta_.template set_bound<false>(built, 1.0f, directions, lanes, [](int, float*) {});
     } else {
       // A lane's points end at t_max (an infinite one: no far plane).
-      frusta_.template set_groups<true>(unbuilt, 1.0f, directions, lanes,
-                                        [&](int g, float* reach) { std::copy_n(group_[g].t_limit, kLanes, reach); });
+      const auto reach = [&](int g, float* out) { std::copy_n(group_[g].t_limit, kLanes, out); };
+      frusta_.template set_groups<true>(unbuilt, 1.0f, directions, lanes, reach);
+      frusta_.template set_bound<true>(built, 1.0f, directions, lanes, reach);
     }
-    frusta_built_ |= unbuilt;
+    frusta_built_ = built;
   }
 
   // The largest t any lane of `groups` still looks for: its best hit (or

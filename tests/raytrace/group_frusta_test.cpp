@@ -205,6 +205,86 @@ TEST(GroupFrusta, EveryHitTriangleIsReachedBySegmentsFromTheApex) {
   EXPECT_GT(tally.boxes_culled, tally.tried / 5) << tally.boxes_culled << " of " << tally.tried;
 }
 
+// A 16x16-pixel packet (32 groups of 4x2 pixels) with its own frustum
+// (set_bound) tested before the groups': a triangle some lane hits is still
+// reached by that lane's group, from an apex near and far from the origin,
+// for rays and for segments ending at their lane's reach (far plane), and
+// with lanes missing from the groups.
+TEST(GroupFrusta, ThePacketFrustumNeverCullsATriangleALaneHits) {
+  std::mt19937 g(11);
+  int tried = 0, hit = 0, culled = 0;
+  for (const bool segments : {false, true}) {
+    for (const float offset : {0.0f, 60.0f, 4000.0f}) {
+      for (int packet = 0; packet < 20; ++packet) {
+        const Vec3 apex = offset * random_vec(g) + random_vec(g);
+        const Vec3 c = glm::normalize(random_vec(g) + Vec3(0.0f, 0.0f, 1e-3f));
+        const Vec3 u = glm::normalize(glm::cross(c, std::fabs(c.z) < 0.9f ? Vec3(0, 0, 1) : Vec3(1, 0, 0)));
+        const Vec3 v = glm::cross(c, u);
+        const float pixel = 0.0005f * (1.0f + 6.0f * unit(g));
+        float q[32][3][8];
+        alignas(32) float reach[32][8];
+        std::uint32_t lanes[32];
+        std::array<Ray, 256> rays;
+        for (int group = 0; group < 32; ++group) {
+          lanes[group] = packet % 4 == 0 ? (g() & 0xFFu) | 1u : 0xFFu;
+          for (int lane = 0; lane < 8; ++lane) {
+            const float x = static_cast<float>(4 * (group % 4) + lane % 4) - 7.5f;
+            const float y = static_cast<float>(2 * (group / 4) + lane / 4) - 7.5f;
+            const float length = segments ? 1.0f + 40.0f * unit(g) : 1.0f + unit(g);
+            const Vec3 d = length * (c + pixel * (x * u + y * v));
+            for (int a = 0; a < 3; ++a) q[group][a][lane] = d[a];
+            reach[group][lane] = segments ? 1.0f : kInf;
+            Ray& r = rays[static_cast<std::size_t>(8 * group + lane)];
+            r.origin = apex;
+            r.direction = d;
+            r.t_min = 0.0f;
+            r.t_max = reach[group][lane];
+          }
+        }
+        rt::GroupFrusta<32> frusta;
+        frusta.reset(apex, 32);
+        const auto directions = [&](int group) -> const float (&)[3][8] { return q[group]; };
+        const auto lanes_of = [&](int group) { return lanes[group]; };
+        const auto reach_of = [&](int group, float* out) { std::copy(reach[group], reach[group] + 8, out); };
+        if (segments) {
+          frusta.set_groups<true>(~0u, 1.0f, directions, lanes_of, reach_of);
+          frusta.set_bound<true>(~0u, 1.0f, directions, lanes_of, reach_of);
+        } else {
+          frusta.set_groups<false>(~0u, 1.0f, directions, lanes_of, reach_of);
+          frusta.set_bound<false>(~0u, 1.0f, directions, lanes_of, reach_of);
+        }
+        for (int trial = 0; trial < 300; ++trial) {
+          // About a lane's ray, or beside the packet by up to its width.
+          const int k = static_cast<int>(g() % 256);
+          const Ray& r = rays[static_cast<std::size_t>(k)];
+          const float t = segments ? 1.3f * unit(g) : 0.5f + 30.0f * unit(g);
+          const Vec3 at = r.origin + t * r.direction;
+          const float width = 16.0f * pixel * glm::length(r.direction) * (segments ? 1.0f : t);
+          const float size = width * (0.005f + 0.3f * unit(g) * unit(g));
+          const Vec3 shift = 1.5f * width * unit(g) * random_vec(g);
+          const Vec3 p0 = at + shift + size * random_vec(g);
+          const Vec3 p1 = at + shift + size * random_vec(g);
+          const Vec3 p2 = at + shift + size * random_vec(g);
+          const std::uint32_t reached = frusta.reached(p0, p1, p2, ~0u);
+          ++tried;
+          if (reached == 0) ++culled;
+          for (int lane = 0; lane < 256; ++lane) {
+            if (!(lanes[lane / 8] >> (lane % 8) & 1u) || !hits(rays[static_cast<std::size_t>(lane)], p0, p1, p2)) {
+              continue;
+            }
+            ++hit;
+            ASSERT_NE(reached >> (lane / 8) & 1u, 0u)
+                << "lane " << lane << " hits a culled triangle; apex (" << apex.x << "," << apex.y << "," << apex.z
+                << ") packet " << packet << " trial " << trial;
+          }
+        }
+      }
+    }
+  }
+  EXPECT_GT(hit, tried / 10);
+  EXPECT_GT(culled, tried / 5) << culled << " of " << tried;
+}
+
 TEST(GroupFrusta, TrianglesBeyondTheRaysEndsAreCulledByTheFarPlane) {
   // Rays from the light to points 10 to 12 along +z.
   const Vec3 light(3.0f, -2.0f, 1.0f);
