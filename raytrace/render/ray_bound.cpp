@@ -263,6 +263,16 @@ void cull_objects(const Scene& scene, const RayBound& bound, std::vector<std::ui
   // scene. A point within an object's slack of the object lies within that
   // much of a cell that lists the object.
   const float grow = bound.world_slack_bound(detail::max_abs(tree.bounds)) + extra_grow;
+  if (objects.size() <= kFlatCullObjects) {
+    // A few dozen objects (a character's bones, a ground): one box test
+    // each costs less than walking the tree's cells to them (Cally walk,
+    // 2 threads: primary 4.5 -> 4.4 ms, shadow 3.8 -> 3.6 ms). In index
+    // order, as the walk's sorted output.
+    for (std::uint32_t object = 0; object < objects.size(); ++object) {
+      if (test.may_enter(objects[object].box, grow)) out.push_back(object);
+    }
+    return;
+  }
   // Walk the top-level tree over the cells the set may enter; each object
   // is tested once (objects straddle splits and sit in several leaves).
   thread_local std::vector<std::uint32_t> stamp;

@@ -157,6 +157,10 @@ void for_each_reached_leaf(const KdTreeView& tree, const RayBound::Test& test, f
   }
 }
 
+// Scenes with at most this many top-level objects are culled by testing
+// every object's box; larger ones by walking the top-level tree.
+inline constexpr std::size_t kFlatCullObjects = 64;
+
 // The top-level objects (indices into scene.top_level().objects(), in
 // ascending order) that some ray of `bound` may enter, every box grown by
 // extra_grow beyond the bound's own slack bound. Appends to `out`.

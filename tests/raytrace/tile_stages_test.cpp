@@ -323,6 +323,66 @@ TEST(RayBound, SharedOriginGroupsBoundAsTheirLanesDo) {
   EXPECT_TRUE(inf_direction.test().may_enter(Aabb{Vec3(100.0f), Vec3(101.0f)}, 0.0f));
 }
 
+// cull_objects tests every object's box in scenes of up to
+// kFlatCullObjects objects and walks the top-level tree in larger ones:
+// both keep every object whose box a ray of the set enters (in double
+// precision), and both cull most of the others.
+TEST(RayBound, CullKeepsEveryObjectARayEntersWithFewAndManyObjects) {
+  const testing_support::BakedModel& m = testing_support::idle_mannequin();
+  for (const int instances : {1, 6}) {
+    rt::Scene scene;
+    const std::uint32_t character = scene.add_character(m.model.mesh, m.bake.fuzzy.view()).value();
+    for (int i = 0; i < instances; ++i) {
+      const std::uint32_t instance = scene.add_instance(character).value();
+      const Affine3 place = Affine3::translation(Vec3(0.9f * static_cast<float>(i % 3), 0.0f, 0.9f * (i / 3)));
+      ASSERT_TRUE(scene.set_bones(instance, testing_support::clip_pose(m.model, "idle", 0.1 * i, place)).ok());
+    }
+    JobSystem jobs(2);
+    ASSERT_TRUE(scene.prepare_frame(rt::FrameOptions{}, jobs).ok());
+    const std::span<const rt::TopLevelObject> objects = scene.top_level().objects();
+    ASSERT_EQ(objects.size() > rt::kFlatCullObjects, instances == 6) << objects.size();
+    const Aabb world = scene.top_level().bounds();
+    std::mt19937 g(5);
+    std::size_t entered = 0, culled = 0;
+    for (int trial = 0; trial < 3000; ++trial) {
+      alignas(32) float o[3][8], d[3][8], t0[8], t1[8];
+      const Vec3 base = world.lower + Vec3(unit(g), unit(g), unit(g)) * (world.upper - world.lower);
+      const Vec3 aim(unit(g) - 0.5f, unit(g) - 0.5f, unit(g) - 0.5f);
+      for (int lane = 0; lane < 8; ++lane) {
+        for (int a = 0; a < 3; ++a) {
+          o[a][lane] = trial % 2 == 0 ? base[a] : base[a] + 0.2f * (unit(g) - 0.5f);
+          d[a][lane] = aim[a] + 0.05f * (unit(g) - 0.5f);
+        }
+        t0[lane] = 0.0f;
+        t1[lane] = trial % 3 == 0 ? kInf : 0.5f * unit(g);
+      }
+      rt::RayBound bound;
+      const float* const op[3] = {o[0], o[1], o[2]};
+      const float* const dp[3] = {d[0], d[1], d[2]};
+      bound.add_lanes(op, dp, t0, t1, 0xFFu);
+      std::vector<std::uint32_t> kept;
+      rt::cull_objects(scene, bound, kept);
+      ASSERT_TRUE(std::is_sorted(kept.begin(), kept.end()));
+      for (std::uint32_t object = 0; object < objects.size(); ++object) {
+        bool any = false;
+        for (int lane = 0; lane < 8 && !any; ++lane) {
+          any = enters(objects[object].box, Vec3(o[0][lane], o[1][lane], o[2][lane]),
+                       Vec3(d[0][lane], d[1][lane], d[2][lane]), t0[lane], t1[lane]);
+        }
+        const bool listed = std::binary_search(kept.begin(), kept.end(), object);
+        if (any) {
+          ++entered;
+          ASSERT_TRUE(listed) << instances << " instances, trial " << trial << ": object " << object << " culled";
+        } else if (!listed) {
+          ++culled;
+        }
+      }
+    }
+    EXPECT_GT(entered, 500u) << instances << " instances";
+    EXPECT_GT(culled, 3 * entered) << instances << " instances";
+  }
+}
+
 // Random packets around the characters: culled (tile bound, then packet
 // cull, as the renderer does) and unculled traversal agree with single rays.
 TEST(PacketCulling, CulledPacketsFindTheSingleRayHits) {
