@@ -15,11 +15,13 @@
 // meets them in a leaf).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <span>
 #include <vector>
 
 #include "raytrace/geometry/triangle_intersect.h"
+#include "raytrace/render/group_frusta.h"
 #include "raytrace/render/ray_bound.h"
 #include "raytrace/render/tile_scratch.h"
 #include "raytrace/render/traversal.h"
@@ -47,14 +49,45 @@ struct StaticTile {
   std::uint64_t meshes = 0;  // the static meshes they came from
 };
 
+// The cone from one apex (a camera's eye, a point light) spanned by the
+// directions of a tile's extreme rays (its corner pixels', or those to the
+// corners of the box its shadow rays end in), which holds every ray of the
+// tile. A triangle it misses is never tested by the tile's rays: either all
+// three corners lie beyond one of the cone's four planes
+// (render/group_frusta.h), or every corner ray lies beyond one of the
+// triangle's edge planes through the apex. Both with the group frusta's
+// margin: 2^-12 of the coordinate magnitudes (corners and apex) at the
+// triangle, beyond which neither triangle test reports a hit off the
+// triangle. The first drops floor triangles beside a tile, the second the
+// half of a ground quad across its diagonal from the tile.
+class TileCone {
+ public:
+  // No cone: every triangle may be hit.
+  TileCone() = default;
+  // From `count` (at most 8) directions; without a usable frustum (rays
+  // spread over about 75 degrees) nothing is culled.
+  TileCone(const Vec3& apex, const Vec3* directions, int count);
+  bool misses(const Vec3& p0, const Vec3& p1, const Vec3& p2) const;
+
+ private:
+  bool on_ = false;
+  Vec3 apex_{0.0f};
+  std::array<Vec3, 8> directions_{};  // unit
+  int count_ = 0;
+  GroupFrusta<8> frustum_;
+};
+
 // Gathers into `tile` the triangles that some ray of `bound` may reach
 // among `objects` (indices into scene.top_level().objects()), every box
 // grown by `extra_grow` beyond the bound's slack bound as cull_objects
 // grows it. Returns whether the direct tests apply: the fast triangle test,
 // a non-empty list of static meshes only, and at most
 // kMaxStaticTileTriangles triangles reached.
+//
+// Triangles `cone` misses are left out too, and do not count towards the
+// limit (a tile on a ground quad keeps the half it sees).
 bool gather_static_tile(const Scene& scene, TriangleTest test, const RayBound& bound, float extra_grow,
-                        std::span<const std::uint32_t> objects, StaticTile& tile);
+                        std::span<const std::uint32_t> objects, StaticTile& tile, const TileCone& cone = {});
 
 // The nearest hits of the tile's camera rays (from `eye` along s.dir_*)
 // among the gathered triangles: fills t, u, v, triangle, instance and

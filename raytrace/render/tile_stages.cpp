@@ -281,6 +281,33 @@ void set_miss(TileScratch& s, std::size_t k) {
 
 }  // namespace
 
+TileCone camera_tile_cone(const PinholeCamera& camera, const Tile& tile) {
+  const float x0 = static_cast<float>(tile.x0) + 0.5f, x1 = static_cast<float>(tile.x1) - 0.5f;
+  const float y0 = static_cast<float>(tile.y0) + 0.5f, y1 = static_cast<float>(tile.y1) - 0.5f;
+  alignas(32) const float xs[8] = {x0, x1, x0, x1, x0, x1, x0, x1};
+  alignas(32) const float ys[8] = {y0, y0, y1, y1, y0, y0, y1, y1};
+  alignas(32) float q[3][8];
+  const Vec3x8 d = camera.directions_at(Float8::load(xs), Float8::load(ys));
+  d.x.store(q[0]);
+  d.y.store(q[1]);
+  d.z.store(q[2]);
+  Vec3 corners[4];
+  for (int i = 0; i < 4; ++i) corners[i] = Vec3(q[0][i], q[1][i], q[2][i]);
+  return TileCone(camera.eye(), corners, 4);
+}
+
+TileCone shadow_tile_cone(const TileScratch& s) {
+  if (!s.shadows_from_point || !(s.shadow_ends.lower.x <= s.shadow_ends.upper.x)) return {};
+  Vec3 corners[8];
+  for (int corner = 0; corner < 8; ++corner) {
+    for (int a = 0; a < 3; ++a) {
+      const float end = (corner >> a & 1) ? s.shadow_ends.upper[a] : s.shadow_ends.lower[a];
+      corners[corner][a] = end - s.shadow_origin[a];
+    }
+  }
+  return TileCone(s.shadow_origin, corners, 8);
+}
+
 void TileScratch::prepare(const Tile& area, int region_blocks_x, int region_blocks_y) {
   tile = area;
   shadow_placed = 0;
@@ -517,7 +544,7 @@ void trace_primary(const Scene& scene, const PinholeCamera& camera, TriangleTest
   tile_bound.add_groups(eye, dirs, 0.0f, kInf, std::span<const std::uint8_t>(s.block_pixels.data(), blocks));
   cull_objects(scene, tile_bound, lists.tile);
   thread_local StaticTile statics;
-  if (gather_static_tile(scene, test, tile_bound, 0.0f, lists.tile, statics)) {
+  if (gather_static_tile(scene, test, tile_bound, 0.0f, lists.tile, statics, camera_tile_cone(camera, s.tile))) {
     for (std::size_t b = 0; b < blocks; ++b) counters.rays += static_cast<std::uint64_t>(std::popcount(s.block_pixels[b]));
     intersect_static_tile(statics, eye, s, counters);
     return;
@@ -906,7 +933,7 @@ std::uint64_t trace_shadow_rays(const Scene& scene, TriangleTest test, int packe
     s.s_tmax[i] = 1.0f;
   }
   thread_local StaticTile statics;
-  if (gather_static_tile(scene, test, tile_bound, 0.0f, lists.tile, statics)) {
+  if (gather_static_tile(scene, test, tile_bound, 0.0f, lists.tile, statics, shadow_tile_cone(s))) {
     counters.rays += s.shadow_count;
     return occluded_static_tile(statics, l, s, counters);
   }

@@ -15,6 +15,7 @@
 #include "raytrace/camera/camera.h"
 #include "raytrace/render/output_planes.h"
 #include "raytrace/render/renderer.h"
+#include "raytrace/render/static_tiles.h"
 #include "raytrace/render/tile_scratch.h"
 #include "raytrace/scene/scene.h"
 
@@ -28,6 +29,15 @@ void generate_camera_rays(const PinholeCamera& camera, TileScratch& s);
 // region (in blocks) its packets cover: one block for 1 and 8 rays.
 bool valid_packet_rays(int packet_rays);
 void packet_region_blocks(int packet_rays, int& blocks_x, int& blocks_y);
+
+// The cone (render/static_tiles.h) holding every camera ray of `tile`'s
+// pixels: the rays through its corner pixels span the others (a pinhole
+// camera's direction is affine in the pixel before it is normalised, which
+// does not move a ray). And the one holding every shadow ray
+// aim_shadow_rays bounded from a point light (to the corners of
+// s.shadow_ends); without a point light none (nothing is culled).
+TileCone camera_tile_cone(const PinholeCamera& camera, const Tile& tile);
+TileCone shadow_tile_cone(const TileScratch& s);
 
 // Nearest hits of the tile's pixels, with the tile's primary rays culled
 // against the top level as one bound and each packet's again (render/

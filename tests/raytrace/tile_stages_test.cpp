@@ -778,6 +778,93 @@ TEST(StaticTiles, SmallMeshesFindTheSingleRayHits) {
 // 1,164 triangles, as the demo's arena): a tile that sees a few quads
 // gathers them from the mesh's tree and finds every single-ray hit and
 // occlusion; a tile that sees the whole floor does not qualify.
+// A tile's cone (static_tiles.h TileCone) never drops a triangle that a
+// ray inside it hits, by either triangle test: random cones of four or
+// eight corner directions from apexes near and far from the origin,
+// triangles about and beside them, and rays mixed from the corners (as a
+// tile's pixel rays are). It drops most triangles beside the cone, and the
+// half of a ground quad across the diagonal from a narrow cone.
+TEST(StaticTiles, TheTileConeNeverDropsATriangleARayHits) {
+  std::mt19937 g(19);
+  const auto signed_unit = [&] { return 2.0f * unit(g) - 1.0f; };
+  const auto random_vec = [&] { return Vec3(signed_unit(), signed_unit(), signed_unit()); };
+  std::size_t tried = 0, hit = 0, dropped = 0;
+  for (const float offset : {0.0f, 40.0f, 3000.0f}) {
+    for (int c = 0; c < 60; ++c) {
+      const Vec3 apex = offset * random_vec() + random_vec();
+      const Vec3 centre = glm::normalize(random_vec() + Vec3(0.0f, 0.0f, 1e-3f));
+      const Vec3 u = glm::normalize(glm::cross(centre, std::fabs(centre.z) < 0.9f ? Vec3(0, 0, 1) : Vec3(1, 0, 0)));
+      const Vec3 v = glm::cross(centre, u);
+      const float spread = 0.002f + 0.05f * unit(g);
+      const int count = c % 2 == 0 ? 4 : 8;
+      Vec3 corners[8];
+      for (int i = 0; i < count; ++i) {
+        const float x = (i & 1) ? 1.0f : -1.0f, y = (i & 2) ? 1.0f : -1.0f, z = (i & 4) ? 1.3f : 1.0f;
+        corners[i] = (z * (1.0f + unit(g))) * (centre + spread * (x * u + y * v));
+      }
+      const rt::TileCone cone(apex, corners, count);
+      for (int trial = 0; trial < 200; ++trial) {
+        // A point along a mixed ray, and a triangle about it or beside it.
+        Vec3 mixed(0.0f);
+        float weight = 0.0f;
+        for (int i = 0; i < count; ++i) {
+          const float w = unit(g) * unit(g);
+          mixed += w * glm::normalize(corners[i]);
+          weight += w;
+        }
+        mixed /= weight;
+        const float t = 0.5f + 50.0f * unit(g);
+        const Vec3 at = apex + t * mixed;
+        const float size = t * spread * (0.05f + 3.0f * unit(g) * unit(g));
+        const Vec3 shift = 4.0f * t * spread * unit(g) * random_vec();
+        const Vec3 p0 = at + shift + size * random_vec(), p1 = at + shift + size * random_vec(),
+                   p2 = at + shift + size * random_vec();
+        const bool missed = cone.misses(p0, p1, p2);
+        ++tried;
+        if (missed) ++dropped;
+        for (int r = 0; r < 24; ++r) {
+          Vec3 d(0.0f);
+          for (int i = 0; i < count; ++i) d += unit(g) * glm::normalize(corners[i]);
+          if (r < count) d = glm::normalize(corners[r]);  // the corner rays themselves
+          Ray ray;
+          ray.origin = apex;
+          ray.direction = glm::normalize(d);
+          rt::TriangleHit h;
+          const bool fast = rt::intersect_triangle_fast(ray, ray.t_max, p0, p1, p2, h);
+          const bool tight = rt::intersect_triangle_watertight(rt::prepare_watertight(ray), ray, ray.t_max, p0, p1, p2, h);
+          if (!fast && !tight) continue;
+          ++hit;
+          ASSERT_FALSE(missed) << "a ray in the cone hits a dropped triangle; apex (" << apex.x << "," << apex.y << ","
+                               << apex.z << ") cone " << c << " trial " << trial;
+          break;
+        }
+      }
+    }
+  }
+  EXPECT_GT(hit, tried / 10);
+  EXPECT_GT(dropped, tried / 5) << dropped << " of " << tried;
+
+  // A ground quad seen from above: a narrow cone on one side of its
+  // diagonal drops the other half, one across the diagonal keeps both.
+  const Vec3 eye(0.3f, 2.0f, 0.2f);
+  const Vec3 q0(-50.0f, 0.0f, -50.0f), q1(50.0f, 0.0f, -50.0f), q2(-50.0f, 0.0f, 50.0f), q3(50.0f, 0.0f, 50.0f);
+  const auto cone_at = [&](const Vec3& target) {
+    Vec3 corners[4];
+    for (int i = 0; i < 4; ++i) {
+      corners[i] = target + Vec3((i & 1) ? 0.02f : -0.02f, 0.0f, (i & 2) ? 0.02f : -0.02f) - eye;
+    }
+    return rt::TileCone(eye, corners, 4);
+  };
+  const rt::TileCone near_corner_q0 = cone_at(Vec3(-3.0f, 0.0f, -2.0f));  // below the diagonal q1-q2
+  EXPECT_FALSE(near_corner_q0.misses(q0, q2, q1));
+  EXPECT_TRUE(near_corner_q0.misses(q1, q2, q3));
+  const rt::TileCone across = cone_at(Vec3(0.0f, 0.0f, 0.0f));  // on the diagonal
+  EXPECT_FALSE(across.misses(q0, q2, q1));
+  EXPECT_FALSE(across.misses(q1, q2, q3));
+  // No cone drops nothing.
+  EXPECT_FALSE(rt::TileCone().misses(q1, q2, q3));
+}
+
 TEST(StaticTiles, FloorCellsFindTheSingleRayHits) {
   rt::StaticMeshDesc floor;
   constexpr int kQuads = 24;
@@ -830,6 +917,17 @@ TEST(StaticTiles, FloorCellsFindTheSingleRayHits) {
   EXPECT_GT(box_hits, 50u);
   EXPECT_GT(floor_hits, 50u);
   expect_single_ray_hits(sc, camera, s);
+  // Gathered within the tile's cone, as trace_primary gathers: fewer
+  // triangles, the same hits.
+  {
+    const std::size_t by_boxes = tile.triangles.size();
+    ASSERT_TRUE(rt::gather_static_tile(sc, TriangleTest::kFast, bound, 0.0f, objects, tile,
+                                       rt::camera_tile_cone(camera, s.tile)));
+    EXPECT_LT(tile.triangles.size(), by_boxes);
+    rt::intersect_static_tile(tile, camera.eye(), s, counters);
+    expect_single_ray_hits(sc, camera, s);
+    if (HasFatalFailure()) return;
+  }
 
   // Shadow rays from the floor pixels to a point light: the box shadows
   // some of them.
