@@ -61,9 +61,11 @@ struct TileScratch {
   std::vector<float> shadow_lane_x, shadow_lane_y, shadow_lane_z;
   Vec3 shadow_direction{0.0f};
   // Aimed but not placed yet (render/tile_stages.h aim_shadow_rays): the
-  // lanes are chosen and shadow_ends bounds every ray's offset surface
-  // point, but shadow_lane_* are not written.
+  // lanes are chosen, but shadow_lane_* are not written.
   bool shadows_aimed_only = false;
+  // Aimed rays' ends (a point light's rays' far ends, a directional light's
+  // origins) all lie inside; empty after place_shadow_rays, which bounds
+  // nothing.
   Aabb shadow_ends;
   bool shadows_compacted = true;  // shadow_* below hold the placed rays
   // This light's shadow rays, compacted in block order (render/tile_stages.h

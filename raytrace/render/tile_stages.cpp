@@ -699,54 +699,90 @@ void reconstruct_surfaces(const Scene& scene, const Vec3& default_albedo, TileSc
 
 namespace {
 
-// The rounding bound a hit's shadow ray is pushed off its surface by:
-// offset_origin's, for a point light shadow_ray_from_light's wider one.
-Float8 shadow_offset_error(bool point, const Vec3x8& to_light, float light_magnitude, Float8 error) {
-  if (!point) return error;
-  const Float8 reach =
-      Float8(light_magnitude) + Float8(2.0f) * max(max(abs(to_light.x), abs(to_light.y)), abs(to_light.z));
-  return error + Float8(gamma(32)) * reach;
+// One light's terms for placing shadow rays, eight lanes at a time.
+struct ShadowLight {
+  bool point;
+  Vec3x8 at, direction;
+  float magnitude;
+  std::uint8_t dark;  // clears the light's bit of s.lit
+
+  ShadowLight(bool is_point, const Vec3& position, const Vec3& dir, int l)
+      : point(is_point), at{Float8(position.x), Float8(position.y), Float8(position.z)},
+        direction{Float8(dir.x), Float8(dir.y), Float8(dir.z)}, magnitude(detail::max_abs(position)),
+        dark(static_cast<std::uint8_t>(~(1u << l))) {}
+
+  Vec3x8 to_light(const Vec3x8& position) const { return point ? at - position : direction; }
+
+  // The hits of block b whose surface faces the light; the others lose the
+  // light's bit of s.lit (no ray needed).
+  std::uint32_t facing(TileScratch& s, std::size_t b) const {
+    const std::uint32_t lanes = s.block_hits[b];
+    if (lanes == 0) return 0;
+    const std::size_t k0 = b * kBlockLanes;
+    const Vec3x8 to = to_light(load3(s.px, s.py, s.pz, k0));
+    const std::uint32_t toward = (dot(load3(s.gx, s.gy, s.gz, k0), to) > Float8(0.0f)).bits() & lanes;
+    for (std::uint32_t away = lanes & ~toward; away != 0; away &= away - 1) {
+      s.lit[k0 + static_cast<std::size_t>(std::countr_zero(away))] &= dark;
+    }
+    return toward;
+  }
+
+  // offset_origin's push of block b's hits along the camera-facing normal,
+  // by the rounding bound (for a point light shadow_ray_from_light's wider
+  // one): the offset, and the moved points.
+  Vec3x8 offset(const TileScratch& s, std::size_t k0) const {
+    const Vec3x8 position = load3(s.px, s.py, s.pz, k0);
+    const Vec3x8 facing = load3(s.gx, s.gy, s.gz, k0);
+    Float8 e = Float8::load(&s.error[k0]);
+    if (point) {
+      const Vec3x8 to = to_light(position);
+      const Float8 reach = Float8(magnitude) + Float8(2.0f) * max(max(abs(to.x), abs(to.y)), abs(to.z));
+      e = e + Float8(gamma(32)) * reach;
+    }
+    const Float8 distance = abs(facing.x) * e + abs(facing.y) * e + abs(facing.z) * e;
+    return distance * facing;
+  }
+
+  // Block b's rays: the moved points one float further on every axis they
+  // moved; a point light's run from the light to them.
+  void place(TileScratch& s, std::size_t b) const {
+    const std::size_t k0 = b * kBlockLanes;
+    const Vec3x8 push = offset(s, k0);
+    const Vec3x8 moved = load3(s.px, s.py, s.pz, k0) + push;
+    const Vec3x8 end{step_away(moved.x, push.x), step_away(moved.y, push.y), step_away(moved.z, push.z)};
+    store3(point ? end - at : end, s.shadow_lane_x, s.shadow_lane_y, s.shadow_lane_z, k0);
+  }
+};
+
+void start_shadow_rays(const Light& light, TileScratch& s) {
+  s.shadow_placed = 0;
+  s.shadows_compacted = false;
+  s.shadow_count = 0;
+  s.shadow_region_begin.clear();
+  s.shadows_from_point = light.kind == Light::Kind::kPoint;
+  s.shadow_origin = light.position;
+  s.shadow_direction = light.direction;
+  s.shadow_ends = Aabb::empty();  // only aiming bounds the ends
 }
 
 }  // namespace
 
 void aim_shadow_rays(const Light& light, int l, TileScratch& s) {
-  const std::uint8_t dark = static_cast<std::uint8_t>(~(1u << l));
-  const bool point = light.kind == Light::Kind::kPoint;
-  const Vec3x8 light_at{Float8(light.position.x), Float8(light.position.y), Float8(light.position.z)};
-  const Vec3x8 light_dir{Float8(light.direction.x), Float8(light.direction.y), Float8(light.direction.z)};
-  const float light_magnitude = detail::max_abs(light.position);
-  s.shadow_placed = 0;
-  s.shadows_compacted = false;
+  start_shadow_rays(light, s);
   s.shadows_aimed_only = true;
-  s.shadow_count = 0;
-  s.shadow_region_begin.clear();
-  s.shadows_from_point = point;
-  s.shadow_origin = light.position;
-  s.shadow_direction = light.direction;
+  const ShadowLight to(s.shadows_from_point, light.position, light.direction, l);
   Vec3x8 lo{Float8(kInf), Float8(kInf), Float8(kInf)}, hi{Float8(-kInf), Float8(-kInf), Float8(-kInf)};
   for (std::size_t b = 0; b < s.blocks(); ++b) {
-    s.shadow_lanes[b] = 0;
-    const std::uint32_t lanes = s.block_hits[b];
-    if (lanes == 0) continue;
-    const std::size_t k0 = b * kBlockLanes;
-    const Vec3x8 position = load3(s.px, s.py, s.pz, k0);
-    const Vec3x8 facing = load3(s.gx, s.gy, s.gz, k0);
-    const Vec3x8 to_light = point ? light_at - position : light_dir;
-    const std::uint32_t toward = (dot(facing, to_light) > Float8(0.0f)).bits() & lanes;
-    for (std::uint32_t away = lanes & ~toward; away != 0; away &= away - 1) {
-      s.lit[k0 + static_cast<std::size_t>(std::countr_zero(away))] &= dark;  // no ray needed
-    }
+    const std::uint32_t toward = to.facing(s, b);
+    s.shadow_lanes[b] = static_cast<std::uint8_t>(toward);
     if (toward == 0) continue;
-    // The moved points of offset_shadow_rays, bit for bit (the last step,
-    // one float on, is left to the bound's growth).
-    const Float8 e = shadow_offset_error(point, to_light, light_magnitude, Float8::load(&s.error[k0]));
-    const Float8 distance = abs(facing.x) * e + abs(facing.y) * e + abs(facing.z) * e;
-    const Vec3x8 moved = position + distance * facing;
+    // The moved points of place(), bit for bit (the last step, one float
+    // on, is left to the bound's growth).
+    const std::size_t k0 = b * kBlockLanes;
+    const Vec3x8 moved = load3(s.px, s.py, s.pz, k0) + to.offset(s, k0);
     const Mask8 m = Mask8::from_bits(toward);
     lo = select(m, Vec3x8{min(lo.x, moved.x), min(lo.y, moved.y), min(lo.z, moved.z)}, lo);
     hi = select(m, Vec3x8{max(hi.x, moved.x), max(hi.y, moved.y), max(hi.z, moved.z)}, hi);
-    s.shadow_lanes[b] = static_cast<std::uint8_t>(toward);
     s.shadow_placed += static_cast<std::size_t>(std::popcount(toward));
   }
   if (s.shadow_placed == 0) return;
@@ -765,31 +801,25 @@ void aim_shadow_rays(const Light& light, int l, TileScratch& s) {
 void offset_shadow_rays(TileScratch& s) {
   if (!s.shadows_aimed_only) return;
   s.shadows_aimed_only = false;
-  const bool point = s.shadows_from_point;
-  const Vec3x8 light_at{Float8(s.shadow_origin.x), Float8(s.shadow_origin.y), Float8(s.shadow_origin.z)};
-  const Vec3x8 light_dir{Float8(s.shadow_direction.x), Float8(s.shadow_direction.y), Float8(s.shadow_direction.z)};
-  const float light_magnitude = detail::max_abs(s.shadow_origin);
+  const ShadowLight to(s.shadows_from_point, s.shadow_origin, s.shadow_direction, 0);
   for (std::size_t b = 0; b < s.blocks(); ++b) {
-    if (s.shadow_lanes[b] == 0) continue;
-    const std::size_t k0 = b * kBlockLanes;
-    const Vec3x8 position = load3(s.px, s.py, s.pz, k0);
-    const Vec3x8 facing = load3(s.gx, s.gy, s.gz, k0);
-    const Vec3x8 to_light = point ? light_at - position : light_dir;
-    // offset_origin: pushed off along the camera-facing normal by the
-    // rounding bound, then one float further on every axis it moved.
-    const Float8 e = shadow_offset_error(point, to_light, light_magnitude, Float8::load(&s.error[k0]));
-    const Float8 distance = abs(facing.x) * e + abs(facing.y) * e + abs(facing.z) * e;
-    const Vec3x8 offset = distance * facing;
-    const Vec3x8 moved = position + offset;
-    const Vec3x8 end{step_away(moved.x, offset.x), step_away(moved.y, offset.y), step_away(moved.z, offset.z)};
-    // A point light's rays run from the light to the offset points.
-    store3(point ? end - light_at : end, s.shadow_lane_x, s.shadow_lane_y, s.shadow_lane_z, k0);
+    if (s.shadow_lanes[b] != 0) to.place(s, b);
   }
 }
 
 void place_shadow_rays(const Light& light, int l, TileScratch& s) {
-  aim_shadow_rays(light, l, s);
-  offset_shadow_rays(s);
+  // In one pass, without the bound aiming makes: for tracers that take
+  // every ray (the Embree peer of the benchmarks).
+  start_shadow_rays(light, s);
+  s.shadows_aimed_only = false;
+  const ShadowLight to(s.shadows_from_point, light.position, light.direction, l);
+  for (std::size_t b = 0; b < s.blocks(); ++b) {
+    const std::uint32_t toward = to.facing(s, b);
+    s.shadow_lanes[b] = static_cast<std::uint8_t>(toward);
+    if (toward == 0) continue;
+    to.place(s, b);
+    s.shadow_placed += static_cast<std::size_t>(std::popcount(toward));
+  }
 }
 
 void compact_shadow_rays(TileScratch& s) {

@@ -60,12 +60,13 @@ void reconstruct_surfaces(const Scene& scene, const Vec3& default_albedo, TileSc
 // light (t_max inf).
 void place_shadow_rays(const Light& light, int l, TileScratch& s);
 
-// place_shadow_rays in two steps. aim_shadow_rays picks the lanes (and
-// clears bit l of s.lit for hits facing away) and bounds where every ray
-// meets its surface (s.shadow_ends: each offset point lies inside), without
-// computing the rays; offset_shadow_rays then places them. trace_shadow_rays
-// places aimed rays itself, and only when the bound of every ray the box
-// allows reaches some object: a tile in the open pays for no ray.
+// The renderer's way to the same rays, in two steps. aim_shadow_rays picks
+// the lanes (and clears bit l of s.lit for hits facing away) and bounds
+// where every ray ends (s.shadow_ends) without computing the rays;
+// offset_shadow_rays then places them as place_shadow_rays does.
+// trace_shadow_rays places aimed rays itself, and only when the bound of
+// every ray the box allows reaches some object: a tile in the open pays for
+// no ray.
 void aim_shadow_rays(const Light& light, int l, TileScratch& s);
 void offset_shadow_rays(TileScratch& s);
 
