@@ -73,20 +73,10 @@ class GroupFrusta {
     // rectangle turned by 18 degrees, 1.7 times the area.
     const int first = std::countr_zero(lanes);
     const int last = first + 3 < 8 && (lanes >> (first + 3) & 1u) ? first + 3 : 31 - std::countl_zero(lanes);
-    Vec3 across(q[0][last] - q[0][first], q[1][last] - q[1][first], q[2][last] - q[2][first]);
-    across = across - glm::dot(across, c) * c;
-    Vec3 u = normalized(across);
-    if (!(u.x == u.x)) u = normalized(std::fabs(c.x) < 0.5f ? Vec3(0.0f, -c.z, c.y) : Vec3(-c.z, 0.0f, c.x));
-    if (!(u.x == u.x)) return;
-    const Vec3 v = glm::cross(c, u);
-    const auto along = [&](const Vec3& w) { return d.x * Float8(w.x) + d.y * Float8(w.y) + d.z * Float8(w.z); };
-    const Float8 dc = along(c);
-    // Every lane well in front of the centre (within about 75 degrees of
-    // it): slopes stay finite and small. Non-finite lanes fail here too.
-    const Mask8 in_front = (dc > zero) & (dc * dc > Float8(0.0625f) * dot(d, d)) & is_finite(dot(d, d));
-    if ((in_front | !use).bits() != 0xFFu) return;
-    const Float8 inv_dc = Float8(1.0f) / select(use, dc, Float8(1.0f));
-    const Float8 a = along(u) * inv_dc, b = along(v) * inv_dc;
+    Vec3 u, v;
+    if (!row_basis(c, Vec3(q[0][last] - q[0][first], q[1][last] - q[1][first], q[2][last] - q[2][first]), u, v)) return;
+    Float8 a, b, dc;
+    if (!slopes(d, use, c, u, v, a, b, dc)) return;
     const float big = std::numeric_limits<float>::max();
     const float a_lo = reduce_min(select(use, a, Float8(big))), a_hi = reduce_max(select(use, a, Float8(-big)));
     const float b_lo = reduce_min(select(use, b, Float8(big))), b_hi = reduce_max(select(use, b, Float8(-big)));
@@ -172,12 +162,8 @@ class GroupFrusta {
     const int i0 = std::countr_zero(first_lanes);
     const int i1 = i0 + 3 < 8 && (first_lanes >> (i0 + 3) & 1u) ? i0 + 3 : 31 - std::countl_zero(first_lanes);
     const float (&f)[3][8] = q(first);
-    Vec3 across = sign * Vec3(f[0][i1] - f[0][i0], f[1][i1] - f[1][i0], f[2][i1] - f[2][i0]);
-    across = across - glm::dot(across, c) * c;
-    Vec3 u = normalized(across);
-    if (!(u.x == u.x)) u = normalized(std::fabs(c.x) < 0.5f ? Vec3(0.0f, -c.z, c.y) : Vec3(-c.z, 0.0f, c.x));
-    if (!(u.x == u.x)) return;
-    const Vec3 v = glm::cross(c, u);
+    Vec3 u, v;
+    if (!row_basis(c, sign * Vec3(f[0][i1] - f[0][i0], f[1][i1] - f[1][i0], f[2][i1] - f[2][i0]), u, v)) return;
     const float big = std::numeric_limits<float>::max();
     Float8 a_lo(big), a_hi(-big), b_lo(big), b_hi(-big), far(0.0f);
     for (std::uint32_t m = groups; m != 0; m &= m - 1) {
@@ -185,13 +171,8 @@ class GroupFrusta {
       const std::uint32_t l = lanes(g);
       if (l == 0) continue;
       const Mask8 use = Mask8::from_bits(l);
-      const Vec3x8 d = directions(g, l);
-      const auto along = [&](const Vec3& w) { return d.x * Float8(w.x) + d.y * Float8(w.y) + d.z * Float8(w.z); };
-      const Float8 dc = along(c);
-      const Mask8 in_front = (dc > zero) & (dc * dc > Float8(0.0625f) * dot(d, d)) & is_finite(dot(d, d));
-      if ((in_front | !use).bits() != 0xFFu) return;
-      const Float8 inv_dc = Float8(1.0f) / select(use, dc, Float8(1.0f));
-      const Float8 a = along(u) * inv_dc, b = along(v) * inv_dc;
+      Float8 a, b, dc;
+      if (!slopes(directions(g, l), use, c, u, v, a, b, dc)) return;
       a_lo = min(a_lo, select(use, a, Float8(big)));
       a_hi = max(a_hi, select(use, a, Float8(-big)));
       b_lo = min(b_lo, select(use, b, Float8(big)));
@@ -386,6 +367,33 @@ class GroupFrusta {
                                                   : Vec3(std::numeric_limits<float>::quiet_NaN());
   }
   static float sum(Float8 a) { return reduce_add(a); }
+  // The frame a frustum's slopes are measured in around the unit centre
+  // c: u along `across` (a pixel row) made perpendicular to c, or any
+  // perpendicular where that is degenerate, and v = c x u.
+  static bool row_basis(const Vec3& c, Vec3 across, Vec3& u, Vec3& v) {
+    across = across - glm::dot(across, c) * c;
+    u = normalized(across);
+    if (!(u.x == u.x)) u = normalized(std::fabs(c.x) < 0.5f ? Vec3(0.0f, -c.z, c.y) : Vec3(-c.z, 0.0f, c.x));
+    if (!(u.x == u.x)) return false;
+    v = glm::cross(c, u);
+    return true;
+  }
+  // Each lane's slopes a = d.u / d.c and b = d.v / d.c (and d.c) over the
+  // lanes of `use`; false unless every such lane lies well in front of the
+  // centre (within about 75 degrees of it: slopes stay finite and small;
+  // non-finite lanes fail too).
+  static bool slopes(const Vec3x8& d, Mask8 use, const Vec3& c, const Vec3& u, const Vec3& v, Float8& a, Float8& b,
+                     Float8& dc) {
+    const auto along = [&](const Vec3& w) { return d.x * Float8(w.x) + d.y * Float8(w.y) + d.z * Float8(w.z); };
+    dc = along(c);
+    const Float8 zero(0.0f);
+    const Mask8 in_front = (dc > zero) & (dc * dc > Float8(0.0625f) * dot(d, d)) & is_finite(dot(d, d));
+    if ((in_front | !use).bits() != 0xFFu) return false;
+    const Float8 inv_dc = Float8(1.0f) / select(use, dc, Float8(1.0f));
+    a = along(u) * inv_dc;
+    b = along(v) * inv_dc;
+    return true;
+  }
   void set_plane(int i, int g, const Vec3& n) {
     n_[i][0][g] = n.x;
     n_[i][1][g] = n.y;
