@@ -16,6 +16,7 @@
 #include "raytrace/render/static_tiles.h"
 #include "raytrace/render/packet_traversal.h"
 #include "raytrace/render/ray_bound.h"
+#include "raytrace/render/srgb.h"
 #include "raytrace/render/traversal.h"
 #include "raytrace/render/traversal_shared.h"
 #include "runtime/math/float8.h"
@@ -29,37 +30,6 @@ constexpr float kInf = std::numeric_limits<float>::infinity();
 constexpr float gamma(int n) {
   constexpr float u = std::numeric_limits<float>::epsilon() * 0.5f;
   return (static_cast<float>(n) * u) / (1.0f - static_cast<float>(n) * u);
-}
-
-// Linear -> sRGB bytes, eight lanes at a time, by arithmetic: std::pow per
-// channel cost more than the shading itself, and a byte table's three
-// gathers per eight pixels were a quarter of shade_and_write. Above the
-// curve's linear toe, 255 * (1.055 c^(1/2.4) - 0.055) is a degree-4
-// polynomial in c^(1/4), fitted minimax over [0.0031308, 1]: 0.009 of a
-// byte step at most in real arithmetic, so a byte is off the correctly
-// rounded one by at most one step, and only where the exact value lies
-// within 0.01 of a half step (about one value in 200;
-// RenderStatic.ColoursFollowTheShadingModelAndTheSrgbCurve checks against
-// the curve in double). The 0.5 added to the last coefficient rounds by
-// truncation. Lanes not > 0 (NaN too) give 0; lanes above 1 give 255.
-// Evaluated as two halves in q and one in q^2 with fused multiply-adds
-// (three dependent steps where Horner's rule took four products and four
-// sums in turn): the chain's latency was a third of shade_and_write.
-Float8 srgb_steps(Float8 linear) {
-  const Float8 c = min(select(linear > Float8(0.0f), linear, Float8(0.0f)), Float8(1.0f));
-  const Float8 q = sqrt(sqrt(c));
-  const Float8 q2 = q * q;
-  const Float8 low = fused_multiply_add(Float8(5.001527405e+01f), q, Float8(-1.647604179e+01f + 0.5f));
-  const Float8 high = fused_multiply_add(Float8(-8.555185699e+01f), q, Float8(2.862825012e+02f));
-  const Float8 curve =
-      fused_multiply_add(fused_multiply_add(Float8(2.073888969e+01f), q2, high), q2, low);
-  const Float8 toe = c * Float8(12.92f * 255.0f) + Float8(0.5f);
-  return min(select(c <= Float8(0.0031308f), toe, curve), Float8(255.5f));
-}
-std::uint8_t srgb_byte(float linear) {
-  alignas(32) std::int32_t steps[8];
-  store_truncated(srgb_steps(Float8(linear)), steps);
-  return static_cast<std::uint8_t>(steps[0]);
 }
 
 // Eight RGBA8 pixels, R in the low byte, alpha 255.
