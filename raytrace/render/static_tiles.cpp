@@ -94,8 +94,8 @@ bool TileCone::misses(const Vec3& p0, const Vec3& p1, const Vec3& p2) const {
   const double normal_length = glm::length(normal);
   if (!(normal_length > 0.0) || !std::isfinite(normal_length)) return false;
   const double h = std::fabs(glm::dot(normal, a)) / normal_length;
-  const double magnitude = static_cast<double>(std::max({detail::max_abs(p0), detail::max_abs(p1), detail::max_abs(p2)})) +
-                           static_cast<double>(detail::max_abs(apex_));
+  const float corners = std::max({detail::max_abs(p0), detail::max_abs(p1), detail::max_abs(p2)});
+  const double magnitude = static_cast<double>(corners) + static_cast<double>(detail::max_abs(apex_));
   const double margin = 2.0 * 0x1.0p-12 * magnitude;
   if (!(h > margin)) return false;
   const double slope = margin / h;
