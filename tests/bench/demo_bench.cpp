@@ -66,7 +66,20 @@ struct CountResult {
   double rays_per_frame = 0.0;
   std::uint64_t escaped_triangles = 0;
   std::size_t triangles = 0;
+  // Over the measured frames: the tracers' work, and the rays it was for.
+  rt::TraversalCounters primary, shadow;
 };
+
+void add(rt::TraversalCounters& into, const rt::TraversalCounters& from) {
+  into.rays += from.rays;
+  into.node_visits += from.node_visits;
+  into.object_visits += from.object_visits;
+  into.triangle_tests += from.triangle_tests;
+}
+
+double per_ray(std::uint64_t work, std::uint64_t rays) {
+  return rays > 0 ? static_cast<double>(work) / static_cast<double>(rays) : 0.0;
+}
 
 Expected<CountResult> measure(const DemoBenchOptions& o, int characters, JobSystem& jobs) {
   demo::SessionOptions so;
@@ -96,6 +109,8 @@ Expected<CountResult> measure(const DemoBenchOptions& o, int characters, JobSyst
     if (f >= o.warmup) {
       rays += report.render.primary_rays + report.render.shadow_rays;
       r.escaped_triangles += report.scene.escaped_triangles;
+      add(r.primary, report.render.primary);
+      add(r.shadow, report.render.shadow);
     }
   }
   r.phases = session->timers().summarize();
@@ -117,8 +132,18 @@ void print_table(const DemoBenchOptions& o, const std::vector<CountResult>& resu
     std::printf(" %.1f | %.1f | %.1f |\n", r.frame_ms, r.frame_ms > 0.0 ? r.rays_per_frame / (r.frame_ms * 1e3) : 0.0,
                 static_cast<double>(r.escaped_triangles) / o.frames);
   }
+  std::printf("\n| characters | primary: node visits | objects | triangle tests | shadow: node visits | objects |"
+              " triangle tests |\n|---:|---:|---:|---:|---:|---:|---:|\n");
+  for (const CountResult& r : results) {
+    const rt::TraversalCounters& p = r.primary;
+    const rt::TraversalCounters& s = r.shadow;
+    std::printf("| %d | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f |\n", r.characters, per_ray(p.node_visits, p.rays),
+                per_ray(p.object_visits, p.rays), per_ray(p.triangle_tests, p.rays), per_ray(s.node_visits, s.rays),
+                per_ray(s.object_visits, s.rays), per_ray(s.triangle_tests, s.rays));
+  }
   std::printf("\nPhase columns are per-frame medians in ms over %d frames after %d warm-up frames; fps = 1000 /"
-              " their sum. M rays/s counts primary and shadow rays over the whole frame time.\n",
+              " their sum. M rays/s counts primary and shadow rays over the whole frame time. The second table is the"
+              " tracers' work per ray (render/renderer.h TraversalCounters) over the same frames.\n",
               o.frames, o.warmup);
 }
 
