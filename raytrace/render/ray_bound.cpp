@@ -263,13 +263,21 @@ void cull_objects(const Scene& scene, const RayBound& bound, std::vector<std::ui
   // scene. A point within an object's slack of the object lies within that
   // much of a cell that lists the object.
   const float grow = bound.world_slack_bound(detail::max_abs(tree.bounds)) + extra_grow;
-  if (objects.size() <= kFlatCullObjects) {
-    // A few dozen objects (a character's bones, a ground): one box test
-    // each costs less than walking the tree's cells to them (Cally walk,
-    // 2 threads: primary 4.5 -> 4.4 ms, shadow 3.8 -> 3.6 ms). In index
-    // order, as the walk's sorted output.
-    for (std::uint32_t object = 0; object < objects.size(); ++object) {
-      if (test.may_enter(objects[object].box, grow)) out.push_back(object);
+  const std::span<const ObjectRun> runs = top.runs();
+  if (runs.size() <= kFlatCullObjects) {
+    // A few dozen runs (characters, grounds): one box test each, and one
+    // per member of the runs a ray may enter, costs less than walking the
+    // tree's cells to them (Cally walk, 2 threads: primary 4.5 -> 4.4 ms,
+    // shadow 3.8 -> 3.6 ms testing every object; most tiles miss the
+    // character's box, which skips its bones at once). A run's box holds
+    // its members' and its margin is no smaller (the margin grows with the
+    // coordinates), so a member a ray may enter never sits in a run it
+    // cannot. In index order, as the walk's sorted output.
+    for (const ObjectRun& run : runs) {
+      if (run.count > 1 && !test.may_enter(run.box, grow)) continue;
+      for (std::uint32_t object = run.first; object < run.first + run.count; ++object) {
+        if (test.may_enter(objects[object].box, grow)) out.push_back(object);
+      }
     }
     return;
   }

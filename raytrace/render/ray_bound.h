@@ -157,8 +157,10 @@ void for_each_reached_leaf(const KdTreeView& tree, const RayBound::Test& test, f
   }
 }
 
-// Scenes with at most this many top-level objects are culled by testing
-// every object's box; larger ones by walking the top-level tree.
+// Scenes with at most this many runs of top-level objects (characters,
+// static meshes: scene/top_level.h ObjectRun) are culled by testing each
+// run's box, then the boxes of the runs entered; larger ones by walking the
+// top-level tree.
 inline constexpr std::size_t kFlatCullObjects = 64;
 
 // The top-level objects (indices into scene.top_level().objects(), in

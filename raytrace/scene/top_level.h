@@ -22,6 +22,17 @@ struct TopLevelObject {
   Aabb box;                 // world space
 };
 
+// Consecutive objects of one character instance (its bones and its
+// fallback), or one static mesh: a box over the run lets a cull skip a whole
+// character with one test (render/ray_bound.h cull_objects).
+struct ObjectRun {
+  std::uint32_t first = 0;
+  std::uint32_t count = 0;
+  // Holds every coordinate of every member box, lower and upper corners
+  // alike (so also of an inverted one, which the tree skips).
+  Aabb box;
+};
+
 class TopLevel {
  public:
   // Rebuilds the tree over `objects` (taken over; the vector's capacity is
@@ -30,6 +41,8 @@ class TopLevel {
 
   KdTreeView view() const { return tree_.view(); }
   std::span<const TopLevelObject> objects() const { return objects_; }
+  // The objects in runs, in index order: every object in exactly one.
+  std::span<const ObjectRun> runs() const { return runs_; }
   const Aabb& bounds() const { return tree_.bounds; }
   const KdTreeStats& stats() const { return tree_.stats; }
 
@@ -39,6 +52,7 @@ class TopLevel {
  private:
   std::vector<TopLevelObject> objects_;
   std::vector<Aabb> boxes_;
+  std::vector<ObjectRun> runs_;
   KdTree tree_;
 };
 

@@ -29,6 +29,7 @@
 #include "raytrace/render/traversal.h"
 #include "raytrace/render/traversal_shared.h"
 #include "raytrace/scene/scene.h"
+#include "raytrace/scene/top_level.h"
 #include "runtime/jobs/job_system.h"
 #include "runtime/math/float8.h"
 #include "runtime/memory/line_aligned.h"
@@ -323,28 +324,70 @@ TEST(RayBound, SharedOriginGroupsBoundAsTheirLanesDo) {
   EXPECT_TRUE(inf_direction.test().may_enter(Aabb{Vec3(100.0f), Vec3(101.0f)}, 0.0f));
 }
 
-// cull_objects tests every object's box in scenes of up to
-// kFlatCullObjects objects and walks the top-level tree in larger ones:
-// both keep every object whose box a ray of the set enters (in double
-// precision), and both cull most of the others.
+// TopLevel's runs: one per character instance (its bones and fallback,
+// consecutive) and one per static mesh, covering every object once, each
+// run's box holding every coordinate of its members' boxes (an inverted
+// one's too: the tree skips it, the flat cull tests it).
+TEST(TopLevel, RunsGroupEachInstanceAndHoldTheirMembers) {
+  using Kind = rt::TopLevelObject::Kind;
+  const auto box = [](float lo, float hi) { return Aabb{Vec3(lo), Vec3(hi)}; };
+  std::vector<rt::TopLevelObject> objects = {
+      {Kind::kBone, 0, 0, box(0.0f, 1.0f)},    {Kind::kBone, 0, 1, box(-3.0f, -2.0f)},
+      {Kind::kFallback, 0, 0, box(5.0f, 4.0f)},  // inverted
+      {Kind::kBone, 1, 0, box(10.0f, 11.0f)},  {Kind::kBone, 1, 3, Aabb{Vec3(12.0f, 9.0f, 12.0f), Vec3(12.0f, 13.0f, 12.0f)}},
+      {Kind::kStatic, 0, 0, box(-1.0f, 1.0f)}, {Kind::kStatic, 1, 0, box(2.0f, 3.0f)},
+      {Kind::kBone, 2, 0, box(20.0f, 21.0f)}};
+  const std::vector<rt::TopLevelObject> copy = objects;
+  rt::TopLevel top;
+  ASSERT_TRUE(top.build(std::move(objects), rt::KdBuildOptions{}).ok());
+  const std::span<const rt::ObjectRun> runs = top.runs();
+  ASSERT_EQ(runs.size(), 5u);
+  const std::uint32_t firsts[5] = {0, 3, 5, 6, 7}, counts[5] = {3, 2, 1, 1, 1};
+  for (std::size_t r = 0; r < runs.size(); ++r) {
+    EXPECT_EQ(runs[r].first, firsts[r]) << r;
+    EXPECT_EQ(runs[r].count, counts[r]) << r;
+  }
+  EXPECT_EQ(runs[0].box.lower, Vec3(-3.0f));
+  EXPECT_EQ(runs[0].box.upper, Vec3(5.0f));
+  EXPECT_EQ(runs[1].box.lower, Vec3(10.0f, 9.0f, 10.0f));
+  EXPECT_EQ(runs[1].box.upper, Vec3(12.0f, 13.0f, 12.0f));
+  for (const rt::ObjectRun& run : runs) {
+    for (std::uint32_t i = run.first; i < run.first + run.count; ++i) {
+      for (int a = 0; a < 3; ++a) {
+        for (const float c : {copy[i].box.lower[a], copy[i].box.upper[a]}) {
+          EXPECT_LE(run.box.lower[a], c) << i;
+          EXPECT_GE(run.box.upper[a], c) << i;
+        }
+      }
+    }
+  }
+}
+
+// cull_objects tests each run's box (a character's bones, a static mesh),
+// then its members', in scenes of up to kFlatCullObjects runs and walks the
+// top-level tree in larger ones: both keep every object whose box a ray of
+// the set enters (in double precision), and both cull most of the others.
 TEST(RayBound, CullKeepsEveryObjectARayEntersWithFewAndManyObjects) {
   const testing_support::BakedModel& m = testing_support::idle_mannequin();
-  for (const int instances : {1, 6}) {
+  for (const int instances : {1, 6, 70}) {
     rt::Scene scene;
     const std::uint32_t character = scene.add_character(m.model.mesh, m.bake.fuzzy.view()).value();
     for (int i = 0; i < instances; ++i) {
       const std::uint32_t instance = scene.add_instance(character).value();
-      const Affine3 place = Affine3::translation(Vec3(0.9f * static_cast<float>(i % 3), 0.0f, 0.9f * (i / 3)));
+      const int row = instances > 6 ? 9 : 3;
+      const Affine3 place =
+          Affine3::translation(Vec3(0.9f * static_cast<float>(i % row), 0.0f, 0.9f * static_cast<float>(i / row)));
       ASSERT_TRUE(scene.set_bones(instance, testing_support::clip_pose(m.model, "idle", 0.1 * i, place)).ok());
     }
     JobSystem jobs(2);
     ASSERT_TRUE(scene.prepare_frame(rt::FrameOptions{}, jobs).ok());
     const std::span<const rt::TopLevelObject> objects = scene.top_level().objects();
-    ASSERT_EQ(objects.size() > rt::kFlatCullObjects, instances == 6) << objects.size();
+    ASSERT_EQ(scene.top_level().runs().size(), static_cast<std::size_t>(instances));
+    ASSERT_EQ(scene.top_level().runs().size() > rt::kFlatCullObjects, instances == 70);
     const Aabb world = scene.top_level().bounds();
     std::mt19937 g(5);
     std::size_t entered = 0, culled = 0;
-    for (int trial = 0; trial < 3000; ++trial) {
+    for (int trial = 0; trial < (instances > 6 ? 600 : 3000); ++trial) {
       alignas(32) float o[3][8], d[3][8], t0[8], t1[8];
       const Vec3 base = world.lower + Vec3(unit(g), unit(g), unit(g)) * (world.upper - world.lower);
       const Vec3 aim(unit(g) - 0.5f, unit(g) - 0.5f, unit(g) - 0.5f);
