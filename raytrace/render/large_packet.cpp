@@ -616,8 +616,15 @@ class LargeQuery {
     TreeEntry entry;
     for_each_bit(groups, [&](int g) {
       const Group& gr = group_[g];
-      const Vec3x8 inv{Float8::load(gr.inv[0]), Float8::load(gr.inv[1]), Float8::load(gr.inv[2])};
       const Float8 eps = world_eps(gr, box_magnitude, Float8::load(visit_[g].t1));
+      if (frusta_on_) {
+        // The lanes were just clipped to the object's box, which is the
+        // tree's (a static mesh's, the fallback's): a second clip would
+        // only narrow their passage by the difference in slack.
+        enter_tree_unclipped(entry, g, gr.origin(), gr.direction(), eps);
+        return;
+      }
+      const Vec3x8 inv{Float8::load(gr.inv[0]), Float8::load(gr.inv[1]), Float8::load(gr.inv[2])};
       enter_tree(entry, tree, g, gr.origin(), gr.direction(), inv, eps);
     });
     walk_tree(tree, entry, leaf);

@@ -1020,10 +1020,21 @@ TEST(StaticTiles, FloorCellsFindTheSingleRayHits) {
   expect_static_occlusion();
   if (HasFatalFailure()) return;
 
-  // The whole floor from afar reaches far more triangles than a tile may hold.
+  // The whole floor from afar reaches far more triangles than a tile may
+  // hold: the tile's large packets walk the floor's tree with their group
+  // frusta instead, and find the single rays' hits.
   rt::TileScratch w;
   const auto wide = camera_tile(Vec3(0.0f, 20.0f, 20.0f), Vec3(0.0f), 60.0f, 16, 16, w);
   EXPECT_FALSE(rt::gather_static_tile(sc, TriangleTest::kFast, camera_bound(wide, w), 0.0f, objects, tile));
+  int region_x = 1, region_y = 1;
+  rt::packet_region_blocks(256, region_x, region_y);
+  w.prepare(Tile{0, 0, 16, 16, 0}, region_x, region_y);
+  rt::generate_camera_rays(wide, w);
+  rt::TraversalCounters walked;
+  rt::trace_primary(sc, wide, TriangleTest::kFast, 256, w, walked);
+  EXPECT_GT(walked.node_visits, 0u);
+  const std::vector<std::size_t> wide_hits = expect_single_ray_hits(sc, wide, w);
+  EXPECT_GT(wide_hits[0], 100u);
 }
 
 TEST(TileStages, CameraDirectionsAreTheCameraRays) {
