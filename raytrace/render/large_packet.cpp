@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "raytrace/geometry/triangle_intersect8.h"
+#include "raytrace/render/grid_frusta.h"
 #include "raytrace/render/group_frusta.h"
 #include "raytrace/render/interval_bound.h"
 #include "raytrace/render/ray_bound.h"
@@ -214,6 +215,10 @@ class LargeQuery {
   void start(const Scene& scene, const LargePacketRays& rays, PacketHits out) {
     scene_p_ = &scene;
     out_ = out;
+    grid_columns_ = rays.grid_columns;
+    grid_basis_[0] = rays.grid_forward;
+    grid_basis_[1] = rays.grid_right;
+    grid_basis_[2] = rays.grid_up;
     groups_ = std::clamp(rays.groups, 0, kMaxPacketGroups);
     alive_groups_ = 0;
     hits_recorded_ = 0;
@@ -376,6 +381,7 @@ class LargeQuery {
   void prepare_frusta() {
     frusta_on_ = false;
     frusta_built_ = 0;
+    grid_.reset();
     if (!common_origin_) return;
     bool forward = true;
     for_each_bit(alive_groups_, [&](int g) {
@@ -383,14 +389,30 @@ class LargeQuery {
                             Float8(0.0f)).bits() == 0xFFu;
     });
     if (!forward) return;
-    frusta_.reset(common_origin_at_, groups_);
     frusta_on_ = true;
+    // A camera's packet: its grid's slabs stand in for the groups' frusta.
+    const auto directions = [&](int g) -> const float (&)[3][kLanes] { return group_[g].d; };
+    const auto lanes = [&](int g) { return live_[g]; };
+    if (grid_columns_ > 0 && grid_.build(common_origin_at_, grid_basis_[0], grid_basis_[1], grid_basis_[2], groups_,
+                                         grid_columns_, directions, lanes)) {
+      return;
+    }
+    frusta_.reset(common_origin_at_, groups_);
+  }
+
+  // The groups of `groups` whose frustum (or grid slabs) may reach the
+  // triangle, or the box.
+  std::uint32_t frusta_reached(const Vec3& p0, const Vec3& p1, const Vec3& p2, std::uint32_t groups) const {
+    return grid_.on() ? grid_.reached(p0, p1, p2, groups) : frusta_.reached(p0, p1, p2, groups);
+  }
+  std::uint32_t frusta_box_reached(const Aabb& box, std::uint32_t groups) const {
+    return grid_.on() ? grid_.box_reached(box, groups) : frusta_.box_reached(box, groups);
   }
 
   // The frusta of `groups` and of every other live group not built yet:
   // built together, eight at a time, they cost about what one did.
   void ensure_frusta(std::uint32_t groups) {
-    if ((groups & ~frusta_built_) == 0) return;
+    if (grid_.on() || (groups & ~frusta_built_) == 0) return;
     const std::uint32_t unbuilt = alive_groups_ & ~frusta_built_;
     const auto directions = [&](int g) -> const float (&)[3][kLanes] { return group_[g].d; };
     const auto lanes = [&](int g) { return live_[g]; };
@@ -446,7 +468,7 @@ class LargeQuery {
     if (frusta_on_) {
       ensure_frusta(alive_groups_);
       const Vec3 s(visit_slack_);
-      clipped = frusta_.box_reached({object.box.lower - s, object.box.upper + s}, alive_groups_);
+      clipped = frusta_box_reached({object.box.lower - s, object.box.upper + s}, alive_groups_);
       for_each_bit(alive_groups_ & ~clipped, [&](int g) { visit_[g].lanes = visit_[g].leaf_lanes = 0; });
     }
     if (kTest == TriangleTest::kFast && detail::is_small_static(scene_ref(), object)) {
@@ -587,7 +609,7 @@ class LargeQuery {
       if (frusta_on_) {
         if (!items_seen_.first_visit(item)) continue;
         const LeafTriangle tri = corners(item);
-        need_ = frusta_.reached(*tri.p0, *tri.p1, *tri.p2, groups_here & alive_groups_);
+        need_ = frusta_reached(*tri.p0, *tri.p1, *tri.p2, groups_here & alive_groups_);
         if (need_ == 0) continue;
         for_each_bit(need_, [&](int g) { visit_[g].leaf_lanes = visit_[g].lanes & live_[g]; });
         test_groups(need_, *tri.p0, *tri.p1, *tri.p2, tri.triangle, tri.instance);
@@ -955,6 +977,9 @@ class LargeQuery {
   LaneMailbox mailbox_;
   ItemMailbox items_seen_;
   GroupFrusta<kMaxPacketGroups> frusta_;
+  GridFrusta grid_;                 // on: a camera packet's slabs, used instead of frusta_
+  int grid_columns_ = 0;            // LargePacketRays::grid_columns
+  std::array<Vec3, 3> grid_basis_{};  // forward, right, up
   float visit_slack_ = 0.0f;       // run(): a bound on every lane's slack in an object's box clip
   bool frusta_on_ = false;         // frusta_ holds this packet's apex
   std::uint32_t frusta_built_ = 0;  // the groups whose frustum frusta_ holds

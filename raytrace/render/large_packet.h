@@ -43,6 +43,11 @@ struct LargePacketRays {
   const float* t_min = nullptr;
   const float* t_max = nullptr;
   const std::uint8_t* active = nullptr;  // per group, bit i: lane i
+  // Camera packets: the groups are blocks of a pixel grid, grid_columns per
+  // row (row-major), their rays leaving the eye along grid_forward plus
+  // multiples of grid_right and grid_up (render/grid_frusta.h). 0: no grid.
+  int grid_columns = 0;
+  Vec3 grid_forward{0.0f}, grid_right{0.0f}, grid_up{0.0f};
 };
 
 // The nearest hits of every active lane, written to 8 * groups entries of

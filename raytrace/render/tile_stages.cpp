@@ -381,10 +381,10 @@ struct PrimaryLanes {
 };
 
 // One large packet per region: its blocks are consecutive in `s`.
-void trace_primary_large(const Scene& scene, const Vec3& eye, TriangleTest test,
+void trace_primary_large(const Scene& scene, const PinholeCamera& camera, TriangleTest test,
                          const std::vector<std::uint32_t>& objects, TileScratch& s, TraversalCounters& counters) {
   thread_local PrimaryLanes shared;
-  shared.set_eye(eye);
+  shared.set_eye(camera.eye());
   for (std::size_t r = 0; r < s.regions(); ++r) {
     const std::size_t b0 = s.region_begin[r], b1 = s.region_begin[r + 1];
     const std::size_t k0 = b0 * kBlockLanes;
@@ -403,6 +403,15 @@ void trace_primary_large(const Scene& scene, const Vec3& eye, TriangleTest test,
     rays.t_min = shared.t_min;
     rays.t_max = shared.t_max;
     rays.active = &s.block_pixels[b0];
+    // The region's blocks, row-major: as many columns as its first row has.
+    rays.grid_columns = 0;
+    while (b0 + static_cast<std::size_t>(rays.grid_columns) < b1 &&
+           s.block_dy[b0 + static_cast<std::size_t>(rays.grid_columns)] == s.block_dy[b0]) {
+      ++rays.grid_columns;
+    }
+    rays.grid_forward = camera.forward();
+    rays.grid_right = camera.right();
+    rays.grid_up = camera.up();
     TraversalCounters work;
     intersect_large_packet(scene, rays, test, objects,
                            PacketHits{&s.t[k0], &s.u[k0], &s.v[k0], &s.triangle[k0], &s.instance[k0]}, &work);
@@ -520,7 +529,7 @@ void trace_primary(const Scene& scene, const PinholeCamera& camera, TriangleTest
     return;
   }
   if (packet_rays > kPacketSize) {
-    trace_primary_large(scene, eye, test, lists.tile, s, counters);
+    trace_primary_large(scene, camera, test, lists.tile, s, counters);
     return;
   }
   RayPacket packet;

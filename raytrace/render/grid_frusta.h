@@ -1,0 +1,178 @@
+// Frusta of a camera packet's groups, separable. The groups of a primary
+// packet are the 4x2-pixel blocks of a grid (a tile's region, blocks
+// row-major), and measured in the camera's own basis (forward, right, up)
+// the directions of one block fill a rectangle of slopes: right/forward
+// across, up/forward down the image. So every block of a column shares its
+// two side planes and every block of a row its two others, and a triangle
+// is tested against one plane pair per column and per row (three eight-lane
+// evaluations for a 4x8-block region) instead of four planes per group
+// (render/group_frusta.h): the groups it reaches are the crossings of the
+// columns and rows it reaches.
+//
+// Numerical safety: as group_frusta.h, plane by plane. Each plane holds the
+// slopes of every lane on its side, grown by 2^-16 of the slope (far above
+// the rounding of the slopes and of the plane), and a triangle is cut off
+// only when its corners lie beyond the plane by 2^-12 of the coordinate
+// magnitudes (corners and apex), the margin beyond which neither triangle
+// test reports a hit off the triangle.
+#pragma once
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+#include "runtime/math/aabb.h"
+#include "runtime/math/float8.h"
+#include "runtime/math/types.h"
+
+namespace sinew::rt {
+
+class GridFrusta {
+ public:
+  static constexpr int kMaxColumns = 4;
+  static constexpr int kMaxRows = 8;
+
+  // The slabs of `groups` groups (group g at column g % columns, row
+  // g / columns) whose rays leave `apex` along the directions q(g) (a
+  // float[3][8]) of lanes(g), slopes measured along `u` and `v` over `c`
+  // (a camera's right, up and forward). False, culling nothing, when the
+  // grid does not fit kMaxColumns x kMaxRows or a lane is not well in front
+  // of c (more than about 75 degrees off it, or not finite).
+  template <class Q, class Lanes>
+  bool build(const Vec3& apex, const Vec3& c, const Vec3& u, const Vec3& v, int groups, int columns, Q&& q,
+             Lanes&& lanes) {
+    on_ = false;
+    if (columns < 1 || columns > kMaxColumns || groups < 1) return false;
+    const int rows = (groups + columns - 1) / columns;
+    if (rows > kMaxRows) return false;
+    const float big = std::numeric_limits<float>::max();
+    float a_lo[kMaxColumns], a_hi[kMaxColumns], b_lo[kMaxRows], b_hi[kMaxRows];
+    std::fill(std::begin(a_lo), std::end(a_lo), big);
+    std::fill(std::begin(a_hi), std::end(a_hi), -big);
+    std::fill(std::begin(b_lo), std::end(b_lo), big);
+    std::fill(std::begin(b_hi), std::end(b_hi), -big);
+    const Float8 zero(0.0f);
+    const auto along = [](const Vec3x8& d, const Vec3& w) {
+      return d.x * Float8(w.x) + d.y * Float8(w.y) + d.z * Float8(w.z);
+    };
+    for (int g = 0; g < groups; ++g) {
+      const std::uint32_t l = lanes(g) & 0xFFu;
+      if (l == 0) continue;
+      const Mask8 use = Mask8::from_bits(l);
+      const float (&dq)[3][8] = q(g);
+      const Vec3x8 d{select(use, Float8::load(dq[0]), zero), select(use, Float8::load(dq[1]), zero),
+                     select(use, Float8::load(dq[2]), zero)};
+      const Float8 dc = along(d, c);
+      const Mask8 in_front = (dc > zero) & (dc * dc > Float8(0.0625f) * dot(d, d)) & is_finite(dot(d, d));
+      if ((in_front | !use).bits() != 0xFFu) return false;
+      const Float8 inv_dc = Float8(1.0f) / select(use, dc, Float8(1.0f));
+      const Float8 a = along(d, u) * inv_dc, b = along(d, v) * inv_dc;
+      const int column = g % columns, row = g / columns;
+      a_lo[column] = std::min(a_lo[column], reduce_min(select(use, a, Float8(big))));
+      a_hi[column] = std::max(a_hi[column], reduce_max(select(use, a, Float8(-big))));
+      b_lo[row] = std::min(b_lo[row], reduce_min(select(use, b, Float8(big))));
+      b_hi[row] = std::max(b_hi[row], reduce_max(select(use, b, Float8(-big))));
+    }
+    apex_ = apex;
+    apex_magnitude_ = magnitude(apex);
+    columns_ = columns;
+    rows_ = rows;
+    // Outside: n . (p - apex) > 0. Lanes without slopes (no lane in their
+    // column or row) keep zero normals, which never cut.
+    for (auto* n : {&column_n_, &row_hi_n_, &row_lo_n_}) {
+      for (auto& axis : *n) std::fill(std::begin(axis), std::end(axis), 0.0f);
+    }
+    std::fill(std::begin(column_scale_), std::end(column_scale_), 0.0f);
+    std::fill(std::begin(row_hi_scale_), std::end(row_hi_scale_), 0.0f);
+    std::fill(std::begin(row_lo_scale_), std::end(row_lo_scale_), 0.0f);
+    const auto grow = [](float s) { return 0x1.0p-16f * (1.0f + std::fabs(s)); };
+    for (int i = 0; i < columns; ++i) {
+      if (a_lo[i] > a_hi[i]) continue;
+      set_plane(column_n_, column_scale_, i, u - (a_hi[i] + grow(a_hi[i])) * c);
+      set_plane(column_n_, column_scale_, kMaxColumns + i, (a_lo[i] - grow(a_lo[i])) * c - u);
+    }
+    for (int i = 0; i < rows; ++i) {
+      if (b_lo[i] > b_hi[i]) continue;
+      set_plane(row_hi_n_, row_hi_scale_, i, v - (b_hi[i] + grow(b_hi[i])) * c);
+      set_plane(row_lo_n_, row_lo_scale_, i, (b_lo[i] - grow(b_lo[i])) * c - v);
+    }
+    on_ = true;
+    return true;
+  }
+
+  bool on() const { return on_; }
+  void reset() { on_ = false; }
+
+  // The groups of `groups` whose column and row the triangle may reach.
+  std::uint32_t reached(const Vec3& p0, const Vec3& p1, const Vec3& p2, std::uint32_t groups) const {
+    const Vec3 x0 = p0 - apex_, x1 = p1 - apex_, x2 = p2 - apex_;
+    const float corners = std::max({magnitude(p0), magnitude(p1), magnitude(p2)});
+    return uncut(groups, corners, [&](const float (&n)[3][8]) {
+      const Float8 nx = Float8::load(n[0]), ny = Float8::load(n[1]), nz = Float8::load(n[2]);
+      const auto side = [&](const Vec3& x) { return (nx * Float8(x.x) + ny * Float8(x.y)) + nz * Float8(x.z); };
+      return min(min(side(x0), side(x1)), side(x2));
+    });
+  }
+
+  // The groups of `groups` whose column and row may reach `box` (its corner
+  // nearest each plane; an empty or non-finite box is reached by all).
+  std::uint32_t box_reached(const Aabb& box, std::uint32_t groups) const {
+    const Vec3 c = 0.5f * (box.lower + box.upper) - apex_;
+    const Vec3 h = 0.5f * (box.upper - box.lower);
+    const float corners = std::max(magnitude(box.lower), magnitude(box.upper));
+    return uncut(groups, corners, [&](const float (&n)[3][8]) {
+      const Float8 nx = Float8::load(n[0]), ny = Float8::load(n[1]), nz = Float8::load(n[2]);
+      const Float8 centre = (nx * Float8(c.x) + ny * Float8(c.y)) + nz * Float8(c.z);
+      const Float8 reach = (abs(nx) * Float8(h.x) + abs(ny) * Float8(h.y)) + abs(nz) * Float8(h.z);
+      return centre - reach;
+    });
+  }
+
+ private:
+  // nearest(n) is the shape's least signed distance to each of eight
+  // planes; a plane cuts it off beyond the margin for coordinates up to
+  // `corners`.
+  template <class Nearest>
+  std::uint32_t uncut(std::uint32_t groups, float corners, Nearest&& nearest) const {
+    if (!on_) return groups;
+    const Float8 margin(0x1.0p-12f * (corners + apex_magnitude_));
+    const auto cut = [&](const float (&n)[3][8], const float (&scale)[8]) {
+      return (nearest(n) > Float8::load(scale) * margin).bits();
+    };
+    const std::uint32_t columns_cut = cut(column_n_, column_scale_);
+    const std::uint32_t rows_cut = cut(row_hi_n_, row_hi_scale_) | cut(row_lo_n_, row_lo_scale_);
+    const std::uint32_t columns = ~(columns_cut | columns_cut >> kMaxColumns) & ((1u << columns_) - 1u);
+    std::uint32_t rows = ~rows_cut & ((1u << rows_) - 1u);
+    std::uint32_t out = 0;
+    for (; rows != 0; rows &= rows - 1) out |= columns << (columns_ * std::countr_zero(rows));
+    return out & groups;
+  }
+
+  static void set_plane(float (&n)[3][8], float (&scale)[8], int i, const Vec3& plane) {
+    n[0][i] = plane.x;
+    n[1][i] = plane.y;
+    n[2][i] = plane.z;
+    // |n|_1 bounds n . e for |e| <= margin per coordinate; slightly more
+    // for the rounding of the products.
+    scale[i] = 1.001f * (std::fabs(plane.x) + std::fabs(plane.y) + std::fabs(plane.z));
+  }
+  static float magnitude(const Vec3& p) { return std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)}); }
+
+  bool on_ = false;
+  Vec3 apex_{0.0f};
+  float apex_magnitude_ = 0.0f;
+  int columns_ = 1;
+  int rows_ = 1;
+  // Lane i < 4: column i's plane on the side of rising slopes; lane 4 + i:
+  // its plane on the other side. Rows: lane i is row i's plane.
+  alignas(32) float column_n_[3][8] = {};
+  alignas(32) float column_scale_[8] = {};
+  alignas(32) float row_hi_n_[3][8] = {};
+  alignas(32) float row_hi_scale_[8] = {};
+  alignas(32) float row_lo_n_[3][8] = {};
+  alignas(32) float row_lo_scale_[8] = {};
+};
+
+}  // namespace sinew::rt
