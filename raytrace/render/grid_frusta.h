@@ -47,12 +47,14 @@ class GridFrusta {
     if (columns < 1 || columns > kMaxColumns || groups < 1) return false;
     const int rows = (groups + columns - 1) / columns;
     if (rows > kMaxRows) return false;
+    // Each column's and row's slopes gathered lane-wise first, reduced once
+    // at the end (a reduction per group and side cost more than the rest).
     const float big = std::numeric_limits<float>::max();
-    float a_lo[kMaxColumns], a_hi[kMaxColumns], b_lo[kMaxRows], b_hi[kMaxRows];
-    std::fill(std::begin(a_lo), std::end(a_lo), big);
-    std::fill(std::begin(a_hi), std::end(a_hi), -big);
-    std::fill(std::begin(b_lo), std::end(b_lo), big);
-    std::fill(std::begin(b_hi), std::end(b_hi), -big);
+    Float8 a_lo[kMaxColumns], a_hi[kMaxColumns], b_lo[kMaxRows], b_hi[kMaxRows];
+    std::fill(std::begin(a_lo), std::end(a_lo), Float8(big));
+    std::fill(std::begin(a_hi), std::end(a_hi), Float8(-big));
+    std::fill(std::begin(b_lo), std::end(b_lo), Float8(big));
+    std::fill(std::begin(b_hi), std::end(b_hi), Float8(-big));
     const Float8 zero(0.0f);
     const auto along = [](const Vec3x8& d, const Vec3& w) {
       return d.x * Float8(w.x) + d.y * Float8(w.y) + d.z * Float8(w.z);
@@ -70,10 +72,10 @@ class GridFrusta {
       const Float8 inv_dc = Float8(1.0f) / select(use, dc, Float8(1.0f));
       const Float8 a = along(d, u) * inv_dc, b = along(d, v) * inv_dc;
       const int column = g % columns, row = g / columns;
-      a_lo[column] = std::min(a_lo[column], reduce_min(select(use, a, Float8(big))));
-      a_hi[column] = std::max(a_hi[column], reduce_max(select(use, a, Float8(-big))));
-      b_lo[row] = std::min(b_lo[row], reduce_min(select(use, b, Float8(big))));
-      b_hi[row] = std::max(b_hi[row], reduce_max(select(use, b, Float8(-big))));
+      a_lo[column] = min(a_lo[column], select(use, a, Float8(big)));
+      a_hi[column] = max(a_hi[column], select(use, a, Float8(-big)));
+      b_lo[row] = min(b_lo[row], select(use, b, Float8(big)));
+      b_hi[row] = max(b_hi[row], select(use, b, Float8(-big)));
     }
     apex_ = apex;
     apex_magnitude_ = magnitude(apex);
@@ -89,14 +91,16 @@ class GridFrusta {
     std::fill(std::begin(row_lo_scale_), std::end(row_lo_scale_), 0.0f);
     const auto grow = [](float s) { return 0x1.0p-16f * (1.0f + std::fabs(s)); };
     for (int i = 0; i < columns; ++i) {
-      if (a_lo[i] > a_hi[i]) continue;
-      set_plane(column_n_, column_scale_, i, u - (a_hi[i] + grow(a_hi[i])) * c);
-      set_plane(column_n_, column_scale_, kMaxColumns + i, (a_lo[i] - grow(a_lo[i])) * c - u);
+      const float lo = reduce_min(a_lo[i]), hi = reduce_max(a_hi[i]);
+      if (lo > hi) continue;
+      set_plane(column_n_, column_scale_, i, u - (hi + grow(hi)) * c);
+      set_plane(column_n_, column_scale_, kMaxColumns + i, (lo - grow(lo)) * c - u);
     }
     for (int i = 0; i < rows; ++i) {
-      if (b_lo[i] > b_hi[i]) continue;
-      set_plane(row_hi_n_, row_hi_scale_, i, v - (b_hi[i] + grow(b_hi[i])) * c);
-      set_plane(row_lo_n_, row_lo_scale_, i, (b_lo[i] - grow(b_lo[i])) * c - v);
+      const float lo = reduce_min(b_lo[i]), hi = reduce_max(b_hi[i]);
+      if (lo > hi) continue;
+      set_plane(row_hi_n_, row_hi_scale_, i, v - (hi + grow(hi)) * c);
+      set_plane(row_lo_n_, row_lo_scale_, i, (lo - grow(lo)) * c - v);
     }
     on_ = true;
     return true;
