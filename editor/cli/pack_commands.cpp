@@ -21,6 +21,7 @@
 #include "character/bake.h"
 #include "character/pack.h"
 #include "editor/cli/import_limit_flags.h"
+#include "editor/cli/scene_savings.h"
 #include "editor/import/model_loader.h"
 #include "editor/mesh/subdivide.h"
 #include "editor/scene/scene_recipe.h"
@@ -59,6 +60,9 @@ struct BakeOptions {
   int threads = 0;
   std::size_t max_memory_bytes = character::BakeRequest{}.max_memory_bytes;
   GltfImportOptions gltf;
+  // --scene: what the scene saved against the whole model (scene_savings.h).
+  enum class SceneReport { kFull, kSizes, kOff } scene_report = SceneReport::kFull;
+  SceneSavingsOptions scene_report_run;
   bool help = false;
 };
 
@@ -72,6 +76,12 @@ struct BakeFlags {
         scene(l.option("--scene", "RECIPE.json",
                        "bake only what a scene needs: the pose space of the recipe's\n"
                        "clips, and only those clips in the pack (content/scenes/)")),
+        scene_report(l.option("--scene-report", "full|sizes|off",
+                              "with --scene, what it saved against the whole model (every\n"
+                              "clip, every bone its own tree): bones, pack bytes and\n"
+                              "(full, the default) fps rendering both side by side")),
+        scene_report_frames(l.option("--scene-report-frames", "N", "frames rendered per pack (default 30)")),
+        scene_report_size(l.option("--scene-report-size", "WxH", "their size (default 1024x1024)")),
         out(l.option("-o,--out", "OUT.pack",
                      "the pack to write (atomically: an existing file is replaced\n"
                      "only by a complete new pack)")),
@@ -104,6 +114,9 @@ struct BakeFlags {
   const std::vector<std::string>& model;
   const std::optional<std::string>& asset_roots;
   const std::optional<std::string>& scene;
+  const std::optional<std::string>& scene_report;
+  const std::optional<std::string>& scene_report_frames;
+  const std::optional<std::string>& scene_report_size;
   const std::optional<std::string>& out;
   const std::optional<std::string>& pose_space;
   const std::optional<std::string>& clips;
@@ -149,6 +162,24 @@ Expected<BakeOptions> parse_bake_options(const std::vector<std::string>& args, c
     o.pose_space.every_frame_30hz = recipe.every_frame_30hz;
     o.padding = recipe.padding;
     o.scene = std::move(recipe);
+  }
+  if ((f.scene_report || f.scene_report_frames || f.scene_report_size) && !o.scene) {
+    return invalid_argument(f.scene_report ? "--scene-report" : f.scene_report_frames ? "--scene-report-frames"
+                                                                                       : "--scene-report-size",
+                            "", "only with --scene");
+  }
+  if (const std::optional<std::string>& v = f.scene_report) {
+    SINEW_ASSIGN_OR_RETURN(const int c, cli::parse_choice("--scene-report", *v, {"full", "sizes", "off"}));
+    o.scene_report = static_cast<BakeOptions::SceneReport>(c);
+  }
+  if (const std::optional<std::string>& v = f.scene_report_frames) {
+    SINEW_ASSIGN_OR_RETURN(const std::int64_t n, cli::parse_int("--scene-report-frames", *v, 1, 100000));
+    o.scene_report_run.frames = static_cast<int>(n);
+  }
+  if (const std::optional<std::string>& v = f.scene_report_size) {
+    SINEW_ASSIGN_OR_RETURN(const cli::Size2 size, cli::parse_size("--scene-report-size", *v, 8192));
+    o.scene_report_run.width = size.width;
+    o.scene_report_run.height = size.height;
   }
   if (f.model.empty() && o.model_path.empty()) {
     return invalid_argument("MODEL", "0 given", "expected one model file");
@@ -505,6 +536,9 @@ int run_bake(const std::vector<std::string>& args, std::ostream& out, std::ostre
   auto model = load_model(o.model_path, o.gltf);
   if (!model.ok()) return fail(err, "bake", model.status());
   for (const std::string& warning : model->warnings) err << "sinew-editor bake: warning: " << warning << "\n";
+  // The scene's report bakes the whole model too.
+  std::optional<character::Model> whole;
+  if (o.scene && o.scene_report != BakeOptions::SceneReport::kOff) whole = *model;
   if (o.scene) {  // model only what the scene plays
     auto kept = keep_recipe_clips(*model, *o.scene);
     if (!kept.ok()) return fail(err, "bake", kept.status());
@@ -568,6 +602,17 @@ int run_bake(const std::vector<std::string>& args, std::ostream& out, std::ostre
       << (st.rest_area > 0.0 ? st.fuzzy_area / st.rest_area : 0.0) << "x rest, " << std::setprecision(2)
       << st.mean_items_per_leaf << " triangles per leaf, " << rigid_bones_text(st) << ", " << std::setprecision(0)
       << ms_since(start) << " ms\n";
+  if (whole) {
+    SceneSavingsOptions run = o.scene_report_run;
+    run.threads = o.threads;
+    if (o.scene_report == BakeOptions::SceneReport::kSizes) run.frames = 0;
+    out << "measuring what the scene saved (a bake of the whole model"
+        << (run.frames > 0 ? ", and both rendered" : "") << ")...\n"
+        << std::flush;
+    auto savings = measure_scene_savings(*whole, *o.scene, o.out_path, request, run, jobs);
+    if (!savings.ok()) return fail(err, "bake", savings.status());
+    out << describe(*savings, run, jobs.thread_count());
+  }
   return 0;
 }
 

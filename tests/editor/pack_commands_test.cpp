@@ -257,6 +257,74 @@ TEST_F(PackCommands, ASceneRecipeBakesOnlyItsClips) {
   EXPECT_NE(bad.err.find("no_such_clip"), std::string::npos) << bad.err;
 }
 
+// bake --scene reports what the scene saved against the whole model, in
+// the same run: the clips it dropped, its bone trees against one per bone
+// (checked against a bake of every clip with rigid bones kept and
+// `inspect`), the two packs' bytes (the scene's against its file) and both
+// packs' fps playing the recipe's first clip.
+TEST_F(PackCommands, ASceneBakeReportsWhatItSaved) {
+  const std::string dir = fresh_dir("scene_report");
+  const std::string cally = std::string(SINEW_SHARED_DIR) + "/content/cal3d/cally/cally.cfg";
+  const std::string recipe = dir + "/walk.json";
+  std::ofstream(recipe) << R"({"model": ")" << cally << R"(", "clips": ["walk"],
+                               "pose_space": {"samples": 20, "every_frame_30hz": false}})";
+  const CommandRun bake = run(run_bake, {"--scene", recipe, "-o", dir + "/scene.pack", "--threads", "2",
+                                         "--scene-report-frames", "2", "--scene-report-size", "64x48"});
+  ASSERT_EQ(bake.code, 0) << bake.err;
+  const auto number_after = [&](const std::string& text, const std::string& key) -> long long {
+    const std::size_t at = text.find(key);
+    if (at == std::string::npos) return -1;
+    return std::stoll(text.substr(at + key.size()));
+  };
+  const auto whole_j = [&] {
+    EXPECT_EQ(run(run_bake, {cally, "-o", dir + "/whole.pack", "--samples", "20", "--rigid-bones", "keep",
+                             "--threads", "2"})
+                  .code,
+              0);
+    return nlohmann::json::parse(run(run_inspect, {dir + "/whole.pack", "--json"}).out);
+  }();
+  const auto scene_j = nlohmann::json::parse(run(run_inspect, {dir + "/scene.pack", "--json"}).out);
+  const auto trees = [](const nlohmann::json& j) {
+    long long n = 0;
+    for (const auto& bone : j["fuzzy"]["bones"]) n += bone["triangles"].get<long long>() > 0 ? 1 : 0;
+    return n;
+  };
+  const std::size_t clips = whole_j["model"]["clips"].size();
+  EXPECT_NE(bake.out.find("scene drops " + std::to_string(clips - 1) + " of " + std::to_string(clips) + " clips ("),
+            std::string::npos)
+      << bake.out;
+  EXPECT_EQ(bake.out.find("walk,"), std::string::npos) << "walk is kept: " << bake.out;
+  EXPECT_EQ(number_after(bake.out, "scene bone trees: "), trees(scene_j)) << bake.out;
+  EXPECT_EQ(number_after(bake.out, " per instance instead of "), trees(whole_j)) << bake.out;
+  EXPECT_LT(trees(scene_j), trees(whole_j));
+  EXPECT_EQ(number_after(bake.out, "scene pack: "),
+            static_cast<long long>(std::filesystem::file_size(dir + "/scene.pack")))
+      << bake.out;
+  const long long whole_bytes = number_after(bake.out, " bytes instead of ");
+  const long long whole_file = static_cast<long long>(std::filesystem::file_size(dir + "/whole.pack"));
+  EXPECT_NEAR(static_cast<double>(whole_bytes), static_cast<double>(whole_file), 0.01 * static_cast<double>(whole_file))
+      << bake.out;
+  EXPECT_EQ(number_after(bake.out, " pose samples instead of "), whole_j["fuzzy"]["pose_samples"].get<long long>());
+  const std::size_t fps = bake.out.find("scene fps (clip 'walk', 64x48, 2 frames, 2 threads");
+  ASSERT_NE(fps, std::string::npos) << bake.out;
+  EXPECT_GT(number_after(bake.out.substr(fps), "): "), 0);
+  // The temporary pack of the whole model is gone.
+  for (const auto& entry : std::filesystem::directory_iterator(std::filesystem::temp_directory_path())) {
+    EXPECT_NE(entry.path().filename().string().rfind("sinew-scene-whole-" + std::to_string(::getpid()), 0), 0u);
+  }
+  // --scene-report sizes renders nothing; off prints nothing; without --scene it is refused.
+  const CommandRun sizes =
+      run(run_bake, {"--scene", recipe, "-o", dir + "/s.pack", "--threads", "2", "--scene-report", "sizes"});
+  ASSERT_EQ(sizes.code, 0) << sizes.err;
+  EXPECT_NE(sizes.out.find("scene pack: "), std::string::npos);
+  EXPECT_EQ(sizes.out.find("scene fps"), std::string::npos);
+  const CommandRun off = run(run_bake, {"--scene", recipe, "-o", dir + "/o.pack", "--scene-report", "off"});
+  ASSERT_EQ(off.code, 0) << off.err;
+  EXPECT_EQ(off.out.find("scene "), std::string::npos) << off.out;
+  EXPECT_EQ(run(run_bake, {cally, "-o", dir + "/n.pack", "--scene-report", "sizes"}).code, 2);
+  EXPECT_EQ(run(run_bake, {"--scene", recipe, "-o", dir + "/n.pack", "--scene-report", "most"}).code, 2);
+}
+
 // Named pipes given as a model, a pack or a scene recipe are refused at
 // once with a message saying what they are. A reader that blocked in
 // open() instead would wait for a writer forever: the watchdog plays that
