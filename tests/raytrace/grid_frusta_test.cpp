@@ -19,6 +19,7 @@
 #include "runtime/math/aabb.h"
 #include "runtime/math/float8.h"
 #include "runtime/math/ray.h"
+#include "tests/support/slab_test.h"
 
 namespace sinew {
 namespace {
@@ -36,18 +37,7 @@ bool hits(const Ray& ray, const Vec3& p0, const Vec3& p1, const Vec3& p2) {
 
 // Whether the ray's points at t >= 0 meet the box, in double.
 bool enters(const Ray& ray, const Aabb& box) {
-  double t0 = 0.0, t1 = std::numeric_limits<double>::infinity();
-  for (int a = 0; a < 3; ++a) {
-    const double o = ray.origin[a], d = ray.direction[a], lo = box.lower[a], hi = box.upper[a];
-    if (d == 0.0) {
-      if (o < lo || o > hi) return false;
-      continue;
-    }
-    const double n = (lo - o) / d, f = (hi - o) / d;
-    t0 = std::max(t0, std::min(n, f));
-    t1 = std::min(t1, std::max(n, f));
-  }
-  return t0 <= t1;
+  return testing_support::ray_enters_box(ray.origin, ray.direction, 0.0, std::numeric_limits<double>::infinity(), box);
 }
 
 // A region of `columns` x `rows` blocks at pixel (x0, y0): each group's

@@ -15,6 +15,7 @@
 #include "raytrace/render/group_frusta.h"
 #include "runtime/math/aabb.h"
 #include "runtime/math/ray.h"
+#include "tests/support/slab_test.h"
 
 namespace sinew {
 namespace {
@@ -48,18 +49,7 @@ void block_directions(const Vec3& centre, float spread, std::mt19937& g, float (
 
 // Whether the ray's points at t in [t_min, t_max] meet the box, in double.
 bool enters(const Ray& ray, const Aabb& box) {
-  double t0 = ray.t_min, t1 = ray.t_max;
-  for (int a = 0; a < 3; ++a) {
-    const double o = ray.origin[a], d = ray.direction[a], lo = box.lower[a], hi = box.upper[a];
-    if (d == 0.0) {
-      if (o < lo || o > hi) return false;
-      continue;
-    }
-    const double n = (lo - o) / d, f = (hi - o) / d;
-    t0 = std::max(t0, std::min(n, f));
-    t1 = std::min(t1, std::max(n, f));
-  }
-  return t0 <= t1;
+  return testing_support::ray_enters_box(ray.origin, ray.direction, ray.t_min, ray.t_max, box);
 }
 
 struct Tally {

@@ -35,6 +35,7 @@
 #include "runtime/memory/line_aligned.h"
 #include "tests/support/brute_force.h"
 #include "tests/support/idle_mannequin.h"
+#include "tests/support/slab_test.h"
 
 namespace sinew {
 namespace {
@@ -75,20 +76,7 @@ const rt::Scene& scene() {
 
 // Whether the ray enters `box` within [t0, t1], in double precision.
 bool enters(const Aabb& box, const Vec3& o, const Vec3& d, double t0, double t1) {
-  for (int a = 0; a < 3; ++a) {
-    const double oa = o[a], da = d[a];
-    const double lo = box.lower[a], hi = box.upper[a];
-    if (da == 0.0) {
-      if (oa < lo || oa > hi) return false;
-      continue;
-    }
-    double n = (lo - oa) / da;
-    double f = (hi - oa) / da;
-    if (n > f) std::swap(n, f);
-    t0 = std::max(t0, n);
-    t1 = std::min(t1, f);
-  }
-  return t0 <= t1;
+  return testing_support::ray_enters_box(o, d, t0, t1, box);
 }
 
 TEST(RayBound, NeverCullsABoxThatARayEnters) {
