@@ -981,7 +981,7 @@ class LargeQuery {
   int grid_columns_ = 0;            // LargePacketRays::grid_columns
   std::array<Vec3, 3> grid_basis_{};  // forward, right, up
   float visit_slack_ = 0.0f;       // run(): a bound on every lane's slack in an object's box clip
-  bool frusta_on_ = false;         // frusta_ holds this packet's apex
+  bool frusta_on_ = false;         // grid_ (when on) or frusta_ pick each leaf triangle's groups
   std::uint32_t frusta_built_ = 0;  // the groups whose frustum frusta_ holds
   TraversalCounters counters_;
 };

@@ -46,6 +46,8 @@ struct LargePacketRays {
   // Camera packets: the groups are blocks of a pixel grid, grid_columns per
   // row (row-major), their rays leaving the eye along grid_forward plus
   // multiples of grid_right and grid_up (render/grid_frusta.h). 0: no grid.
+  // The grid's planes come from the lanes' own slopes, so rays of another
+  // shape are still bounded, only less tightly.
   int grid_columns = 0;
   Vec3 grid_forward{0.0f}, grid_right{0.0f}, grid_up{0.0f};
 };
