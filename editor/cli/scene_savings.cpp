@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <span>
 #include <sstream>
 #include <system_error>
 
@@ -14,9 +15,9 @@
 namespace sinew::editor {
 namespace {
 
-std::uint32_t trees_with_triangles(const rt::FuzzyCharacterData& fuzzy) {
-  return static_cast<std::uint32_t>(std::count_if(fuzzy.bone_trees.begin(), fuzzy.bone_trees.end(),
-                                                  [](const rt::BoneTree& t) { return t.triangle_count > 0; }));
+std::uint32_t trees_with_triangles(std::span<const rt::BoneTree> trees) {
+  return static_cast<std::uint32_t>(
+      std::count_if(trees.begin(), trees.end(), [](const rt::BoneTree& t) { return t.triangle_count > 0; }));
 }
 
 // Removes the file when it goes out of scope (the whole model's pack).
@@ -65,11 +66,7 @@ Expected<SceneSavings> measure_scene_savings(const character::Model& whole, cons
   std::error_code size_error;
   s.scene_bytes = std::filesystem::file_size(scene_pack, size_error);
   if (size_error) return make_error(ErrorCode::kIoError, scene_pack, "size", "", size_error.message());
-  std::uint32_t scene_trees = 0;
-  for (std::uint32_t b = 0; b < scene.fuzzy().bone_count; ++b) {
-    scene_trees += scene.fuzzy().bone_trees[b].triangle_count > 0 ? 1u : 0u;
-  }
-  s.scene_trees = scene_trees;
+  s.scene_trees = trees_with_triangles(scene.fuzzy().bone_trees);
   s.scene_samples = scene.fuzzy_stats().sample_count;
 
   // The whole model: every clip at the recipe's sampling, every bone its own tree.
@@ -78,7 +75,7 @@ Expected<SceneSavings> measure_scene_savings(const character::Model& whole, cons
   request.fuzzy.merge_rigid_bones = false;
   request.fuzzy.progress = nullptr;
   SINEW_ASSIGN_OR_RETURN(const character::InMemoryBake bake, character::bake_in_memory(whole, request, jobs));
-  s.whole_trees = trees_with_triangles(bake.fuzzy);
+  s.whole_trees = trees_with_triangles(bake.fuzzy.bone_trees);
   s.whole_samples = bake.fuzzy.stats.sample_count;
   const TemporaryFile whole_pack{(std::filesystem::temp_directory_path() /
                                   ("sinew-scene-whole-" + std::to_string(::getpid()) + ".pack"))

@@ -1,7 +1,6 @@
 #include "raytrace/scene/top_level.h"
 
 #include <algorithm>
-#include <limits>
 #include <utility>
 
 namespace sinew::rt {
@@ -29,10 +28,7 @@ Status TopLevel::build(std::vector<TopLevelObject>&& objects, const KdBuildOptio
   for (const TopLevelObject& object : objects_) boxes_.push_back(object.box);
   runs_.clear();
   for (std::uint32_t i = 0; i < objects_.size(); ++i) {
-    if (runs_.empty() || !same_run(objects_[runs_.back().first], objects_[i])) {
-      const float inf = std::numeric_limits<float>::infinity();
-      runs_.push_back({i, 0, Aabb{Vec3(inf), Vec3(-inf)}});
-    }
+    if (runs_.empty() || !same_run(objects_[runs_.back().first], objects_[i])) runs_.push_back({i, 0, Aabb::empty()});
     ++runs_.back().count;
     grow_run(runs_.back(), objects_[i].box);
   }
