@@ -63,8 +63,9 @@ struct RenderFlags {
         instances(l.option("--instances", "N", "copies side by side along +X, each 0.37 s later (default 1)")),
         frames(l.option("--frames", "N", "frames rendered at 30 fps from --time; the last is written (default 1)")),
         triangle_test(l.option("--triangle-test", "fast|watertight", "ray-triangle test (default fast)")),
-        packet_rays(l.option("--packet-rays", "1|8|64|256",
-                             "rays traced together: single rays, 4x2, 8x8 or 16x16 pixels (default 256)")),
+        packet_rays(l.option("--packet-rays", "1|8|64|256|512",
+                             "rays traced together: single rays, 4x2, 8x8, 16x16 or 32x16 pixels\n"
+                             "(default 256)")),
         asset_roots(l.option("--asset-roots", "A:B",
                              "more folders a glTF file's buffers may be read from (by default\n"
                              "only its own folder and below)")),
@@ -216,8 +217,8 @@ Status parse_run(const RenderFlags& f, RenderOptions& o) {
   }
   SINEW_RETURN_IF_ERROR(f.import_limits.apply(o.gltf.limits));
   if (const std::optional<std::string>& text = f.packet_rays) {
-    SINEW_ASSIGN_OR_RETURN(const int i, cli::parse_choice("--packet-rays", *text, {"1", "8", "64", "256"}));
-    o.packet_rays = std::array<int, 4>{1, 8, 64, 256}[static_cast<std::size_t>(i)];
+    SINEW_ASSIGN_OR_RETURN(const int i, cli::parse_choice("--packet-rays", *text, {"1", "8", "64", "256", "512"}));
+    o.packet_rays = std::array<int, 5>{1, 8, 64, 256, 512}[static_cast<std::size_t>(i)];
   }
   if (const std::optional<std::string>& text = f.bone_boxes) {
     SINEW_ASSIGN_OR_RETURN(const int i, cli::parse_choice("--bone-boxes", *text, {"exact", "cheap"}));

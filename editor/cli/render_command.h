@@ -60,7 +60,7 @@ struct RenderOptions {
   int instances = 1;
   int frames = 1;
   rt::TriangleTest triangle_test = rt::TriangleTest::kFast;
-  int packet_rays = rt::RenderSettings{}.packet_rays;  // 1, 8, 64 or 256 rays traced together
+  int packet_rays = rt::RenderSettings{}.packet_rays;  // 1, 8, 64, 256 or 512 rays traced together
   GltfImportOptions gltf;                               // --asset-roots
   rt::BoneBoxMode bone_boxes = rt::BoneBoxMode::kExact;
   bool fallback = true;

@@ -4,8 +4,8 @@
 // the directions of one block fill a rectangle of slopes: right/forward
 // across, up/forward down the image. So every block of a column shares its
 // two side planes and every block of a row its two others, and a triangle
-// is tested against one plane pair per column and per row (three eight-lane
-// evaluations for a 4x8-block region) instead of four planes per group
+// is tested against one plane pair per column and per row (four eight-lane
+// evaluations for up to 8x8 blocks) instead of four planes per group
 // (render/group_frusta.h): the groups it reaches are the crossings of the
 // columns and rows it reaches.
 //
@@ -31,7 +31,7 @@ namespace sinew::rt {
 
 class GridFrusta {
  public:
-  static constexpr int kMaxColumns = 4;
+  static constexpr int kMaxColumns = 8;
   static constexpr int kMaxRows = 8;
 
   // The slabs of `groups` groups (group g at column g % columns, row
@@ -83,24 +83,19 @@ class GridFrusta {
     rows_ = rows;
     // Outside: n . (p - apex) > 0. Lanes without slopes (no lane in their
     // column or row) keep zero normals, which never cut.
-    for (auto* n : {&column_n_, &row_hi_n_, &row_lo_n_}) {
-      for (auto& axis : *n) std::fill(std::begin(axis), std::end(axis), 0.0f);
-    }
-    std::fill(std::begin(column_scale_), std::end(column_scale_), 0.0f);
-    std::fill(std::begin(row_hi_scale_), std::end(row_hi_scale_), 0.0f);
-    std::fill(std::begin(row_lo_scale_), std::end(row_lo_scale_), 0.0f);
+    for (Planes* p : {&column_hi_, &column_lo_, &row_hi_, &row_lo_}) *p = Planes{};
     const auto grow = [](float s) { return 0x1.0p-16f * (1.0f + std::fabs(s)); };
     for (int i = 0; i < columns; ++i) {
       const float lo = reduce_min(a_lo[i]), hi = reduce_max(a_hi[i]);
       if (lo > hi) continue;
-      set_plane(column_n_, column_scale_, i, u - (hi + grow(hi)) * c);
-      set_plane(column_n_, column_scale_, kMaxColumns + i, (lo - grow(lo)) * c - u);
+      column_hi_.set(i, u - (hi + grow(hi)) * c);
+      column_lo_.set(i, (lo - grow(lo)) * c - u);
     }
     for (int i = 0; i < rows; ++i) {
       const float lo = reduce_min(b_lo[i]), hi = reduce_max(b_hi[i]);
       if (lo > hi) continue;
-      set_plane(row_hi_n_, row_hi_scale_, i, v - (hi + grow(hi)) * c);
-      set_plane(row_lo_n_, row_lo_scale_, i, (lo - grow(lo)) * c - v);
+      row_hi_.set(i, v - (hi + grow(hi)) * c);
+      row_lo_.set(i, (lo - grow(lo)) * c - v);
     }
     on_ = true;
     return true;
@@ -110,7 +105,7 @@ class GridFrusta {
   void reset() { on_ = false; }
 
   // The groups of `groups` whose column and row the triangle may reach.
-  std::uint32_t reached(const Vec3& p0, const Vec3& p1, const Vec3& p2, std::uint32_t groups) const {
+  std::uint64_t reached(const Vec3& p0, const Vec3& p1, const Vec3& p2, std::uint64_t groups) const {
     const Vec3 x0 = p0 - apex_, x1 = p1 - apex_, x2 = p2 - apex_;
     const float corners = std::max({magnitude(p0), magnitude(p1), magnitude(p2)});
     return uncut(groups, corners, [&](const float (&n)[3][8]) {
@@ -122,7 +117,7 @@ class GridFrusta {
 
   // The groups of `groups` whose column and row may reach `box` (its corner
   // nearest each plane; an empty or non-finite box is reached by all).
-  std::uint32_t box_reached(const Aabb& box, std::uint32_t groups) const {
+  std::uint64_t box_reached(const Aabb& box, std::uint64_t groups) const {
     const Vec3 c = 0.5f * (box.lower + box.upper) - apex_;
     const Vec3 h = 0.5f * (box.upper - box.lower);
     const float corners = std::max(magnitude(box.lower), magnitude(box.upper));
@@ -139,29 +134,31 @@ class GridFrusta {
   // planes; a plane cuts it off beyond the margin for coordinates up to
   // `corners`.
   template <class Nearest>
-  std::uint32_t uncut(std::uint32_t groups, float corners, Nearest&& nearest) const {
+  std::uint64_t uncut(std::uint64_t groups, float corners, Nearest&& nearest) const {
     if (!on_) return groups;
     const Float8 margin(0x1.0p-12f * (corners + apex_magnitude_));
-    const auto cut = [&](const float (&n)[3][8], const float (&scale)[8]) {
-      return (nearest(n) > Float8::load(scale) * margin).bits();
-    };
-    const std::uint32_t columns_cut = cut(column_n_, column_scale_);
-    const std::uint32_t rows_cut = cut(row_hi_n_, row_hi_scale_) | cut(row_lo_n_, row_lo_scale_);
-    const std::uint32_t columns = ~(columns_cut | columns_cut >> kMaxColumns) & ((1u << columns_) - 1u);
-    std::uint32_t rows = ~rows_cut & ((1u << rows_) - 1u);
-    std::uint32_t out = 0;
+    const auto cut = [&](const Planes& p) { return (nearest(p.n) > Float8::load(p.scale) * margin).bits(); };
+    const std::uint64_t columns = ~(cut(column_hi_) | cut(column_lo_)) & ((1u << columns_) - 1u);
+    std::uint32_t rows = ~(cut(row_hi_) | cut(row_lo_)) & ((1u << rows_) - 1u);
+    std::uint64_t out = 0;
     for (; rows != 0; rows &= rows - 1) out |= columns << (columns_ * std::countr_zero(rows));
     return out & groups;
   }
 
-  static void set_plane(float (&n)[3][8], float (&scale)[8], int i, const Vec3& plane) {
-    n[0][i] = plane.x;
-    n[1][i] = plane.y;
-    n[2][i] = plane.z;
-    // |n|_1 bounds n . e for |e| <= margin per coordinate; slightly more
-    // for the rounding of the products.
-    scale[i] = 1.001f * (std::fabs(plane.x) + std::fabs(plane.y) + std::fabs(plane.z));
-  }
+  // Up to eight planes side by side, plane i in lane i. Lanes without one
+  // keep zero normals, which never cut.
+  struct Planes {
+    alignas(32) float n[3][8] = {};
+    alignas(32) float scale[8] = {};
+    void set(int i, const Vec3& plane) {
+      n[0][i] = plane.x;
+      n[1][i] = plane.y;
+      n[2][i] = plane.z;
+      // |n|_1 bounds n . e for |e| <= margin per coordinate; slightly more
+      // for the rounding of the products.
+      scale[i] = 1.001f * (std::fabs(plane.x) + std::fabs(plane.y) + std::fabs(plane.z));
+    }
+  };
   static float magnitude(const Vec3& p) { return std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)}); }
 
   bool on_ = false;
@@ -169,14 +166,9 @@ class GridFrusta {
   float apex_magnitude_ = 0.0f;
   int columns_ = 1;
   int rows_ = 1;
-  // Lane i < 4: column i's plane on the side of rising slopes; lane 4 + i:
-  // its plane on the other side. Rows: lane i is row i's plane.
-  alignas(32) float column_n_[3][8] = {};
-  alignas(32) float column_scale_[8] = {};
-  alignas(32) float row_hi_n_[3][8] = {};
-  alignas(32) float row_hi_scale_[8] = {};
-  alignas(32) float row_lo_n_[3][8] = {};
-  alignas(32) float row_lo_scale_[8] = {};
+  // Lane i: column (row) i's plane on the side of rising slopes (hi) and
+  // on the other side (lo).
+  Planes column_hi_, column_lo_, row_hi_, row_lo_;
 };
 
 }  // namespace sinew::rt

@@ -107,10 +107,10 @@ class GroupFrusta {
   // construction transposed: a packet's frusta cost about what one did);
   // the others one by one.
   template <bool kFar, class Q, class Lanes, class Reach>
-  void set_groups(std::uint32_t groups, float sign, Q&& q, Lanes&& lanes, Reach&& reach) {
+  void set_groups(std::uint64_t groups, float sign, Q&& q, Lanes&& lanes, Reach&& reach) {
     for (int base = 0; base < groups_; base += 8) {
       std::uint32_t full = 0;
-      for (std::uint32_t m = (groups >> base) & 0xFFu; m != 0; m &= m - 1) {
+      for (std::uint32_t m = static_cast<std::uint32_t>(groups >> base) & 0xFFu; m != 0; m &= m - 1) {
         const int g = base + std::countr_zero(m);
         const std::uint32_t l = lanes(g);
         if (l == 0xFFu) {
@@ -133,9 +133,9 @@ class GroupFrusta {
   // instead of one per block of eight groups. Rays spread over more than
   // about 75 degrees leave the packet without one.
   template <bool kFar, class Q, class Lanes, class Reach>
-  void set_bound(std::uint32_t groups, float sign, Q&& q, Lanes&& lanes, Reach&& reach) {
+  void set_bound(std::uint64_t groups, float sign, Q&& q, Lanes&& lanes, Reach&& reach) {
     bound_groups_ = 0;
-    groups &= groups_ >= 32 ? ~0u : (1u << groups_) - 1u;
+    groups &= groups_ >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << groups_) - 1u;
     if (groups == 0) return;
     const Float8 zero(0.0f);
     const auto directions = [&](int g, std::uint32_t use_bits) {
@@ -147,7 +147,7 @@ class GroupFrusta {
     };
     Vec3x8 sum{zero, zero, zero};
     int first = -1;
-    for (std::uint32_t m = groups; m != 0; m &= m - 1) {
+    for (std::uint64_t m = groups; m != 0; m &= m - 1) {
       const int g = std::countr_zero(m);
       const std::uint32_t l = lanes(g);
       if (l == 0) continue;
@@ -166,7 +166,7 @@ class GroupFrusta {
     if (!row_basis(c, sign * Vec3(f[0][i1] - f[0][i0], f[1][i1] - f[1][i0], f[2][i1] - f[2][i0]), u, v)) return;
     const float big = std::numeric_limits<float>::max();
     Float8 a_lo(big), a_hi(-big), b_lo(big), b_hi(-big), far(0.0f);
-    for (std::uint32_t m = groups; m != 0; m &= m - 1) {
+    for (std::uint64_t m = groups; m != 0; m &= m - 1) {
       const int g = std::countr_zero(m);
       const std::uint32_t l = lanes(g);
       if (l == 0) continue;
@@ -211,7 +211,7 @@ class GroupFrusta {
   // when its corner nearest the plane does; the same margin as reached()
   // covers the rounding of that corner's distance. A box that is empty or
   // not finite is reached by every group (its distances are NaN or inf).
-  std::uint32_t box_reached(const Aabb& box, std::uint32_t groups) const {
+  std::uint64_t box_reached(const Aabb& box, std::uint64_t groups) const {
     const Vec3 c = 0.5f * (box.lower + box.upper) - apex_;
     const Vec3 h = 0.5f * (box.upper - box.lower);
     const float corners = std::max(magnitude(box.lower), magnitude(box.upper));
@@ -223,7 +223,7 @@ class GroupFrusta {
   }
 
   // The groups of `groups` whose frustum the triangle may reach.
-  std::uint32_t reached(const Vec3& p0, const Vec3& p1, const Vec3& p2, std::uint32_t groups) const {
+  std::uint64_t reached(const Vec3& p0, const Vec3& p1, const Vec3& p2, std::uint64_t groups) const {
     const Vec3 x0 = p0 - apex_, x1 = p1 - apex_, x2 = p2 - apex_;
     const float corners = std::max({magnitude(p0), magnitude(p1), magnitude(p2)});
     if (groups != 0 && (groups & ~bound_groups_) == 0) {
@@ -249,11 +249,11 @@ class GroupFrusta {
   // when that exceeds the margin for coordinates up to `corners` (for the
   // far plane, beyond its offset). Groups without a frustum are never cut.
   template <class Nearest>
-  std::uint32_t uncut(std::uint32_t groups, float corners, Nearest&& nearest) const {
+  std::uint64_t uncut(std::uint64_t groups, float corners, Nearest&& nearest) const {
     const Float8 margin(0x1.0p-12f * (corners + apex_magnitude_));
-    std::uint32_t out = 0;
+    std::uint64_t out = 0;
     for (int base = 0; base < groups_; base += 8) {
-      const std::uint32_t part = (groups >> base) & 0xFFu;
+      const std::uint64_t part = (groups >> base) & 0xFFu;
       if (part == 0) continue;
       const std::uint32_t block = static_cast<std::uint32_t>(base / 8);
       const std::uint32_t sides = sides_[block], far = far_[block];
@@ -272,7 +272,7 @@ class GroupFrusta {
           culled_by_sides = culled_by_sides | (d > limit);
         }
       }
-      const std::uint32_t culled = (culled_by_sides.bits() & sides) | (culled_by_far.bits() & far);
+      const std::uint64_t culled = (culled_by_sides.bits() & sides) | (culled_by_far.bits() & far);
       out |= (part & ~culled) << base;
     }
     return out;
@@ -418,7 +418,7 @@ class GroupFrusta {
   alignas(32) float bound_n_[3][8] = {};
   alignas(32) float bound_scale_[8] = {};
   alignas(32) float bound_offset_[8] = {};
-  std::uint32_t bound_groups_ = 0;
+  std::uint64_t bound_groups_ = 0;
 };
 
 }  // namespace sinew::rt

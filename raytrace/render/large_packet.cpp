@@ -61,8 +61,8 @@ namespace {
 
 using detail::max_abs;
 
-template <class Fn>
-void for_each_bit(std::uint32_t mask, Fn&& fn) {
+template <class Mask, class Fn>
+void for_each_bit(Mask mask, Fn&& fn) {
   while (mask != 0) {
     const int i = std::countr_zero(mask);
     mask &= mask - 1;
@@ -267,7 +267,7 @@ class LargeQuery {
         const Mask8 same = (o[0] == Float8(common_origin_at_.x)) & (o[1] == Float8(common_origin_at_.y)) &
                            (o[2] == Float8(common_origin_at_.z));
         common_origin_ = common_origin_ && (same.bits() & live_[g]) == live_[g];
-        alive_groups_ |= 1u << g;
+        alive_groups_ |= GroupMask{1} << g;
       }
       if constexpr (kTest == TriangleTest::kWatertight) {
         for_each_bit(live_[g], [&](int lane) { watertight_[g][lane] = prepare_watertight(world_ray(g, lane)); });
@@ -402,22 +402,22 @@ class LargeQuery {
 
   // The groups of `groups` whose frustum (or grid slabs) may reach the
   // triangle, or the box.
-  std::uint32_t frusta_reached(const Vec3& p0, const Vec3& p1, const Vec3& p2, std::uint32_t groups) const {
+  GroupMask frusta_reached(const Vec3& p0, const Vec3& p1, const Vec3& p2, GroupMask groups) const {
     return grid_.on() ? grid_.reached(p0, p1, p2, groups) : frusta_.reached(p0, p1, p2, groups);
   }
-  std::uint32_t frusta_box_reached(const Aabb& box, std::uint32_t groups) const {
+  GroupMask frusta_box_reached(const Aabb& box, GroupMask groups) const {
     return grid_.on() ? grid_.box_reached(box, groups) : frusta_.box_reached(box, groups);
   }
 
   // The frusta of `groups` and of every other live group not built yet:
   // built together, eight at a time, they cost about what one did.
-  void ensure_frusta(std::uint32_t groups) {
+  void ensure_frusta(GroupMask groups) {
     if (grid_.on() || (groups & ~frusta_built_) == 0) return;
-    const std::uint32_t unbuilt = alive_groups_ & ~frusta_built_;
+    const GroupMask unbuilt = alive_groups_ & ~frusta_built_;
     const auto directions = [&](int g) -> const float (&)[3][kLanes] { return group_[g].d; };
     const auto lanes = [&](int g) { return live_[g]; };
     // The packet's own frustum over every group built so far.
-    const std::uint32_t built = frusta_built_ | unbuilt;
+    const GroupMask built = frusta_built_ | unbuilt;
     if constexpr (!kAnyHit) {
       frusta_.template set_groups<false>(unbuilt, 1.0f, directions, lanes, [](int, float*) {});
       frusta_.template set_bound<false>(built, 1.0f, directions, lanes, [](int, float*) {});
@@ -432,7 +432,7 @@ class LargeQuery {
 
   // The largest t any lane of `groups` still looks for: its best hit (or
   // t_max), capped by its exit from the current object when `visit` holds it.
-  float packet_limit(std::uint32_t groups, const VisitGroup* visit) const {
+  float packet_limit(GroupMask groups, const VisitGroup* visit) const {
     float limit = -kInf;
     for_each_bit(groups, [&](int g) { limit = std::max(limit, group_limit(g, visit)); });
     return limit;
@@ -458,13 +458,13 @@ class LargeQuery {
   // Enters one object: each group's lanes clipped to its box as the single
   // ray clips them (render/traversal.cpp visit).
   void visit(const TopLevelObject& object, std::uint32_t object_index) {
-    std::uint32_t groups = 0;
+    GroupMask groups = 0;
     const float box_magnitude = max_abs(object.box);
     // With group frusta, only the groups whose frustum reaches the box
     // grown by every lane's slack clip their lanes to it: most groups of a
     // packet miss most of the objects its bound reaches (a shadow packet's
     // groups enter about one object in three). The others enter nothing.
-    std::uint32_t clipped = alive_groups_;
+    GroupMask clipped = alive_groups_;
     if (frusta_on_) {
       ensure_frusta(alive_groups_);
       const Vec3 s(visit_slack_);
@@ -477,7 +477,7 @@ class LargeQuery {
       // tests decide (run()'s short cut for packets of such meshes).
       for_each_bit(clipped, [&](int g) {
         visit_[g].lanes = visit_[g].leaf_lanes = live_[g];
-        if (live_[g] != 0) groups |= 1u << g;
+        if (live_[g] != 0) groups |= GroupMask{1} << g;
         counters_.object_visits += static_cast<std::uint64_t>(std::popcount(live_[g]));
       });
       if (groups != 0) visit_small_static(scene_ref().static_meshes()[object.index], groups);
@@ -494,7 +494,7 @@ class LargeQuery {
       t0.store(vg.t0);
       t1.store(vg.t1);
       if (vg.lanes != 0) {
-        groups |= 1u << g;
+        groups |= GroupMask{1} << g;
         counters_.object_visits += static_cast<std::uint64_t>(std::popcount(vg.lanes));
       }
     });
@@ -525,7 +525,7 @@ class LargeQuery {
           visit_with_small_packets(object_index, groups);
           return;
         }
-        const auto leaf = [&](std::span<const std::uint32_t> triangles, std::uint32_t groups_here) {
+        const auto leaf = [&](std::span<const std::uint32_t> triangles, GroupMask groups_here) {
           return test_leaf(triangles, groups_here, [&](std::uint32_t t) {
             const auto& v = mesh.desc.triangles[t];
             return LeafTriangle{&mesh.desc.positions[v[0]], &mesh.desc.positions[v[1]], &mesh.desc.positions[v[2]],
@@ -542,7 +542,7 @@ class LargeQuery {
           return;
         }
         const SkinnedMesh& mesh = *scene_ref().characters()[frame.character].mesh;
-        const auto leaf = [&](std::span<const std::uint32_t> items, std::uint32_t groups_here) {
+        const auto leaf = [&](std::span<const std::uint32_t> items, GroupMask groups_here) {
           return test_leaf(items, groups_here, [&](std::uint32_t item) {
             const std::uint32_t t = frame.escaped_triangles[item];
             const auto& v = mesh.triangles[t];
@@ -556,7 +556,7 @@ class LargeQuery {
     }
   }
 
-  void visit_small_static(const Scene::StaticMesh& mesh, std::uint32_t groups) {
+  void visit_small_static(const Scene::StaticMesh& mesh, GroupMask groups) {
     for (std::uint32_t t = 0; t < mesh.desc.triangles.size() && groups != 0; ++t) {
       const auto& v = mesh.desc.triangles[t];
       const Vec3& p0 = mesh.desc.positions[v[0]];
@@ -570,7 +570,7 @@ class LargeQuery {
   // Trees too big for one walk per packet: each group is an 8-ray packet
   // filtered to the one object (render/packet_traversal.h), whose lanes
   // walk only the cells their own rays reach and stop at their own hits.
-  void visit_with_small_packets(std::uint32_t object_index, std::uint32_t groups) {
+  void visit_with_small_packets(std::uint32_t object_index, GroupMask groups) {
     const std::uint32_t list[1] = {object_index};
     const ObjectFilter filter{list};
     for_each_bit(groups, [&](int g) {
@@ -603,7 +603,7 @@ class LargeQuery {
   // per item (mailboxed by its index) by the groups with lanes in the leaf
   // left to test it. Returns true when every lane is answered (any hit).
   template <class CornersFn>
-  bool test_leaf(std::span<const std::uint32_t> items, std::uint32_t groups_here, CornersFn&& corners) {
+  bool test_leaf(std::span<const std::uint32_t> items, GroupMask groups_here, CornersFn&& corners) {
     if (frusta_on_) ensure_frusta(groups_here & alive_groups_);
     for (const std::uint32_t item : items) {
       if (frusta_on_) {
@@ -617,7 +617,7 @@ class LargeQuery {
         need_ = 0;
         for_each_bit(groups_here & alive_groups_, [&](int g) {
           visit_[g].leaf_lanes = mailbox_.untested(item, g, leaf_lanes_[g]) & live_[g];
-          if (visit_[g].leaf_lanes != 0) need_ |= 1u << g;
+          if (visit_[g].leaf_lanes != 0) need_ |= GroupMask{1} << g;
         });
         if (need_ == 0) continue;
         const LeafTriangle tri = corners(item);
@@ -632,7 +632,7 @@ class LargeQuery {
   // A world-space tree below the top level (a static mesh's, the escape
   // fallback's): the world rays with the single ray's slack for the tree.
   template <class LeafFn>
-  void visit_world_tree(const KdTreeView& tree, std::uint32_t groups, LeafFn& leaf) {
+  void visit_world_tree(const KdTreeView& tree, GroupMask groups, LeafFn& leaf) {
     if (tree.empty()) return;
     const float box_magnitude = max_abs(tree.bounds);
     TreeEntry entry;
@@ -652,7 +652,7 @@ class LargeQuery {
     walk_tree(tree, entry, leaf);
   }
 
-  void visit_bone(const InstanceFrame& frame, std::uint32_t bone, std::uint32_t groups) {
+  void visit_bone(const InstanceFrame& frame, std::uint32_t bone, GroupMask groups) {
     const Scene::Character& character = scene_ref().characters()[frame.character];
     const KdTreeView tree = character.fuzzy.bone_tree(bone);
     if (tree.empty()) return;
@@ -693,7 +693,7 @@ class LargeQuery {
       enter_tree(entry, tree, g, o, d, inv, eps);
     });
     const SkinnedMesh& mesh = *character.mesh;
-    const auto leaf = [&](std::span<const std::uint32_t> triangles, std::uint32_t groups_here) {
+    const auto leaf = [&](std::span<const std::uint32_t> triangles, GroupMask groups_here) {
       return test_leaf(triangles, groups_here, [&](std::uint32_t t) {
         const auto& v = mesh.triangles[t];
         return LeafTriangle{&frame.positions[v[0]], &frame.positions[v[1]], &frame.positions[v[2]], t,
@@ -708,7 +708,7 @@ class LargeQuery {
   struct TreeEntry {
     RangeAccumulator ranges;
     float eps = 0.0f;  // the largest lane slack
-    std::uint32_t groups = 0;
+    GroupMask groups = 0;
   };
 
   // Group g's rays o + t d in the tree's frame (reciprocals inv, lane
@@ -743,7 +743,7 @@ class LargeQuery {
     const Float8 t0 = Float8::load(vg.t0), t1 = Float8::load(vg.t1);
     entry.ranges.add(o, d, t0, t1, vg.lanes);
     entry.eps = std::max(entry.eps, reduce_max(select(Mask8::from_bits(vg.lanes), eps, Float8(0.0f))));
-    entry.groups |= 1u << g;
+    entry.groups |= GroupMask{1} << g;
   }
 
   template <class LeafFn>
@@ -762,7 +762,7 @@ class LargeQuery {
   // leaf, the groups whose own bound reaches its cell test its triangles.
   // `leaf` returns true to stop (every lane answered).
   template <class LeafFn>
-  void traverse(const KdTreeView& tree, const IntervalBound& bound, const IntervalBound::Growth& grow, std::uint32_t groups,
+  void traverse(const KdTreeView& tree, const IntervalBound& bound, const IntervalBound::Growth& grow, GroupMask groups,
                 LeafFn& leaf) {
     // The packet's limit changes only when a lane records a hit.
     std::uint64_t seen = ~std::uint64_t{0};
@@ -836,18 +836,18 @@ class LargeQuery {
         } else if (node.item_count() > 0) {
           // Each group's lanes clipped to the cell exactly, as their single
           // rays would be (grown by each lane's own slack).
-          std::uint32_t reaching = 0;
+          GroupMask reaching = 0;
           const Aabb cell = cur.box();
           // With group frusta each triangle picks its groups itself, more
           // tightly than the cell would.
           if (frusta_on_) reaching = groups & alive_groups_;
-          for_each_bit(frusta_on_ ? 0u : groups & alive_groups_, [&](int g) {
+          for_each_bit(frusta_on_ ? GroupMask{0} : groups & alive_groups_, [&](int g) {
             const VisitGroup& vg = visit_[g];
             Float8 t0 = Float8::load(vg.t0), t1 = Float8::load(vg.t1);
             if constexpr (!kAnyHit) t1 = min(t1, Float8::load(group_[g].t_limit));
             leaf_lanes_[g] = clip_lanes(cell, Float8::load(vg.lane_eps), vg.origin(), vg.direction(),
                                         vg.inverse(), vg.lanes & live_[g], t0, t1);
-            if (leaf_lanes_[g] != 0) reaching |= 1u << g;
+            if (leaf_lanes_[g] != 0) reaching |= GroupMask{1} << g;
           });
           if (reaching != 0 && leaf(tree.items.subspan(node.first_item(), node.item_count()), reaching)) return;
         }
@@ -859,7 +859,7 @@ class LargeQuery {
 
   // Tests one world-space triangle for the live lanes of each group of
   // `groups` that reach it (visit_[g].leaf_lanes).
-  void test_groups(std::uint32_t groups, const Vec3& p0, const Vec3& p1, const Vec3& p2, std::uint32_t triangle,
+  void test_groups(GroupMask groups, const Vec3& p0, const Vec3& p1, const Vec3& p2, std::uint32_t triangle,
                    std::uint32_t instance) {
     if constexpr (kTest == TriangleTest::kFast) {
       if (common_origin_) {
@@ -953,7 +953,7 @@ class LargeQuery {
   void retire(int g, int lane) {
     blocked_[g] |= 1u << lane;
     live_[g] &= ~(1u << lane);
-    if (live_[g] == 0) alive_groups_ &= ~(1u << g);
+    if (live_[g] == 0) alive_groups_ &= ~(GroupMask{1} << g);
   }
 
   const Scene* scene_p_ = nullptr;
@@ -963,14 +963,14 @@ class LargeQuery {
   std::array<Group, kMaxPacketGroups> group_;
   std::array<VisitGroup, kMaxPacketGroups> visit_;
   std::array<std::uint32_t, kMaxPacketGroups> leaf_lanes_{};  // per group: the lanes reaching the current leaf
-  std::uint32_t tree_groups_ = 0;  // the groups walking the current tree
-  std::uint32_t need_ = 0;  // test_leaf: the groups with lanes left to test the current item
+  GroupMask tree_groups_ = 0;  // the groups walking the current tree
+  GroupMask need_ = 0;  // test_leaf: the groups with lanes left to test the current item
   std::array<std::array<WatertightRay, kLanes>, kTest == TriangleTest::kWatertight ? kMaxPacketGroups : 1>
       watertight_;
   std::array<std::uint32_t, kMaxPacketGroups> live_{};
   std::array<std::uint32_t, kMaxPacketGroups> valid_{};
   std::array<std::uint32_t, kMaxPacketGroups> blocked_{};
-  std::uint32_t alive_groups_ = 0;
+  GroupMask alive_groups_ = 0;
   std::uint64_t hits_recorded_ = 0;
   bool common_origin_ = false;  // every live lane starts at common_origin_at_
   Vec3 common_origin_at_{0.0f};
@@ -982,7 +982,7 @@ class LargeQuery {
   std::array<Vec3, 3> grid_basis_{};  // forward, right, up
   float visit_slack_ = 0.0f;       // run(): a bound on every lane's slack in an object's box clip
   bool frusta_on_ = false;         // grid_ (when on) or frusta_ pick each leaf triangle's groups
-  std::uint32_t frusta_built_ = 0;  // the groups whose frustum frusta_ holds
+  GroupMask frusta_built_ = 0;  // the groups whose frustum frusta_ holds
   TraversalCounters counters_;
 };
 

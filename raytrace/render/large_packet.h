@@ -1,5 +1,5 @@
-// Large packets: up to 32 groups of eight rays (a tile's 8x8- or 16x16-pixel
-// region) traced together through the top level and every kd-tree. Where
+// Large packets: up to 64 groups of eight rays (a tile's 8x8-, 16x16- or
+// 32x16-pixel region) traced together through the top level and every kd-tree. Where
 // the 8-ray packets of render/packet_traversal.h make each lane repeat the
 // single ray's walk, a large packet walks a tree once for all its rays,
 // culling whole cells with a conservative interval bound on the rays
@@ -31,7 +31,10 @@
 
 namespace sinew::rt {
 
-inline constexpr int kMaxPacketGroups = 32;  // 256 rays: a 16x16-pixel region
+inline constexpr int kMaxPacketGroups = 64;  // 512 rays: a 32x16-pixel region
+// A set of a packet's groups, bit g for group g.
+using GroupMask = std::uint64_t;
+static_assert(kMaxPacketGroups <= 64, "a GroupMask holds one bit per group");
 
 // A large packet's rays in place: 8 * groups lanes, every array contiguous
 // over them (unaligned is fine). Lanes whose bit in `active[group]` is 0 are

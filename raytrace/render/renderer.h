@@ -53,8 +53,8 @@ struct RenderSettings {
   Vec3 default_albedo{0.7f};  // meshes without material colors
   int tile_size = 32;
   // Rays traced together: 1 (single rays), 8 (4x2-pixel packets,
-  // render/packet_traversal.h), 64 or 256 (8x8- or 16x16-pixel packets
-  // culled cell by cell, render/large_packet.h). Shadow rays are packed
+  // render/packet_traversal.h), 64, 256 or 512 (8x8-, 16x16- or
+  // 32x16-pixel packets culled cell by cell, render/large_packet.h). Shadow rays are packed
   // from the same pixels. The hits agree (large packets may pick another
   // triangle only at an exact tie in t); other values are refused.
   int packet_rays = 256;

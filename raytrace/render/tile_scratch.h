@@ -2,7 +2,7 @@
 // tiles and frames. The tile's pixels are laid out in blocks of 4x2 (eight
 // lanes: one ray group, one Float8): pixel k = 8 * block + lane, lane =
 // 4 * (y % 2) + x % 4. Blocks are grouped into regions (the large packets
-// of render/large_packet.h: 8x8 or 16x16 pixels, or one block each),
+// of render/large_packet.h: 8x8, 16x16 or 32x16 pixels, or one block each),
 // regions row-major over the tile and blocks row-major within a region, so
 // a region's blocks, rays and hits are consecutive. Every stage
 // (render/tile_stages.h) walks the blocks, so the rays, hits and surfaces of

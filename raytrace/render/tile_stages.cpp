@@ -471,17 +471,21 @@ std::uint64_t trace_shadow_large(const Scene& scene, TriangleTest test, const st
 }  // namespace
 
 bool valid_packet_rays(int packet_rays) {
-  return packet_rays == 1 || packet_rays == 8 || packet_rays == 64 || packet_rays == 256;
+  return packet_rays == 1 || packet_rays == 8 || packet_rays == 64 || packet_rays == 256 || packet_rays == 512;
 }
 
 void packet_region_blocks(int packet_rays, int& blocks_x, int& blocks_y) {
-  // Square regions of 4x2 blocks: 8x8 pixels are 2x4 blocks, 16x16 are 4x8.
+  // Regions of 4x2-pixel blocks: 8x8 pixels are 2x4 blocks, 16x16 are 4x8,
+  // 32x16 are 8x8 (the grid's most, render/grid_frusta.h).
   blocks_x = blocks_y = 1;
   if (packet_rays == 64) {
     blocks_x = 2;
     blocks_y = 4;
   } else if (packet_rays == 256) {
     blocks_x = 4;
+    blocks_y = 8;
+  } else if (packet_rays == 512) {
+    blocks_x = 8;
     blocks_y = 8;
   }
 }

@@ -42,7 +42,7 @@ TileCone shadow_tile_cone(const TileScratch& s);
 // Nearest hits of the tile's pixels, with the tile's primary rays culled
 // against the top level as one bound and each packet's again (render/
 // ray_bound.h). packet_rays (RenderSettings): 1 is one single-ray query per
-// pixel, no culling; 64 and 256 need `s` prepared with the matching
+// pixel, no culling; 64, 256 and 512 need `s` prepared with the matching
 // regions (packet_region_blocks). Fills t, u, v, triangle, instance and
 // block_hits.
 void trace_primary(const Scene& scene, const PinholeCamera& camera, TriangleTest test, int packet_rays,

@@ -1,6 +1,6 @@
 // Grid frusta (render/grid_frusta.h) of camera packets never cull a group
 // whose ray hits a triangle or enters a box, by either triangle test, for
-// random cameras, image sizes and regions (1 to 4 columns, 1 to 8 rows of
+// random cameras, image sizes and regions (1 to 8 columns, 1 to 8 rows of
 // 4x2-pixel blocks, partial lane masks), near the origin and thousands of
 // units from it; they cull most triangles beside a group; and a grid that
 // does not fit, or a lane behind the camera, culls nothing.
@@ -94,14 +94,14 @@ TEST(GridFrusta, NeverCullAGroupWhoseRayHitsOrEnters) {
       const auto made = rt::PinholeCamera::create({eye, target, Vec3(0, 1, 0), fov}, width, height);
       if (!made.ok()) continue;
       const rt::PinholeCamera& camera = made.value();
-      const int columns = 1 + static_cast<int>(g() % 4), rows = 1 + static_cast<int>(g() % 8);
+      const int columns = 1 + static_cast<int>(g() % 8), rows = 1 + static_cast<int>(g() % 8);
       const int x0 = static_cast<int>(g() % static_cast<unsigned>(std::max(1, width - 4 * columns)));
       const int y0 = static_cast<int>(g() % static_cast<unsigned>(std::max(1, height - 2 * rows)));
       const Region r = make_region(camera, x0, y0, columns, rows, view % 3 == 0, g);
       rt::GridFrusta grid;
       if (!build(grid, camera, r)) continue;  // wide views: rays far off the forward axis
       const int groups = columns * rows;
-      const std::uint32_t all = groups == 32 ? ~0u : (1u << groups) - 1u;
+      const std::uint64_t all = groups == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << groups) - 1u;
       for (int trial = 0; trial < 200; ++trial) {
         // About a lane's ray, at a random size, shifted by up to the region's width.
         const int group = static_cast<int>(g() % static_cast<unsigned>(groups));
@@ -115,10 +115,10 @@ TEST(GridFrusta, NeverCullAGroupWhoseRayHitsOrEnters) {
         const Vec3 shift = 1.5f * width_there * unit(g) * random_vec(g);
         const Vec3 p0 = at + shift + size * random_vec(g), p1 = at + shift + size * random_vec(g),
                    p2 = at + shift + size * random_vec(g);
-        const std::uint32_t reached = grid.reached(p0, p1, p2, all);
+        const std::uint64_t reached = grid.reached(p0, p1, p2, all);
         const Vec3 half = size * Vec3(unit(g), unit(g), unit(g));
         const Aabb box{at + shift - half, at + shift + half};
-        const std::uint32_t box_reached = grid.box_reached(box, all);
+        const std::uint64_t box_reached = grid.box_reached(box, all);
         ++tried;
         for (int k = 0; k < groups; ++k) {
           ++group_trials;
@@ -156,17 +156,17 @@ TEST(GridFrusta, GridsThatDoNotFitOrLanesBehindCullNothing) {
   std::mt19937 g(3);
   const auto camera = rt::PinholeCamera::create({Vec3(0.0f), Vec3(0, 0, -1), Vec3(0, 1, 0), 40.0f}, 256, 256).value();
   rt::GridFrusta grid;
-  const Region wide = make_region(camera, 0, 0, 5, 2, false, g);
+  const Region wide = make_region(camera, 0, 0, 9, 2, false, g);
   EXPECT_FALSE(build(grid, camera, wide));
   const Region tall = make_region(camera, 0, 0, 1, 9, false, g);
   EXPECT_FALSE(build(grid, camera, tall));
-  Region behind = make_region(camera, 100, 100, 4, 8, false, g);
+  Region behind = make_region(camera, 100, 100, 8, 8, false, g);
   ASSERT_TRUE(build(grid, camera, behind));
   // A triangle far to the side is culled for every group...
   const Vec3 q0(50.0f, 0.0f, -1.0f), q1(51.0f, 0.0f, -1.0f), q2(50.0f, 1.0f, -1.0f);
-  EXPECT_EQ(grid.reached(q0, q1, q2, ~0u), 0u);
-  // ...but not once a lane looks backwards, nor after reset().
-  behind.d[7][2][3] = 1.0f;
+  EXPECT_EQ(grid.reached(q0, q1, q2, ~std::uint64_t{0}), 0u);
+  // ...but not once a lane of the last group looks backwards, nor after reset().
+  behind.d[63][2][3] = 1.0f;
   EXPECT_FALSE(build(grid, camera, behind));
   EXPECT_EQ(grid.reached(q0, q1, q2, 0xFFu), 0xFFu);
   ASSERT_TRUE(build(grid, camera, make_region(camera, 100, 100, 4, 8, false, g)));

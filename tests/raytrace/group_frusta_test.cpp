@@ -195,7 +195,7 @@ TEST(GroupFrusta, EveryHitTriangleIsReachedBySegmentsFromTheApex) {
   EXPECT_GT(tally.boxes_culled, tally.tried / 5) << tally.boxes_culled << " of " << tally.tried;
 }
 
-// A 16x16-pixel packet (32 groups of 4x2 pixels) with its own frustum
+// A 32x16-pixel packet (64 groups of 4x2 pixels, the most a packet holds) with its own frustum
 // (set_bound) tested before the groups': a triangle some lane hits is still
 // reached by that lane's group, from an apex near and far from the origin,
 // for rays and for segments ending at their lane's reach (far plane), and
@@ -211,15 +211,15 @@ TEST(GroupFrusta, ThePacketFrustumNeverCullsATriangleALaneHits) {
         const Vec3 u = glm::normalize(glm::cross(c, std::fabs(c.z) < 0.9f ? Vec3(0, 0, 1) : Vec3(1, 0, 0)));
         const Vec3 v = glm::cross(c, u);
         const float pixel = 0.0005f * (1.0f + 6.0f * unit(g));
-        float q[32][3][8];
-        alignas(32) float reach[32][8];
-        std::uint32_t lanes[32];
-        std::array<Ray, 256> rays;
-        for (int group = 0; group < 32; ++group) {
+        float q[64][3][8];
+        alignas(32) float reach[64][8];
+        std::uint32_t lanes[64];
+        std::array<Ray, 512> rays;
+        for (int group = 0; group < 64; ++group) {
           lanes[group] = packet % 4 == 0 ? (g() & 0xFFu) | 1u : 0xFFu;
           for (int lane = 0; lane < 8; ++lane) {
-            const float x = static_cast<float>(4 * (group % 4) + lane % 4) - 7.5f;
-            const float y = static_cast<float>(2 * (group / 4) + lane / 4) - 7.5f;
+            const float x = static_cast<float>(4 * (group % 8) + lane % 4) - 15.5f;
+            const float y = static_cast<float>(2 * (group / 8) + lane / 4) - 7.5f;
             const float length = segments ? 1.0f + 40.0f * unit(g) : 1.0f + unit(g);
             const Vec3 d = length * (c + pixel * (x * u + y * v));
             for (int a = 0; a < 3; ++a) q[group][a][lane] = d[a];
@@ -231,21 +231,21 @@ TEST(GroupFrusta, ThePacketFrustumNeverCullsATriangleALaneHits) {
             r.t_max = reach[group][lane];
           }
         }
-        rt::GroupFrusta<32> frusta;
-        frusta.reset(apex, 32);
+        rt::GroupFrusta<64> frusta;
+        frusta.reset(apex, 64);
         const auto directions = [&](int group) -> const float (&)[3][8] { return q[group]; };
         const auto lanes_of = [&](int group) { return lanes[group]; };
         const auto reach_of = [&](int group, float* out) { std::copy(reach[group], reach[group] + 8, out); };
         if (segments) {
-          frusta.set_groups<true>(~0u, 1.0f, directions, lanes_of, reach_of);
-          frusta.set_bound<true>(~0u, 1.0f, directions, lanes_of, reach_of);
+          frusta.set_groups<true>(~std::uint64_t{0}, 1.0f, directions, lanes_of, reach_of);
+          frusta.set_bound<true>(~std::uint64_t{0}, 1.0f, directions, lanes_of, reach_of);
         } else {
-          frusta.set_groups<false>(~0u, 1.0f, directions, lanes_of, reach_of);
-          frusta.set_bound<false>(~0u, 1.0f, directions, lanes_of, reach_of);
+          frusta.set_groups<false>(~std::uint64_t{0}, 1.0f, directions, lanes_of, reach_of);
+          frusta.set_bound<false>(~std::uint64_t{0}, 1.0f, directions, lanes_of, reach_of);
         }
         for (int trial = 0; trial < 300; ++trial) {
           // About a lane's ray, or beside the packet by up to its width.
-          const int k = static_cast<int>(g() % 256);
+          const int k = static_cast<int>(g() % 512);
           const Ray& r = rays[static_cast<std::size_t>(k)];
           const float t = segments ? 1.3f * unit(g) : 0.5f + 30.0f * unit(g);
           const Vec3 at = r.origin + t * r.direction;
@@ -255,10 +255,10 @@ TEST(GroupFrusta, ThePacketFrustumNeverCullsATriangleALaneHits) {
           const Vec3 p0 = at + shift + size * random_vec(g);
           const Vec3 p1 = at + shift + size * random_vec(g);
           const Vec3 p2 = at + shift + size * random_vec(g);
-          const std::uint32_t reached = frusta.reached(p0, p1, p2, ~0u);
+          const std::uint64_t reached = frusta.reached(p0, p1, p2, ~std::uint64_t{0});
           ++tried;
           if (reached == 0) ++culled;
-          for (int lane = 0; lane < 256; ++lane) {
+          for (int lane = 0; lane < 512; ++lane) {
             if (!(lanes[lane / 8] >> (lane % 8) & 1u) || !hits(rays[static_cast<std::size_t>(lane)], p0, p1, p2)) {
               continue;
             }

@@ -486,7 +486,7 @@ TEST(RenderStatic, AFloorAtExactlyZeroDoesNotShadowItself) {
   auto camera = rt::PinholeCamera::create(desc, 64, 64);
   ASSERT_TRUE(camera.ok());
   for (const Vec3& light : {Vec3(6.0f, 12.0f, 4.0f), Vec3(0.5f, 0.25f, 0.5f), Vec3(3e4f, 6e4f, -2e4f)}) {
-    for (const int packet_rays : {1, 8, 64, 256}) {
+    for (const int packet_rays : {1, 8, 64, 256, 512}) {
       const rt::RenderStats stats = render_lit(scene, *camera, light, packet_rays, TriangleTest::kFast, jobs);
       EXPECT_GT(stats.shadow_rays, 1000u);
       EXPECT_EQ(stats.shadowed, 0u) << packet_rays << " rays per packet, light y " << light.y;
@@ -612,7 +612,7 @@ TEST(RenderStatic, ATiltedFloorDoesNotShadowItselfUnderNearAndFarLights) {
   ASSERT_TRUE(camera.ok());
   for (const Vec3& light : {centre + 20.0f * up + 3.0f * u, centre + 0.4f * up + 1.0f * v,
                             centre + 5e4f * up - 2e4f * u, centre + 3.0f * up + 4e3f * v}) {
-    for (const int packet_rays : {1, 8, 64, 256}) {
+    for (const int packet_rays : {1, 8, 64, 256, 512}) {
       for (const TriangleTest test : kTests) {
         const rt::RenderStats stats = render_lit(scene, *camera, light, packet_rays, test, jobs);
         EXPECT_GT(stats.shadow_rays, 2000u);

@@ -276,8 +276,8 @@ TEST_P(RenderOracle, PosesInsideThePoseSpaceMatchBruteForce) {
     for (std::size_t c = 0; c < cameras.size(); ++c) {
       if (!full && c != k % cameras.size()) continue;
       const int size = full ? 256 : (big ? 32 : 48);
-      // Packets of 8, 64 and 256 rays in turn.
-      const int packet_rays = std::array<int, 3>{8, 64, 256}[(k + c) % 3];
+      // Packets of 8, 64, 256 and 512 rays in turn.
+      const int packet_rays = std::array<int, 4>{8, 64, 256, 512}[(k + c) % 4];
       for (const TriangleTest test : kTests) {
         compare_primary(scene, soup, cameras[c], size, test, jobs, primary, packet_rays);
       }
@@ -342,7 +342,7 @@ TEST(SubdividedCallyOracle, LevelsOneToFourMatchBruteForce) {
       const auto cameras = cameras_around(posed, 2);
       for (const TriangleTest test : kTests) {
         compare_primary(scene, soup, cameras[k % cameras.size()], 48, test, jobs, primary,
-                        std::array<int, 3>{8, 64, 256}[k % 3]);
+                        std::array<int, 4>{8, 64, 256, 512}[k % 4]);
       }
       compare_random(scene, soup, posed, 100, random, rays);
     }

@@ -509,7 +509,7 @@ struct PacketArrays {
   rt::LargePacketRays rays;
 };
 
-// Random large packets (1 to 32 groups) around the characters: shared
+// Random large packets (1 to 64 groups) around the characters: shared
 // origins with coherent directions, scattered origins with mixed direction
 // signs, origins inside bone boxes, partial lane masks and finite t ranges,
 // invalid lanes; given every object or only the tile's cull. Each lane's
@@ -524,7 +524,7 @@ TEST(LargePackets, FindTheSingleRayHits) {
   for (std::uint32_t i = 0; i < every.size(); ++i) every[i] = i;
   std::size_t hits = 0, checked = 0;
   for (int p = 0; p < 240; ++p) {
-    const int groups = std::array<int, 4>{1, 3, 8, 32}[static_cast<std::size_t>(p % 4)];
+    const int groups = std::array<int, 5>{1, 3, 8, 32, 64}[static_cast<std::size_t>(p % 5)];
     PacketArrays arrays(groups, kInf);
     const std::size_t n = arrays.n;
     auto& o = arrays.o;
@@ -610,7 +610,7 @@ TEST(LargePackets, ShadowRaysToAPointLightMatchSingleRays) {
   std::size_t blocked_count = 0, checked = 0;
   for (const Vec3& light : lights) {
     for (int p = 0; p < 60; ++p) {
-      const int groups = 1 + static_cast<int>(g() % 32);
+      const int groups = 1 + static_cast<int>(g() % 64);
       PacketArrays arrays(groups, 1.0f);
       const std::size_t n = arrays.n;
       auto& o = arrays.o;
@@ -1275,7 +1275,7 @@ TEST(Renderer, PacketsMatchSingleRaysAndBruteForceAtEdgesAndInsideCharacters) {
       const auto camera = rt::PinholeCamera::create(desc, w, h).value();
       for (const TriangleTest test : kTests) {
         const Frame single = render(sc, camera, 16, 1, test, jobs);
-        for (const int packet_rays : {8, 64, 256}) {
+        for (const int packet_rays : {8, 64, 256, 512}) {
           for (const int tile : {1, 3, 5, 16, 64}) {
             const Frame packets = render(sc, camera, tile, packet_rays, test, jobs);
             EXPECT_EQ(packets.triangle, single.triangle) << "tile " << tile << ", " << packet_rays << " rays";
