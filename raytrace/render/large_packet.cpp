@@ -221,7 +221,7 @@ class LargeQuery {
     grid_basis_[2] = rays.grid_up;
     groups_ = std::clamp(rays.groups, 0, kMaxPacketGroups);
     alive_groups_ = 0;
-    hits_recorded_ = 0;
+    limits_lowered_ = 0;
     common_origin_ = false;
     frusta_on_ = false;
     counters_ = {};
@@ -764,16 +764,33 @@ class LargeQuery {
   template <class LeafFn>
   void traverse(const KdTreeView& tree, const IntervalBound& bound, const IntervalBound::Growth& grow, GroupMask groups,
                 LeafFn& leaf) {
-    // The packet's limit changes only when a lane records a hit.
-    std::uint64_t seen = ~std::uint64_t{0};
+    // The packet's limit is the largest of its groups' (group_limit), and
+    // a group's changes only when one of its lanes records a hit: only
+    // those groups are looked at again (a closest-hit packet's groups stay
+    // alive throughout).
+    alignas(32) std::array<float, kMaxPacketGroups> group_limits;
     float cached = kInf;
+    const int blocks = (groups_ + kLanes - 1) / kLanes;
+    const auto packet_max = [&] {
+      Float8 m(-kInf);
+      for (int i = 0; i < blocks; ++i) m = max(m, Float8::load(&group_limits[static_cast<std::size_t>(i * kLanes)]));
+      return reduce_max(m);
+    };
+    if constexpr (!kAnyHit) {
+      group_limits.fill(-kInf);
+      for_each_bit(groups & alive_groups_, [&](int g) { group_limits[g] = group_limit(g, visit_.data()); });
+      cached = packet_max();
+      limits_lowered_ = 0;
+    }
     const auto limit = [&]() {
       if constexpr (kAnyHit) {
         return bound.t_hi();
       } else {
-        if (seen != hits_recorded_) {
-          seen = hits_recorded_;
-          cached = packet_limit(groups & alive_groups_, visit_.data());
+        if (limits_lowered_ != 0) {
+          for_each_bit(limits_lowered_ & groups & alive_groups_,
+                       [&](int g) { group_limits[g] = group_limit(g, visit_.data()); });
+          limits_lowered_ = 0;
+          cached = packet_max();
         }
         return cached;
       }
@@ -935,13 +952,13 @@ class LargeQuery {
         out_.triangle[k0 + static_cast<std::size_t>(lane)] = triangle;
         out_.instance[k0 + static_cast<std::size_t>(lane)] = instance;
       });
-      ++hits_recorded_;
+      limits_lowered_ |= GroupMask{1} << g;
     }
   }
 
   void record(int g, int lane, float t, float u, float v, std::uint32_t triangle, std::uint32_t instance) {
     group_[g].t_limit[lane] = t;
-    ++hits_recorded_;
+    limits_lowered_ |= GroupMask{1} << g;
     const std::size_t k = static_cast<std::size_t>(g) * kLanes + static_cast<std::size_t>(lane);
     out_.t[k] = t;
     out_.u[k] = u;
@@ -971,7 +988,7 @@ class LargeQuery {
   std::array<std::uint32_t, kMaxPacketGroups> valid_{};
   std::array<std::uint32_t, kMaxPacketGroups> blocked_{};
   GroupMask alive_groups_ = 0;
-  std::uint64_t hits_recorded_ = 0;
+  GroupMask limits_lowered_ = 0;  // the groups that recorded a hit since traverse() last looked
   bool common_origin_ = false;  // every live lane starts at common_origin_at_
   Vec3 common_origin_at_{0.0f};
   LaneMailbox mailbox_;
