@@ -102,7 +102,7 @@ struct BakeFlags {
                              "top-level objects per frame; default) or keeps its own (keep)")),
         sah_intersection_cost(l.option("--sah-intersection-cost", "C",
                                        "the bone trees' triangle cost against a cell visit's 1\n"
-                                       "(default 0.5, tuned for 64-ray packets; 1.5\n"
+                                       "(default 0.15, tuned for 256-ray packets; 1.5\n"
                                        "builds deeper trees, which suit --packet-rays 1)")),
         threads(l.option("--threads", "N", "worker threads (default 0: all cores)")),
         max_memory_mib(l.option("--max-memory-mib", "M",

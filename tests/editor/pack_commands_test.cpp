@@ -150,7 +150,7 @@ TEST_F(PackCommands, SahIntersectionCostShapesTheBoneTrees) {
     return nlohmann::json::parse(inspect.out)["fuzzy"];
   };
   const auto packet = bake_and_inspect("default.pack", {});
-  const auto explicit_default = bake_and_inspect("half.pack", {"--sah-intersection-cost", "0.5"});
+  const auto explicit_default = bake_and_inspect("default_named.pack", {"--sah-intersection-cost", "0.15"});
   const auto single_ray = bake_and_inspect("deep.pack", {"--sah-intersection-cost", "1.5"});
   EXPECT_EQ(packet["nodes"], explicit_default["nodes"]);
   EXPECT_GT(single_ray["nodes"].get<std::size_t>(), packet["nodes"].get<std::size_t>());
