@@ -57,8 +57,8 @@ struct FuzzyBakeOptions {
   // ratio (1.5) the trees split about ten times as often as pays. Measured
   // on every model in shared/content and the six-mannequin demo
   // (docs/RAYTRACE.md, "Bone tree build"): 0.15 traces 256-ray packets 3-24%
-  // faster than 0.5 (twice as fast where 0.5 left a tree over the large
-  // packets' node limit), single rays slower.
+  // faster than 0.5, and up to twice as fast on finely subdivided meshes;
+  // single rays and 8-ray packets are slower.
   KdBuildOptions kd{.traversal_cost = 1.0f, .intersection_cost = 0.15f, .empty_bonus = 0.2f, .max_leaf_items = 1,
                     .max_depth = 0};
   std::size_t memory_budget_bytes = std::size_t{256} << 20;

@@ -25,34 +25,7 @@ namespace sinew::rt {
 namespace {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
-// Trees with more nodes than this (finely subdivided meshes, large static
-// meshes) are walked by each group as an 8-ray packet: one walk per packet
-// would reach every cell in the packet's whole bound up to its farthest hit.
-constexpr std::size_t kLargePacketMaxTreeNodes = 2048;
-
-}  // namespace
-
-namespace {
-
 constexpr int kLanes = 8;
-
-// Eight rays (arrays of eight lanes) as an 8-ray packet, lanes of `lanes` active.
-RayPacket packet_of(const float* const o[3], const float* const d[3], const float* t_min, const float* t_max,
-                    std::uint32_t lanes) {
-  RayPacket p;
-  for (int i = 0; i < kLanes; ++i) {
-    p.ox[i] = o[0][i];
-    p.oy[i] = o[1][i];
-    p.oz[i] = o[2][i];
-    p.dx[i] = d[0][i];
-    p.dy[i] = d[1][i];
-    p.dz[i] = d[2][i];
-    p.t_min[i] = t_min[i];
-    p.t_max[i] = t_max[i];
-  }
-  p.active = static_cast<std::uint8_t>(lanes);
-  return p;
-}
 
 }  // namespace
 
@@ -364,7 +337,7 @@ class LargeQuery {
       if constexpr (!kAnyHit) {
         if (begin[i].entry > packet_limit(alive_groups_, nullptr)) return;
       }
-      visit(all[begin[i].object], begin[i].object);
+      visit(all[begin[i].object]);
     }
   }
 
@@ -457,7 +430,7 @@ class LargeQuery {
 
   // Enters one object: each group's lanes clipped to its box as the single
   // ray clips them (render/traversal.cpp visit).
-  void visit(const TopLevelObject& object, std::uint32_t object_index) {
+  void visit(const TopLevelObject& object) {
     GroupMask groups = 0;
     const float box_magnitude = max_abs(object.box);
     // With group frusta, only the groups whose frustum reaches the box
@@ -506,23 +479,13 @@ class LargeQuery {
     }
     switch (object.kind) {
       case TopLevelObject::Kind::kBone: {
-        const InstanceFrame& frame = scene_ref().instances()[object.index];
-        if (scene_ref().characters()[frame.character].fuzzy.bone_tree(object.bone).nodes.size() >
-            kLargePacketMaxTreeNodes) {
-          visit_with_small_packets(object_index, groups);
-        } else {
-          visit_bone(frame, object.bone, groups);
-        }
+        visit_bone(scene_ref().instances()[object.index], object.bone, groups);
         return;
       }
       case TopLevelObject::Kind::kStatic: {
         const Scene::StaticMesh& mesh = scene_ref().static_meshes()[object.index];
         if (mesh.desc.triangles.size() <= detail::kBruteForceStaticTriangles) {
           visit_small_static(mesh, groups);
-          return;
-        }
-        if (mesh.tree.nodes.size() > kLargePacketMaxTreeNodes) {
-          visit_with_small_packets(object_index, groups);
           return;
         }
         const auto leaf = [&](std::span<const std::uint32_t> triangles, GroupMask groups_here) {
@@ -537,10 +500,6 @@ class LargeQuery {
       }
       case TopLevelObject::Kind::kFallback: {
         const InstanceFrame& frame = scene_ref().instances()[object.index];
-        if (frame.fallback.nodes.size() > kLargePacketMaxTreeNodes) {
-          visit_with_small_packets(object_index, groups);
-          return;
-        }
         const SkinnedMesh& mesh = *scene_ref().characters()[frame.character].mesh;
         const auto leaf = [&](std::span<const std::uint32_t> items, GroupMask groups_here) {
           return test_leaf(items, groups_here, [&](std::uint32_t item) {
@@ -565,36 +524,6 @@ class LargeQuery {
       test_groups(groups, p0, p1, p2, t, mesh.instance_id);
       groups &= alive_groups_;
     }
-  }
-
-  // Trees too big for one walk per packet: each group is an 8-ray packet
-  // filtered to the one object (render/packet_traversal.h), whose lanes
-  // walk only the cells their own rays reach and stop at their own hits.
-  void visit_with_small_packets(std::uint32_t object_index, GroupMask groups) {
-    const std::uint32_t list[1] = {object_index};
-    const ObjectFilter filter{list};
-    for_each_bit(groups, [&](int g) {
-      const std::uint32_t lanes = visit_[g].lanes & live_[g];
-      if (lanes == 0) return;
-      const Group& gr = group_[g];
-      const float* const o[3] = {gr.o[0], gr.o[1], gr.o[2]};
-      const float* const d[3] = {gr.d[0], gr.d[1], gr.d[2]};
-      const RayPacket p = packet_of(o, d, gr.t_min, gr.t_limit, lanes);
-      TraversalCounters work;
-      if constexpr (kAnyHit) {
-        const std::uint32_t blocked = occluded_packet(scene_ref(), p, kTest, &work, &filter) & lanes;
-        for_each_bit(blocked, [&](int lane) { retire(g, lane); });
-      } else {
-        Hit hits[kPacketSize];
-        intersect_packet(scene_ref(), p, kTest, hits, &work, &filter);
-        for_each_bit(lanes, [&](int lane) {
-          const Hit& h = hits[lane];
-          if (h.valid()) record(g, lane, h.t, h.u, h.v, h.triangle_id, h.instance_id);
-        });
-      }
-      counters_.node_visits += work.node_visits;
-      counters_.triangle_tests += work.triangle_tests;
-    });
   }
 
   // A leaf's items for the groups reaching it. `corners(item)` gives the
@@ -1047,6 +976,24 @@ void occluded_large_packet(const Scene& scene, const LargePacketRays& rays, Tria
 #else
 
 namespace {
+// Eight rays (arrays of eight lanes) as an 8-ray packet, lanes of `lanes` active.
+RayPacket packet_of(const float* const o[3], const float* const d[3], const float* t_min, const float* t_max,
+                    std::uint32_t lanes) {
+  RayPacket p;
+  for (int i = 0; i < kLanes; ++i) {
+    p.ox[i] = o[0][i];
+    p.oy[i] = o[1][i];
+    p.oz[i] = o[2][i];
+    p.dx[i] = d[0][i];
+    p.dy[i] = d[1][i];
+    p.dz[i] = d[2][i];
+    p.t_min[i] = t_min[i];
+    p.t_max[i] = t_max[i];
+  }
+  p.active = static_cast<std::uint8_t>(lanes);
+  return p;
+}
+
 RayPacket group_of(const LargePacketRays& rays, int g) {
   const std::size_t k0 = static_cast<std::size_t>(g) * kLanes;
   const float* const o[3] = {rays.o[0] + k0, rays.o[1] + k0, rays.o[2] + k0};
