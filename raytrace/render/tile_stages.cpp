@@ -147,18 +147,11 @@ bool gather_lanes(const Scene& scene, const TileScratch& s, std::size_t k0, std:
                   const Vec3& default_albedo, float (&p)[3][3][8], float (&n)[3][3][8], float (&albedo)[3][8],
                   std::uint32_t& with_normals, std::uint32_t& on_character) {
   const std::span<const Scene::ObjectSlot> slots = scene.object_slots();
-  // One triangle under every hit lane (most blocks of a ground or of a
+  // One triangle under the whole block (most blocks of a ground or of a
   // close-up): load it once and broadcast it.
-  const int first = std::countr_zero(hits);
-  bool uniform = true;
-  for (int lane = first + 1; lane < kBlockLanes && uniform; ++lane) {
-    const std::size_t k = k0 + static_cast<std::size_t>(lane);
-    uniform = !(hits >> lane & 1u) ||
-              (s.triangle[k] == s.triangle[k0 + static_cast<std::size_t>(first)] &&
-               s.instance[k] == s.instance[k0 + static_cast<std::size_t>(first)]);
-  }
-  if (uniform && hits == 0xFFu) {
-    const std::size_t k = k0 + static_cast<std::size_t>(first);
+  if (hits == 0xFFu && (lanes_equal(&s.triangle[k0], s.triangle[k0]) & lanes_equal(&s.instance[k0], s.instance[k0])) ==
+                           0xFFu) {
+    const std::size_t k = k0;
     const MeshRefs mesh = mesh_refs(scene, slots[s.instance[k]]);
     const std::uint32_t tri = s.triangle[k];
     const auto& v = mesh.triangles[tri];
@@ -600,11 +593,8 @@ void reconstruct_surfaces(const Scene& scene, const Vec3& default_albedo, TileSc
     s.block_on_character[b] = 0;
     if (hits == 0) continue;
     const std::size_t k0 = b * kBlockLanes;
-    bool kept = hits == 0xFFu && kept_triangle != kInvalidId;
-    for (int lane = 0; lane < kBlockLanes && kept; ++lane) {
-      const std::size_t k = k0 + static_cast<std::size_t>(lane);
-      kept = s.triangle[k] == kept_triangle && s.instance[k] == kept_instance;
-    }
+    const bool kept = hits == 0xFFu && kept_triangle != kInvalidId &&
+                      (lanes_equal(&s.triangle[k0], kept_triangle) & lanes_equal(&s.instance[k0], kept_instance)) == 0xFFu;
     bool uniform = kept;
     if (!kept) {
       kept_triangle = kInvalidId;  // the arrays are about to change

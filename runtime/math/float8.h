@@ -146,6 +146,13 @@ inline void compress_store_lane_indices(std::uint32_t* out, std::uint32_t base, 
                       _mm256_add_epi32(lanes, _mm256_set1_epi32(static_cast<int>(base))));
 }
 
+// Bit i set where values[i] == value, for eight values (unaligned).
+inline std::uint32_t lanes_equal(const std::uint32_t* values, std::uint32_t value) {
+  const __m256i v = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(values));
+  const __m256i same = _mm256_cmpeq_epi32(v, _mm256_set1_epi32(static_cast<int>(value)));
+  return static_cast<std::uint32_t>(_mm256_movemask_ps(_mm256_castsi256_ps(same)));
+}
+
 #else  // lane by lane
 
 struct Mask8 {
@@ -246,6 +253,11 @@ inline void compress_store_lane_indices(std::uint32_t* out, std::uint32_t base, 
   for (int i = 0; i < 8; ++i) {
     if (mask >> i & 1u) out[n++] = base + static_cast<std::uint32_t>(i);
   }
+}
+inline std::uint32_t lanes_equal(const std::uint32_t* values, std::uint32_t value) {
+  std::uint32_t bits = 0;
+  for (int i = 0; i < 8; ++i) bits |= values[i] == value ? 1u << i : 0u;
+  return bits;
 }
 
 #endif
