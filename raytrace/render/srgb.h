@@ -22,9 +22,11 @@ namespace sinew::rt {
 // where the exact value lies within 0.001 of a half step
 // (Srgb.BytesAreTheCorrectlyRoundedCurveButAtHalfSteps checks that against
 // the curve in double). The 0.5 added rounds by truncation. Lanes not > 0
-// (NaN too) give 0; lanes above 1 give 255. It replaced c^(1/4) by two
-// square roots and a polynomial in that: the square roots' throughput was
-// most of the encoding's cost.
+// (NaN too) give 0; lanes above 1 give 255 (a value of at most 255.5005).
+// It replaced c^(1/4) by two square roots and a polynomial in that: the
+// square roots' throughput was most of the encoding's cost. Each of its
+// operations counts: it is a third of the shading (docs/RAYTRACE.md,
+// "Shading").
 inline constexpr float kSrgbScale[16] = {  // 255 * 1.055 * 2^(e/2.4), e = -9 .. 0
     19.9954033f, 26.6906605f, 35.627758f, 47.5573502f, 63.4814453f, 84.7375641f, 113.111076f, 150.985184f,
     201.541031f, 269.024994f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
@@ -35,7 +37,12 @@ inline constexpr float kSrgbOffset = -255.0f * 0.055f + 0.5f;
 
 // Each lane's byte plus a fraction (truncate to get the byte).
 inline Float8 srgb_steps(Float8 linear) {
+#if SINEW_FLOAT8_AVX2
+  // maxps takes its second operand, zero, where the first is NaN.
+  const Float8 c = min(Float8{_mm256_max_ps(linear.v, _mm256_setzero_ps())}, Float8(1.0f));
+#else
   const Float8 c = min(select(linear > Float8(0.0f), linear, Float8(0.0f)), Float8(1.0f));
+#endif
   const Float8 toe = c * Float8(12.92f * 255.0f) + Float8(0.5f);
 #if SINEW_FLOAT8_AVX2
   const __m256i bits = _mm256_castps_si256(max(c, Float8(kSrgbToe)).v);
@@ -45,8 +52,8 @@ inline Float8 srgb_steps(Float8 linear) {
       _mm256_or_si256(_mm256_and_si256(bits, _mm256_set1_epi32(0x007FFFFF)), _mm256_set1_epi32(0x3F800000)))};
   const __m256 low = _mm256_permutevar8x32_ps(_mm256_loadu_ps(kSrgbScale), index);
   const __m256 high = _mm256_permutevar8x32_ps(_mm256_loadu_ps(kSrgbScale + 8), index);
-  const Float8 scale{
-      _mm256_blendv_ps(low, high, _mm256_castsi256_ps(_mm256_cmpgt_epi32(index, _mm256_set1_epi32(7))))};
+  // The index is 0 to 9: its bit 3, shifted into the sign, picks the table.
+  const Float8 scale{_mm256_blendv_ps(low, high, _mm256_castsi256_ps(_mm256_slli_epi32(index, 28)))};
   const Float8 t = m - Float8(1.0f);
 #else
   const Float8 scale = Float8::map([&](int i) {
@@ -65,7 +72,9 @@ inline Float8 srgb_steps(Float8 linear) {
   const Float8 p45 = fused_multiply_add(Float8(kSrgbM[5]), t, Float8(kSrgbM[4]));
   const Float8 root = fused_multiply_add(fused_multiply_add(p45, t2, p23), t2, p01);
   const Float8 curve = fused_multiply_add(scale, root, Float8(kSrgbOffset));
-  return min(select(c <= Float8(kSrgbToe), toe, curve), Float8(255.5f));
+  // At c = 1 the curve is 255.5005 (under 256, so no clamp: it truncates
+  // to 255).
+  return select(c <= Float8(kSrgbToe), toe, curve);
 }
 inline std::uint8_t srgb_byte(float linear) {
   alignas(32) std::int32_t steps[8];

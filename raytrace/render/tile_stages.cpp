@@ -33,7 +33,7 @@ constexpr float gamma(int n) {
 }
 
 // Eight RGBA8 pixels, R in the low byte, alpha 255.
-void srgb_pixels(const Vec3x8& linear, std::uint32_t* out) {
+[[gnu::always_inline]] inline void srgb_pixels(const Vec3x8& linear, std::uint32_t* out) {
 #if SINEW_FLOAT8_AVX2
   const auto bytes = [](Float8 x) { return _mm256_cvttps_epi32(srgb_steps(x).v); };
   const __m256i rgba = _mm256_or_si256(
@@ -970,10 +970,98 @@ std::uint64_t trace_shadow_rays(const Scene& scene, TriangleTest test, int packe
   return blocked_count;
 }
 
+namespace {
+
+// A light's terms for the shading, eight lanes wide, made once per tile.
+struct LightTerms {
+  bool point;
+  Vec3x8 at;  // the position (point) or the direction (directional)
+  Vec3x8 color;
+};
+
+// The linear colour of block b's hits: the arithmetic of shade_and_write's
+// general path, in the same order (the images are the same bit for bit).
+Vec3x8 block_color(const RenderSettings& settings, std::span<const LightTerms> lights, const TileScratch& s,
+                   std::size_t b, std::uint32_t hits) {
+  const std::size_t k0 = b * kBlockLanes;
+  const Vec3x8 position = load3(s.px, s.py, s.pz, k0);
+  const Vec3x8 n = load3(s.nx, s.ny, s.nz, k0);
+  Vec3x8 radiance{Float8(settings.ambient.x), Float8(settings.ambient.y), Float8(settings.ambient.z)};
+  for (std::size_t l = 0; l < lights.size(); ++l) {
+    const std::uint32_t lit_bits = lane_bits(&s.lit[k0], static_cast<int>(l)) & hits;
+    if (lit_bits == 0) continue;
+    const LightTerms& light = lights[l];
+    const Vec3x8 to_light = light.point ? light.at - position : light.at;
+    const Float8 cosine = select(Mask8::from_bits(lit_bits),
+                                 max(dot(n, to_light) / sqrt(dot(to_light, to_light)), Float8(0.0f)), Float8(0.0f));
+    radiance = radiance + Vec3x8{light.color.x * cosine, light.color.y * cosine, light.color.z * cosine};
+  }
+  return {Float8::load(&s.ar[k0]) * radiance.x, Float8::load(&s.ag[k0]) * radiance.y,
+          Float8::load(&s.ab[k0]) * radiance.z};
+}
+
+// Colour alone, the output a game asks for: each block's two rows go from
+// the register to the plane, whose base and pitch sit in locals (stores
+// through a plane's bytes could otherwise alias every field the loop reads,
+// and each would be loaded again after every store).
+void shade_rgba8_only(const RenderSettings& settings, std::span<const Light> lights,
+                      const OutputPlane<std::uint8_t>& plane, TileScratch& s) {
+  std::array<LightTerms, kMaxLights> terms;
+  for (std::size_t l = 0; l < lights.size(); ++l) {
+    const Light& light = lights[l];
+    const bool point = light.kind == Light::Kind::kPoint;
+    const Vec3 at = point ? light.position : light.direction;
+    terms[l] = {point, {Float8(at.x), Float8(at.y), Float8(at.z)},
+                {Float8(light.color.x), Float8(light.color.y), Float8(light.color.z)}};
+  }
+  const std::span<const LightTerms> shading_lights(terms.data(), lights.size());
+  std::byte* const base = plane.base;
+  const std::size_t pitch = plane.pitch;
+  const int x0 = plane.x0, y0 = plane.y0;
+  std::uint32_t background;
+  const std::array<std::uint8_t, 4> background_bytes = {srgb_byte(settings.background.x),
+                                                         srgb_byte(settings.background.y),
+                                                         srgb_byte(settings.background.z), 255};
+  std::memcpy(&background, background_bytes.data(), 4);
+  std::uint32_t background_row[kBlockWidth];
+  for (std::uint32_t& pixel : background_row) pixel = background;
+  const std::size_t blocks = s.lanes / kBlockLanes;
+  for (std::size_t b = 0; b < blocks; ++b) {
+    const std::uint32_t pixels = s.block_pixels[b];
+    const std::uint32_t hits = s.block_hits[b];
+    std::byte* const row0 = base + static_cast<std::size_t>(s.block_y0(b) - y0) * pitch +
+                            static_cast<std::size_t>(s.block_x0(b) - x0) * 4;
+    alignas(32) std::uint32_t rgba[kBlockLanes];
+    if (hits != 0) srgb_pixels(block_color(settings, shading_lights, s, b, hits), rgba);
+    if (pixels == 0xFFu && (hits == 0xFFu || hits == 0u)) {
+      const std::uint32_t* const source = hits != 0 ? rgba : nullptr;
+      for (int row = 0; row < kBlockHeight; ++row) {
+        std::memcpy(row0 + static_cast<std::size_t>(row) * pitch,
+                    source ? source + row * kBlockWidth : background_row, sizeof(background_row));
+      }
+      continue;
+    }
+    for (std::uint32_t m = pixels; m != 0; m &= m - 1) {
+      const int lane = std::countr_zero(m);
+      std::byte* const pixel = row0 + static_cast<std::size_t>(lane / kBlockWidth) * pitch +
+                               static_cast<std::size_t>(lane % kBlockWidth) * 4;
+      std::memcpy(pixel, hits >> lane & 1u ? &rgba[lane] : &background, 4);
+    }
+  }
+}
+
+}  // namespace
+
 void shade_and_write(const RenderSettings& settings, std::span<const Light> lights, const OutputPlanes& host,
                      TileScratch& s) {
   // Written to the tile's staging planes, stored to the host's at the end.
   const OutputPlanes& out = s.staging.stage(host, s.tile);
+  if (host.rgba8.wanted() && !host.rgba32f.wanted() && !host.depth.wanted() && !host.normal.wanted() &&
+      !host.triangle.wanted() && !host.instance.wanted()) {
+    shade_rgba8_only(settings, lights, out.rgba8, s);
+    s.staging.flush(host);
+    return;
+  }
   const std::size_t blocks = s.lanes / kBlockLanes;
   const bool want_color = out.want_color();
   const std::array<std::uint8_t, 4> background_bytes = {srgb_byte(settings.background.x),

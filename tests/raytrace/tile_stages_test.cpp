@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <memory>
 #include <random>
@@ -1401,6 +1402,63 @@ TEST(Renderer, StagedAndInPlaceOutputsHoldTheSameBytes) {
         ASSERT_TRUE(std::equal(row.begin(), row.end(),
                                reinterpret_cast<const std::byte*>(packed.triangle.data() + y * w)))
             << "row " << y;
+      }
+    }
+  }
+}
+
+// Colour alone (a game's frame) takes its own path through the shading
+// (shade_rgba8_only, render/tile_stages.cpp); its bytes must be those of a
+// render that asks for every output, staged or in place, with partial
+// blocks at the image's edges and lights of both kinds.
+TEST(Renderer, ColourAloneHoldsTheBytesOfARenderOfEveryOutput) {
+  const rt::Scene& sc = scene();
+  JobSystem jobs(2);
+  const rt::CameraDesc desc{Vec3(0.5f, 1.4f, 3.0f), Vec3(0.0f, 0.9f, 0.0f), Vec3(0, 1, 0), 45.0f};
+  rt::Light lights[2];
+  lights[0].position = Vec3(-2.0f, 5.0f, 3.0f);
+  lights[0].color = Vec3(0.9f, 0.6f, 0.3f);
+  lights[1].kind = rt::Light::Kind::kDirectional;
+  lights[1].direction = Vec3(0.5f, 1.0f, -0.2f);
+  lights[1].color = Vec3(0.2f, 0.3f, 0.5f);
+  for (const auto& [w, h] : {std::pair{37, 23}, std::pair{64, 40}}) {
+    const auto camera = rt::PinholeCamera::create(desc, w, h).value();
+    const std::size_t row_bytes = 4 * static_cast<std::size_t>(w);
+    for (const std::size_t light_count : {std::size_t{1}, std::size_t{2}}) {
+      for (const int tile : {5, 16, 32}) {
+        rt::RenderSettings settings;
+        settings.tile_size = tile;
+        settings.lights = std::span<const rt::Light>(lights, light_count);
+        HostFrame every(w, h, 64, 0, 0);
+        rt::Renderer renderer;
+        ASSERT_TRUE(renderer.render(sc, camera, settings, every.buffers, jobs).ok());
+        std::size_t on_character = 0;
+        for (int y = 0; y < h; ++y) {
+          const auto ids = every.row(5, y, row_bytes);
+          for (int x = 0; x < w; ++x) {
+            std::uint32_t id;
+            std::memcpy(&id, ids.data() + 4 * x, 4);
+            on_character += id < 2 ? 1 : 0;
+          }
+        }
+        EXPECT_GT(on_character, static_cast<std::size_t>(w * h / 20));
+        // Staged (rows on lines) and in place (rows 4 bytes past a line).
+        for (const auto& [align, offset] : {std::pair<std::size_t, std::size_t>{64, 0}, {4, 4}}) {
+          HostPlane color(offset, (row_bytes + align - 1) / align * align, h);
+          rt::FrameBuffers only;
+          only.width = w;
+          only.height = h;
+          only.color_rgba8 = color.span<std::uint8_t>();
+          only.row_pitch.color_rgba8 = color.pitch;
+          ASSERT_TRUE(renderer.render(sc, camera, settings, only, jobs).ok());
+          for (int y = 0; y < h; ++y) {
+            const auto reference = every.row(0, y, row_bytes);
+            const std::byte* row = color.bytes.data() + offset + static_cast<std::size_t>(y) * color.pitch;
+            ASSERT_TRUE(std::equal(reference.begin(), reference.end(), row))
+                << "row " << y << " tile " << tile << " " << w << "x" << h << ", " << light_count << " lights";
+            for (std::size_t i = row_bytes; i < color.pitch; ++i) ASSERT_EQ(row[i], std::byte{0xA5});
+          }
+        }
       }
     }
   }
