@@ -26,7 +26,7 @@ namespace sinew::rt {
 // It replaced c^(1/4) by two square roots and a polynomial in that: the
 // square roots' throughput was most of the encoding's cost. Each of its
 // operations counts: it is a third of the shading (docs/RAYTRACE.md,
-// "Shading").
+// "Renderer", sRGB bytes).
 inline constexpr float kSrgbScale[16] = {  // 255 * 1.055 * 2^(e/2.4), e = -9 .. 0
     19.9954033f, 26.6906605f, 35.627758f, 47.5573502f, 63.4814453f, 84.7375641f, 113.111076f, 150.985184f,
     201.541031f, 269.024994f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f};

@@ -52,6 +52,11 @@ struct TileScratch {
   std::vector<float> ar, ag, ab;     // albedo
   std::vector<float> error;          // rounding bound of the position, every axis
   std::vector<std::uint8_t> lit;     // bit l: light l reaches the hit
+  // A colour-only frame's shading (render/tile_stages.h shade_and_write):
+  // the linear colour of each hit, and its RGBA8 pixel, encoded sixteen
+  // lanes at a time (render/srgb_encode.h).
+  std::vector<float> lr, lg, lb;
+  std::vector<std::uint32_t> rgba8;
   // This light's shadow rays as placed, lane by lane (render/tile_stages.h
   // place_shadow_rays): per block the lanes with a ray, and per lane the
   // ray's direction (a point light's, from shadow_origin) or its origin (a
@@ -87,7 +92,7 @@ struct TileScratch {
   // Lays out `area`'s pixels in regions of region_blocks_x by
   // region_blocks_y blocks (clipped at the tile's edges) and sizes every
   // array (padded to whole groups, plus one group of slack for the shadow
-  // rays' unaligned groups).
+  // rays' unaligned groups, and the sRGB encoding's pairs of blocks).
   void prepare(const Tile& area, int region_blocks_x = 1, int region_blocks_y = 1);
 
   std::size_t blocks() const { return lanes / kBlockLanes; }

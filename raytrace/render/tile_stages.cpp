@@ -17,6 +17,7 @@
 #include "raytrace/render/packet_traversal.h"
 #include "raytrace/render/ray_bound.h"
 #include "raytrace/render/srgb.h"
+#include "raytrace/render/srgb_encode.h"
 #include "raytrace/render/traversal.h"
 #include "raytrace/render/traversal_shared.h"
 #include "runtime/math/float8.h"
@@ -303,16 +304,19 @@ void TileScratch::prepare(const Tile& area, int region_blocks_x, int region_bloc
     block_dy.resize(blocks);
   }
   // One spare group: a region's shadow rays start anywhere in the compacted
-  // arrays and are read a whole group at a time.
+  // arrays and are read a whole group at a time, and the sRGB encoding
+  // reads and writes pairs of blocks.
+  static_assert(kSrgbEncodeLanes == 2 * kBlockLanes);
   const std::size_t arrays = lanes + kBlockLanes;
   if (capacity_ < arrays) {
     for (std::vector<float>* a : {&dir_x, &dir_y, &dir_z, &t, &u, &v, &px, &py, &pz, &gx, &gy, &gz, &nx, &ny,
                                   &nz, &ar, &ag, &ab, &error, &so_x, &so_y, &so_z, &sd_x, &sd_y, &sd_z, &s_tmax,
-                                  &shadow_lane_x, &shadow_lane_y, &shadow_lane_z}) {
+                                  &shadow_lane_x, &shadow_lane_y, &shadow_lane_z, &lr, &lg, &lb}) {
       a->resize(arrays);
     }
     triangle.resize(arrays);
     instance.resize(arrays);
+    rgba8.resize(arrays);
     lit.resize(arrays);
     shadow_pixel.resize(arrays);
     capacity_ = arrays;
@@ -1000,10 +1004,12 @@ Vec3x8 block_color(const RenderSettings& settings, std::span<const LightTerms> l
           Float8::load(&s.ab[k0]) * radiance.z};
 }
 
-// Colour alone, the output a game asks for: each block's two rows go from
-// the register to the plane, whose base and pitch sit in locals (stores
-// through a plane's bytes could otherwise alias every field the loop reads,
-// and each would be loaded again after every store).
+// Colour alone, the output a game asks for, in three passes: the blocks'
+// linear colours, their sRGB bytes sixteen lanes at a time where the CPU
+// has AVX-512 (render/srgb_encode.h), and the rows. The plane's base and
+// pitch sit in locals: stores through a plane's bytes could otherwise alias
+// every field the loop reads, and each would be loaded again after every
+// store.
 void shade_rgba8_only(const RenderSettings& settings, std::span<const Light> lights,
                       const OutputPlane<std::uint8_t>& plane, TileScratch& s) {
   std::array<LightTerms, kMaxLights> terms;
@@ -1027,12 +1033,35 @@ void shade_rgba8_only(const RenderSettings& settings, std::span<const Light> lig
   for (std::uint32_t& pixel : background_row) pixel = background;
   const std::size_t blocks = s.lanes / kBlockLanes;
   for (std::size_t b = 0; b < blocks; ++b) {
+    const std::uint32_t hits = s.block_hits[b];
+    if (hits == 0) continue;
+    const Vec3x8 color = block_color(settings, shading_lights, s, b, hits);
+    const std::size_t k0 = b * kBlockLanes;
+    color.x.store(&s.lr[k0]);
+    color.y.store(&s.lg[k0]);
+    color.z.store(&s.lb[k0]);
+  }
+  // Encoded a pair of blocks at a time, in runs of pairs with a hit (the
+  // lanes without one encode what they held, and are not written).
+  const std::size_t pairs = (blocks + 1) / 2;
+  std::size_t run = 0;
+  for (std::size_t pair = 0; pair <= pairs; ++pair) {
+    if (pair < pairs) {
+      const std::size_t b = 2 * pair;
+      if ((s.block_hits[b] | (b + 1 < blocks ? s.block_hits[b + 1] : 0u)) != 0) continue;
+    }
+    if (pair > run) {
+      const std::size_t k = run * kSrgbEncodeLanes;
+      srgb_encode(&s.lr[k], &s.lg[k], &s.lb[k], &s.rgba8[k], (pair - run) * kSrgbEncodeLanes);
+    }
+    run = pair + 1;
+  }
+  for (std::size_t b = 0; b < blocks; ++b) {
     const std::uint32_t pixels = s.block_pixels[b];
     const std::uint32_t hits = s.block_hits[b];
+    const std::uint32_t* const rgba = &s.rgba8[b * kBlockLanes];
     std::byte* const row0 = base + static_cast<std::size_t>(s.block_y0(b) - y0) * pitch +
                             static_cast<std::size_t>(s.block_x0(b) - x0) * 4;
-    alignas(32) std::uint32_t rgba[kBlockLanes];
-    if (hits != 0) srgb_pixels(block_color(settings, shading_lights, s, b, hits), rgba);
     if (pixels == 0xFFu && (hits == 0xFFu || hits == 0u)) {
       const std::uint32_t* const source = hits != 0 ? rgba : nullptr;
       for (int row = 0; row < kBlockHeight; ++row) {

@@ -1,15 +1,18 @@
 // The sRGB encoding (render/srgb.h) against IEC 61966-2-1's curve in
 // double: every 97th float of [0, 1] gets the correctly rounded byte, or one
 // step off only where the exact value lies within 0.001 of a half step; the
-// toe, the clamps and NaN.
+// toe, the clamps and NaN. The many-pixel encoder (render/srgb_encode.h)
+// gives those bytes on each of its paths.
 #include <gtest/gtest.h>
 
 #include <bit>
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <vector>
 
 #include "raytrace/render/srgb.h"
+#include "raytrace/render/srgb_encode.h"
 
 namespace sinew {
 namespace {
@@ -52,6 +55,78 @@ TEST(Srgb, ClampsAndTheToe) {
   EXPECT_EQ(rt::srgb_byte(0.002f), 7);
   // On the curve: 255 * (1.055 * 0.2^(1/2.4) - 0.055) = 123.55 -> 124.
   EXPECT_EQ(rt::srgb_byte(0.2f), 124);
+}
+
+// Channel values the encoder must handle: every 4099th float of [0, 1] (its
+// toe and curve, with denormals), the edges, values past the clamps, NaN
+// and infinities, padded to whole groups of sixteen.
+std::vector<float> encoder_inputs() {
+  std::vector<float> values;
+  for (std::uint32_t bits = 0; bits <= std::bit_cast<std::uint32_t>(1.0f); bits += 4099) {
+    values.push_back(std::bit_cast<float>(bits));
+  }
+  constexpr float kNaN = std::numeric_limits<float>::quiet_NaN(), kInf = std::numeric_limits<float>::infinity();
+  for (const float c : {0.0f, -0.0f, -1.0f, -kInf, kInf, kNaN, -kNaN, 1.0f, std::nextafter(1.0f, 2.0f), 7.5f,
+                        0.0031308f, std::nextafter(0.0031308f, 0.0f), std::nextafter(0.0031308f, 1.0f), 0.2f,
+                        std::numeric_limits<float>::denorm_min(), std::numeric_limits<float>::max()}) {
+    values.push_back(c);
+  }
+  while (values.size() % rt::kSrgbEncodeLanes != 0) values.push_back(0.5f);
+  return values;
+}
+
+// Pixel i's channels: value i, value i + 1 and value i + 2 (wrapping), so
+// each value lands in every channel and lane position.
+struct EncoderCase {
+  std::vector<float> r, g, b;
+  explicit EncoderCase(const std::vector<float>& v) : r(v), g(v.size()), b(v.size()) {
+    for (std::size_t i = 0; i < v.size(); ++i) {
+      g[i] = v[(i + 1) % v.size()];
+      b[i] = v[(i + 2) % v.size()];
+    }
+  }
+  std::uint32_t expected(std::size_t i) const {
+    return static_cast<std::uint32_t>(rt::srgb_byte(r[i])) | static_cast<std::uint32_t>(rt::srgb_byte(g[i])) << 8 |
+           static_cast<std::uint32_t>(rt::srgb_byte(b[i])) << 16 | 0xFF000000u;
+  }
+};
+
+TEST(SrgbEncode, EightLanesGiveTheBytesOfTheCurve) {
+  const EncoderCase c(encoder_inputs());
+  std::vector<std::uint32_t> rgba(c.r.size(), 0u);
+  rt::srgb_encode_8(c.r.data(), c.g.data(), c.b.data(), rgba.data(), rgba.size());
+  for (std::size_t i = 0; i < rgba.size(); ++i) ASSERT_EQ(rgba[i], c.expected(i)) << "pixel " << i << " r " << c.r[i];
+  EXPECT_GT(rgba.size(), 250'000u);
+}
+
+// Skipped on CPUs without AVX-512 (srgb_encode never takes this path there).
+TEST(SrgbEncode, SixteenLanesGiveTheBytesOfEightLanesBitForBit) {
+  if (!rt::srgb_encode_16_available()) GTEST_SKIP() << "this CPU has no AVX-512F";
+  const EncoderCase c(encoder_inputs());
+  std::vector<std::uint32_t> eight(c.r.size(), 0u), sixteen(c.r.size(), 0u);
+  rt::srgb_encode_8(c.r.data(), c.g.data(), c.b.data(), eight.data(), eight.size());
+  rt::srgb_encode_16(c.r.data(), c.g.data(), c.b.data(), sixteen.data(), sixteen.size());
+  for (std::size_t i = 0; i < eight.size(); ++i) {
+    ASSERT_EQ(sixteen[i], eight[i]) << "pixel " << i << " r " << c.r[i] << " g " << c.g[i] << " b " << c.b[i];
+  }
+  EXPECT_STREQ(rt::srgb_encode_path(), "avx512");
+}
+
+// The encoder writes exactly count pixels, from any starting lane.
+TEST(SrgbEncode, WritesCountPixelsAndNoMore) {
+  const EncoderCase c(encoder_inputs());
+  for (const std::size_t offset : {std::size_t{0}, std::size_t{8}, std::size_t{5}}) {
+    std::vector<std::uint32_t> rgba(offset + 3 * rt::kSrgbEncodeLanes, 0xA5A5A5A5u);
+    rt::srgb_encode(c.r.data() + offset, c.g.data() + offset, c.b.data() + offset, rgba.data() + offset,
+                    2 * rt::kSrgbEncodeLanes);
+    for (std::size_t i = 0; i < rgba.size(); ++i) {
+      if (i < offset || i >= offset + 2 * rt::kSrgbEncodeLanes) {
+        ASSERT_EQ(rgba[i], 0xA5A5A5A5u) << i;
+      } else {
+        ASSERT_EQ(rgba[i], c.expected(i)) << i;
+      }
+    }
+  }
 }
 
 }  // namespace
