@@ -346,15 +346,30 @@ void TileScratch::prepare(const Tile& area, int region_blocks_x, int region_bloc
 }
 
 void generate_camera_rays(const PinholeCamera& camera, TileScratch& s) {
-  const Float8 lane = Float8::lane_index();
-  // Lane i sits at (i % 4, i / 4) in its block: (0,1,2,3,0,1,2,3), (0,0,0,0,1,1,1,1).
-  const Float8 lane_x = lane - Float8(4.0f) * select(lane >= Float8(4.0f), Float8(1.0f), Float8(0.0f));
-  const Float8 lane_y = select(lane >= Float8(4.0f), Float8(1.0f), Float8(0.0f));
-  for (std::size_t k = 0; k < s.lanes; k += kBlockLanes) {
-    // Pixel centres (integer + 0.5, exact in float), as PinholeCamera::ray.
-    const Float8 x = Float8(static_cast<float>(s.pixel_x(k))) + lane_x + Float8(0.5f);
-    const Float8 y = Float8(static_cast<float>(s.pixel_y(k))) + lane_y + Float8(0.5f);
-    store3(camera.directions_at(x, y), s.dir_x, s.dir_y, s.dir_z, k);
+  // Each column's and each row's offset once per tile (pixel centres,
+  // integer + 0.5, exact in float, as PinholeCamera::ray), out to the
+  // blocks' edges.
+  thread_local std::vector<float> columns, rows;
+  columns.resize(static_cast<std::size_t>(s.blocks_x) * kBlockWidth);
+  rows.resize(static_cast<std::size_t>(s.blocks_y) * kBlockHeight);
+  for (std::size_t i = 0; i < columns.size(); ++i) {
+    columns[i] = camera.right_offset(static_cast<float>(s.tile.x0 + static_cast<int>(i)) + 0.5f);
+  }
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    rows[i] = camera.up_offset(static_cast<float>(s.tile.y0 + static_cast<int>(i)) + 0.5f);
+  }
+  for (std::size_t b = 0; b < s.blocks(); ++b) {
+    // Lane i sits at (i % 4, i / 4) in its block.
+    const float* const a = &columns[static_cast<std::size_t>(s.block_dx[b])];
+    const float* const r = &rows[static_cast<std::size_t>(s.block_dy[b])];
+#if SINEW_FLOAT8_AVX2
+    const Float8 right{_mm256_broadcast_ps(reinterpret_cast<const __m128*>(a))};
+    const Float8 up{_mm256_insertf128_ps(_mm256_set1_ps(r[0]), _mm_set1_ps(r[1]), 1)};
+#else
+    const Float8 right = Float8::map([&](int i) { return a[i % kBlockWidth]; });
+    const Float8 up = Float8::map([&](int i) { return r[i / kBlockWidth]; });
+#endif
+    store3(camera.directions_from(right, up), s.dir_x, s.dir_y, s.dir_z, b * kBlockLanes);
   }
 }
 
