@@ -83,19 +83,32 @@ class GridFrusta {
     rows_ = rows;
     // Outside: n . (p - apex) > 0. Lanes without slopes (no lane in their
     // column or row) keep zero normals, which never cut.
-    for (Planes* p : {&column_hi_, &column_lo_, &row_hi_, &row_lo_}) *p = Planes{};
+    for (Planes* p : {&column_hi_, &column_lo_, &row_hi_, &row_lo_, &outer_}) *p = Planes{};
     const auto grow = [](float s) { return 0x1.0p-16f * (1.0f + std::fabs(s)); };
+    float a_min = big, a_max = -big, b_min = big, b_max = -big;
     for (int i = 0; i < columns; ++i) {
       const float lo = reduce_min(a_lo[i]), hi = reduce_max(a_hi[i]);
       if (lo > hi) continue;
       column_hi_.set(i, u - (hi + grow(hi)) * c);
       column_lo_.set(i, (lo - grow(lo)) * c - u);
+      a_min = std::min(a_min, lo);
+      a_max = std::max(a_max, hi);
     }
     for (int i = 0; i < rows; ++i) {
       const float lo = reduce_min(b_lo[i]), hi = reduce_max(b_hi[i]);
       if (lo > hi) continue;
       row_hi_.set(i, v - (hi + grow(hi)) * c);
       row_lo_.set(i, (lo - grow(lo)) * c - v);
+      b_min = std::min(b_min, lo);
+      b_max = std::max(b_max, hi);
+    }
+    // The whole packet's four sides, the same planes at its extreme slopes
+    // (none without a lane).
+    if (a_min <= a_max && b_min <= b_max) {
+      outer_.set(0, u - (a_max + grow(a_max)) * c);
+      outer_.set(1, (a_min - grow(a_min)) * c - u);
+      outer_.set(2, v - (b_max + grow(b_max)) * c);
+      outer_.set(3, (b_min - grow(b_min)) * c - v);
     }
     on_ = true;
     return true;
@@ -132,12 +145,15 @@ class GridFrusta {
  private:
   // nearest(n) is the shape's least signed distance to each of eight
   // planes; a plane cuts it off beyond the margin for coordinates up to
-  // `corners`.
+  // `corners`. The packet's own sides first: most shapes a packet's walk
+  // meets lie outside it (two in three of the triangles of Cally's leaves
+  // at 213,888 triangles), and one evaluation settles them instead of four.
   template <class Nearest>
   std::uint64_t uncut(std::uint64_t groups, float corners, Nearest&& nearest) const {
     if (!on_) return groups;
     const Float8 margin(0x1.0p-12f * (corners + apex_magnitude_));
     const auto cut = [&](const Planes& p) { return (nearest(p.n) > Float8::load(p.scale) * margin).bits(); };
+    if (cut(outer_) != 0) return 0;
     const std::uint64_t columns = ~(cut(column_hi_) | cut(column_lo_)) & ((1u << columns_) - 1u);
     std::uint32_t rows = ~(cut(row_hi_) | cut(row_lo_)) & ((1u << rows_) - 1u);
     std::uint64_t out = 0;
@@ -167,8 +183,8 @@ class GridFrusta {
   int columns_ = 1;
   int rows_ = 1;
   // Lane i: column (row) i's plane on the side of rising slopes (hi) and
-  // on the other side (lo).
-  Planes column_hi_, column_lo_, row_hi_, row_lo_;
+  // on the other side (lo); the packet's sides in lanes 0 to 3 of outer_.
+  Planes column_hi_, column_lo_, row_hi_, row_lo_, outer_;
 };
 
 }  // namespace sinew::rt
