@@ -19,6 +19,7 @@
 #include "runtime/jobs/job_system.h"
 #include "tests/bench/bench_options.h"
 #include "tests/bench/bench_support.h"
+#include "tests/bench/demo_bench.h"
 #include "tests/bench/embree_bench.h"
 #include "tests/bench/paper_bench.h"
 #include "tests/bench/raytrace_bench.h"
@@ -33,7 +34,7 @@ namespace fs = std::filesystem;
 
 // --- options -------------------------------------------------------------------
 
-const std::vector<std::string> kAllSections = {"paper", "embree", "tradeoff", "scaling"};
+const std::vector<std::string> kAllSections = {"paper", "embree", "demo", "tradeoff", "scaling"};
 
 struct Options {
   bool quick = false;
@@ -48,7 +49,7 @@ std::vector<BenchFlag> bench_flags() {
       {"--quick", "", "a smoke run under 5 minutes on 2 cores (default --out build/report-quick)"},
       {"--out", "DIR", "where BENCHMARKS.md, img/ and bench-data/ go (default: the source tree's docs/)"},
       {"--sections", "LIST",
-       "paper,embree,tradeoff,scaling (default all); the other sections are kept\n"
+       "paper,embree,demo,tradeoff,scaling (default all); the other sections are kept\n"
        "from the last report written to the same --out"},
       shared_flag(),
   };
@@ -65,7 +66,7 @@ Status read_options(const BenchArgs& parsed, Options& o) {
     SINEW_ASSIGN_OR_RETURN(o.sections, cli::parse_list("--sections", *text));
     for (const std::string& s : o.sections) {
       if (std::find(kAllSections.begin(), kAllSections.end(), s) == kAllSections.end()) {
-        return invalid_argument("--sections", s, "unknown section (expected paper, embree, tradeoff or scaling)");
+        return invalid_argument("--sections", s, "unknown section (expected paper, embree, demo, tradeoff or scaling)");
       }
     }
   }
@@ -478,7 +479,17 @@ std::string embree_headline(const Run& r, const char* label) {
   return md;
 }
 
-std::string headlines(const Run* paper, const Run* embree_small, const Run* embree_large, const Run* tradeoff) {
+// The demo run's entry for `characters`, or null.
+const Json* demo_count(const Run* demo, int characters) {
+  if (demo == nullptr || !demo->json.contains("counts")) return nullptr;
+  for (const Json& c : demo->json["counts"]) {
+    if (number(c, "characters") == characters) return &c;
+  }
+  return nullptr;
+}
+
+std::string headlines(const Run* paper, const Run* embree_small, const Run* embree_large, const Run* demo,
+                      const Run* tradeoff) {
   std::string md = "## Headlines\n\n";
   if (const Json* row = table2_row(paper, 0)) {
     md += format("- Cally, %s triangles, 1024×1024, primary rays only: **%s fps on 1 thread** (%s on 2); the paper: "
@@ -493,6 +504,14 @@ std::string headlines(const Run* paper, const Run* embree_small, const Run* embr
                           format("Cally subdivided (%s triangles)", thousands(number(embree_large->json, "triangles")).c_str())
                               .c_str());
   }
+  if (const Json* six = demo_count(demo, 6)) {
+    const Json size = demo->json.value("size", Json::array());
+    const std::string pixels = size.size() == 2 ? format("%d×%d", size[0].get<int>(), size[1].get<int>()) : "?";
+    const double threads = number(demo->json, "threads");
+    md += format("- The game demo, 6 characters with shadows, %s, %s thread%s: **%s fps** (%s ms a frame).\n",
+                 pixels.c_str(), cell(threads, 0).c_str(), threads == 1.0 ? "" : "s", cell(number(*six, "fps"), 1).c_str(),
+                 cell(number(*six, "frame_ms"), 1).c_str());
+  }
   if (tradeoff && tradeoff->json.contains("knee")) {
     for (const Json& k : tradeoff->json["knee"]) {
       md += format("- Knee of the speed/accuracy curve, %s pose space: %s samples (%s fps, hole fraction %s).\n",
@@ -501,6 +520,27 @@ std::string headlines(const Run* paper, const Run* embree_small, const Run* embr
     }
   }
   return md + "\n";
+}
+
+// The game demo's frame per character count: fps and the phases that
+// make it (the demo's own session: its arena, characters and camera).
+std::string demo_markdown(const Run& r) {
+  std::string md = "## The game demo\n\n";
+  md += "The demo's own session (`game_demo/`: the arena, the procedural mannequins walking a scripted path, the "
+        "follow camera, one point light with shadow rays), timed frame by frame; fps = 1000 / the sum of the phases' "
+        "per-frame medians. Command: `" + r.command + "`.\n\n";
+  if (!r.json.contains("counts") || r.json["counts"].empty()) return md + failure_line(r) + "\n";
+  md += "| characters | fps | frame ms | trace primary ms | trace shadow ms | shade ms | skinning ms | top level ms |\n"
+        "|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+  for (const Json& c : r.json["counts"]) {
+    const Json phases = c.value("phases_ms", Json::object());
+    md += format("| %s | %s | %s | %s | %s | %s | %s | %s |\n", cell(number(c, "characters"), 0).c_str(),
+                 cell(number(c, "fps"), 1).c_str(), cell(number(c, "frame_ms")).c_str(),
+                 cell(number(phases, "trace primary")).c_str(), cell(number(phases, "trace shadow")).c_str(),
+                 cell(number(phases, "shade")).c_str(), cell(number(phases, "skinning")).c_str(),
+                 cell(number(phases, "top level")).c_str());
+  }
+  return md + failure_line(r) + "\n";
 }
 
 // --- the document ------------------------------------------------------------------------
@@ -541,7 +581,8 @@ std::string document(const Options& o, const Report& report, const std::string& 
         "\n```\n\nThe raw numbers are in `bench-data/*.json` beside this file; each section names the command that "
         "measured it. Earlier, per-issue measurements (animation against Cal3D, the bake's memory bound, the game "
         "demo) are in [MEASUREMENTS.md](MEASUREMENTS.md).\n\n";
-  md += headlines(report.find("paper"), report.find("embree"), report.find("embree-large"), report.find("tradeoff"));
+  md += headlines(report.find("paper"), report.find("embree"), report.find("embree-large"), report.find("demo"),
+                  report.find("tradeoff"));
 
   if (const Run* paper = report.find("paper")) {
     md += pasted_markdown(*paper);
@@ -563,6 +604,7 @@ std::string document(const Options& o, const Report& report, const std::string& 
     if (!plots.embree.empty()) md += "\n![frame time per contender](" + plots.embree + ")\n";
     md += "\n";
   }
+  if (const Run* demo = report.find("demo")) md += demo_markdown(*demo);
   if (const Run* trade = report.find("tradeoff")) {
     md += pasted_markdown(*trade);
     md += failure_line(*trade);
@@ -681,6 +723,13 @@ void run_all(const Options& o, const std::string& data_dir, Report& report) {
                                            "--threads", "1"}
                 : std::vector<std::string>{"--subdivide", "4", "--clips", "walk", "--frames", "8", "--threads", "1,2"};
     report.runs.push_back(run_bench("embree", "embree-large", with_common(large), false, data_dir, run_embree_bench));
+  }
+  if (wanted(o, "demo")) {
+    // The demo takes no --shared: its characters are procedural.
+    const std::vector<std::string> demo =
+        o.quick ? std::vector<std::string>{"--characters", "6", "--frames", "5", "--size", "256x256", "--threads", "1"}
+                : std::vector<std::string>{"--characters", "1,6,12", "--frames", "60", "--threads", "2"};
+    report.runs.push_back(run_bench("demo", "demo", demo, false, data_dir, run_demo_bench));
   }
   if (wanted(o, "tradeoff")) {
     report.runs.push_back(run_bench("tradeoff", "tradeoff",
