@@ -64,9 +64,11 @@ struct TileScratch {
   std::size_t shadow_placed = 0;
   std::vector<std::uint8_t> shadow_lanes;
   std::vector<float> shadow_lane_x, shadow_lane_y, shadow_lane_z;
+  std::vector<float> shadow_push_x, shadow_push_y, shadow_push_z;
   Vec3 shadow_direction{0.0f};
   // Aimed but not placed yet (render/tile_stages.h aim_shadow_rays): the
-  // lanes are chosen, but shadow_lane_* are not written.
+  // lanes are chosen, shadow_lane_* hold the pushed-off points and
+  // shadow_push_* the pushes, which placing turns into the rays.
   bool shadows_aimed_only = false;
   // Aimed rays' ends (a point light's rays' far ends, a directional light's
   // origins) all lie inside; empty after place_shadow_rays, which bounds

@@ -311,7 +311,8 @@ void TileScratch::prepare(const Tile& area, int region_blocks_x, int region_bloc
   if (capacity_ < arrays) {
     for (std::vector<float>* a : {&dir_x, &dir_y, &dir_z, &t, &u, &v, &px, &py, &pz, &gx, &gy, &gz, &nx, &ny,
                                   &nz, &ar, &ag, &ab, &error, &so_x, &so_y, &so_z, &sd_x, &sd_y, &sd_z, &s_tmax,
-                                  &shadow_lane_x, &shadow_lane_y, &shadow_lane_z, &lr, &lg, &lb}) {
+                                  &shadow_lane_x, &shadow_lane_y, &shadow_lane_z, &shadow_push_x,
+                                  &shadow_push_y, &shadow_push_z, &lr, &lg, &lb}) {
       a->resize(arrays);
     }
     triangle.resize(arrays);
@@ -740,7 +741,9 @@ struct ShadowLight {
   void place(TileScratch& s, std::size_t b) const {
     const std::size_t k0 = b * kBlockLanes;
     const Vec3x8 push = offset(s, k0);
-    const Vec3x8 moved = load3(s.px, s.py, s.pz, k0) + push;
+    place_moved(s, k0, load3(s.px, s.py, s.pz, k0) + push, push);
+  }
+  void place_moved(TileScratch& s, std::size_t k0, const Vec3x8& moved, const Vec3x8& push) const {
     const Vec3x8 end{step_away(moved.x, push.x), step_away(moved.y, push.y), step_away(moved.z, push.z)};
     store3(point ? end - at : end, s.shadow_lane_x, s.shadow_lane_y, s.shadow_lane_z, k0);
   }
@@ -769,9 +772,13 @@ void aim_shadow_rays(const Light& light, int l, TileScratch& s) {
     s.shadow_lanes[b] = static_cast<std::uint8_t>(toward);
     if (toward == 0) continue;
     // The moved points of place(), bit for bit (the last step, one float
-    // on, is left to the bound's growth).
+    // on, is left to the bound's growth), kept with their push for
+    // offset_shadow_rays.
     const std::size_t k0 = b * kBlockLanes;
-    const Vec3x8 moved = load3(s.px, s.py, s.pz, k0) + to.offset(s, k0);
+    const Vec3x8 push = to.offset(s, k0);
+    const Vec3x8 moved = load3(s.px, s.py, s.pz, k0) + push;
+    store3(moved, s.shadow_lane_x, s.shadow_lane_y, s.shadow_lane_z, k0);
+    store3(push, s.shadow_push_x, s.shadow_push_y, s.shadow_push_z, k0);
     const Mask8 m = Mask8::from_bits(toward);
     lo = select(m, Vec3x8{min(lo.x, moved.x), min(lo.y, moved.y), min(lo.z, moved.z)}, lo);
     hi = select(m, Vec3x8{max(hi.x, moved.x), max(hi.y, moved.y), max(hi.z, moved.z)}, hi);
@@ -795,7 +802,10 @@ void offset_shadow_rays(TileScratch& s) {
   s.shadows_aimed_only = false;
   const ShadowLight to(s.shadows_from_point, s.shadow_origin, s.shadow_direction, 0);
   for (std::size_t b = 0; b < s.blocks(); ++b) {
-    if (s.shadow_lanes[b] != 0) to.place(s, b);
+    if (s.shadow_lanes[b] == 0) continue;
+    const std::size_t k0 = b * kBlockLanes;
+    to.place_moved(s, k0, load3(s.shadow_lane_x, s.shadow_lane_y, s.shadow_lane_z, k0),
+                   load3(s.shadow_push_x, s.shadow_push_y, s.shadow_push_z, k0));
   }
 }
 
