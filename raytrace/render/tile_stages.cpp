@@ -141,9 +141,9 @@ MeshRefs mesh_refs(const Scene& scene, const Scene::ObjectSlot& slot) {
   return r;
 }
 
-// Each lane's corners, corner normals and albedo, lane by lane (lanes
-// without a hit get a harmless unit triangle). Returns true when every lane
-// hit one triangle, loaded once and broadcast.
+// Each lane's corners, corner normals and albedo (lanes without a hit get a
+// harmless unit triangle). Returns true when every lane hit one triangle,
+// loaded once and broadcast.
 bool gather_lanes(const Scene& scene, const TileScratch& s, std::size_t k0, std::uint32_t hits,
                   const Vec3& default_albedo, float (&p)[3][3][8], float (&n)[3][3][8], float (&albedo)[3][8],
                   std::uint32_t& with_normals, std::uint32_t& on_character) {
@@ -174,43 +174,54 @@ bool gather_lanes(const Scene& scene, const TileScratch& s, std::size_t k0, std:
     for (int a = 0; a < 3; ++a) Float8(color[a]).store(albedo[a]);
     return true;
   }
-    // The mesh behind the last instance seen: neighbouring lanes mostly hit
-    // the same one.
-    std::uint32_t resolved = kInvalidId;
-    MeshRefs mesh;
-    for (int lane = 0; lane < kBlockLanes; ++lane) {
-      const std::size_t k = k0 + static_cast<std::size_t>(lane);
-      Vec3 corner[3] = {Vec3(0.0f), Vec3(1.0f, 0.0f, 0.0f), Vec3(0.0f, 1.0f, 0.0f)};
-      Vec3 normal[3] = {Vec3(0.0f), Vec3(0.0f), Vec3(0.0f)};
-      Vec3 color = default_albedo;
-      if (hits >> lane & 1u) {
-        if (s.instance[k] != resolved) {
-          resolved = s.instance[k];
-          mesh = mesh_refs(scene, slots[resolved]);
-        }
-        const std::uint32_t tri = s.triangle[k];
-        const auto& v = mesh.triangles[tri];
-        if (!mesh.is_static) on_character |= 1u << lane;
-        for (int i = 0; i < 3; ++i) corner[i] = mesh.positions[v[static_cast<std::size_t>(i)]];
-        if (!mesh.normals.empty()) {
-          for (int i = 0; i < 3; ++i) normal[i] = mesh.normals[v[static_cast<std::size_t>(i)]];
-          with_normals |= 1u << lane;
-        }
-        // Characters without per-triangle materials use the default albedo;
-        // static meshes without them use material 0.
-        const std::uint32_t m = tri < mesh.triangle_material.size() ? mesh.triangle_material[tri]
-                                : mesh.is_static                     ? 0u
-                                                                     : kInvalidId;
-        if (m < mesh.material_colors.size()) color = mesh.material_colors[m];
-      }
-      for (int i = 0; i < 3; ++i) {
-        for (int a = 0; a < 3; ++a) {
-          p[i][a][lane] = corner[i][a];
-          n[i][a][lane] = normal[i][a];
-        }
-      }
-      for (int a = 0; a < 3; ++a) albedo[a][lane] = color[a];
+  // Triangle by triangle: a block's lanes mostly hit one to three, so each
+  // distinct triangle's corners, normals and colour are loaded once and
+  // blended into its lanes (lane by lane cost eight scalar stores of
+  // each). Lanes without a hit keep a harmless unit triangle.
+  Float8 pc[3][3], nc[3][3], color[3];
+  for (int i = 0; i < 3; ++i) {
+    for (int a = 0; a < 3; ++a) {
+      pc[i][a] = Float8(i == a + 1 ? 1.0f : 0.0f);
+      nc[i][a] = Float8(0.0f);
     }
+  }
+  for (int a = 0; a < 3; ++a) color[a] = Float8(default_albedo[a]);
+  for (std::uint32_t left = hits; left != 0;) {
+    const std::size_t k = k0 + static_cast<std::size_t>(std::countr_zero(left));
+    const std::uint32_t tri = s.triangle[k], instance = s.instance[k];
+    const std::uint32_t same = lanes_equal(&s.triangle[k0], tri) & lanes_equal(&s.instance[k0], instance) & left;
+    left &= ~same;
+    const Mask8 use = Mask8::from_bits(same);
+    const MeshRefs mesh = mesh_refs(scene, slots[instance]);
+    const auto& v = mesh.triangles[tri];
+    if (!mesh.is_static) on_character |= same;
+    for (int i = 0; i < 3; ++i) {
+      const Vec3& c = mesh.positions[v[static_cast<std::size_t>(i)]];
+      for (int a = 0; a < 3; ++a) pc[i][a] = select(use, Float8(c[a]), pc[i][a]);
+    }
+    if (!mesh.normals.empty()) {
+      for (int i = 0; i < 3; ++i) {
+        const Vec3& nn = mesh.normals[v[static_cast<std::size_t>(i)]];
+        for (int a = 0; a < 3; ++a) nc[i][a] = select(use, Float8(nn[a]), nc[i][a]);
+      }
+      with_normals |= same;
+    }
+    // Characters without per-triangle materials use the default albedo;
+    // static meshes without them use material 0.
+    const std::uint32_t m = tri < mesh.triangle_material.size() ? mesh.triangle_material[tri]
+                            : mesh.is_static                     ? 0u
+                                                                 : kInvalidId;
+    if (m < mesh.material_colors.size()) {
+      for (int a = 0; a < 3; ++a) color[a] = select(use, Float8(mesh.material_colors[m][a]), color[a]);
+    }
+  }
+  for (int i = 0; i < 3; ++i) {
+    for (int a = 0; a < 3; ++a) {
+      pc[i][a].store(p[i][a]);
+      nc[i][a].store(n[i][a]);
+    }
+  }
+  for (int a = 0; a < 3; ++a) color[a].store(albedo[a]);
     return false;
 }
 
@@ -601,9 +612,9 @@ void reconstruct_surfaces(const Scene& scene, const Vec3& default_albedo, TileSc
   // repeat a harmless unit triangle). A whole block on the triangle of the
   // last uniform block (a ground's blocks, mostly) keeps them, and the
   // normal, as they are.
-  alignas(32) float p[3][3][8];  // [corner][axis][lane]
-  alignas(32) float n[3][3][8];
-  alignas(32) float albedo[3][8];
+  alignas(32) float p[3][3][8] = {};  // [corner][axis][lane]
+  alignas(32) float n[3][3][8] = {};
+  alignas(32) float albedo[3][8] = {};
   std::uint32_t with_normals = 0, on_character = 0;
   std::uint32_t kept_triangle = kInvalidId, kept_instance = kInvalidId;
   Vec3x8 kept_geometric{};
