@@ -1159,6 +1159,70 @@ TEST(TileStages, SurfacesAndShadowOriginsAreTheScalarOnes) {
 // directions must hold) lies inside s.shadow_ends, at coordinates from
 // 1e-3 to 1e6, with surfaces at zero too. The bound stays on the lit side
 // of a flat receiver, so a ground in the open is culled.
+// Blocks whose lanes hit several triangles: the same triangle index on
+// both characters and on the ground, lanes that miss between them, in every
+// order. Each block's corners are loaded once per distinct (instance,
+// triangle) and blended into its lanes (render/tile_stages.cpp
+// gather_lanes); every lane must still be surface_at's, bit for bit.
+TEST(TileStages, SurfacesOfBlocksOnSeveralTrianglesAreTheScalarOnes) {
+  const rt::Scene& sc = scene();
+  std::vector<std::uint32_t> characters, statics;
+  for (std::uint32_t id = 0; id < sc.object_slots().size(); ++id) {
+    (sc.object_slots()[id].kind == rt::Scene::ObjectKind::kCharacter ? characters : statics).push_back(id);
+  }
+  ASSERT_GE(characters.size(), 2u);
+  ASSERT_GE(statics.size(), 1u);
+  const auto camera =
+      rt::PinholeCamera::create({Vec3(0.5f, 1.4f, 3.0f), Vec3(0.0f, 0.9f, 0.0f), Vec3(0, 1, 0), 45.0f}, 64, 64)
+          .value();
+  // (instance, triangle) choices: triangle 1 on each object, triangle 2 on
+  // the first character; lanes draw from the first `kinds` of them.
+  const std::array<std::pair<std::uint32_t, std::uint32_t>, 4> choices = {
+      {{characters[0], 1u}, {characters[1], 1u}, {statics[0], 1u}, {characters[0], 2u}}};
+  std::mt19937 g(11);
+  std::size_t checked = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    rt::TileScratch s;
+    s.prepare(Tile{0, 0, 16, 8, 0});
+    rt::generate_camera_rays(camera, s);
+    const std::size_t kinds = 1 + static_cast<std::size_t>(trial % 4);
+    for (std::size_t b = 0; b < s.blocks(); ++b) {
+      std::uint32_t hits = 0;
+      for (int lane = 0; lane < rt::kBlockLanes; ++lane) {
+        const std::size_t k = b * rt::kBlockLanes + static_cast<std::size_t>(lane);
+        const bool miss = trial % 3 == 0 && g() % 4 == 0;
+        const auto [instance, triangle] = choices[g() % kinds];
+        s.t[k] = miss ? kInf : 1.0f + unit(g);
+        s.u[k] = 0.5f * unit(g);
+        s.v[k] = 0.5f * unit(g);
+        s.triangle[k] = miss ? kInvalidId : triangle;
+        s.instance[k] = miss ? kInvalidId : instance;
+        hits |= miss ? 0u : 1u << lane;
+      }
+      s.block_hits[b] = static_cast<std::uint8_t>(hits);
+    }
+    rt::reconstruct_surfaces(sc, Vec3(0.7f), s);
+    for (std::size_t k = 0; k < s.lanes; ++k) {
+      if (!s.hit(k)) continue;
+      const rt::SurfacePoint p = rt::surface_at(sc, Hit{s.t[k], s.u[k], s.v[k], s.triangle[k], s.instance[k]}, Vec3(0.7f));
+      const Vec3 dir(s.dir_x[k], s.dir_y[k], s.dir_z[k]);
+      Vec3 facing = p.geometric_normal;
+      if (glm::dot(facing, dir) > 0.0f) facing = -facing;
+      Vec3 n = p.shading_normal;
+      if (glm::dot(n, facing) < 0.0f) n = -n;
+      ASSERT_EQ(Vec3(s.px[k], s.py[k], s.pz[k]), p.position) << "trial " << trial << " lane " << k;
+      ASSERT_EQ(Vec3(s.gx[k], s.gy[k], s.gz[k]), facing) << "trial " << trial << " lane " << k;
+      ASSERT_EQ(Vec3(s.nx[k], s.ny[k], s.nz[k]), n) << "trial " << trial << " lane " << k;
+      ASSERT_EQ(Vec3(s.ar[k], s.ag[k], s.ab[k]), p.albedo) << "trial " << trial << " lane " << k;
+      ASSERT_EQ(s.error[k], p.error.x) << "trial " << trial << " lane " << k;
+      const bool lane_on_character = (s.block_on_character[k / rt::kBlockLanes] >> (k % rt::kBlockLanes) & 1u) != 0;
+      ASSERT_EQ(lane_on_character, sc.object_slots()[s.instance[k]].kind == rt::Scene::ObjectKind::kCharacter);
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 20000u);
+}
+
 TEST(TileStages, AimedShadowRaysEndInsideTheirBound) {
   std::mt19937 g(7);
   std::size_t checked = 0;
