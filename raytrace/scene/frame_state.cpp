@@ -63,19 +63,20 @@ void update_bone_frames(InstanceFrame& frame, const FuzzyCharacterView& fuzzy) {
 }
 
 void skin_instance(InstanceFrame& frame, const SkinnedMesh& mesh, const FuzzyCharacterView& fuzzy,
-                   bool normals, SkinningPath path, JobSystem& jobs) {
+                   bool normals, bool exact_boxes, SkinningPath path, JobSystem& jobs) {
   frame.positions.resize(mesh.vertex_count());
   frame.normals.resize(normals && !mesh.normals.empty() ? mesh.vertex_count() : 0);
   frame.escaped.resize(fuzzy.vertex_checks.size());
+  frame.chunk_bone_boxes.resize(exact_boxes ? skinning_chunk_count(mesh.vertex_count()) * frame.bone_from_world.size()
+                                            : 0);
   const EscapeCheckInput escape{fuzzy.vertex_check_begin, fuzzy.vertex_checks, frame.bone_from_world,
-                                frame.tolerance};
+                                frame.tolerance, frame.chunk_bone_boxes};
   const SkinningTargets targets{frame.positions, frame.normals, frame.escaped};
   const SkinningResult result = skin_vertices(mesh, frame.skinning, targets, &escape, &jobs, path);
   frame.escaped_checks = result.escaped_checks;
 }
 
-void compute_bone_boxes(InstanceFrame& frame, const FuzzyCharacterView& fuzzy, bool exact,
-                        JobSystem& jobs) {
+void compute_bone_boxes(InstanceFrame& frame, const FuzzyCharacterView& fuzzy, bool exact) {
   const std::size_t bones = frame.skinning.size();
   frame.bone_world_boxes.assign(bones, Aabb::empty());
   if (!exact) {
@@ -87,24 +88,15 @@ void compute_bone_boxes(InstanceFrame& frame, const FuzzyCharacterView& fuzzy, b
     return;
   }
   // The vertex checks list, per vertex, exactly the bones whose triangles use
-  // it: growing each check's bone box by its vertex gives every bone the
-  // bounds of its skinned triangles. Fixed chunks each fill their own row of
-  // boxes, merged in chunk order (deterministic for any thread count).
-  const std::size_t vertices = frame.positions.size();
-  constexpr std::size_t kGrain = 8192;
-  const std::size_t chunks = (vertices + kGrain - 1) / kGrain;
-  std::vector<Aabb> partial(chunks * bones, Aabb::empty());
-  jobs.parallel_for(0, vertices, kGrain, [&](Range range) {
-    Aabb* boxes = partial.data() + (range.begin / kGrain) * bones;
-    for (std::size_t v = range.begin; v < range.end; ++v) {
-      const Vec3& p = frame.positions[v];
-      for (std::uint32_t c = fuzzy.vertex_check_begin[v]; c < fuzzy.vertex_check_begin[v + 1]; ++c) {
-        boxes[fuzzy.vertex_checks[c].bone].extend(p);
-      }
+  // it: the boxes of each check's bone grown by its vertex, gathered per
+  // chunk by the skinning (skin_instance), give every bone the bounds of its
+  // skinned triangles, merged here in chunk order.
+  const std::size_t stride = frame.bone_from_world.size();
+  const std::size_t rows = stride > 0 ? frame.chunk_bone_boxes.size() / stride : 0;
+  for (std::size_t row = 0; row < rows; ++row) {
+    for (std::size_t b = 0; b < std::min(bones, stride); ++b) {
+      frame.bone_world_boxes[b].extend(frame.chunk_bone_boxes[row * stride + b]);
     }
-  });
-  for (std::size_t chunk = 0; chunk < chunks; ++chunk) {
-    for (std::size_t b = 0; b < bones; ++b) frame.bone_world_boxes[b].extend(partial[chunk * bones + b]);
   }
   for (std::size_t b = 0; b < bones; ++b) {
     if (!frame.bone_usable[b]) frame.bone_world_boxes[b] = Aabb::empty();

@@ -41,6 +41,9 @@ struct InstanceFrame {
   std::vector<Vec3> positions;  // skinned, world space
   std::vector<Vec3> normals;    // skinned, world space, not unit length (empty when not asked)
   std::vector<std::uint8_t> escaped;  // per vertex check: 1 = outside its fuzzy box
+  // Exact bone boxes: per skinning chunk and bone, the box of its checked
+  // vertices (EscapeCheckInput::chunk_bone_boxes), merged by compute_bone_boxes.
+  std::vector<Aabb> chunk_bone_boxes;
 
   std::vector<std::uint32_t> escaped_triangles;  // triangle ids routed through the fallback
   KdTree fallback;  // world-space tree; items index escaped_triangles
@@ -55,14 +58,15 @@ inline constexpr float kFrameRelativeSlack = 8.0f * 0x1.0p-24f;
 // Inverses, usable flags and escape tolerances from `skinning`.
 void update_bone_frames(InstanceFrame& frame, const FuzzyCharacterView& fuzzy);
 
-// Skins positions (and normals) and runs the escape check.
+// Skins positions (and normals) and runs the escape check; with
+// `exact_boxes`, it also gathers the bone boxes compute_bone_boxes merges.
 void skin_instance(InstanceFrame& frame, const SkinnedMesh& mesh, const FuzzyCharacterView& fuzzy,
-                   bool normals, SkinningPath path, JobSystem& jobs);
+                   bool normals, bool exact_boxes, SkinningPath path, JobSystem& jobs);
 
-// Per bone world boxes: exact (union of the bone's skinned vertices) or
-// cheap (the fuzzy root box, grown by the tolerance, carried by the bone matrix).
-void compute_bone_boxes(InstanceFrame& frame, const FuzzyCharacterView& fuzzy, bool exact,
-                        JobSystem& jobs);
+// Per bone world boxes: exact (union of the bone's skinned vertices, from
+// the boxes skin_instance gathered with exact_boxes) or cheap (the fuzzy
+// root box, grown by the tolerance, carried by the bone matrix).
+void compute_bone_boxes(InstanceFrame& frame, const FuzzyCharacterView& fuzzy, bool exact);
 
 // Collects triangles with an escaped corner (or on a singular bone) and
 // builds the world-space fallback tree over them.

@@ -121,11 +121,12 @@ Expected<FrameStats> Scene::prepare_frame(const FrameOptions& options, JobSystem
     const Character& character = characters_[frame.character];
     auto start = std::chrono::steady_clock::now();
     update_bone_frames(frame, character.fuzzy);
-    skin_instance(frame, *character.mesh, character.fuzzy, options.normals, options.skinning, jobs);
+    skin_instance(frame, *character.mesh, character.fuzzy, options.normals, options.bone_boxes == BoneBoxMode::kExact,
+                  options.skinning, jobs);
     skinning_ms += ms_since(start);
 
     start = std::chrono::steady_clock::now();
-    compute_bone_boxes(frame, character.fuzzy, options.bone_boxes == BoneBoxMode::kExact, jobs);
+    compute_bone_boxes(frame, character.fuzzy, options.bone_boxes == BoneBoxMode::kExact);
     boxes_ms += ms_since(start);
 
     start = std::chrono::steady_clock::now();

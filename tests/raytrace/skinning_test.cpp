@@ -247,7 +247,7 @@ struct RandomChecks {
   std::vector<Affine3> bone_from_world;
   std::vector<float> tolerance;
   std::vector<std::uint8_t> expected;
-  EscapeCheckInput input() const { return {begin, checks, bone_from_world, tolerance}; }
+  EscapeCheckInput input() const { return {begin, checks, bone_from_world, tolerance, {}}; }
 };
 
 RandomChecks random_checks(std::mt19937& rng, const SkinnedMesh& mesh, const std::vector<Affine3>& bones,
@@ -388,7 +388,7 @@ SkinnedMesh one_vertex_mesh(const HandBuiltScene& s, const Vec3& p) {
 TEST(SkinningEscape, HandBuiltChecks) {
   const HandBuiltScene s = hand_built_scene();
   ASSERT_FALSE(is_finite(s.bone_from_world[3]));  // the premise of the zero-scale cases
-  const EscapeCheckInput escape{s.begin, s.checks, s.bone_from_world, s.tolerance};
+  const EscapeCheckInput escape{s.begin, s.checks, s.bone_from_world, s.tolerance, {}};
   JobSystem two(2);
   for (const SkinningPath path : available_paths()) {
     for (JobSystem* jobs : {static_cast<JobSystem*>(nullptr), &two}) {
@@ -412,7 +412,7 @@ TEST(SkinningEscape, ToleranceIsPerBone) {
                                   check_of(2, in_bone2 + Vec3(0.1f, -0.5f, -0.5f), in_bone2 + 0.5f)};
   std::vector<std::uint32_t> begin{0, 2};
   const SkinnedMesh mesh = one_vertex_mesh(s, p);
-  const EscapeCheckInput escape{begin, checks, s.bone_from_world, s.tolerance};
+  const EscapeCheckInput escape{begin, checks, s.bone_from_world, s.tolerance, {}};
   const Skinned out = run_skinning(mesh, s.bones, SkinningPath::kAuto, nullptr, false, &escape);
   EXPECT_EQ(out.escaped, (std::vector<std::uint8_t>{1, 0}));
   EXPECT_EQ(out.result.escaped_checks, 1u);
@@ -425,10 +425,80 @@ TEST(SkinningEscape, BoneWithoutTransformEscapes) {
   std::vector<VertexCheck> checks{check_of(5, Vec3(-1e30f), Vec3(1e30f)), check_of(1, p - 0.5f, p + 0.5f)};
   std::vector<std::uint32_t> begin{0, 2};
   const SkinnedMesh mesh = one_vertex_mesh(s, p);
-  const EscapeCheckInput escape{begin, checks, s.bone_from_world, s.tolerance};
+  const EscapeCheckInput escape{begin, checks, s.bone_from_world, s.tolerance, {}};
   const Skinned out = run_skinning(mesh, s.bones, SkinningPath::kAuto, nullptr, false, &escape);
   EXPECT_EQ(out.escaped, (std::vector<std::uint8_t>{1, 0}));
   EXPECT_EQ(out.result.escaped_checks, 1u);
+}
+
+// The check's bone-frame point must be Affine3::transform_point's, bit for
+// bit (the check runs four lanes at once): boxes whose faces lie exactly on
+// that float point hold it, boxes one float beyond it do not (tolerance 0),
+// on every axis and side, for random bones and vertices.
+TEST(SkinningEscape, BoxFacesOnThePointDecideByItsExactBits) {
+  std::mt19937 rng(77);
+  const std::vector<Affine3> bones = random_bones(rng, 9, 3.0f);
+  const SkinnedMesh mesh = random_mesh(rng, 600, 9, {2.0f, 2.0f});
+  for (const SkinningPath path : available_paths()) {
+    // Each path's own skinned positions (the paths agree to rounding only).
+    const Skinned skinned = run_skinning(mesh, bones, path);
+    RandomChecks rc;
+    for (const Affine3& b : bones) rc.bone_from_world.push_back(inverse(b));
+    rc.tolerance.assign(bones.size(), 0.0f);
+    rc.begin.push_back(0);
+    for (std::size_t v = 0; v < mesh.vertex_count(); ++v) {
+      const std::uint32_t bone = static_cast<std::uint32_t>(rng() % bones.size());
+      const Vec3 q = rc.bone_from_world[bone].transform_point(skinned.positions[v]);
+      const int axis = static_cast<int>(rng() % 3);
+      const bool upper_face = rng() % 2 == 0;
+      const bool beyond = rng() % 2 == 0;
+      Aabb box{q - 1.0f, q + 1.0f};
+      const float inf = std::numeric_limits<float>::infinity();
+      if (upper_face) {
+        box.upper[axis] = beyond ? std::nextafter(q[axis], -inf) : q[axis];
+      } else {
+        box.lower[axis] = beyond ? std::nextafter(q[axis], inf) : q[axis];
+      }
+      rc.checks.push_back({bone, box});
+      rc.expected.push_back(beyond ? 1 : 0);
+      rc.begin.push_back(static_cast<std::uint32_t>(rc.checks.size()));
+    }
+    const EscapeCheckInput escape = rc.input();
+    const Skinned out = run_skinning(mesh, bones, path, nullptr, false, &escape);
+    ASSERT_EQ(out.positions, skinned.positions);
+    EXPECT_EQ(out.escaped, rc.expected);
+    EXPECT_GT(flags_set(rc.expected), 200u);
+  }
+}
+
+// Each chunk's bone boxes, merged in chunk order, are the boxes of every
+// bone's checked vertices (what the scene's exact bone boxes are), with any
+// thread count.
+TEST(SkinningEscape, ChunkBoneBoxesBoundEachBonesCheckedVertices) {
+  std::mt19937 rng(91);
+  const std::vector<Affine3> bones = random_bones(rng, 13, 2.0f);
+  const SkinnedMesh mesh = random_mesh(rng, 4097, 13, {2.0f, 2.0f});
+  RandomChecks rc = random_checks(rng, mesh, bones);
+  JobSystem two(2);
+  for (JobSystem* jobs : {static_cast<JobSystem*>(nullptr), &two}) {
+    std::vector<Aabb> chunk_boxes(skinning_chunk_count(mesh.vertex_count()) * bones.size(),
+                                  Aabb{Vec3(-7.0f), Vec3(7.0f)});
+    EscapeCheckInput escape = rc.input();
+    escape.chunk_bone_boxes = chunk_boxes;
+    const Skinned out = run_skinning(mesh, bones, SkinningPath::kAuto, jobs, false, &escape);
+    std::vector<Aabb> merged(bones.size(), Aabb::empty()), expected(bones.size(), Aabb::empty());
+    for (std::size_t row = 0; row < chunk_boxes.size() / bones.size(); ++row) {
+      for (std::size_t b = 0; b < bones.size(); ++b) merged[b].extend(chunk_boxes[row * bones.size() + b]);
+    }
+    for (std::size_t v = 0; v < mesh.vertex_count(); ++v) {
+      for (std::uint32_t c = rc.begin[v]; c < rc.begin[v + 1]; ++c) expected[rc.checks[c].bone].extend(out.positions[v]);
+    }
+    for (std::size_t b = 0; b < bones.size(); ++b) {
+      EXPECT_EQ(merged[b].lower, expected[b].lower) << "bone " << b;
+      EXPECT_EQ(merged[b].upper, expected[b].upper) << "bone " << b;
+      EXPECT_FALSE(expected[b].is_empty()) << "bone " << b;
+    }
+  }
 }
 
 TEST(SkinningNormals, SkippedWhenTargetIsEmpty) {
