@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <system_error>
 #include <vector>
 
 #include "character/pack.h"
@@ -19,24 +20,34 @@
 
 namespace sinew::testing_support {
 
-// The idle-baked mannequin as a pack file (written once).
+// The idle-baked mannequin as a pack file: written once per test process
+// into the temporary folder, and removed when the process exits (ctest runs
+// each test in a process of its own, so a file left behind per process
+// filled the folder).
 inline const std::string& mannequin_pack_path() {
-  static const std::string path = [] {
-    const BakedModel& baked = idle_mannequin();
-    character::PackContents contents;
-    contents.model = &baked.model;
-    contents.fuzzy = &baked.bake.fuzzy;
-    contents.pose_space.desc.mode = anim::PoseSpaceMode::kClip;
-    contents.pose_space.desc.clips = {"idle"};
-    contents.provenance.source_name = "mannequin";
-    contents.provenance.tool_version = "api test";
-    const std::string p = (std::filesystem::temp_directory_path() /
-                           ("sinew_api_test_mannequin_" + std::to_string(::getpid()) + ".pack"))
-                              .string();
-    EXPECT_TRUE(character::write_pack(p, contents).ok());
-    return p;
-  }();
-  return path;
+  struct TemporaryPack {
+    std::string path;
+    TemporaryPack() {
+      const BakedModel& baked = idle_mannequin();
+      character::PackContents contents;
+      contents.model = &baked.model;
+      contents.fuzzy = &baked.bake.fuzzy;
+      contents.pose_space.desc.mode = anim::PoseSpaceMode::kClip;
+      contents.pose_space.desc.clips = {"idle"};
+      contents.provenance.source_name = "mannequin";
+      contents.provenance.tool_version = "api test";
+      path = (std::filesystem::temp_directory_path() /
+              ("sinew_api_test_mannequin_" + std::to_string(::getpid()) + ".pack"))
+                 .string();
+      EXPECT_TRUE(character::write_pack(path, contents).ok());
+    }
+    ~TemporaryPack() {
+      std::error_code ignored;
+      std::filesystem::remove(path, ignored);
+    }
+  };
+  static const TemporaryPack pack;
+  return pack.path;
 }
 
 // The mannequin pack through the public API.
