@@ -1019,8 +1019,24 @@ struct LightTerms {
   Vec3x8 color;
 };
 
-// The linear colour of block b's hits: the arithmetic of shade_and_write's
-// general path, in the same order (the images are the same bit for bit).
+// The terms of `lights` (at most kMaxLights), in their order.
+struct ShadingLights {
+  std::array<LightTerms, kMaxLights> terms;
+  std::size_t count = 0;
+  explicit ShadingLights(std::span<const Light> lights) : count(std::min(lights.size(), kMaxLights)) {
+    for (std::size_t l = 0; l < count; ++l) {
+      const Light& light = lights[l];
+      const bool point = light.kind == Light::Kind::kPoint;
+      const Vec3 at = point ? light.position : light.direction;
+      terms[l] = {point, {Float8(at.x), Float8(at.y), Float8(at.z)},
+                  {Float8(light.color.x), Float8(light.color.y), Float8(light.color.z)}};
+    }
+  }
+  std::span<const LightTerms> span() const { return {terms.data(), count}; }
+};
+
+// The linear colour of block b's hits: ambient plus each light's N·L where
+// it is unblocked, times the albedo.
 Vec3x8 block_color(const RenderSettings& settings, std::span<const LightTerms> lights, const TileScratch& s,
                    std::size_t b, std::uint32_t hits) {
   const std::size_t k0 = b * kBlockLanes;
@@ -1048,15 +1064,8 @@ Vec3x8 block_color(const RenderSettings& settings, std::span<const LightTerms> l
 // store.
 void shade_rgba8_only(const RenderSettings& settings, std::span<const Light> lights,
                       const OutputPlane<std::uint8_t>& plane, TileScratch& s) {
-  std::array<LightTerms, kMaxLights> terms;
-  for (std::size_t l = 0; l < lights.size(); ++l) {
-    const Light& light = lights[l];
-    const bool point = light.kind == Light::Kind::kPoint;
-    const Vec3 at = point ? light.position : light.direction;
-    terms[l] = {point, {Float8(at.x), Float8(at.y), Float8(at.z)},
-                {Float8(light.color.x), Float8(light.color.y), Float8(light.color.z)}};
-  }
-  const std::span<const LightTerms> shading_lights(terms.data(), lights.size());
+  const ShadingLights terms(lights);
+  const std::span<const LightTerms> shading_lights = terms.span();
   std::byte* const base = plane.base;
   const std::size_t pitch = plane.pitch;
   const int x0 = plane.x0, y0 = plane.y0;
@@ -1129,6 +1138,7 @@ void shade_and_write(const RenderSettings& settings, std::span<const Light> ligh
   }
   const std::size_t blocks = s.lanes / kBlockLanes;
   const bool want_color = out.want_color();
+  const ShadingLights shading_lights(lights);
   const std::array<std::uint8_t, 4> background_bytes = {srgb_byte(settings.background.x),
                                                          srgb_byte(settings.background.y),
                                                          srgb_byte(settings.background.z), 255};
@@ -1150,25 +1160,7 @@ void shade_and_write(const RenderSettings& settings, std::span<const Light> ligh
         (Float8::load(&s.t[k0]) * sqrt(dot(dir, dir))).store(depth);
       }
       if (want_color) {
-        const Vec3x8 position = load3(s.px, s.py, s.pz, k0);
-        const Vec3x8 n = load3(s.nx, s.ny, s.nz, k0);
-        Vec3x8 radiance{Float8(settings.ambient.x), Float8(settings.ambient.y), Float8(settings.ambient.z)};
-        for (std::size_t l = 0; l < lights.size(); ++l) {
-          const std::uint32_t lit_bits = lane_bits(&s.lit[k0], static_cast<int>(l)) & hits;
-          if (lit_bits == 0) continue;
-          const Light& light = lights[l];
-          const Vec3x8 to_light =
-              light.kind == Light::Kind::kPoint
-                  ? Vec3x8{Float8(light.position.x), Float8(light.position.y), Float8(light.position.z)} - position
-                  : Vec3x8{Float8(light.direction.x), Float8(light.direction.y), Float8(light.direction.z)};
-          const Float8 cosine =
-              select(Mask8::from_bits(lit_bits), max(dot(n, to_light) / sqrt(dot(to_light, to_light)), Float8(0.0f)),
-                     Float8(0.0f));
-          radiance = radiance + Vec3x8{Float8(light.color.x) * cosine, Float8(light.color.y) * cosine,
-                                       Float8(light.color.z) * cosine};
-        }
-        const Vec3x8 color{Float8::load(&s.ar[k0]) * radiance.x, Float8::load(&s.ag[k0]) * radiance.y,
-                           Float8::load(&s.ab[k0]) * radiance.z};
+        const Vec3x8 color = block_color(settings, shading_lights.span(), s, b, hits);
         color.x.store(linear[0]);
         color.y.store(linear[1]);
         color.z.store(linear[2]);
