@@ -222,7 +222,7 @@ bool gather_lanes(const Scene& scene, const TileScratch& s, std::size_t k0, std:
     }
   }
   for (int a = 0; a < 3; ++a) color[a].store(albedo[a]);
-    return false;
+  return false;
 }
 
 // Of the tile's objects, those `packet` may enter, into lists.packet. With
