@@ -142,56 +142,45 @@ std::size_t count_escapes(const EscapeCheckInput& e, [[maybe_unused]] std::span<
   if (boxes != nullptr) std::fill(boxes, boxes + bones, Aabb::empty());
 
   std::size_t count = 0;
+  for (std::size_t v = r.begin; v < end; ++v) {
+    const std::size_t first = std::min<std::size_t>(check_begin[v], checks.size());
+    const std::size_t last = std::min<std::size_t>(check_begin[v + 1], checks.size());
+    const Vec3 world = positions[v];
 #if SINEW_ESCAPE_SSE
-  // Four lanes per check (x, y, z and a spare), about a quarter of the
-  // scalar check's instructions: the check is per vertex and per bone, and
-  // at 855,552 triangles it was as long as the skinning itself.
-  for (std::size_t v = r.begin; v < end; ++v) {
-    const std::size_t first = std::min<std::size_t>(check_begin[v], checks.size());
-    const std::size_t last = std::min<std::size_t>(check_begin[v + 1], checks.size());
-    const Vec3 world = positions[v];
+    // Four lanes per check (x, y, z and a spare), about a quarter of the
+    // scalar check's instructions: the check is per vertex and per bone, and
+    // at 855,552 triangles it was as long as the skinning itself.
     const __m128 x = _mm_set1_ps(world.x), y = _mm_set1_ps(world.y), z = _mm_set1_ps(world.z);
-    for (std::size_t c = first; c < last; ++c) {
-      const VertexCheck& check = checks[c];
-      if (boxes != nullptr && check.bone < bones) boxes[check.bone].extend(world);
-      bool out = true;
-      if (check.bone < bone_limit) {
-        const BoneColumns& m = columns[check.bone];
-        const __m128 q =
-            _mm_add_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(m.c[0], x), _mm_mul_ps(m.c[1], y)), _mm_mul_ps(m.c[2], z)),
-                       m.c[3]);
-        const __m128 tol = _mm_set1_ps(tolerance[check.bone]);
-        // The box's lower corner, and its upper one read from lower.z on (in
-        // bounds), moved down a lane.
-        const __m128 lower = _mm_loadu_ps(&check.box.lower.x);
-        const __m128 from_z = _mm_loadu_ps(&check.box.lower.z);
-        const __m128 upper = _mm_shuffle_ps(from_z, from_z, _MM_SHUFFLE(3, 3, 2, 1));
-        const __m128 inside = _mm_and_ps(_mm_and_ps(_mm_cmpge_ps(q, _mm_sub_ps(lower, tol)),
-                                                    _mm_cmple_ps(q, _mm_add_ps(upper, tol))),
-                                         _mm_cmpeq_ps(_mm_sub_ps(q, q), _mm_setzero_ps()));
-        out = (_mm_movemask_ps(inside) & 7) != 7;
-      }
-      count += static_cast<std::size_t>(out);
-      if (c < escaped.size()) escaped[c] = static_cast<std::uint8_t>(out);
-    }
-  }
+    const auto inside = [&](const VertexCheck& check) {
+      const BoneColumns& m = columns[check.bone];
+      const __m128 q =
+          _mm_add_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(m.c[0], x), _mm_mul_ps(m.c[1], y)), _mm_mul_ps(m.c[2], z)),
+                     m.c[3]);
+      const __m128 tol = _mm_set1_ps(tolerance[check.bone]);
+      // The box's lower corner, and its upper one read from lower.z on (in
+      // bounds), moved down a lane.
+      const __m128 lower = _mm_loadu_ps(&check.box.lower.x);
+      const __m128 from_z = _mm_loadu_ps(&check.box.lower.z);
+      const __m128 upper = _mm_shuffle_ps(from_z, from_z, _MM_SHUFFLE(3, 3, 2, 1));
+      const __m128 in = _mm_and_ps(
+          _mm_and_ps(_mm_cmpge_ps(q, _mm_sub_ps(lower, tol)), _mm_cmple_ps(q, _mm_add_ps(upper, tol))),
+          _mm_cmpeq_ps(_mm_sub_ps(q, q), _mm_setzero_ps()));
+      return (_mm_movemask_ps(in) & 7) == 7;
+    };
 #else
-  for (std::size_t v = r.begin; v < end; ++v) {
-    const std::size_t first = std::min<std::size_t>(check_begin[v], checks.size());
-    const std::size_t last = std::min<std::size_t>(check_begin[v + 1], checks.size());
-    const Vec3 world = positions[v];
+    const auto inside = [&](const VertexCheck& check) {
+      return inside_grown_box(bone_from_world[check.bone].transform_point(world), check.box, tolerance[check.bone]);
+    };
+#endif
     for (std::size_t c = first; c < last; ++c) {
       const VertexCheck& check = checks[c];
       if (boxes != nullptr && check.bone < bones) boxes[check.bone].extend(world);
       // A check naming a bone without a transform or tolerance escapes.
-      const bool out = check.bone >= bone_limit ||
-                       !inside_grown_box(bone_from_world[check.bone].transform_point(world), check.box,
-                                         tolerance[check.bone]);
+      const bool out = check.bone >= bone_limit || !inside(check);
       count += static_cast<std::size_t>(out);
       if (c < escaped.size()) escaped[c] = static_cast<std::uint8_t>(out);
     }
   }
-#endif
   return count;
 }
 
