@@ -62,8 +62,9 @@ void update_bone_frames(InstanceFrame& frame, const FuzzyCharacterView& fuzzy) {
   }
 }
 
-void skin_instance(InstanceFrame& frame, const SkinnedMesh& mesh, const FuzzyCharacterView& fuzzy,
-                   bool normals, bool exact_boxes, SkinningPath path, JobSystem& jobs) {
+void skin_instance(InstanceFrame& frame, const SkinnedMesh& mesh, const PackedInfluences& influences,
+                   const FuzzyCharacterView& fuzzy, bool normals, bool exact_boxes, SkinningPath path,
+                   JobSystem& jobs) {
   frame.positions.resize(mesh.vertex_count());
   frame.normals.resize(normals && !mesh.normals.empty() ? mesh.vertex_count() : 0);
   frame.escaped.resize(fuzzy.vertex_checks.size());
@@ -72,7 +73,7 @@ void skin_instance(InstanceFrame& frame, const SkinnedMesh& mesh, const FuzzyCha
   const EscapeCheckInput escape{fuzzy.vertex_check_begin, fuzzy.vertex_checks, frame.bone_from_world,
                                 frame.tolerance, frame.chunk_bone_boxes};
   const SkinningTargets targets{frame.positions, frame.normals, frame.escaped};
-  const SkinningResult result = skin_vertices(mesh, frame.skinning, targets, &escape, &jobs, path);
+  const SkinningResult result = skin_vertices(mesh, influences, frame.skinning, targets, &escape, &jobs, path);
   frame.escaped_checks = result.escaped_checks;
 }
 

@@ -60,8 +60,10 @@ void update_bone_frames(InstanceFrame& frame, const FuzzyCharacterView& fuzzy);
 
 // Skins positions (and normals) and runs the escape check; with
 // `exact_boxes`, it also gathers the bone boxes compute_bone_boxes merges.
-void skin_instance(InstanceFrame& frame, const SkinnedMesh& mesh, const FuzzyCharacterView& fuzzy,
-                   bool normals, bool exact_boxes, SkinningPath path, JobSystem& jobs);
+// `influences` is pack_influences(mesh).
+void skin_instance(InstanceFrame& frame, const SkinnedMesh& mesh, const PackedInfluences& influences,
+                   const FuzzyCharacterView& fuzzy, bool normals, bool exact_boxes, SkinningPath path,
+                   JobSystem& jobs);
 
 // Per bone world boxes: exact (union of the bone's skinned vertices, from
 // the boxes skin_instance gathered with exact_boxes) or cheap (the fuzzy

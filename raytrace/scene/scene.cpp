@@ -31,7 +31,7 @@ Scene& Scene::operator=(Scene&&) noexcept = default;
 
 Expected<std::uint32_t> Scene::add_character(const SkinnedMesh& mesh, const FuzzyCharacterView& fuzzy) {
   SINEW_RETURN_IF_ERROR(validate_fuzzy_character(mesh, fuzzy));
-  characters_.push_back({&mesh, fuzzy});
+  characters_.push_back({&mesh, fuzzy, pack_influences(mesh)});
   return static_cast<std::uint32_t>(characters_.size() - 1);
 }
 
@@ -121,7 +121,7 @@ Expected<FrameStats> Scene::prepare_frame(const FrameOptions& options, JobSystem
     const Character& character = characters_[frame.character];
     auto start = std::chrono::steady_clock::now();
     update_bone_frames(frame, character.fuzzy);
-    skin_instance(frame, *character.mesh, character.fuzzy, options.normals, options.bone_boxes == BoneBoxMode::kExact,
+    skin_instance(frame, *character.mesh, character.influences, character.fuzzy, options.normals, options.bone_boxes == BoneBoxMode::kExact,
                   options.skinning, jobs);
     skinning_ms += ms_since(start);
 

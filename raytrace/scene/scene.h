@@ -108,6 +108,7 @@ class Scene {
   struct Character {
     const SkinnedMesh* mesh = nullptr;
     FuzzyCharacterView fuzzy;
+    PackedInfluences influences;  // the mesh's, packed once for the skinning
   };
   struct StaticMesh {
     StaticMeshDesc desc;

@@ -38,8 +38,7 @@ namespace {
 
 static_assert(sizeof(Vec3) == 3 * sizeof(float), "kernels read Vec3 arrays as packed floats");
 static_assert(sizeof(Affine3) == detail::kFloatsPerBone * sizeof(float), "kernels read bones as 12 floats");
-static_assert(sizeof(std::array<std::uint16_t, kMaxInfluences>) == kMaxInfluences * sizeof(std::uint16_t));
-static_assert(sizeof(std::array<float, kMaxInfluences>) == kMaxInfluences * sizeof(float));
+static_assert(kInfluenceGroupLanes == detail::kAvx2Lanes, "a group of packed influences is one register");
 
 // Large enough to amortise the task overhead.
 constexpr std::size_t kChunkVertices = kSkinningChunkVertices;
@@ -47,12 +46,12 @@ static_assert(kChunkVertices % detail::kAvx2Lanes == 0);
 
 void skin_vertex_scalar(const detail::SkinningArrays& a, std::size_t v) {
   float m[detail::kFloatsPerBone] = {};
-  const float* weights = a.weights + v * kMaxInfluences;
-  const std::uint16_t* joints = a.joints + v * kMaxInfluences;
-  for (int k = 0; k < kMaxInfluences; ++k) {
-    const float w = weights[k];
+  const std::size_t group = v / detail::kAvx2Lanes;
+  const std::size_t lane = v % detail::kAvx2Lanes;
+  for (std::size_t slot = a.group_slot_begin[group]; slot < a.group_slot_begin[group + 1]; ++slot) {
+    const float w = a.slot_weights[slot * detail::kAvx2Lanes + lane];
     if (w == 0.0f) continue;
-    const float* bone = a.bones + detail::kFloatsPerBone * joints[k];
+    const float* bone = a.bones + detail::kFloatsPerBone * a.slot_joints[slot * detail::kAvx2Lanes + lane];
     for (std::size_t e = 0; e < detail::kFloatsPerBone; ++e) m[e] += w * bone[e];
   }
   const float* p = a.rest_positions + 3 * v;
@@ -184,16 +183,20 @@ std::size_t count_escapes(const EscapeCheckInput& e, [[maybe_unused]] std::span<
   return count;
 }
 
-std::size_t skinnable_vertex_count(const SkinnedMesh& mesh, const SkinningTargets& targets) {
-  return std::min({mesh.positions.size(), mesh.joints.size(), mesh.weights.size(), targets.positions.size()});
+std::size_t skinnable_vertex_count(const SkinnedMesh& mesh, const PackedInfluences& influences,
+                                   const SkinningTargets& targets) {
+  return std::min({mesh.positions.size(), influences.vertex_count,
+                   influences.group_count() * kInfluenceGroupLanes, targets.positions.size()});
 }
 
-detail::SkinningArrays flat_arrays(const SkinnedMesh& mesh, std::span<const Affine3> bones,
-                                   const SkinningTargets& targets, std::size_t vertex_count) {
+detail::SkinningArrays flat_arrays(const SkinnedMesh& mesh, const PackedInfluences& influences,
+                                   std::span<const Affine3> bones, const SkinningTargets& targets,
+                                   std::size_t vertex_count) {
   detail::SkinningArrays a;
   a.rest_positions = reinterpret_cast<const float*>(mesh.positions.data());
-  a.joints = mesh.joints.empty() ? nullptr : mesh.joints.front().data();
-  a.weights = mesh.weights.empty() ? nullptr : mesh.weights.front().data();
+  a.group_slot_begin = influences.group_slot_begin.data();
+  a.slot_joints = influences.joints.data();
+  a.slot_weights = influences.weights.data();
   a.bones = reinterpret_cast<const float*>(bones.data());
   a.positions = reinterpret_cast<float*>(targets.positions.data());
   const bool normals = mesh.normals.size() >= vertex_count && targets.normals.size() >= vertex_count &&
@@ -220,13 +223,19 @@ bool avx2_skinning_available() {
 SkinningResult skin_vertices(const SkinnedMesh& mesh, std::span<const Affine3> bones,
                              const SkinningTargets& targets, const EscapeCheckInput* escape,
                              JobSystem* jobs, SkinningPath path) {
+  return skin_vertices(mesh, pack_influences(mesh), bones, targets, escape, jobs, path);
+}
+
+SkinningResult skin_vertices(const SkinnedMesh& mesh, const PackedInfluences& influences,
+                             std::span<const Affine3> bones, const SkinningTargets& targets,
+                             const EscapeCheckInput* escape, JobSystem* jobs, SkinningPath path) {
   SkinningResult result;
   const bool use_avx2 = path != SkinningPath::kScalar && avx2_skinning_available();
   result.path_used = use_avx2 ? SkinningPath::kAvx2 : SkinningPath::kScalar;
 
-  const std::size_t vertex_count = skinnable_vertex_count(mesh, targets);
+  const std::size_t vertex_count = skinnable_vertex_count(mesh, influences, targets);
   if (vertex_count == 0) return result;
-  const detail::SkinningArrays arrays = flat_arrays(mesh, bones, targets, vertex_count);
+  const detail::SkinningArrays arrays = flat_arrays(mesh, influences, bones, targets, vertex_count);
   const std::span<const Vec3> positions = targets.positions;
 
   // One escape count per chunk, summed in chunk order afterwards: no atomics

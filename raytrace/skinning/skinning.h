@@ -18,6 +18,7 @@
 #include <span>
 
 #include "raytrace/fuzzy/fuzzy_character.h"
+#include "raytrace/skinning/packed_influences.h"
 #include "runtime/math/affine.h"
 #include "runtime/mesh/skinned_mesh.h"
 
@@ -84,6 +85,12 @@ struct SkinningResult {
 // `bones` are the skinning matrices (bind pose -> world) indexed by the mesh's
 // joint indices; the caller guarantees every joint index is < bones.size()
 // (the bake and the loaders validate it). `jobs` may be null (single thread).
+// `influences` is pack_influences(mesh), packed once per mesh; the overload
+// without it packs them on every call.
+SkinningResult skin_vertices(const SkinnedMesh& mesh, const PackedInfluences& influences,
+                             std::span<const Affine3> bones, const SkinningTargets& targets,
+                             const EscapeCheckInput* escape, JobSystem* jobs,
+                             SkinningPath path = SkinningPath::kAuto);
 SkinningResult skin_vertices(const SkinnedMesh& mesh, std::span<const Affine3> bones,
                              const SkinningTargets& targets, const EscapeCheckInput* escape,
                              JobSystem* jobs, SkinningPath path = SkinningPath::kAuto);

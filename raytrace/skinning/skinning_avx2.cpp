@@ -1,12 +1,11 @@
 // AVX2+FMA linear blend skinning, 8 vertices per iteration.
 //
-// Each lane is one vertex. The 8 lanes' weights are transposed out of the
-// per-vertex AoS array so that register k holds slot k; a slot whose weight
-// is zero in all 8 lanes is skipped (most meshes use at most 4 influences).
-// Otherwise each lane's bone rows are loaded (two rows per 256-bit register)
-// and transposed into 12 column registers, and the blended matrix
+// Each lane is one vertex of a group of the packed influences
+// (packed_influences.h), whose slots hold the group's weights a register at
+// a time. Per slot each lane's bone rows are loaded (two rows per 256-bit
+// register) and transposed into 12 column registers, and the blended matrix
 // sum_k w_k B_k is accumulated with FMAs, then applied to the rest position
-// (and its 3x3 part to the rest normal). A lane with weight 0 in a live slot
+// (and its 3x3 part to the rest normal). A lane past its own influences
 // adds 0 * B (exactly 0, skinning matrices are finite), so the result matches
 // the scalar path, which skips zero weights, up to rounding.
 //
@@ -28,36 +27,6 @@ namespace sinew::rt::detail {
 #if defined(__AVX2__) && defined(__FMA__)
 
 namespace {
-
-constexpr int kSlots = 8;  // kMaxInfluences; runtime/ headers are not included here on purpose
-
-// rows[i] holds lane i's 8 values; afterwards rows[k] holds slot k of lanes 0..7.
-void transpose8x8(__m256 rows[8]) {
-  const __m256 t0 = _mm256_unpacklo_ps(rows[0], rows[1]);
-  const __m256 t1 = _mm256_unpackhi_ps(rows[0], rows[1]);
-  const __m256 t2 = _mm256_unpacklo_ps(rows[2], rows[3]);
-  const __m256 t3 = _mm256_unpackhi_ps(rows[2], rows[3]);
-  const __m256 t4 = _mm256_unpacklo_ps(rows[4], rows[5]);
-  const __m256 t5 = _mm256_unpackhi_ps(rows[4], rows[5]);
-  const __m256 t6 = _mm256_unpacklo_ps(rows[6], rows[7]);
-  const __m256 t7 = _mm256_unpackhi_ps(rows[6], rows[7]);
-  const __m256 u0 = _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(1, 0, 1, 0));
-  const __m256 u1 = _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(3, 2, 3, 2));
-  const __m256 u2 = _mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(1, 0, 1, 0));
-  const __m256 u3 = _mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(3, 2, 3, 2));
-  const __m256 u4 = _mm256_shuffle_ps(t4, t6, _MM_SHUFFLE(1, 0, 1, 0));
-  const __m256 u5 = _mm256_shuffle_ps(t4, t6, _MM_SHUFFLE(3, 2, 3, 2));
-  const __m256 u6 = _mm256_shuffle_ps(t5, t7, _MM_SHUFFLE(1, 0, 1, 0));
-  const __m256 u7 = _mm256_shuffle_ps(t5, t7, _MM_SHUFFLE(3, 2, 3, 2));
-  rows[0] = _mm256_permute2f128_ps(u0, u4, 0x20);
-  rows[1] = _mm256_permute2f128_ps(u1, u5, 0x20);
-  rows[2] = _mm256_permute2f128_ps(u2, u6, 0x20);
-  rows[3] = _mm256_permute2f128_ps(u3, u7, 0x20);
-  rows[4] = _mm256_permute2f128_ps(u0, u4, 0x31);
-  rows[5] = _mm256_permute2f128_ps(u1, u5, 0x31);
-  rows[6] = _mm256_permute2f128_ps(u2, u6, 0x31);
-  rows[7] = _mm256_permute2f128_ps(u3, u7, 0x31);
-}
 
 struct Vec3x8 {
   __m256 x;
@@ -110,25 +79,18 @@ void load_bone_row8(const float* const lane_bones[8], int r, __m256 cols[4]) {
   cols[3] = _mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(3, 2, 3, 2));
 }
 
-Matrix3x4x8 blend_bones(const SkinningArrays& a, std::size_t v0) {
-  __m256 weights[kSlots];
-  for (int lane = 0; lane < 8; ++lane) {
-    weights[lane] = _mm256_loadu_ps(a.weights + (v0 + static_cast<std::size_t>(lane)) * kSlots);
-  }
-  transpose8x8(weights);
-
+// Group g's slots are whole registers: one load of the slot's weights, and
+// its joints straight from the slot (no transpose).
+Matrix3x4x8 blend_bones(const SkinningArrays& a, std::size_t group) {
   Matrix3x4x8 out;
   for (__m256& e : out.m) e = _mm256_setzero_ps();
-  const __m256 zero = _mm256_setzero_ps();
-  for (int k = 0; k < kSlots; ++k) {
-    const __m256 w = weights[k];
-    // Unordered "not equal" keeps NaN weights, as the scalar path does.
-    if (_mm256_movemask_ps(_mm256_cmp_ps(w, zero, _CMP_NEQ_UQ)) == 0) continue;
-    // Joints are read straight from the AoS array: only live slots need them.
+  const std::size_t first = a.group_slot_begin[group];
+  const std::size_t last = a.group_slot_begin[group + 1];
+  for (std::size_t slot = first; slot < last; ++slot) {
+    const __m256 w = _mm256_loadu_ps(a.slot_weights + slot * kAvx2Lanes);
+    const std::uint16_t* joints = a.slot_joints + slot * kAvx2Lanes;
     const float* lane_bones[8];
-    for (std::size_t lane = 0; lane < 8; ++lane) {
-      lane_bones[lane] = a.bones + kFloatsPerBone * a.joints[(v0 + lane) * kSlots + static_cast<std::size_t>(k)];
-    }
+    for (std::size_t lane = 0; lane < 8; ++lane) lane_bones[lane] = a.bones + kFloatsPerBone * joints[lane];
     for (int r = 0; r < 3; ++r) {
       __m256 cols[4];
       load_bone_row8(lane_bones, r, cols);
@@ -167,7 +129,7 @@ Vec3x8 transform_vector8(const Matrix3x4x8& b, const Vec3x8& n) {
 void skin_range_avx2(const SkinningArrays& a, std::size_t begin, std::size_t end) {
   const bool with_normals = a.rest_normals != nullptr && a.normals != nullptr;
   for (std::size_t v = begin; v + kAvx2Lanes <= end; v += kAvx2Lanes) {
-    const Matrix3x4x8 blended = blend_bones(a, v);
+    const Matrix3x4x8 blended = blend_bones(a, v / kAvx2Lanes);
     store_xyz8(a.positions + 3 * v, transform_point8(blended, load_xyz8(a.rest_positions + 3 * v)));
     if (with_normals) {
       store_xyz8(a.normals + 3 * v, transform_vector8(blended, load_xyz8(a.rest_normals + 3 * v)));

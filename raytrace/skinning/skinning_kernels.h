@@ -14,13 +14,16 @@
 namespace sinew::rt::detail {
 
 // One frame's skinning inputs and outputs as flat arrays. Vertices are
-// 3 floats (x, y, z), influences kMaxInfluences per vertex, bones 12 floats
-// (three rows [r0 r1 r2 t]).
+// 3 floats (x, y, z), bones 12 floats (three rows [r0 r1 r2 t]), influences
+// as PackedInfluences lays them out (packed_influences.h): per group of
+// kAvx2Lanes vertices its slots [group_slot_begin[g], group_slot_begin[g+1]),
+// each slot kAvx2Lanes weights and joints.
 struct SkinningArrays {
   const float* rest_positions = nullptr;
   const float* rest_normals = nullptr;  // null: no normals are written
-  const std::uint16_t* joints = nullptr;
-  const float* weights = nullptr;
+  const std::uint32_t* group_slot_begin = nullptr;
+  const std::uint16_t* slot_joints = nullptr;
+  const float* slot_weights = nullptr;
   const float* bones = nullptr;
   float* positions = nullptr;
   float* normals = nullptr;             // null: no normals are written
@@ -29,7 +32,7 @@ struct SkinningArrays {
 inline constexpr std::size_t kFloatsPerBone = 12;
 inline constexpr std::size_t kAvx2Lanes = 8;
 
-// Skins vertices [begin, end); end - begin must be a multiple of kAvx2Lanes.
+// Skins vertices [begin, end); begin and end must be multiples of kAvx2Lanes.
 // Call only when avx2_kernel_compiled() and the CPU has AVX2 and FMA.
 void skin_range_avx2(const SkinningArrays& arrays, std::size_t begin, std::size_t end);
 
