@@ -19,6 +19,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <vector>
 
@@ -140,6 +141,29 @@ std::size_t count_escapes(const EscapeCheckInput& e, [[maybe_unused]] std::span<
                           : nullptr;
   if (boxes != nullptr) std::fill(boxes, boxes + bones, Aabb::empty());
 
+#if SINEW_ESCAPE_SSE
+  // The box of the current run of checks against one bone, kept in
+  // registers and merged into the bone's box when the bone changes: extending
+  // the box in memory check after check made each wait for the last one's
+  // store (0.6 of 2.0 ms a frame at 855,552 triangles, 1 thread). Each side
+  // keeps the earlier value on ties and NaNs, as Aabb::extend does, so the
+  // boxes have the same bits.
+  std::size_t run_bone = bones;  // none yet
+  __m128 run_lower = _mm_set1_ps(std::numeric_limits<float>::infinity());
+  __m128 run_upper = _mm_set1_ps(-std::numeric_limits<float>::infinity());
+  const auto end_run = [&] {
+    if (run_bone >= bones) return;
+    alignas(16) float lower[4];
+    alignas(16) float upper[4];
+    _mm_store_ps(lower, run_lower);
+    _mm_store_ps(upper, run_upper);
+    boxes[run_bone].extend(Aabb{Vec3(lower[0], lower[1], lower[2]), Vec3(upper[0], upper[1], upper[2])});
+    run_bone = bones;
+    run_lower = _mm_set1_ps(std::numeric_limits<float>::infinity());
+    run_upper = _mm_set1_ps(-std::numeric_limits<float>::infinity());
+  };
+#endif
+
   std::size_t count = 0;
   for (std::size_t v = r.begin; v < end; ++v) {
     const std::size_t first = std::min<std::size_t>(check_begin[v], checks.size());
@@ -171,15 +195,32 @@ std::size_t count_escapes(const EscapeCheckInput& e, [[maybe_unused]] std::span<
       return inside_grown_box(bone_from_world[check.bone].transform_point(world), check.box, tolerance[check.bone]);
     };
 #endif
+#if SINEW_ESCAPE_SSE
+    const __m128 point = _mm_setr_ps(world.x, world.y, world.z, 0.0f);
+    const auto extend_box = [&](std::size_t bone) {
+      if (bone != run_bone) {
+        end_run();
+        run_bone = bone;
+      }
+      // min_ps(a, b) is a < b ? a : b: the run's side stays on ties and NaNs.
+      run_lower = _mm_min_ps(point, run_lower);
+      run_upper = _mm_max_ps(point, run_upper);
+    };
+#else
+    const auto extend_box = [&](std::size_t bone) { boxes[bone].extend(world); };
+#endif
     for (std::size_t c = first; c < last; ++c) {
       const VertexCheck& check = checks[c];
-      if (boxes != nullptr && check.bone < bones) boxes[check.bone].extend(world);
+      if (boxes != nullptr && check.bone < bones) extend_box(check.bone);
       // A check naming a bone without a transform or tolerance escapes.
       const bool out = check.bone >= bone_limit || !inside(check);
       count += static_cast<std::size_t>(out);
       if (c < escaped.size()) escaped[c] = static_cast<std::uint8_t>(out);
     }
   }
+#if SINEW_ESCAPE_SSE
+  end_run();
+#endif
   return count;
 }
 
