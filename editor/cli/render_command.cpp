@@ -66,6 +66,9 @@ struct RenderFlags {
         packet_rays(l.option("--packet-rays", "1|8|64|256|512",
                              "rays traced together: single rays, 4x2, 8x8, 16x16 or 32x16 pixels\n"
                              "(default 256)")),
+        split_fine_shadows(l.option("--split-fine-shadows", "on|off",
+                                    "shadow rays of regions on pixel-sized triangles as 8x8-pixel\n"
+                                    "packets (default on)")),
         asset_roots(l.option("--asset-roots", "A:B",
                              "more folders a glTF file's buffers may be read from (by default\n"
                              "only its own folder and below)")),
@@ -93,6 +96,7 @@ struct RenderFlags {
   const std::optional<std::string>& frames;
   const std::optional<std::string>& triangle_test;
   const std::optional<std::string>& packet_rays;
+  const std::optional<std::string>& split_fine_shadows;
   const std::optional<std::string>& asset_roots;
   const std::optional<std::string>& bone_boxes;
   const std::optional<std::string>& fallback;
@@ -204,6 +208,9 @@ Status parse_run(const RenderFlags& f, RenderOptions& o) {
   }
   if (const std::optional<std::string>& text = f.fallback) {
     SINEW_ASSIGN_OR_RETURN(o.fallback, cli::parse_on_off("--fallback", *text));
+  }
+  if (const std::optional<std::string>& text = f.split_fine_shadows) {
+    SINEW_ASSIGN_OR_RETURN(o.split_fine_shadows, cli::parse_on_off("--split-fine-shadows", *text));
   }
   if (const std::optional<std::string>& text = f.ground) {
     SINEW_ASSIGN_OR_RETURN(o.ground, cli::parse_on_off("--ground", *text));
@@ -427,6 +434,7 @@ Expected<RenderOutputs> render_model(const RenderOptions& options) {
   rt::RenderSettings settings;
   settings.triangle_test = options.triangle_test;
   settings.packet_rays = options.packet_rays;
+  settings.split_fine_shadow_packets = options.split_fine_shadows;
   settings.shadows = options.shadows;
 
   const std::size_t pixels = static_cast<std::size_t>(options.width) * static_cast<std::size_t>(options.height);

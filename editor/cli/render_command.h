@@ -61,6 +61,7 @@ struct RenderOptions {
   int frames = 1;
   rt::TriangleTest triangle_test = rt::TriangleTest::kFast;
   int packet_rays = rt::RenderSettings{}.packet_rays;  // 1, 8, 64, 256 or 512 rays traced together
+  bool split_fine_shadows = rt::RenderSettings{}.split_fine_shadow_packets;
   GltfImportOptions gltf;                               // --asset-roots
   rt::BoneBoxMode bone_boxes = rt::BoneBoxMode::kExact;
   bool fallback = true;

@@ -160,6 +160,7 @@ void render_tile(const Scene& scene, const PinholeCamera& camera, const RenderSe
   int region_x = 1, region_y = 1;
   packet_region_blocks(settings.packet_rays, region_x, region_y);
   s.prepare(tile, region_x, region_y);
+  s.split_fine_shadows = settings.split_fine_shadow_packets;
   const auto t0 = Clock::now();
   generate_camera_rays(camera, s);
   trace_primary(scene, camera, settings.triangle_test, settings.packet_rays, s, record.primary);

@@ -86,8 +86,12 @@ struct TileScratch {
   Vec3 shadow_origin{0.0f};
   // Shadow run r: rays [shadow_region_begin[r], shadow_region_begin[r + 1])
   // come from one region's pixels, those on characters or those on static
-  // meshes (runs without a ray have no entry).
+  // meshes (runs without a ray have no entry). With split_fine_shadows
+  // (RenderSettings::split_fine_shadow_packets), a region whose character
+  // hits lie on pixel-sized triangles gives its character rays one run per
+  // 8x8 pixels.
   std::vector<std::uint32_t> shadow_region_begin;
+  bool split_fine_shadows = true;
   // The tile's outputs until shade_and_write stores them (render/output_staging.h).
   OutputStaging staging;
 

@@ -1056,7 +1056,7 @@ TEST(TileStages, SurfacesAndShadowOriginsAreTheScalarOnes) {
           .value();
   rt::Light light;
   light.position = Vec3(2.0f, 4.0f, 3.0f);
-  std::size_t hits = 0, rays = 0, split_regions = 0;
+  std::size_t hits = 0, rays = 0, split_regions = 0, square_runs = 0;
   // Regions of one block (8-ray packets) and of 4x8 blocks (256 rays).
   for (const int region_x : {1, 4}) {
     for (int ty = 0; ty < 64; ty += 16) {
@@ -1117,7 +1117,9 @@ TEST(TileStages, SurfacesAndShadowOriginsAreTheScalarOnes) {
         }
         EXPECT_EQ(lane_rays, s.shadow_count);
         // Runs: region by region, a region's rays on characters, then its
-        // rays on static meshes, each in lane order.
+        // rays on static meshes, each in lane order; a region on pixel-sized
+        // triangles (the mannequins at 64x64) gives its character rays one
+        // run per 8x8 pixels.
         if (s.shadow_count == 0) {
           EXPECT_TRUE(s.shadow_region_begin.empty());
           continue;
@@ -1139,8 +1141,21 @@ TEST(TileStages, SurfacesAndShadowOriginsAreTheScalarOnes) {
             }
           }
           if (r > 0) {
-            ASSERT_TRUE(region > last_region || (region == last_region && kind > last_kind)) << r;
-            if (region == last_region) ++split_regions;
+            const bool next_square = region == last_region && kind == 0 && last_kind == 0;
+            ASSERT_TRUE(region > last_region || (region == last_region && kind > last_kind) || next_square) << r;
+            if (region == last_region && kind > last_kind) ++split_regions;
+            if (next_square) ++square_runs;
+          }
+          if (kind == 0) {
+            // Within one 8x8 square when the region's character rays split,
+            // and in any case within one region.
+            const auto square = [&](std::size_t k) { return std::pair(s.pixel_x(k) / 8, s.pixel_y(k) / 8); };
+            const bool split = (r > 0 && region == last_region && last_kind == 0) ||
+                               (r + 2 < s.shadow_region_begin.size() &&
+                                region_of(s.shadow_pixel[i1]) == region && on_character(s.shadow_pixel[i1]));
+            for (std::size_t i = i0; split && i < i1; ++i) {
+              ASSERT_EQ(square(s.shadow_pixel[i]), square(s.shadow_pixel[i0])) << i;
+            }
           }
           last_region = region;
           last_kind = kind;
@@ -1151,6 +1166,7 @@ TEST(TileStages, SurfacesAndShadowOriginsAreTheScalarOnes) {
   EXPECT_GT(hits, 2000u);
   EXPECT_GT(rays, 1000u);
   EXPECT_GT(split_regions, 4u) << "regions with rays on both kinds of mesh";
+  EXPECT_GT(square_runs, 0u) << "regions whose character rays run as 8x8-pixel packets";
 }
 
 // aim_shadow_rays bounds where the rays of offset_shadow_rays end without
@@ -1321,6 +1337,98 @@ Frame render(const rt::Scene& sc, const rt::PinholeCamera& camera, int tile, int
   rt::Renderer renderer;
   EXPECT_TRUE(renderer.render(sc, camera, settings, buffers, jobs).ok());
   return f;
+}
+
+// A 16x16-pixel region of 4x8 blocks, every pixel on a character with a
+// shadow ray to a point light, its triangles given per block by `ids`
+// (lane i of block b on triangle 10 * b + ids[i]; triangles of different
+// blocks never meet in a pair).
+rt::TileScratch fine_region(const std::array<std::uint32_t, 8>& ids, bool split) {
+  rt::TileScratch s;
+  s.prepare(Tile{0, 0, 16, 16, 0}, 4, 8);
+  s.split_fine_shadows = split;
+  for (std::size_t b = 0; b < s.blocks(); ++b) {
+    s.block_hits[b] = 0xFF;
+    s.block_on_character[b] = 0xFF;
+    s.shadow_lanes[b] = 0xFF;
+  }
+  for (std::size_t k = 0; k < s.lanes; ++k) {
+    s.triangle[k] = static_cast<std::uint32_t>(10 * (k / 8)) + ids[k % 8];
+    s.instance[k] = 0;
+    s.shadow_lane_x[k] = static_cast<float>(k);
+    s.shadow_lane_y[k] = 1.0f;
+    s.shadow_lane_z[k] = -1.0f;
+  }
+  s.shadows_from_point = true;
+  s.shadow_origin = Vec3(0.0f, 5.0f, 0.0f);
+  s.shadows_aimed_only = false;
+  s.shadows_compacted = false;
+  rt::compact_shadow_rays(s);
+  return s;
+}
+
+// Lanes 0-3 are a block's top row, 4-7 its bottom row: ten neighbouring
+// pairs (six across, four down). A region splits when at least two in three
+// of its pairs lie on different triangles (hand-counted below).
+TEST(TileStages, ShadowRaysOfRegionsOnPixelSizedTrianglesRunAsEightByEightPackets) {
+  const std::array<std::uint32_t, 8> distinct{0, 1, 2, 3, 4, 5, 6, 7};  // 10 of 10 pairs differ
+  const std::array<std::uint32_t, 8> seven{0, 0, 1, 2, 3, 0, 1, 4};     // 2 + 3 across, 2 down: 7
+  const std::array<std::uint32_t, 8> six{0, 0, 1, 2, 3, 0, 1, 2};       // 2 + 3 across, 1 down: 6
+  const std::array<std::uint32_t, 8> one{5, 5, 5, 5, 5, 5, 5, 5};       // none
+  const std::vector<std::uint32_t> quadrants{0, 64, 128, 192, 256};
+  const std::vector<std::uint32_t> whole{0, 256};
+  EXPECT_EQ(fine_region(distinct, true).shadow_region_begin, quadrants);
+  EXPECT_EQ(fine_region(seven, true).shadow_region_begin, quadrants);
+  EXPECT_EQ(fine_region(six, true).shadow_region_begin, whole);
+  EXPECT_EQ(fine_region(one, true).shadow_region_begin, whole);
+  EXPECT_EQ(fine_region(distinct, false).shadow_region_begin, whole);
+
+  // Each run holds one 8x8 quadrant's 64 rays, every ray once.
+  const rt::TileScratch s = fine_region(distinct, true);
+  std::vector<int> seen(256, 0);
+  for (std::size_t run = 0; run < 4; ++run) {
+    for (std::size_t i = s.shadow_region_begin[run]; i < s.shadow_region_begin[run + 1]; ++i) {
+      const std::size_t k = s.shadow_pixel[i];
+      const int x = s.pixel_x(k), y = s.pixel_y(k);
+      EXPECT_EQ(x / 8, static_cast<int>(run % 2)) << "ray " << i;
+      EXPECT_EQ(y / 8, static_cast<int>(run / 2)) << "ray " << i;
+      ++seen[static_cast<std::size_t>(16 * y + x)];
+      EXPECT_EQ(s.sd_x[i], static_cast<float>(k));  // the lane's own ray
+    }
+  }
+  EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), 256);
+}
+
+// Far from the camera the mannequins' triangles are a pixel or less: the
+// regions split, and the image is the single rays' either way.
+TEST(Renderer, SplitShadowPacketsOnFineTrianglesShadeAsSingleRays) {
+  const rt::Scene& sc = scene();
+  JobSystem jobs(2);
+  const auto camera =
+      rt::PinholeCamera::create({Vec3(0.5f, 1.4f, 14.0f), Vec3(0.0f, 0.9f, 0.0f), Vec3(0, 1, 0), 8.0f}, 67, 61)
+          .value();
+  const std::size_t n = static_cast<std::size_t>(camera.width() * camera.height());
+  const auto color = [&](int packet_rays, bool split, rt::TraversalCounters* shadow) {
+    std::vector<std::uint8_t> rgba(4 * n);
+    rt::FrameBuffers buffers{camera.width(), camera.height(), rgba, {}, {}, {}, {}, {}, {}};
+    rt::RenderSettings settings;
+    settings.packet_rays = packet_rays;
+    settings.split_fine_shadow_packets = split;
+    rt::Renderer renderer;
+    const Expected<rt::RenderStats> stats = renderer.render(sc, camera, settings, buffers, jobs);
+    EXPECT_TRUE(stats.ok());
+    if (shadow != nullptr && stats.ok()) *shadow = stats->shadow;
+    return rgba;
+  };
+  const std::vector<std::uint8_t> single = color(1, true, nullptr);
+  for (const int packet_rays : {256, 512}) {
+    rt::TraversalCounters whole, split;
+    EXPECT_EQ(color(packet_rays, false, &whole), single) << packet_rays;
+    EXPECT_EQ(color(packet_rays, true, &split), single) << packet_rays;
+    // Smaller packets walk the trees otherwise: the split happened.
+    EXPECT_TRUE(split.node_visits != whole.node_visits || split.triangle_tests != whole.triangle_tests)
+        << packet_rays;
+  }
 }
 
 // Odd image sizes and tile sizes put partial 4x2 blocks on every tile and
