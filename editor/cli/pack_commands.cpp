@@ -57,6 +57,7 @@ struct BakeOptions {
   rt::CandidateBones candidates = rt::CandidateBones::kAll;
   bool merge_rigid_bones = rt::FuzzyBakeOptions{}.merge_rigid_bones;
   float sah_intersection_cost = rt::FuzzyBakeOptions{}.kd.intersection_cost;
+  bool sah_intersection_cost_given = false;  // else the bake's size-based default
   int threads = 0;
   std::size_t max_memory_bytes = character::BakeRequest{}.max_memory_bytes;
   GltfImportOptions gltf;
@@ -102,8 +103,9 @@ struct BakeFlags {
                              "top-level objects per frame; default) or keeps its own (keep)")),
         sah_intersection_cost(l.option("--sah-intersection-cost", "C",
                                        "the bone trees' triangle cost against a cell visit's 1\n"
-                                       "(default 0.15, tuned for 256-ray packets; 1.5\n"
-                                       "builds deeper trees, which suit --packet-rays 1)")),
+                                       "(default 0.15, 0.05 from 25,000 triangles, tuned for\n"
+                                       "256-ray packets; 1.5 builds deeper trees, which suit\n"
+                                       "--packet-rays 1)")),
         threads(l.option("--threads", "N", "worker threads (default 0: all cores)")),
         max_memory_mib(l.option("--max-memory-mib", "M",
                                 "refuse a bake whose working set would exceed M MiB\n"
@@ -249,6 +251,7 @@ Expected<BakeOptions> parse_bake_options(const std::vector<std::string>& args, c
   if (const std::optional<std::string>& v = f.sah_intersection_cost) {
     SINEW_ASSIGN_OR_RETURN(const double cost, cli::parse_double("--sah-intersection-cost", *v, 0.01, 100.0));
     o.sah_intersection_cost = static_cast<float>(cost);
+    o.sah_intersection_cost_given = true;
   }
   if (const std::optional<std::string>& v = f.threads) {
     SINEW_ASSIGN_OR_RETURN(o.threads, cli::parse_threads("--threads", *v));
@@ -550,6 +553,7 @@ int run_bake(const std::vector<std::string>& args, std::ostream& out, std::ostre
   request.fuzzy.candidates = o.candidates;
   request.fuzzy.merge_rigid_bones = o.merge_rigid_bones;
   request.fuzzy.kd.intersection_cost = o.sah_intersection_cost;
+  request.fuzzy.fine_mesh_cost = !o.sah_intersection_cost_given;
   request.max_memory_bytes = o.max_memory_bytes;
   request.fuzzy.memory_budget_bytes = std::min(request.fuzzy.memory_budget_bytes, o.max_memory_bytes / 4);
   if (!o.limits_path.empty()) {

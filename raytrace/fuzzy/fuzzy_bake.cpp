@@ -538,6 +538,10 @@ Status build_bone_trees(std::span<const Aabb> triangle_boxes, const FuzzyBakeOpt
     }
   }
 
+  KdBuildOptions kd = options.kd;
+  if (options.fine_mesh_cost && out.triangle_bone.size() >= kFineMeshTriangles) {
+    kd.intersection_cost = kFineMeshIntersectionCost;
+  }
   std::vector<std::optional<KdTree>> trees(bone_count);
   std::vector<Status> errors(bone_count);
   jobs.parallel_for(0, bone_count, 1, [&](Range r) {
@@ -546,7 +550,7 @@ Status build_bone_trees(std::span<const Aabb> triangle_boxes, const FuzzyBakeOpt
       std::vector<Aabb> boxes;
       boxes.reserve(begin[b + 1] - begin[b]);
       for (std::uint32_t i = begin[b]; i < begin[b + 1]; ++i) boxes.push_back(triangle_boxes[triangles[i]]);
-      Expected<KdTree> tree = build_kd_tree(boxes, options.kd);
+      Expected<KdTree> tree = build_kd_tree(boxes, kd);
       if (tree.ok()) {
         trees[b] = std::move(tree).value();
       } else {

@@ -598,6 +598,30 @@ TEST_P(FuzzyBakeModes, ChunkingAndThreadCountDoNotChangeTheResult) {
   expect_identical(reference, bake_ok(rig, one_bone, 3));
 }
 
+// From kFineMeshTriangles triangles on, the bone trees build with
+// kFineMeshIntersectionCost unless fine_mesh_cost is cleared: the same
+// bytes as an explicit kd.intersection_cost of 0.05 there, and of the
+// given cost below it or with the default off.
+TEST(FuzzyBakeTrees, FineMeshesBuildWithTheFineMeshCost) {
+  Rig fine = arm_rig(4, 6, 3);
+  fine.mesh = arm_mesh(4, 200, 0.125);  // 33 rings x 200 segments: 12,800 triangles
+  Rig finer = fine;
+  finer.mesh = arm_mesh(4, 400, 0.125);  // 25,600 triangles
+  ASSERT_LT(fine.mesh.triangle_count(), kFineMeshTriangles);
+  ASSERT_GE(finer.mesh.triangle_count(), kFineMeshTriangles);
+
+  FuzzyBakeOptions fixed;
+  fixed.fine_mesh_cost = false;
+  FuzzyBakeOptions explicit_fine = fixed;
+  explicit_fine.kd.intersection_cost = kFineMeshIntersectionCost;
+  const FuzzyCharacterData by_default = bake_ok(finer, FuzzyBakeOptions{});
+  expect_identical(by_default, bake_ok(finer, explicit_fine));
+  // The two costs build different trees here, so the comparison above can fail.
+  EXPECT_NE(by_default.stats.node_count, bake_ok(finer, fixed).stats.node_count);
+  // Below the threshold the default keeps kd.intersection_cost.
+  expect_identical(bake_ok(fine, FuzzyBakeOptions{}), bake_ok(fine, fixed));
+}
+
 TEST(FuzzyBakeMemory, TheBudgetBoundsTheBoxStorage) {
   // 40 extra root bones make the vertex x bone boxes the largest buffer.
   Rig rig = arm_rig(4, 6, 26);
