@@ -103,6 +103,13 @@ struct TileScratch {
 
   std::size_t blocks() const { return lanes / kBlockLanes; }
   std::size_t regions() const { return region_begin.empty() ? 0 : region_begin.size() - 1; }
+  // Region r's blocks are row-major: its width in blocks is its first row's.
+  std::size_t region_columns(std::size_t r) const {
+    const std::size_t b0 = region_begin[r], b1 = region_begin[r + 1];
+    std::size_t columns = 0;
+    while (b0 + columns < b1 && block_dy[b0 + columns] == block_dy[b0]) ++columns;
+    return columns;
+  }
   int block_x0(std::size_t b) const { return tile.x0 + block_dx[b]; }
   int block_y0(std::size_t b) const { return tile.y0 + block_dy[b]; }
   int pixel_x(std::size_t k) const { return block_x0(k / kBlockLanes) + static_cast<int>(k % kBlockWidth); }

@@ -427,12 +427,7 @@ void trace_primary_large(const Scene& scene, const PinholeCamera& camera, Triang
     rays.t_min = shared.t_min;
     rays.t_max = shared.t_max;
     rays.active = &s.block_pixels[b0];
-    // The region's blocks, row-major: as many columns as its first row has.
-    rays.grid_columns = 0;
-    while (b0 + static_cast<std::size_t>(rays.grid_columns) < b1 &&
-           s.block_dy[b0 + static_cast<std::size_t>(rays.grid_columns)] == s.block_dy[b0]) {
-      ++rays.grid_columns;
-    }
+    rays.grid_columns = static_cast<int>(s.region_columns(r));
     rays.grid_forward = camera.forward();
     rays.grid_right = camera.right();
     rays.grid_up = camera.up();
@@ -837,20 +832,6 @@ void place_shadow_rays(const Light& light, int l, TileScratch& s) {
 
 namespace {
 
-// A region's blocks are row-major (TileScratch::prepare): its width is the
-// run of blocks on its first row.
-struct RegionShape {
-  std::size_t width = 0;
-  std::size_t height = 0;
-};
-
-RegionShape region_shape(const TileScratch& s, std::size_t b0, std::size_t b1) {
-  RegionShape shape;
-  while (b0 + shape.width < b1 && s.block_dy[b0 + shape.width] == s.block_dy[b0]) ++shape.width;
-  shape.height = shape.width == 0 ? 0 : (b1 - b0 + shape.width - 1) / shape.width;
-  return shape;
-}
-
 // Fine geometry's shadow packets: 8x8 pixels. Measured against 4x4 and
 // 8x4 (and the whole 16x16 region) at 213,888 and 855,552 triangles
 // (docs/RAYTRACE.md, "Shadow packets on fine meshes").
@@ -931,33 +912,29 @@ void compact_shadow_rays(TileScratch& s) {
     const std::size_t b0 = s.region_begin[r], b1 = s.region_begin[r + 1];
     std::uint32_t statics = 0;
     for (std::size_t b = b0; b < b1; ++b) statics |= s.shadow_lanes[b] & ~s.block_on_character[b];
-    const RegionShape shape = region_shape(s, b0, b1);
-    if (s.split_fine_shadows && shape.width > kSplitBlocksX && fine_geometry(s, b0, b1)) {
-      // Pixel-sized triangles: the region's character rays as square
-      // packets of kSplitBlocksX x kSplitBlocksY blocks. A large packet's
-      // rays all end on the surface, so its leaves near the surface are
-      // reached by every group, and there a finer mesh means more
-      // triangles per group: at 855,552 triangles 8x8-pixel packets take
-      // 25 triangle tests a shadow ray where 16x16 take 37.
-      for (std::size_t sy = 0; sy < shape.height; sy += kSplitBlocksY) {
-        for (std::size_t sx = 0; sx < shape.width; sx += kSplitBlocksX) {
-          for (std::size_t y = sy; y < std::min(shape.height, sy + kSplitBlocksY); ++y) {
-            for (std::size_t x = sx; x < std::min(shape.width, sx + kSplitBlocksX); ++x) {
-              const std::size_t b = b0 + y * shape.width + x;
-              if (b >= b1) continue;
-              const std::uint32_t on_character = s.block_on_character[b] & s.shadow_lanes[b];
-              if (on_character != 0) add_block(b, on_character);
-            }
+    // The character rays in packets of square x square_rows blocks: the
+    // whole region, or on pixel-sized triangles 8x8-pixel squares. A large
+    // packet's rays all end on the surface, so its leaves near the surface
+    // are reached by every group, and there a finer mesh means more
+    // triangles per group: at 855,552 triangles 8x8-pixel packets take 25
+    // triangle tests a shadow ray where 16x16 take 37.
+    const std::size_t columns = s.region_columns(r);
+    const std::size_t rows = columns == 0 ? 0 : (b1 - b0 + columns - 1) / columns;
+    const bool split = s.split_fine_shadows && columns > kSplitBlocksX && fine_geometry(s, b0, b1);
+    const std::size_t square = split ? kSplitBlocksX : columns;
+    const std::size_t square_rows = split ? kSplitBlocksY : rows;
+    for (std::size_t sy = 0; sy < rows; sy += square_rows) {
+      for (std::size_t sx = 0; sx < columns; sx += square) {
+        for (std::size_t y = sy; y < std::min(rows, sy + square_rows); ++y) {
+          for (std::size_t x = sx; x < std::min(columns, sx + square); ++x) {
+            const std::size_t b = b0 + y * columns + x;
+            if (b >= b1) continue;
+            const std::uint32_t on_character = s.block_on_character[b] & s.shadow_lanes[b];
+            if (on_character != 0) add_block(b, on_character);
           }
-          close_run();
         }
+        close_run();
       }
-    } else {
-      for (std::size_t b = b0; b < b1; ++b) {
-        const std::uint32_t on_character = s.block_on_character[b] & s.shadow_lanes[b];
-        if (on_character != 0) add_block(b, on_character);
-      }
-      close_run();
     }
     if (statics == 0) continue;
     for (std::size_t b = b0; b < b1; ++b) {

@@ -121,8 +121,8 @@ Expected<FrameStats> Scene::prepare_frame(const FrameOptions& options, JobSystem
     const Character& character = characters_[frame.character];
     auto start = std::chrono::steady_clock::now();
     update_bone_frames(frame, character.fuzzy);
-    skin_instance(frame, *character.mesh, character.influences, character.fuzzy, options.normals, options.bone_boxes == BoneBoxMode::kExact,
-                  options.skinning, jobs);
+    skin_instance(frame, *character.mesh, character.influences, character.fuzzy, options.normals,
+                  options.bone_boxes == BoneBoxMode::kExact, options.skinning, jobs);
     skinning_ms += ms_since(start);
 
     start = std::chrono::steady_clock::now();
