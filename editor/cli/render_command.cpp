@@ -76,6 +76,10 @@ struct RenderFlags {
         fallback(l.option("--fallback", "on|off",
                           "exact rendering of triangles outside their fuzzy boxes (default on)")),
         ground(l.option("--ground", "on|off", "the ground quad under the model (default on)")),
+        pose_clusters(l.option("--pose-clusters", "K",
+                               "pose-space clusters per bone in the bake, each a tighter tree\n"
+                               "(0-64, default 0: none; in-memory bakes, a pack has its own)")),
+        clusters(l.option("--clusters", "on|off", "bones use the clusters the bake or pack has (default on)")),
         import_limits(l) {}
 
   const std::vector<std::string>& model;
@@ -101,6 +105,8 @@ struct RenderFlags {
   const std::optional<std::string>& bone_boxes;
   const std::optional<std::string>& fallback;
   const std::optional<std::string>& ground;
+  const std::optional<std::string>& pose_clusters;
+  const std::optional<std::string>& clusters;
   ImportLimitFlags import_limits;
 };
 
@@ -212,6 +218,13 @@ Status parse_run(const RenderFlags& f, RenderOptions& o) {
   if (const std::optional<std::string>& text = f.split_fine_shadows) {
     SINEW_ASSIGN_OR_RETURN(o.split_fine_shadows, cli::parse_on_off("--split-fine-shadows", *text));
   }
+  if (const std::optional<std::string>& text = f.pose_clusters) {
+    SINEW_ASSIGN_OR_RETURN(const std::int64_t k, cli::parse_int("--pose-clusters", *text, 0, rt::kMaxPoseClusters));
+    o.pose_clusters = static_cast<std::uint32_t>(k);
+  }
+  if (const std::optional<std::string>& text = f.clusters) {
+    SINEW_ASSIGN_OR_RETURN(o.use_clusters, cli::parse_on_off("--clusters", *text));
+  }
   if (const std::optional<std::string>& text = f.ground) {
     SINEW_ASSIGN_OR_RETURN(o.ground, cli::parse_on_off("--ground", *text));
   }
@@ -319,6 +332,9 @@ Expected<std::string> stats_document(const RenderOptions& options, const charact
                     {"escaped_triangles", s.escaped_triangles},
                     {"total_escaped_checks", s.total_escaped_checks},
                     {"total_escaped_triangles", s.total_escaped_triangles}};
+  doc["clusters"] = {{"clusters", s.clusters},
+                     {"cluster_bones", s.cluster_bones},
+                     {"total_cluster_misses", s.total_cluster_misses}};
   doc["fps"] = s.fps;
   return doc.dump(2) + "\n";
 }
@@ -397,6 +413,7 @@ Expected<RenderOutputs> render_model(const RenderOptions& options) {
   if (!pack || !pack->has_fuzzy()) {
     character::BakeRequest request;
     request.pose_space = options.pose_space;
+    request.fuzzy.pose_clusters = options.pose_clusters;
     if (!options.limits_path.empty()) {
       SINEW_ASSIGN_OR_RETURN(request.limits, anim::load_joint_limits(options.limits_path, model.skeleton));
     }
@@ -431,6 +448,7 @@ Expected<RenderOutputs> render_model(const RenderOptions& options) {
   rt::FrameOptions frame_options;
   frame_options.bone_boxes = options.bone_boxes;
   frame_options.fallback = options.fallback;
+  frame_options.pose_clusters = options.use_clusters;
   rt::RenderSettings settings;
   settings.triangle_test = options.triangle_test;
   settings.packet_rays = options.packet_rays;
@@ -496,11 +514,14 @@ Expected<RenderOutputs> render_model(const RenderOptions& options) {
     stats.escaped_triangles = frame.escaped_triangles;
     stats.total_escaped_checks += frame.escaped_checks;
     stats.total_escaped_triangles += frame.escaped_triangles;
+    stats.cluster_bones = frame.cluster_bones;
+    stats.total_cluster_misses += frame.cluster_misses;
     out.last_frame_seconds = seconds;
   }
   stats.triangles = model.mesh.triangle_count();
   stats.bones = model.skeleton.joint_count();
   stats.pose_samples = bake.fuzzy.stats.sample_count;
+  stats.clusters = static_cast<std::uint32_t>(fuzzy.clusters.size());
   stats.median_frame_ms = median_of(frame_ms);
   stats.fps = stats.median_frame_ms > 0.0 ? 1000.0 / stats.median_frame_ms : 0.0;
   SINEW_ASSIGN_OR_RETURN(out.stats_json, stats_document(options, model, bake, out));
@@ -540,6 +561,11 @@ void print_summary(const RenderOptions& options, const RenderOutputs& o, std::os
   text << "escapes (last frame): " << s.escaped_checks << " checks, " << s.escaped_triangles
        << " triangles; over all frames: " << s.total_escaped_checks << " checks, " << s.total_escaped_triangles
        << " triangles\n";
+  if (s.clusters > 0) {
+    text << "pose-space clusters: " << s.clusters << ", " << s.cluster_bones
+         << " bones on a cluster's tree (last frame), " << s.total_cluster_misses
+         << " bones back on their full tree over all frames\n";
+  }
   text << "wrote " << options.out_dir << "/{color.png,depth.exr,triangle_id.exr,stats.json}\n";
   out << text.str();
 }

@@ -65,6 +65,11 @@ struct RenderOptions {
   GltfImportOptions gltf;                               // --asset-roots
   rt::BoneBoxMode bone_boxes = rt::BoneBoxMode::kExact;
   bool fallback = true;
+  // In-memory bakes only (a pack has its own): pose-space clusters per bone
+  // (rt::FuzzyBakeOptions::pose_clusters, 0: none); and whether bones use
+  // the clusters a bake or pack has (rt::FrameOptions::pose_clusters).
+  std::uint32_t pose_clusters = 0;
+  bool use_clusters = true;
   bool ground = true;  // the ground quad under the model (--ground off: characters alone)
   // Called with one line per step (import, bake, frames, write); null: quiet.
   std::function<void(std::string_view)> progress;
@@ -90,6 +95,9 @@ struct RenderStatsSummary {
   std::size_t escaped_triangles = 0;
   std::size_t total_escaped_checks = 0;  // over all frames
   std::size_t total_escaped_triangles = 0;
+  std::uint32_t clusters = 0;            // the bake's or pack's pose-space clusters, all bones
+  std::size_t cluster_bones = 0;         // last frame: bones on a cluster's tree
+  std::size_t total_cluster_misses = 0;  // over all frames: bones whose cluster a vertex left
 };
 
 // Everything the last frame produced, for tests and callers in-process.

@@ -7,7 +7,10 @@
 //      then update each triangle's best (smallest-area) bone
 //   -> one more sweep for the vertex boxes of the chosen bones (the escape
 //      checks), whose unions are the triangles' fuzzy boxes
-//   -> per bone an SAH kd-tree over its triangles' fuzzy boxes.
+//   -> with pose_clusters: per bone, its samples clustered by its feature
+//      (pose_clusters.h) and one more sweep for each cluster's check boxes
+//   -> per bone an SAH kd-tree over its triangles' fuzzy boxes, then one
+//      per cluster over the cluster's boxes.
 //
 // Every box is a min/max over samples, which is independent of the order the
 // samples and vertices are visited in, so the result depends neither on the
@@ -23,6 +26,7 @@
 #include <string>
 #include <utility>
 
+#include "raytrace/fuzzy/pose_clusters.h"
 #include "raytrace/skinning/skinning.h"
 #include "runtime/core/format_number.h"
 #include "runtime/mesh/mesh_checks.h"
@@ -134,6 +138,10 @@ Status validate_input(const FuzzyBakeInput& input, const FuzzyBakeOptions& optio
   if (!std::isfinite(options.padding) || options.padding < 0.0f) {
     return invalid_argument("padding", format_number(options.padding),
                             "must be finite and not negative");
+  }
+  if (options.pose_clusters > kMaxPoseClusters) {
+    return invalid_argument("pose_clusters", std::to_string(options.pose_clusters),
+                            "at most " + std::to_string(kMaxPoseClusters));
   }
   return check_skinned_mesh(MeshOrigin{}, *input.mesh, bones);
 }
@@ -523,6 +531,12 @@ std::vector<Aabb> triangle_fuzzy_boxes(const FuzzyCharacterData& out) {
 // ---------------------------------------------------------------------------
 // Bone trees
 
+KdBuildOptions tree_build_options(const FuzzyBakeOptions& options, std::size_t triangle_count) {
+  KdBuildOptions kd = options.kd;
+  if (options.fine_mesh_cost && triangle_count >= kFineMeshTriangles) kd.intersection_cost = kFineMeshIntersectionCost;
+  return kd;
+}
+
 Status build_bone_trees(std::span<const Aabb> triangle_boxes, const FuzzyBakeOptions& options,
                         JobSystem& jobs, FuzzyCharacterData& out) {
   const std::uint32_t bone_count = out.bone_count;
@@ -538,10 +552,7 @@ Status build_bone_trees(std::span<const Aabb> triangle_boxes, const FuzzyBakeOpt
     }
   }
 
-  KdBuildOptions kd = options.kd;
-  if (options.fine_mesh_cost && out.triangle_bone.size() >= kFineMeshTriangles) {
-    kd.intersection_cost = kFineMeshIntersectionCost;
-  }
+  const KdBuildOptions kd = tree_build_options(options, out.triangle_bone.size());
   std::vector<std::optional<KdTree>> trees(bone_count);
   std::vector<Status> errors(bone_count);
   jobs.parallel_for(0, bone_count, 1, [&](Range r) {
@@ -585,6 +596,162 @@ Status build_bone_trees(std::span<const Aabb> triangle_boxes, const FuzzyBakeOpt
   out.stats.node_count = static_cast<std::uint32_t>(out.nodes.size());
   out.stats.mean_items_per_leaf =
       full_leaves ? static_cast<double>(item_refs) / static_cast<double>(full_leaves) : 0.0;
+  return {};
+}
+
+// ---------------------------------------------------------------------------
+// Pose-space clusters
+
+// Per bone, each sample's cluster (empty for a bone without clusters).
+using ClusterMembers = std::vector<std::vector<std::uint32_t>>;
+
+// Clusters each bone's samples by its feature and lays out the clusters,
+// their centres and the check ranks; the boxes are grown by
+// grow_cluster_boxes and the trees built by build_cluster_trees.
+ClusterMembers plan_clusters(const Samples& samples, const FuzzyBakeOptions& options, float translation_scale,
+                             JobSystem& jobs, FuzzyCharacterData& out) {
+  const std::uint32_t bone_count = out.bone_count;
+  cluster_feature_bones(samples.mesh, out.vertex_check_begin, out.vertex_checks, bone_count, out.feature_bone_begin,
+                        out.feature_bones);
+  out.feature_translation_scale = translation_scale;
+  std::vector<std::uint32_t> triangles(bone_count, 0);
+  for (const std::uint16_t b : out.triangle_bone) ++triangles[b];
+  std::vector<std::uint32_t> checks(bone_count, 0);
+  out.check_rank.resize(out.vertex_checks.size());
+  for (std::size_t c = 0; c < out.vertex_checks.size(); ++c) out.check_rank[c] = checks[out.vertex_checks[c].bone]++;
+
+  // Per bone: k-means over its samples' features (bones in parallel).
+  ClusterMembers members(bone_count);
+  std::vector<std::vector<float>> centres(bone_count);
+  std::vector<std::uint32_t> counts(bone_count, 0);
+  const std::size_t sample_count = samples.count();
+  jobs.parallel_for(0, bone_count, 1, [&](Range r) {
+    for (std::size_t b = r.begin; b < r.end; ++b) {
+      const std::span<const std::uint16_t> feature_bones(
+          out.feature_bones.data() + out.feature_bone_begin[b], out.feature_bone_begin[b + 1] - out.feature_bone_begin[b]);
+      if (triangles[b] == 0 || feature_bones.empty()) continue;
+      const std::size_t dims = feature_bones.size() * kClusterFeatureFloats;
+      std::vector<float> features(sample_count * dims);
+      for (std::size_t s = 0; s < sample_count; ++s) {
+        cluster_feature(samples.bone_from_pose(s)[b], samples.pose(s), feature_bones, translation_scale,
+                        features.data() + s * dims);
+      }
+      counts[b] = cluster_points(features, sample_count, dims, options.pose_clusters, members[b], centres[b]);
+      // One cluster is the full tree again.
+      if (counts[b] < 2) {
+        counts[b] = 0;
+        members[b].clear();
+      }
+    }
+  });
+  out.bone_cluster_begin.assign(1, 0);
+  std::size_t boxes = 0;
+  for (std::uint32_t b = 0; b < bone_count; ++b) {
+    const std::size_t dims = (out.feature_bone_begin[b + 1] - out.feature_bone_begin[b]) * kClusterFeatureFloats;
+    for (std::uint32_t k = 0; k < counts[b]; ++k) {
+      BoneCluster cluster;
+      cluster.box_begin = static_cast<std::uint32_t>(boxes);
+      cluster.centre_begin = static_cast<std::uint32_t>(out.cluster_centres.size());
+      out.cluster_centres.insert(out.cluster_centres.end(), centres[b].begin() + static_cast<std::ptrdiff_t>(k * dims),
+                                 centres[b].begin() + static_cast<std::ptrdiff_t>((k + 1) * dims));
+      boxes += checks[b];
+      out.clusters.push_back(cluster);
+    }
+    out.bone_cluster_begin.push_back(static_cast<std::uint32_t>(out.clusters.size()));
+  }
+  out.cluster_boxes.assign(boxes, Aabb::empty());
+  return members;
+}
+
+// Each cluster's boxes of its bone's checks: the check's vertex over the
+// cluster's samples, in the bone's frame (grow_check_boxes over a subset).
+Status grow_cluster_boxes(const Samples& samples, const ClusterMembers& members, float pad, JobSystem& jobs,
+                          Progress& progress, FuzzyCharacterData& out) {
+  SINEW_RETURN_IF_ERROR(sweep_samples(samples, jobs, progress, [&](Range r, std::size_t s0, std::size_t s1) {
+    for (std::size_t v = r.begin; v < r.end; ++v) {
+      const std::uint32_t first = out.vertex_check_begin[v], last = out.vertex_check_begin[v + 1];
+      bool clustered = false;
+      for (std::uint32_t c = first; c < last; ++c) clustered = clustered || !members[out.vertex_checks[c].bone].empty();
+      if (!clustered) continue;
+      for (std::size_t s = s0; s < s1; ++s) {
+        const Vec3 p = skin_point(samples.mesh, v, samples.pose(s));
+        const Affine3* bone_from_pose = samples.bone_from_pose(s);
+        for (std::uint32_t c = first; c < last; ++c) {
+          const std::uint32_t b = out.vertex_checks[c].bone;
+          if (members[b].empty()) continue;
+          const BoneCluster& cluster = out.clusters[out.bone_cluster_begin[b] + members[b][s]];
+          out.cluster_boxes[cluster.box_begin + out.check_rank[c]].extend(bone_from_pose[b].transform_point(p));
+        }
+      }
+    }
+  }));
+  for (Aabb& box : out.cluster_boxes) pad_box(box, pad);
+  return {};
+}
+
+// A tree per cluster over its bone's triangles and their cluster boxes,
+// appended after the full trees; and the clusters' fuzzy area.
+Status build_cluster_trees(const SkinnedMesh& mesh, const KdBuildOptions& kd, JobSystem& jobs,
+                           FuzzyCharacterData& out) {
+  const std::uint32_t bone_count = out.bone_count;
+  std::vector<std::vector<std::uint32_t>> bone_triangles(bone_count);
+  for (std::size_t t = 0; t < out.triangle_bone.size(); ++t) {
+    bone_triangles[out.triangle_bone[t]].push_back(static_cast<std::uint32_t>(t));
+  }
+  const auto cluster_box = [&](const BoneCluster& cluster, std::uint32_t t) {
+    Aabb box;
+    for (const std::uint32_t c : out.triangle_checks[t]) box.extend(out.cluster_boxes[cluster.box_begin + out.check_rank[c]]);
+    return box;
+  };
+  std::vector<std::uint32_t> cluster_bone(out.clusters.size());
+  for (std::uint32_t b = 0; b < bone_count; ++b) {
+    for (std::uint32_t q = out.bone_cluster_begin[b]; q < out.bone_cluster_begin[b + 1]; ++q) cluster_bone[q] = b;
+  }
+  std::vector<std::optional<KdTree>> trees(out.clusters.size());
+  std::vector<Status> errors(out.clusters.size());
+  jobs.parallel_for(0, out.clusters.size(), 1, [&](Range r) {
+    for (std::size_t q = r.begin; q < r.end; ++q) {
+      std::vector<Aabb> boxes;
+      for (const std::uint32_t t : bone_triangles[cluster_bone[q]]) boxes.push_back(cluster_box(out.clusters[q], t));
+      Expected<KdTree> tree = build_kd_tree(boxes, kd);
+      if (tree.ok()) {
+        trees[q] = std::move(tree).value();
+      } else {
+        errors[q] = std::move(tree).status();
+      }
+    }
+  });
+  for (const Status& error : errors) SINEW_RETURN_IF_ERROR(error);
+  for (std::size_t q = 0; q < out.clusters.size(); ++q) {
+    BoneTree& bt = out.clusters[q].tree;
+    const std::vector<std::uint32_t>& triangles = bone_triangles[cluster_bone[q]];
+    bt.triangle_count = static_cast<std::uint32_t>(triangles.size());
+    bt.node_begin = static_cast<std::uint32_t>(out.nodes.size());
+    bt.item_begin = static_cast<std::uint32_t>(out.items.size());
+    bt.node_count = static_cast<std::uint32_t>(trees[q]->nodes.size());
+    bt.item_count = static_cast<std::uint32_t>(trees[q]->items.size());
+    bt.bounds = trees[q]->bounds;
+    out.nodes.insert(out.nodes.end(), trees[q]->nodes.begin(), trees[q]->nodes.end());
+    for (const std::uint32_t item : trees[q]->items) out.items.push_back(triangles[item]);
+  }
+  // Each triangle's area averaged over its bone's clusters.
+  double area = 0.0;
+  for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
+    const std::uint16_t b = out.triangle_bone[t];
+    const std::uint32_t first = out.bone_cluster_begin[b], last = out.bone_cluster_begin[b + 1];
+    if (first == last) {
+      Aabb box;
+      for (const std::uint32_t c : out.triangle_checks[t]) box.extend(out.vertex_checks[c].box);
+      area += surface_area_d(box);
+      continue;
+    }
+    double sum = 0.0;
+    for (std::uint32_t q = first; q < last; ++q) sum += surface_area_d(cluster_box(out.clusters[q], static_cast<std::uint32_t>(t)));
+    area += sum / static_cast<double>(last - first);
+  }
+  out.stats.cluster_fuzzy_area = area;
+  out.stats.cluster_count = static_cast<std::uint32_t>(out.clusters.size());
+  out.stats.node_count = static_cast<std::uint32_t>(out.nodes.size());
   return {};
 }
 
@@ -667,7 +834,8 @@ Expected<FuzzyCharacterData> bake_fuzzy_character(const FuzzyBakeInput& input,
   const std::uint32_t chunk_bones = static_cast<std::uint32_t>(
       std::clamp<std::size_t>(options.memory_budget_bytes / bytes_per_bone, 1, bone_count));
   const std::uint32_t chunk_count = (bone_count + chunk_bones - 1) / chunk_bones;
-  Progress progress(options, static_cast<double>(samples.count()) * (chunk_count + 1));
+  const std::uint32_t sweeps = chunk_count + 1 + (options.pose_clusters > 0 ? 1 : 0);
+  Progress progress(options, static_cast<double>(samples.count()) * sweeps);
 
   {
     BoxChunk chunk;
@@ -703,6 +871,16 @@ Expected<FuzzyCharacterData> bake_fuzzy_character(const FuzzyBakeInput& input,
   sampling_start = Clock::now();
   SINEW_RETURN_IF_ERROR(grow_check_boxes(samples, pad, jobs, progress, out));
   stats.sampling_ms += ms_since(sampling_start);
+  ClusterMembers cluster_members;
+  if (options.pose_clusters > 0) {
+    const auto clustering_start = Clock::now();
+    const float scale = padding_distance(mesh, 1.0f);
+    cluster_members = plan_clusters(samples, options, scale > 0.0f ? scale : 1.0f, jobs, out);
+    SINEW_RETURN_IF_ERROR(grow_cluster_boxes(samples, cluster_members, pad, jobs, progress, out));
+    memory.hold(bytes_of(out.cluster_boxes) + bytes_of(out.check_rank));
+    stats.clustering_ms = ms_since(clustering_start);
+    stats.clusters_per_bone = options.pose_clusters;
+  }
   memory.release(bytes_of(inverses));
   inverses = std::vector<Affine3>{};  // `samples` is not used past this point
   assignment_start = Clock::now();
@@ -717,6 +895,9 @@ Expected<FuzzyCharacterData> bake_fuzzy_character(const FuzzyBakeInput& input,
   SINEW_RETURN_IF_ERROR(progress.report("build", kSweepShare));
   const auto build_start = Clock::now();
   SINEW_RETURN_IF_ERROR(build_bone_trees(triangle_boxes, options, jobs, out));
+  if (options.pose_clusters > 0) {
+    SINEW_RETURN_IF_ERROR(build_cluster_trees(mesh, tree_build_options(options, triangle_count), jobs, out));
+  }
   memory.hold(bytes_of(out.nodes) + bytes_of(out.items) + bytes_of(out.bone_trees));
   stats.build_ms = ms_since(build_start);
   stats.peak_bytes = memory.peak();

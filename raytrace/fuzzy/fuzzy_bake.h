@@ -45,6 +45,10 @@ struct FuzzyBakeInput {
 inline constexpr std::size_t kFineMeshTriangles = 25'000;
 inline constexpr float kFineMeshIntersectionCost = 0.05f;
 
+// FuzzyBakeOptions::pose_clusters at most: each cluster is another tree and
+// another box per check of its bone.
+inline constexpr std::uint32_t kMaxPoseClusters = 64;
+
 struct FuzzyBakeOptions {
   CandidateBones candidates = CandidateBones::kAll;
   // A bone that moves rigidly with its parent in every sample gives its
@@ -73,6 +77,11 @@ struct FuzzyBakeOptions {
   // a time and larger leaves pay (docs/RAYTRACE.md, "Bone tree build").
   // Clear it to build with kd.intersection_cost at every size.
   bool fine_mesh_cost = true;
+  // Pose-space clusters per bone (raytrace/fuzzy/pose_clusters.h,
+  // docs/RAYTRACE.md "Pose-space clusters"): at most this many, each with a
+  // tree and escape boxes over its samples alone, besides the full tree.
+  // 0: none (the paper's structure). At most kMaxPoseClusters.
+  std::uint32_t pose_clusters = 0;
   std::size_t memory_budget_bytes = std::size_t{256} << 20;
   // Called from the calling thread with a phase name ("sampling",
   // "assignment", "build") and the fraction of the whole bake done, in [0, 1].
@@ -81,7 +90,8 @@ struct FuzzyBakeOptions {
 };
 
 // Errors: kInvalidArgument (no mesh, no samples, samples not a multiple of
-// bone_count, bone_parents of the wrong size, bad padding); kInvalidData
+// bone_count, bone_parents of the wrong size, bad padding, pose_clusters
+// above kMaxPoseClusters); kInvalidData
 // naming the first non-finite sample matrix ("samples[s].bone[b]") or a vertex
 // whose joint index is out of range ("joints[v][k]"); kCancelled.
 Expected<FuzzyCharacterData> bake_fuzzy_character(const FuzzyBakeInput& input,

@@ -50,6 +50,26 @@ struct VertexCheck {
 };
 static_assert(sizeof(VertexCheck) == 28);
 
+// Pose-space clusters (FuzzyBakeOptions::pose_clusters, docs/RAYTRACE.md
+// "Pose-space clusters"): a bone's pose samples split by how the bones that
+// move its triangles sit relative to it, and per cluster a tighter tree over
+// the same triangles and the boxes of the bone's escape checks over that
+// cluster's samples alone. Each frame a bone picks the cluster whose centre
+// is nearest its pose; the escape check then proves its vertices inside the
+// cluster's boxes, or the bone falls back to its full tree.
+struct BoneCluster {
+  BoneTree tree;                  // a slice of the character's node and item arrays, the bone's triangles
+  std::uint32_t box_begin = 0;    // into cluster_boxes: one box per check of the bone, by check_rank
+  std::uint32_t centre_begin = 0; // into cluster_centres: 12 floats per feature bone of the bone
+};
+static_assert(sizeof(BoneCluster) == 56);
+
+// The feature a bone's clusters are told apart by: for each of its feature
+// bones j, the 3x4 matrix S_b^-1 S_j (row-major), its translation column
+// divided by `translation_scale` (the bind-pose bounds' diagonal) so that a
+// move across the model weighs about as a turn of a radian.
+inline constexpr std::size_t kClusterFeatureFloats = 12;
+
 struct FuzzyCharacterView {
   std::uint32_t bone_count = 0;
   std::span<const std::uint16_t> triangle_bone;             // per triangle: its bone
@@ -59,10 +79,28 @@ struct FuzzyCharacterView {
   std::span<const std::uint32_t> vertex_check_begin;        // per vertex + 1: CSR into vertex_checks
   std::span<const VertexCheck> vertex_checks;
   std::span<const std::array<std::uint32_t, 3>> triangle_checks;  // per triangle corner: index into vertex_checks
+  // Pose-space clusters; all empty without them.
+  std::span<const std::uint32_t> bone_cluster_begin;  // per bone + 1: CSR into clusters
+  std::span<const BoneCluster> clusters;
+  std::span<const std::uint32_t> check_rank;          // per vertex check: its index among its bone's checks
+  std::span<const Aabb> cluster_boxes;
+  std::span<const std::uint32_t> feature_bone_begin;  // per bone + 1: CSR into feature_bones
+  std::span<const std::uint16_t> feature_bones;
+  std::span<const float> cluster_centres;
+  float feature_translation_scale = 1.0f;
 
-  KdTreeView bone_tree(std::uint32_t bone) const {
-    const BoneTree& b = bone_trees[bone];
+  KdTreeView bone_tree(std::uint32_t bone) const { return tree_view(bone_trees[bone]); }
+  KdTreeView tree_view(const BoneTree& b) const {
     return {nodes.subspan(b.node_begin, b.node_count), items.subspan(b.item_begin, b.item_count), b.bounds};
+  }
+  bool has_clusters() const { return !clusters.empty(); }
+  std::span<const BoneCluster> bone_clusters(std::uint32_t bone) const {
+    if (bone_cluster_begin.empty()) return {};
+    return clusters.subspan(bone_cluster_begin[bone], bone_cluster_begin[bone + 1] - bone_cluster_begin[bone]);
+  }
+  std::span<const std::uint16_t> bone_feature_bones(std::uint32_t bone) const {
+    if (feature_bone_begin.empty()) return {};
+    return feature_bones.subspan(feature_bone_begin[bone], feature_bone_begin[bone + 1] - feature_bone_begin[bone]);
   }
 };
 
@@ -88,6 +126,13 @@ struct FuzzyBakeStats {
   double assignment_ms = 0.0;       // choosing each triangle's bone
   double build_ms = 0.0;            // building the kd-trees
   std::size_t peak_bytes = 0;       // the largest working set the bake allocated at once
+  std::uint32_t clusters_per_bone = 0;  // FuzzyBakeOptions::pose_clusters (0: none)
+  std::uint32_t cluster_count = 0;      // clusters over all bones (bones whose triangles never move have none)
+  // The sum over triangles of their fuzzy box area averaged over their
+  // bone's clusters (a bone without clusters counts its full tree's box):
+  // beside fuzzy_area, what the clusters tighten.
+  double cluster_fuzzy_area = 0.0;
+  double clustering_ms = 0.0;           // clustering the samples and growing the cluster boxes
 };
 
 struct FuzzyCharacterData {
@@ -99,11 +144,21 @@ struct FuzzyCharacterData {
   std::vector<std::uint32_t> vertex_check_begin;
   std::vector<VertexCheck> vertex_checks;
   std::vector<std::array<std::uint32_t, 3>> triangle_checks;
+  std::vector<std::uint32_t> bone_cluster_begin;
+  std::vector<BoneCluster> clusters;
+  std::vector<std::uint32_t> check_rank;
+  std::vector<Aabb> cluster_boxes;
+  std::vector<std::uint32_t> feature_bone_begin;
+  std::vector<std::uint16_t> feature_bones;
+  std::vector<float> cluster_centres;
+  float feature_translation_scale = 1.0f;
   FuzzyBakeStats stats;
 
   FuzzyCharacterView view() const {
-    return {bone_count, triangle_bone, bone_trees, nodes, items, vertex_check_begin, vertex_checks,
-            triangle_checks};
+    return {bone_count,         triangle_bone, bone_trees,         nodes,         items,
+            vertex_check_begin, vertex_checks, triangle_checks,    bone_cluster_begin,
+            clusters,           check_rank,    cluster_boxes,      feature_bone_begin,
+            feature_bones,      cluster_centres, feature_translation_scale};
   }
 };
 

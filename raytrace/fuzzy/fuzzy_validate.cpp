@@ -26,8 +26,7 @@ Status bad_character(std::string_view field, std::string value, std::string_view
 // Checks what traversal relies on so that a corrupt pack or a mismatched
 // bake cannot make it read out of bounds: node links, leaf item ranges and
 // depth within each bone's slice, item values within the triangle count.
-Status validate_tree(const KdTreeView& tree, std::uint32_t item_limit, std::uint32_t bone) {
-  const std::string where = "bone_trees[" + std::to_string(bone) + "]";
+Status validate_tree(const KdTreeView& tree, std::uint32_t item_limit, const std::string& where) {
   struct Pending {
     std::uint32_t node;
     int depth;
@@ -97,52 +96,172 @@ bool listed_where_needed(const KdTreeView& tree, std::uint32_t node_index, std::
          (!above || listed_where_needed(tree, node.above_child(), item, above_box));
 }
 
-// The trees against the mesh: the bone slices tile the node and item arrays
-// in bone order; leaf items are increasing triangles of the tree's own bone;
-// and every triangle is inside its bone's root box and listed in every leaf
-// its fuzzy box (the union of its corners' check boxes) overlaps. Together
-// with the escape check this is what makes a ray find every triangle.
-Status validate_tree_contents(const SkinnedMesh& mesh, const FuzzyCharacterView& fuzzy) {
-  std::size_t node_at = 0, item_at = 0;
-  std::vector<std::uint32_t> per_bone(fuzzy.bone_count, 0);
-  for (const std::uint16_t b : fuzzy.triangle_bone) ++per_bone[b];
-  for (std::uint32_t b = 0; b < fuzzy.bone_count; ++b) {
-    const BoneTree& bt = fuzzy.bone_trees[b];
-    const std::string where = "bone_trees[" + std::to_string(b) + "]";
-    if (bt.node_begin != node_at || bt.item_begin != item_at) {
-      return bad_character(where + ".node_begin", std::to_string(bt.node_begin),
-                           "the bones' slices must follow each other in bone order without gaps or overlap "
-                           "(expected nodes from " + std::to_string(node_at) + ", items from " +
-                               std::to_string(item_at) + ")");
-    }
-    node_at += bt.node_count;
-    item_at += bt.item_count;
-    if (bt.triangle_count != per_bone[b]) {
-      return bad_character(where + ".triangle_count", std::to_string(bt.triangle_count),
-                           std::to_string(per_bone[b]) + " triangles are assigned to the bone");
-    }
-    if ((bt.node_count == 0) != (per_bone[b] == 0)) {
-      return bad_character(where + ".node_count", std::to_string(bt.node_count),
-                           "a bone has a tree exactly when triangles are assigned to it");
-    }
-    const KdTreeView tree = fuzzy.bone_tree(b);
-    for (std::size_t n = 0; n < tree.nodes.size(); ++n) {
-      const KdNode& node = tree.nodes[n];
-      if (!node.is_leaf()) continue;
-      if (std::size_t{node.first_item()} + node.item_count() > tree.items.size()) {
-        return bad_character(where + ".nodes[" + std::to_string(n) + "]", std::to_string(node.first_item()),
-                             "leaf items outside the item array");
+// One tree of bone b (its full tree or a cluster's) against the mesh: its
+// slice starts where the previous one ended, its leaf items are increasing
+// triangles of b, and every triangle of b is inside its root box and listed
+// in every leaf its fuzzy box (box_of(t): the union of its corners' boxes
+// for this tree) overlaps. Together with the escape check this is what
+// makes a ray find every triangle.
+template <class BoxOf>
+Status validate_tree_slice(const FuzzyCharacterView& fuzzy, const BoneTree& bt, std::uint32_t b,
+                           std::span<const std::uint32_t> bone_triangles, const std::string& where,
+                           std::size_t& node_at, std::size_t& item_at, BoxOf&& box_of) {
+  if (bt.node_begin != node_at || bt.item_begin != item_at) {
+    return bad_character(where + ".node_begin", std::to_string(bt.node_begin),
+                         "the trees' slices must follow each other in order (bones, then clusters) without gaps "
+                         "or overlap (expected nodes from " + std::to_string(node_at) + ", items from " +
+                             std::to_string(item_at) + ")");
+  }
+  if (has_nan(bt.bounds)) return bad_character(where + ".bounds", "NaN", "box is not a number");
+  if (std::size_t{bt.node_begin} + bt.node_count > fuzzy.nodes.size() ||
+      std::size_t{bt.item_begin} + bt.item_count > fuzzy.items.size()) {
+    return bad_character(where, std::to_string(bt.node_begin), "slice outside the node or item array");
+  }
+  node_at += bt.node_count;
+  item_at += bt.item_count;
+  if (bt.triangle_count != bone_triangles.size()) {
+    return bad_character(where + ".triangle_count", std::to_string(bt.triangle_count),
+                         std::to_string(bone_triangles.size()) + " triangles are assigned to the bone");
+  }
+  if ((bt.node_count == 0) != bone_triangles.empty()) {
+    return bad_character(where + ".node_count", std::to_string(bt.node_count),
+                         "a bone has a tree exactly when triangles are assigned to it");
+  }
+  const KdTreeView tree = fuzzy.tree_view(bt);
+  SINEW_RETURN_IF_ERROR(validate_tree(tree, static_cast<std::uint32_t>(fuzzy.triangle_bone.size()), where));
+  for (std::size_t n = 0; n < tree.nodes.size(); ++n) {
+    const KdNode& node = tree.nodes[n];
+    if (!node.is_leaf()) continue;
+    for (std::uint32_t i = 0; i < node.item_count(); ++i) {
+      const std::uint32_t t = tree.items[node.first_item() + i];
+      if (fuzzy.triangle_bone[t] != b) {
+        return bad_character(where + ".items[" + std::to_string(node.first_item() + i) + "]", std::to_string(t),
+                             "a triangle of bone " + std::to_string(fuzzy.triangle_bone[t]));
       }
-      for (std::uint32_t i = 0; i < node.item_count(); ++i) {
-        const std::uint32_t t = tree.items[node.first_item() + i];
-        if (fuzzy.triangle_bone[t] != b) {
-          return bad_character(where + ".items[" + std::to_string(node.first_item() + i) + "]", std::to_string(t),
-                               "a triangle of bone " + std::to_string(fuzzy.triangle_bone[t]));
+      if (i > 0 && !(tree.items[node.first_item() + i - 1] < t)) {
+        return bad_character(where + ".nodes[" + std::to_string(n) + "]", std::to_string(t),
+                             "leaf items must increase");
+      }
+    }
+  }
+  for (const std::uint32_t t : bone_triangles) {
+    const Aabb box = box_of(t);
+    const std::string field = where + " triangle " + std::to_string(t);
+    for (int a = 0; a < 3; ++a) {
+      if (!(box.lower[a] >= tree.bounds.lower[a] && box.upper[a] <= tree.bounds.upper[a])) {
+        return bad_character(field, std::to_string(b), "the triangle's fuzzy box leaves its tree's bounds");
+      }
+    }
+    if (!listed_where_needed(tree, 0, t, box)) {
+      return bad_character(field, std::to_string(b),
+                           "the triangle is missing from a leaf of its tree that its fuzzy box overlaps");
+    }
+  }
+  return {};
+}
+
+// A CSR offset array: `count` + 1 entries from 0, not decreasing, ending at `total`.
+Status validate_offsets(std::span<const std::uint32_t> begin, std::size_t count, std::size_t total,
+                        const std::string& name) {
+  if (begin.size() != count + 1 || begin.front() != 0 || begin.back() != total) {
+    return bad_character(name, std::to_string(begin.size()) + " offsets",
+                         "expected " + std::to_string(count + 1) + " offsets from 0 to " + std::to_string(total));
+  }
+  for (std::size_t i = 0; i < count; ++i) {
+    if (begin[i] > begin[i + 1]) return bad_character(name + "[" + std::to_string(i) + "]", std::to_string(begin[i]), "offsets decrease");
+  }
+  return {};
+}
+
+// The clusters' own arrays (FuzzyBakeOptions::pose_clusters): offsets,
+// feature bones, check ranks, every cluster's box and centre ranges in
+// bounds, finite centres, boxes without NaN. Their trees are checked with
+// the bones'.
+Status validate_cluster_arrays(const FuzzyCharacterView& fuzzy, std::span<const std::uint32_t> bone_checks) {
+  const std::uint32_t bones = fuzzy.bone_count;
+  SINEW_RETURN_IF_ERROR(validate_offsets(fuzzy.bone_cluster_begin, bones, fuzzy.clusters.size(), "bone_cluster_begin"));
+  SINEW_RETURN_IF_ERROR(validate_offsets(fuzzy.feature_bone_begin, bones, fuzzy.feature_bones.size(), "feature_bone_begin"));
+  for (std::size_t i = 0; i < fuzzy.feature_bones.size(); ++i) {
+    if (fuzzy.feature_bones[i] >= bones) {
+      return bad_character("feature_bones[" + std::to_string(i) + "]", std::to_string(fuzzy.feature_bones[i]), "no such bone");
+    }
+  }
+  if (!(std::isfinite(fuzzy.feature_translation_scale) && fuzzy.feature_translation_scale > 0.0f)) {
+    return bad_character("feature_translation_scale", std::to_string(fuzzy.feature_translation_scale),
+                         "must be finite and positive");
+  }
+  if (fuzzy.check_rank.size() != fuzzy.vertex_checks.size()) {
+    return bad_character("check_rank", std::to_string(fuzzy.check_rank.size()),
+                         "expected one rank per vertex check (" + std::to_string(fuzzy.vertex_checks.size()) + ")");
+  }
+  for (std::size_t c = 0; c < fuzzy.check_rank.size(); ++c) {
+    const std::uint32_t b = fuzzy.vertex_checks[c].bone;
+    if (fuzzy.check_rank[c] >= bone_checks[b] && fuzzy.bone_cluster_begin[b] != fuzzy.bone_cluster_begin[b + 1]) {
+      return bad_character("check_rank[" + std::to_string(c) + "]", std::to_string(fuzzy.check_rank[c]),
+                           "not below the " + std::to_string(bone_checks[b]) + " checks of bone " + std::to_string(b));
+    }
+  }
+  for (std::uint32_t b = 0; b < bones; ++b) {
+    const std::size_t dims = std::size_t{fuzzy.feature_bone_begin[b + 1] - fuzzy.feature_bone_begin[b]} * kClusterFeatureFloats;
+    for (std::uint32_t q = fuzzy.bone_cluster_begin[b]; q < fuzzy.bone_cluster_begin[b + 1]; ++q) {
+      const BoneCluster& cluster = fuzzy.clusters[q];
+      const std::string where = "clusters[" + std::to_string(q) + "]";
+      if (std::size_t{cluster.box_begin} + bone_checks[b] > fuzzy.cluster_boxes.size()) {
+        return bad_character(where + ".box_begin", std::to_string(cluster.box_begin),
+                             "the bone's " + std::to_string(bone_checks[b]) + " check boxes run past cluster_boxes (" +
+                                 std::to_string(fuzzy.cluster_boxes.size()) + ")");
+      }
+      if (std::size_t{cluster.centre_begin} + dims > fuzzy.cluster_centres.size()) {
+        return bad_character(where + ".centre_begin", std::to_string(cluster.centre_begin),
+                             "the centre runs past cluster_centres (" + std::to_string(fuzzy.cluster_centres.size()) + ")");
+      }
+      for (std::size_t i = 0; i < dims; ++i) {
+        if (!std::isfinite(fuzzy.cluster_centres[cluster.centre_begin + i])) {
+          return bad_character("cluster_centres[" + std::to_string(cluster.centre_begin + i) + "]",
+                               std::to_string(fuzzy.cluster_centres[cluster.centre_begin + i]), "not finite");
         }
-        if (i > 0 && !(tree.items[node.first_item() + i - 1] < t)) {
-          return bad_character(where + ".nodes[" + std::to_string(n) + "]", std::to_string(t),
-                               "leaf items must increase");
+      }
+    }
+  }
+  for (std::size_t i = 0; i < fuzzy.cluster_boxes.size(); ++i) {
+    if (has_nan(fuzzy.cluster_boxes[i])) return bad_character("cluster_boxes[" + std::to_string(i) + "]", "NaN", "box is not a number");
+  }
+  return {};
+}
+
+// Every tree, the bones' and then the clusters', against the mesh; the
+// slices together cover the node and item arrays.
+Status validate_tree_contents(const FuzzyCharacterView& fuzzy) {
+  std::vector<std::vector<std::uint32_t>> bone_triangles(fuzzy.bone_count);
+  for (std::size_t t = 0; t < fuzzy.triangle_bone.size(); ++t) {
+    bone_triangles[fuzzy.triangle_bone[t]].push_back(static_cast<std::uint32_t>(t));
+  }
+  std::size_t node_at = 0, item_at = 0;
+  for (std::uint32_t b = 0; b < fuzzy.bone_count; ++b) {
+    SINEW_RETURN_IF_ERROR(validate_tree_slice(fuzzy, fuzzy.bone_trees[b], b, bone_triangles[b],
+                                              "bone_trees[" + std::to_string(b) + "]", node_at, item_at,
+                                              [&](std::uint32_t t) {
+                                                Aabb box;
+                                                for (const std::uint32_t c : fuzzy.triangle_checks[t]) box.extend(fuzzy.vertex_checks[c].box);
+                                                return box;
+                                              }));
+  }
+  if (fuzzy.has_clusters()) {
+    for (std::uint32_t b = 0; b < fuzzy.bone_count; ++b) {
+      for (std::uint32_t q = fuzzy.bone_cluster_begin[b]; q < fuzzy.bone_cluster_begin[b + 1]; ++q) {
+        const BoneCluster& cluster = fuzzy.clusters[q];
+        if (bone_triangles[b].empty()) {
+          return bad_character("clusters[" + std::to_string(q) + "]", std::to_string(b), "clusters of a bone without triangles");
         }
+        SINEW_RETURN_IF_ERROR(validate_tree_slice(fuzzy, cluster.tree, b, bone_triangles[b],
+                                                  "clusters[" + std::to_string(q) + "].tree", node_at, item_at,
+                                                  [&](std::uint32_t t) {
+                                                    Aabb box;
+                                                    for (const std::uint32_t c : fuzzy.triangle_checks[t]) {
+                                                      box.extend(fuzzy.cluster_boxes[cluster.box_begin + fuzzy.check_rank[c]]);
+                                                    }
+                                                    return box;
+                                                  }));
       }
     }
   }
@@ -150,22 +269,6 @@ Status validate_tree_contents(const SkinnedMesh& mesh, const FuzzyCharacterView&
     return bad_character("bone_trees", std::to_string(node_at) + " nodes, " + std::to_string(item_at) + " items",
                          "the slices must cover the " + std::to_string(fuzzy.nodes.size()) + " nodes and " +
                              std::to_string(fuzzy.items.size()) + " items");
-  }
-  for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
-    const std::uint32_t b = fuzzy.triangle_bone[t];
-    Aabb box;
-    for (const std::uint32_t c : fuzzy.triangle_checks[t]) box.extend(fuzzy.vertex_checks[c].box);
-    const KdTreeView tree = fuzzy.bone_tree(b);
-    const std::string field = "triangle_bone[" + std::to_string(t) + "]";
-    for (int a = 0; a < 3; ++a) {
-      if (!(box.lower[a] >= tree.bounds.lower[a] && box.upper[a] <= tree.bounds.upper[a])) {
-        return bad_character(field, std::to_string(b), "the triangle's fuzzy box leaves its bone tree's bounds");
-      }
-    }
-    if (!listed_where_needed(tree, 0, static_cast<std::uint32_t>(t), box)) {
-      return bad_character(field, std::to_string(b),
-                           "the triangle is missing from a leaf of its bone's tree that its fuzzy box overlaps");
-    }
   }
   return {};
 }
@@ -222,19 +325,14 @@ Status validate_fuzzy_character(const SkinnedMesh& mesh, const FuzzyCharacterVie
       }
     }
   }
-  for (std::uint32_t b = 0; b < fuzzy.bone_count; ++b) {
-    const BoneTree& tree = fuzzy.bone_trees[b];
-    if (has_nan(tree.bounds)) {
-      return bad_character("bone_trees[" + std::to_string(b) + "].bounds", "NaN", "box is not a number");
-    }
-    if (std::size_t{tree.node_begin} + tree.node_count > fuzzy.nodes.size() ||
-        std::size_t{tree.item_begin} + tree.item_count > fuzzy.items.size()) {
-      return bad_character("bone_trees[" + std::to_string(b) + "]", std::to_string(tree.node_begin),
-                           "slice outside the node or item array");
-    }
-    SINEW_RETURN_IF_ERROR(validate_tree(fuzzy.bone_tree(b), static_cast<std::uint32_t>(triangles), b));
-  }
-  return validate_tree_contents(mesh, fuzzy);
+  std::vector<std::uint32_t> bone_checks(fuzzy.bone_count, 0);
+  for (const VertexCheck& check : fuzzy.vertex_checks) ++bone_checks[check.bone];
+  const bool any_cluster_array = !fuzzy.bone_cluster_begin.empty() || !fuzzy.clusters.empty() ||
+                                 !fuzzy.check_rank.empty() || !fuzzy.cluster_boxes.empty() ||
+                                 !fuzzy.feature_bone_begin.empty() || !fuzzy.feature_bones.empty() ||
+                                 !fuzzy.cluster_centres.empty();
+  if (any_cluster_array) SINEW_RETURN_IF_ERROR(validate_cluster_arrays(fuzzy, bone_checks));
+  return validate_tree_contents(fuzzy);
 }
 
 }  // namespace sinew::rt

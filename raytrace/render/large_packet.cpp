@@ -583,7 +583,7 @@ class LargeQuery {
 
   void visit_bone(const InstanceFrame& frame, std::uint32_t bone, GroupMask groups) {
     const Scene::Character& character = scene_ref().characters()[frame.character];
-    const KdTreeView tree = character.fuzzy.bone_tree(bone);
+    const KdTreeView tree = frame.bone_tree(character.fuzzy, bone);
     if (tree.empty()) return;
     const Affine3& to_bone = frame.bone_from_world[bone];
     const InstanceFrame::BoneCarry& carry = frame.bone_carry[bone];

@@ -477,7 +477,7 @@ class PacketQuery {
 
   bool visit_bone(const InstanceFrame& frame, std::uint32_t bone, std::uint32_t lanes, Intervals& span) {
     const Scene::Character& character = scene_.characters()[frame.character];
-    const KdTreeView tree = character.fuzzy.bone_tree(bone);
+    const KdTreeView tree = frame.bone_tree(character.fuzzy, bone);
     const Affine3& to_bone = frame.bone_from_world[bone];
     const InstanceFrame::BoneCarry& carry = frame.bone_carry[bone];
     // Per lane Affine3::transform_point / transform_vector, term by term in

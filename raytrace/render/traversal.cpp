@@ -174,7 +174,7 @@ class Query {
 
   bool visit_bone(const InstanceFrame& frame, std::uint32_t bone, float t0, float t1) {
     const Scene::Character& character = scene_.characters()[frame.character];
-    const KdTreeView tree = character.fuzzy.bone_tree(bone);
+    const KdTreeView tree = frame.bone_tree(character.fuzzy, bone);
     const Affine3& to_bone = frame.bone_from_world[bone];
     const Vec3 o = to_bone.transform_point(ray_.origin);
     const Vec3 d = to_bone.transform_vector(ray_.direction);

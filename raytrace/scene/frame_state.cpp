@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "raytrace/fuzzy/pose_clusters.h"
 #include "runtime/jobs/job_system.h"
 
 namespace sinew::rt {
@@ -62,6 +63,30 @@ void update_bone_frames(InstanceFrame& frame, const FuzzyCharacterView& fuzzy) {
   }
 }
 
+void choose_bone_clusters(InstanceFrame& frame, const FuzzyCharacterView& fuzzy, bool use) {
+  const std::size_t bones = frame.skinning.size();
+  frame.bone_cluster.assign(bones, -1);
+  frame.bone_check_boxes.assign(bones, nullptr);
+  frame.cluster_bones = 0;
+  frame.cluster_misses = 0;
+  if (!use || !fuzzy.has_clusters()) return;
+  std::vector<float> feature;
+  for (std::uint32_t b = 0; b < std::min<std::size_t>(bones, fuzzy.bone_count); ++b) {
+    const std::span<const BoneCluster> clusters = fuzzy.bone_clusters(b);
+    if (clusters.empty() || !frame.bone_usable[b]) continue;
+    const std::span<const std::uint16_t> feature_bones = fuzzy.bone_feature_bones(b);
+    feature.resize(feature_bones.size() * kClusterFeatureFloats);
+    cluster_feature(frame.bone_from_world[b], frame.skinning, feature_bones, fuzzy.feature_translation_scale,
+                    feature.data());
+    const int k = nearest_cluster(clusters, fuzzy.cluster_centres, feature);
+    if (k < 0) continue;
+    const std::size_t q = fuzzy.bone_cluster_begin[b] + static_cast<std::size_t>(k);
+    frame.bone_cluster[b] = static_cast<std::int32_t>(q);
+    frame.bone_check_boxes[b] = fuzzy.cluster_boxes.data() + fuzzy.clusters[q].box_begin;
+    ++frame.cluster_bones;
+  }
+}
+
 void skin_instance(InstanceFrame& frame, const SkinnedMesh& mesh, const PackedInfluences& influences,
                    const FuzzyCharacterView& fuzzy, bool normals, bool exact_boxes, SkinningPath path,
                    JobSystem& jobs) {
@@ -70,11 +95,45 @@ void skin_instance(InstanceFrame& frame, const SkinnedMesh& mesh, const PackedIn
   frame.escaped.resize(fuzzy.vertex_checks.size());
   frame.chunk_bone_boxes.resize(exact_boxes ? skinning_chunk_count(mesh.vertex_count()) * frame.bone_from_world.size()
                                             : 0);
-  const EscapeCheckInput escape{fuzzy.vertex_check_begin, fuzzy.vertex_checks, frame.bone_from_world,
-                                frame.tolerance, frame.chunk_bone_boxes};
+  const bool clustered = frame.cluster_bones > 0 && frame.bone_check_boxes.size() == frame.bone_from_world.size();
+  const EscapeCheckInput escape{fuzzy.vertex_check_begin,
+                                fuzzy.vertex_checks,
+                                frame.bone_from_world,
+                                frame.tolerance,
+                                frame.chunk_bone_boxes,
+                                clustered ? std::span<const Aabb* const>(frame.bone_check_boxes)
+                                          : std::span<const Aabb* const>{},
+                                clustered ? fuzzy.check_rank : std::span<const std::uint32_t>{}};
   const SkinningTargets targets{frame.positions, frame.normals, frame.escaped};
   const SkinningResult result = skin_vertices(mesh, influences, frame.skinning, targets, &escape, &jobs, path);
   frame.escaped_checks = result.escaped_checks;
+}
+
+void settle_bone_clusters(InstanceFrame& frame, const FuzzyCharacterView& fuzzy, JobSystem& jobs) {
+  if (frame.cluster_bones == 0 || frame.escaped_checks == 0) return;
+  bool missed = false;
+  const std::size_t checks = std::min(frame.escaped.size(), fuzzy.vertex_checks.size());
+  for (std::size_t c = 0; c < checks; ++c) {
+    if (!frame.escaped[c]) continue;
+    const std::uint32_t b = fuzzy.vertex_checks[c].bone;
+    if (b >= frame.bone_cluster.size() || frame.bone_cluster[b] < 0) continue;
+    frame.bone_cluster[b] = -1;
+    frame.bone_check_boxes[b] = nullptr;
+    --frame.cluster_bones;
+    ++frame.cluster_misses;
+    missed = true;
+  }
+  if (!missed) return;
+  const bool clustered = frame.cluster_bones > 0;
+  const EscapeCheckInput escape{fuzzy.vertex_check_begin,
+                                fuzzy.vertex_checks,
+                                frame.bone_from_world,
+                                frame.tolerance,
+                                frame.chunk_bone_boxes,
+                                clustered ? std::span<const Aabb* const>(frame.bone_check_boxes)
+                                          : std::span<const Aabb* const>{},
+                                clustered ? fuzzy.check_rank : std::span<const std::uint32_t>{}};
+  frame.escaped_checks = check_escapes(escape, frame.positions, frame.escaped, &jobs);
 }
 
 void compute_bone_boxes(InstanceFrame& frame, const FuzzyCharacterView& fuzzy, bool exact) {
@@ -83,7 +142,7 @@ void compute_bone_boxes(InstanceFrame& frame, const FuzzyCharacterView& fuzzy, b
   if (!exact) {
     for (std::size_t b = 0; b < bones; ++b) {
       if (!frame.bone_usable[b]) continue;
-      const Aabb local = grown(fuzzy.bone_trees[b].bounds, frame.tolerance[b]);
+      const Aabb local = grown(frame.bone_tree(fuzzy, static_cast<std::uint32_t>(b)).bounds, frame.tolerance[b]);
       frame.bone_world_boxes[b] = transform(frame.skinning[b], local);
     }
     return;

@@ -45,6 +45,21 @@ struct InstanceFrame {
   // vertices (EscapeCheckInput::chunk_bone_boxes), merged by compute_bone_boxes.
   std::vector<Aabb> chunk_bone_boxes;
 
+  // Pose-space clusters (FuzzyCharacterView::clusters): per bone the
+  // cluster whose tree and boxes it uses this frame (an index into
+  // clusters), or -1 for its full tree; and the boxes its checks are held to
+  // (the cluster's, null for the checks' own).
+  std::vector<std::int32_t> bone_cluster;
+  std::vector<const Aabb*> bone_check_boxes;
+  std::size_t cluster_bones = 0;   // bones on a cluster's tree this frame
+  std::size_t cluster_misses = 0;  // bones whose cluster a vertex left: back on their full tree
+
+  // The tree bone b is traversed with this frame.
+  KdTreeView bone_tree(const FuzzyCharacterView& fuzzy, std::uint32_t bone) const {
+    const std::int32_t q = bone < bone_cluster.size() ? bone_cluster[bone] : -1;
+    return q < 0 ? fuzzy.bone_tree(bone) : fuzzy.tree_view(fuzzy.clusters[static_cast<std::size_t>(q)].tree);
+  }
+
   std::vector<std::uint32_t> escaped_triangles;  // triangle ids routed through the fallback
   KdTree fallback;  // world-space tree; items index escaped_triangles
   std::size_t escaped_checks = 0;
@@ -58,12 +73,22 @@ inline constexpr float kFrameRelativeSlack = 8.0f * 0x1.0p-24f;
 // Inverses, usable flags and escape tolerances from `skinning`.
 void update_bone_frames(InstanceFrame& frame, const FuzzyCharacterView& fuzzy);
 
+// Picks each bone's pose-space cluster, the one whose centre is nearest its
+// feature this frame (raytrace/fuzzy/pose_clusters.h); none (-1) for every
+// bone when `use` is false or the character has no clusters.
+void choose_bone_clusters(InstanceFrame& frame, const FuzzyCharacterView& fuzzy, bool use);
+
 // Skins positions (and normals) and runs the escape check; with
 // `exact_boxes`, it also gathers the bone boxes compute_bone_boxes merges.
 // `influences` is pack_influences(mesh).
 void skin_instance(InstanceFrame& frame, const SkinnedMesh& mesh, const PackedInfluences& influences,
                    const FuzzyCharacterView& fuzzy, bool normals, bool exact_boxes, SkinningPath path,
                    JobSystem& jobs);
+
+// After skin_instance: a bone whose cluster a vertex left goes back to its
+// full tree, and the escape check runs again (positions as they are)
+// against the full boxes of those bones.
+void settle_bone_clusters(InstanceFrame& frame, const FuzzyCharacterView& fuzzy, JobSystem& jobs);
 
 // Per bone world boxes: exact (union of the bone's skinned vertices, from
 // the boxes skin_instance gathered with exact_boxes) or cheap (the fuzzy

@@ -121,8 +121,10 @@ Expected<FrameStats> Scene::prepare_frame(const FrameOptions& options, JobSystem
     const Character& character = characters_[frame.character];
     auto start = std::chrono::steady_clock::now();
     update_bone_frames(frame, character.fuzzy);
+    choose_bone_clusters(frame, character.fuzzy, options.pose_clusters);
     skin_instance(frame, *character.mesh, character.influences, character.fuzzy, options.normals,
                   options.bone_boxes == BoneBoxMode::kExact, options.skinning, jobs);
+    settle_bone_clusters(frame, character.fuzzy, jobs);
     skinning_ms += ms_since(start);
 
     start = std::chrono::steady_clock::now();
@@ -141,6 +143,8 @@ Expected<FrameStats> Scene::prepare_frame(const FrameOptions& options, JobSystem
     stats.escaped_checks += frame.escaped_checks;
     stats.escaped_triangles += frame.escaped_triangles.size();
     stats.singular_bones += frame.singular_bones;
+    stats.cluster_bones += frame.cluster_bones;
+    stats.cluster_misses += frame.cluster_misses;
   }
 
   const auto start = std::chrono::steady_clock::now();

@@ -44,6 +44,10 @@ struct FrameOptions {
   // stays 0: nothing is routed), and may show as holes.
   bool fallback = true;
   bool normals = true;  // skin normals (shading needs them; depth-only passes do not)
+  // Bones of characters baked with pose-space clusters use the tree of the
+  // cluster nearest their pose (FuzzyBakeOptions::pose_clusters). Off: every
+  // bone its full tree, as a pack without clusters.
+  bool pose_clusters = true;
   SkinningPath skinning = SkinningPath::kAuto;
   KdBuildOptions top_level_kd{.traversal_cost = 1.0f, .intersection_cost = 4.0f,
                               .empty_bonus = 0.2f, .max_leaf_items = 1, .max_depth = 0};
@@ -54,6 +58,8 @@ struct FrameStats {
   std::size_t escaped_checks = 0;     // (vertex, bone) pairs outside their fuzzy boxes
   std::size_t escaped_triangles = 0;  // triangles routed through the fallback (0 with it off)
   std::size_t singular_bones = 0;     // bones without a finite inverse (zero scale)
+  std::size_t cluster_bones = 0;      // bones traversed with a pose-space cluster's tree
+  std::size_t cluster_misses = 0;     // bones whose cluster a vertex left: back on their full tree
   std::uint32_t top_level_objects = 0;
   std::uint32_t top_level_nodes = 0;
 };

@@ -132,6 +132,16 @@ std::size_t count_escapes(const EscapeCheckInput& e, [[maybe_unused]] std::span<
   const std::span<const Affine3> bone_from_world = e.bone_from_world;
   const std::span<const float> tolerance = e.tolerance;
   const std::size_t bone_limit = std::min(bone_from_world.size(), tolerance.size());
+  // A bone's checks held to its cluster's boxes, when it has one.
+  const std::span<const Aabb* const> bone_boxes =
+      e.check_rank.size() >= checks.size() && e.bone_boxes.size() >= bone_limit ? e.bone_boxes
+                                                                                 : std::span<const Aabb* const>{};
+  const std::span<const std::uint32_t> check_rank = e.check_rank;
+  const auto box_of = [&](const VertexCheck& check, std::size_t c) -> const Aabb& {
+    if (bone_boxes.empty()) return check.box;
+    const Aabb* boxes_of_bone = bone_boxes[check.bone];
+    return boxes_of_bone != nullptr ? boxes_of_bone[check_rank[c]] : check.box;
+  };
   const std::size_t end = std::min(r.end, check_begin.empty() ? 0 : check_begin.size() - 1);
   // This chunk's row of bone boxes, when asked for and sized as documented.
   const std::size_t bones = bone_from_world.size();
@@ -174,7 +184,7 @@ std::size_t count_escapes(const EscapeCheckInput& e, [[maybe_unused]] std::span<
     // scalar check's instructions: the check is per vertex and per bone, and
     // at 855,552 triangles it was as long as the skinning itself.
     const __m128 x = _mm_set1_ps(world.x), y = _mm_set1_ps(world.y), z = _mm_set1_ps(world.z);
-    const auto inside = [&](const VertexCheck& check) {
+    const auto inside = [&](const VertexCheck& check, const Aabb& box) {
       const BoneColumns& m = columns[check.bone];
       const __m128 q =
           _mm_add_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(m.c[0], x), _mm_mul_ps(m.c[1], y)), _mm_mul_ps(m.c[2], z)),
@@ -182,8 +192,8 @@ std::size_t count_escapes(const EscapeCheckInput& e, [[maybe_unused]] std::span<
       const __m128 tol = _mm_set1_ps(tolerance[check.bone]);
       // The box's lower corner, and its upper one read from lower.z on (in
       // bounds), moved down a lane.
-      const __m128 lower = _mm_loadu_ps(&check.box.lower.x);
-      const __m128 from_z = _mm_loadu_ps(&check.box.lower.z);
+      const __m128 lower = _mm_loadu_ps(&box.lower.x);
+      const __m128 from_z = _mm_loadu_ps(&box.lower.z);
       const __m128 upper = _mm_shuffle_ps(from_z, from_z, _MM_SHUFFLE(3, 3, 2, 1));
       const __m128 in = _mm_and_ps(
           _mm_and_ps(_mm_cmpge_ps(q, _mm_sub_ps(lower, tol)), _mm_cmple_ps(q, _mm_add_ps(upper, tol))),
@@ -191,8 +201,8 @@ std::size_t count_escapes(const EscapeCheckInput& e, [[maybe_unused]] std::span<
       return (_mm_movemask_ps(in) & 7) == 7;
     };
 #else
-    const auto inside = [&](const VertexCheck& check) {
-      return inside_grown_box(bone_from_world[check.bone].transform_point(world), check.box, tolerance[check.bone]);
+    const auto inside = [&](const VertexCheck& check, const Aabb& box) {
+      return inside_grown_box(bone_from_world[check.bone].transform_point(world), box, tolerance[check.bone]);
     };
 #endif
 #if SINEW_ESCAPE_SSE
@@ -213,7 +223,7 @@ std::size_t count_escapes(const EscapeCheckInput& e, [[maybe_unused]] std::span<
       const VertexCheck& check = checks[c];
       if (boxes != nullptr && check.bone < bones) extend_box(check.bone);
       // A check naming a bone without a transform or tolerance escapes.
-      const bool out = check.bone >= bone_limit || !inside(check);
+      const bool out = check.bone >= bone_limit || !inside(check, box_of(check, c));
       count += static_cast<std::size_t>(out);
       if (c < escaped.size()) escaped[c] = static_cast<std::uint8_t>(out);
     }
@@ -300,6 +310,26 @@ SkinningResult skin_vertices(const SkinnedMesh& mesh, const PackedInfluences& in
   }
   result.escaped_checks = std::accumulate(chunk_escapes.begin(), chunk_escapes.end(), std::size_t{0});
   return result;
+}
+
+std::size_t check_escapes(const EscapeCheckInput& escape, std::span<const Vec3> positions,
+                          std::span<std::uint8_t> escaped, JobSystem* jobs) {
+  const std::size_t vertex_count =
+      std::min(positions.size(), escape.vertex_check_begin.empty() ? 0 : escape.vertex_check_begin.size() - 1);
+  const std::size_t chunk_count = (vertex_count + kChunkVertices - 1) / kChunkVertices;
+  std::vector<std::size_t> chunk_escapes(chunk_count, 0);
+  const std::vector<BoneColumns> columns = bone_columns(escape);
+  const auto run_chunk = [&](Range r) {
+    chunk_escapes[r.begin / kChunkVertices] = count_escapes(escape, columns, positions, escaped, r);
+  };
+  if (jobs != nullptr) {
+    jobs->parallel_for(0, vertex_count, kChunkVertices, run_chunk);
+  } else {
+    for (std::size_t begin = 0; begin < vertex_count; begin += kChunkVertices) {
+      run_chunk(Range{begin, std::min(vertex_count, begin + kChunkVertices)});
+    }
+  }
+  return std::accumulate(chunk_escapes.begin(), chunk_escapes.end(), std::size_t{0});
 }
 
 }  // namespace sinew::rt

@@ -60,6 +60,12 @@ struct EscapeCheckInput {
   // triangles, gathered while the check reads the checks anyway (a pass of
   // its own read every check again: 1.7 ms a frame at 855,552 triangles).
   std::span<Aabb> chunk_bone_boxes;
+  // Optional (empty: every check against its own box): per bone, the boxes
+  // its checks are held to instead, indexed by check_rank (the bone's
+  // pose-space cluster's, FuzzyCharacterView::cluster_boxes), or null for
+  // the checks' own. check_rank has one entry per check when given.
+  std::span<const Aabb* const> bone_boxes;
+  std::span<const std::uint32_t> check_rank;
 };
 
 // The work is split over vertices in chunks of this many (a multiple of
@@ -94,6 +100,12 @@ SkinningResult skin_vertices(const SkinnedMesh& mesh, const PackedInfluences& in
 SkinningResult skin_vertices(const SkinnedMesh& mesh, std::span<const Affine3> bones,
                              const SkinningTargets& targets, const EscapeCheckInput* escape,
                              JobSystem* jobs, SkinningPath path = SkinningPath::kAuto);
+
+// The escape check alone over positions already skinned (as skin_vertices
+// runs it: the same bits, escaped flags and chunk_bone_boxes): for a frame
+// whose bones changed the boxes they are held to. Returns the escaped checks.
+std::size_t check_escapes(const EscapeCheckInput& escape, std::span<const Vec3> positions,
+                          std::span<std::uint8_t> escaped, JobSystem* jobs);
 
 // Whether this build and CPU can run SkinningPath::kAvx2.
 bool avx2_skinning_available();

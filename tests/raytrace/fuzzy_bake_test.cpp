@@ -22,7 +22,11 @@
 #include <string>
 #include <vector>
 
+#include "raytrace/fuzzy/pose_clusters.h"
+#include "raytrace/scene/scene.h"
+#include "raytrace/render/traversal.h"
 #include "runtime/jobs/job_system.h"
+#include "tests/support/brute_force.h"
 
 namespace sinew::rt {
 namespace {
@@ -838,6 +842,8 @@ TEST(FuzzyBakeValidation, EveryBadInputIsRejectedNamingItsField) {
        ErrorCode::kInvalidArgument, "padding"},
       {"nan padding", [nan](Rig&, FuzzyBakeOptions& o, FuzzyBakeInput&) { o.padding = nan; },
        ErrorCode::kInvalidArgument, "padding"},
+      {"too many clusters", [](Rig&, FuzzyBakeOptions& o, FuzzyBakeInput&) { o.pose_clusters = kMaxPoseClusters + 1; },
+       ErrorCode::kInvalidArgument, "pose_clusters"},
       {"joint range", [](Rig& rig, FuzzyBakeOptions&, FuzzyBakeInput&) { rig.mesh.joints[7][5] = 3; },
        ErrorCode::kInvalidData, "joints[7][5]"},
       {"joints size", [](Rig& rig, FuzzyBakeOptions&, FuzzyBakeInput&) { rig.mesh.joints.pop_back(); },
@@ -867,6 +873,197 @@ TEST(FuzzyBakeValidation, EveryBadInputIsRejectedNamingItsField) {
     ASSERT_FALSE(result.ok()) << bad.name;
     EXPECT_EQ(result.status().code(), bad.code) << bad.name << ": " << result.status().message();
     EXPECT_EQ(result.status().field(), bad.field) << bad.name << ": " << result.status().message();
+  }
+}
+
+// ---------------------------------------------------------------------------
+// Pose-space clusters (FuzzyBakeOptions::pose_clusters)
+
+FuzzyBakeOptions with_clusters(std::uint32_t k) {
+  FuzzyBakeOptions options;
+  options.pose_clusters = k;
+  return options;
+}
+
+// The cluster a frame picks for bone b in sampled pose s, as the scene does
+// (frame_state.cpp): the feature from inverse(S_b) and S, the nearest centre.
+int runtime_cluster(const FuzzyCharacterView& fuzzy, const Rig& rig, std::size_t s, std::uint32_t b) {
+  const std::span<const std::uint16_t> feature_bones = fuzzy.bone_feature_bones(b);
+  std::vector<float> feature(feature_bones.size() * kClusterFeatureFloats);
+  cluster_feature(inverse(rig.pose(s)[b]), rig.pose(s), feature_bones, fuzzy.feature_translation_scale, feature.data());
+  return nearest_cluster(fuzzy.bone_clusters(b), fuzzy.cluster_centres, feature);
+}
+
+TEST(FuzzyBakeClusters, KMeansSplitsApartGroupsAndKeepsOnlyDistinctPoints) {
+  // Two groups around (0, 0) and (10, 0): two clusters, whatever k above 1.
+  const std::vector<float> points = {0.0f, 0.0f, 0.5f, 0.0f, 0.0f, 0.5f, 10.0f, 0.0f, 10.5f, 0.0f, 10.0f, 0.5f};
+  std::vector<std::uint32_t> member;
+  std::vector<float> centres;
+  ASSERT_EQ(cluster_points(points, 6, 2, 2, member, centres), 2u);
+  EXPECT_EQ(member[0], member[1]);
+  EXPECT_EQ(member[1], member[2]);
+  EXPECT_EQ(member[3], member[4]);
+  EXPECT_EQ(member[4], member[5]);
+  EXPECT_NE(member[0], member[3]);
+  // The centres are the groups' means (hand-computed: 1/6 and 10 + 1/6).
+  const std::size_t low = member[0];
+  EXPECT_FLOAT_EQ(centres[low * 2], 0.5f / 3.0f);
+  EXPECT_FLOAT_EQ(centres[low * 2 + 1], 0.5f / 3.0f);
+  EXPECT_FLOAT_EQ(centres[(1 - low) * 2], 10.0f + 0.5f / 3.0f);
+  // Three distinct values among six points: at most three clusters for any k.
+  const std::vector<float> repeated = {1.0f, 1.0f, 2.0f, 2.0f, 3.0f, 3.0f};
+  EXPECT_EQ(cluster_points(repeated, 6, 1, 8, member, centres), 3u);
+  EXPECT_EQ(member[0], member[1]);
+  EXPECT_NE(member[1], member[2]);
+  EXPECT_EQ(cluster_points(repeated, 6, 1, 1, member, centres), 1u);
+  EXPECT_EQ(cluster_points({}, 0, 1, 4, member, centres), 0u);
+}
+
+// The conservativeness invariant for every tree a bone may choose: in each
+// sampled pose, the cluster the frame picks holds every vertex of the bone's
+// checks (against the double-precision skinning), its tree lists every
+// triangle where its box needs it (validate_fuzzy_character), and the
+// cluster's boxes lie inside the full ones and are smaller in sum.
+TEST(FuzzyBakeClusters, EverySampledPoseLiesInTheClusterItsBonesPick) {
+  const Rig rig = arm_rig(5, 60, 31);
+  const FuzzyCharacterData data = bake_ok(rig, with_clusters(6));
+  const FuzzyCharacterView fuzzy = data.view();
+  ASSERT_TRUE(validate_fuzzy_character(rig.mesh, fuzzy).ok());
+  ASSERT_TRUE(fuzzy.has_clusters());
+  EXPECT_EQ(data.stats.cluster_count, data.clusters.size());
+  EXPECT_LT(data.stats.cluster_fuzzy_area, 0.8 * data.stats.fuzzy_area);
+  const RefSamples ref = reference_samples(rig);
+  std::size_t held = 0;
+  for (std::size_t s = 0; s < rig.sample_count(); ++s) {
+    for (std::size_t v = 0; v < rig.mesh.vertex_count(); ++v) {
+      for (std::uint32_t c = data.vertex_check_begin[v]; c < data.vertex_check_begin[v + 1]; ++c) {
+        const std::uint32_t b = data.vertex_checks[c].bone;
+        if (fuzzy.bone_clusters(b).empty()) continue;
+        const int k = runtime_cluster(fuzzy, rig, s, b);
+        ASSERT_GE(k, 0);
+        const BoneCluster& cluster = fuzzy.bone_clusters(b)[static_cast<std::size_t>(k)];
+        const Aabb& box = data.cluster_boxes[cluster.box_begin + data.check_rank[c]];
+        const glm::dvec3 p = apply(ref.bone_from_pose[s][b], ref.skinned[s][v]);
+        ASSERT_TRUE(box_contains(box, p)) << "sample " << s << " vertex " << v << " bone " << b << " cluster " << k;
+        for (int a = 0; a < 3; ++a) {
+          EXPECT_GE(box.lower[a], data.vertex_checks[c].box.lower[a]);
+          EXPECT_LE(box.upper[a], data.vertex_checks[c].box.upper[a]);
+        }
+        ++held;
+      }
+    }
+  }
+  EXPECT_GT(held, 0u);
+}
+
+TEST(FuzzyBakeClusters, ThreadCountDoesNotChangeTheClusters) {
+  const Rig rig = arm_rig(5, 40, 32);
+  const FuzzyCharacterData a = bake_ok(rig, with_clusters(5), 1);
+  const FuzzyCharacterData b = bake_ok(rig, with_clusters(5), 3);
+  expect_identical(a, b);
+  expect_same_bytes(a.bone_cluster_begin, b.bone_cluster_begin, "bone_cluster_begin");
+  expect_same_bytes(a.clusters, b.clusters, "clusters");
+  expect_same_bytes(a.check_rank, b.check_rank, "check_rank");
+  expect_same_bytes(a.cluster_boxes, b.cluster_boxes, "cluster_boxes");
+  expect_same_bytes(a.feature_bones, b.feature_bones, "feature_bones");
+  expect_same_bytes(a.cluster_centres, b.cluster_centres, "cluster_centres");
+  // Without clusters the bake is the one it always was.
+  const FuzzyCharacterData none = bake_ok(rig, FuzzyBakeOptions{}, 2);
+  EXPECT_TRUE(none.clusters.empty());
+  EXPECT_TRUE(none.cluster_boxes.empty());
+  ASSERT_GT(a.nodes.size(), none.nodes.size());
+  expect_same_bytes(std::vector<KdNode>(a.nodes.begin(), a.nodes.begin() + static_cast<std::ptrdiff_t>(none.nodes.size())),
+                    none.nodes, "the full trees' nodes come first, as without clusters");
+  expect_same_bytes(a.bone_trees, none.bone_trees, "full trees with and without clusters");
+  expect_same_bytes(a.vertex_checks, none.vertex_checks, "checks with and without clusters");
+}
+
+// A scene on the clusters: sampled poses use cluster trees and never miss;
+// poses far outside the pose space miss, fall back to the full trees (and
+// the escape fallback), and still trace exactly as brute force.
+TEST(FuzzyBakeClusters, ScenesUseClusterTreesAndStayExactOutsideThePoseSpace) {
+  const Rig rig = arm_rig(5, 40, 33);
+  const FuzzyCharacterData data = bake_ok(rig, with_clusters(6));
+  Scene scene;
+  auto character = scene.add_character(rig.mesh, data.view());
+  ASSERT_TRUE(character.ok()) << character.status().message();
+  ASSERT_TRUE(scene.add_instance(*character).ok());
+  JobSystem jobs(2);
+  const std::vector<Affine3> wild = chain_poses(rig.parents, 6, 3.0, 77, false);
+  Rng rng(5);
+  std::size_t checked = 0, wrong = 0, misses = 0;
+  for (std::size_t k = 0; k < 16; ++k) {
+    const bool outside = k >= 10;
+    const std::span<const Affine3> pose =
+        outside ? std::span<const Affine3>(wild).subspan((k - 10) * rig.parents.size(), rig.parents.size())
+                : rig.pose(k * 3);
+    ASSERT_TRUE(scene.set_bones(0, pose).ok());
+    auto stats = scene.prepare_frame(FrameOptions{}, jobs);
+    ASSERT_TRUE(stats.ok()) << stats.status().message();
+    if (!outside) {
+      EXPECT_EQ(stats->cluster_misses, 0u) << "sample " << k * 3;
+      EXPECT_EQ(stats->escaped_checks, 0u) << "sample " << k * 3;
+      EXPECT_GT(stats->cluster_bones, 0u) << "sample " << k * 3;
+    }
+    misses += stats->cluster_misses;
+    const std::vector<testing_support::SoupTriangle> soup = testing_support::world_triangles(scene);
+    for (int i = 0; i < 400; ++i) {
+      const glm::dvec3 o = glm::dvec3(rng.uniform(-3, 8), rng.uniform(-4, 4), rng.uniform(-4, 4));
+      const testing_support::SoupTriangle& tri = soup[static_cast<std::size_t>(i) % soup.size()];
+      Ray ray;
+      ray.origin = Vec3(o);
+      ray.direction = (tri.p0 + tri.p1 + tri.p2) / 3.0f - ray.origin;
+      for (const TriangleTest test : {TriangleTest::kFast, TriangleTest::kWatertight}) {
+        const Hit ours = intersect(scene, ray, test);
+        const Hit ref = testing_support::nearest(soup, ray, test);
+        ++checked;
+        if (!testing_support::same_nearest(ours, ref, soup, ray, test)) ++wrong;
+      }
+    }
+  }
+  EXPECT_GT(misses, 0u) << "the wild poses should leave some cluster";
+  EXPECT_EQ(wrong, 0u) << "of " << checked << " rays";
+}
+
+TEST(FuzzyBakeClusters, CorruptClusterDataIsRefusedNamingTheField) {
+  const Rig rig = arm_rig(4, 30, 34);
+  const FuzzyCharacterData good = bake_ok(rig, with_clusters(4));
+  ASSERT_FALSE(good.clusters.empty());
+  struct Case {
+    const char* name;
+    std::function<void(FuzzyCharacterData&)> spoil;
+    const char* field;
+  };
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const std::vector<Case> cases = {
+      {"box range", [](FuzzyCharacterData& d) { d.clusters.back().box_begin = static_cast<std::uint32_t>(d.cluster_boxes.size()); },
+       "clusters[" },
+      {"rank", [](FuzzyCharacterData& d) {
+         for (std::size_t c = 0; c < d.check_rank.size(); ++c) {
+           const std::uint32_t b = d.vertex_checks[c].bone;
+           if (d.bone_cluster_begin[b] != d.bone_cluster_begin[b + 1]) {
+             d.check_rank[c] = 1u << 30;
+             return;
+           }
+         } },
+       "check_rank["},
+      {"nan box", [nan](FuzzyCharacterData& d) { d.cluster_boxes[0].lower.y = nan; }, "cluster_boxes[0]"},
+      {"nan centre", [nan](FuzzyCharacterData& d) { d.cluster_centres[0] = nan; }, "cluster_centres[0]"},
+      {"feature bone", [](FuzzyCharacterData& d) { d.feature_bones[0] = 999; }, "feature_bones[0]"},
+      {"offsets", [](FuzzyCharacterData& d) { d.bone_cluster_begin.pop_back(); }, "bone_cluster_begin"},
+      {"shrunk tree", [](FuzzyCharacterData& d) {
+         BoneTree& t = d.clusters.back().tree;
+         t.bounds.upper.x = t.bounds.lower.x; },
+       "clusters["},
+      {"scale", [](FuzzyCharacterData& d) { d.feature_translation_scale = 0.0f; }, "feature_translation_scale"},
+  };
+  for (const Case& c : cases) {
+    FuzzyCharacterData bad = good;
+    c.spoil(bad);
+    const Status status = validate_fuzzy_character(rig.mesh, bad.view());
+    ASSERT_FALSE(status.ok()) << c.name;
+    EXPECT_EQ(status.code(), ErrorCode::kInvalidData) << c.name;
+    EXPECT_EQ(std::string(status.field()).rfind(c.field, 0), 0u) << c.name << ": " << status.message();
   }
 }
 

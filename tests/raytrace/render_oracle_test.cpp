@@ -295,6 +295,72 @@ TEST_P(RenderOracle, PosesInsideThePoseSpaceMatchBruteForce) {
   RecordProperty("random_rays", static_cast<int>(rays.checked));
 }
 
+// Pose-space clusters (FuzzyBakeOptions::pose_clusters): sampled poses run
+// on the cluster trees without a miss, poses halfway between two samples
+// may leave a cluster (the bone goes back to its full tree), and poses
+// mixing two far-apart samples bone by bone leave the pose space (the
+// escape fallback); every one traces as brute force.
+TEST_P(RenderOracle, PoseClusterTreesMatchBruteForce) {
+  JobSystem jobs(2);
+  const Subject subject = GetParam();
+  character::BakeRequest request;
+  request.fuzzy.pose_clusters = 8;
+  const Baked baked = bake(subject, jobs, request);
+  ASSERT_GT(baked.bones, 0u);
+  ASSERT_GT(baked.sample_count(), 1u);
+  ASSERT_FALSE(baked.bake.fuzzy.clusters.empty());
+
+  const Aabb rest = bounds_of(baked.model.mesh.positions);
+  rt::Scene scene;
+  auto character = scene.add_character(baked.model.mesh, baked.bake.fuzzy.view());
+  ASSERT_TRUE(character.ok()) << character.status().message();
+  ASSERT_TRUE(scene.add_instance(*character).ok());
+  ASSERT_TRUE(scene.add_static_mesh(ground_under(rest, subject.up_axis)).ok());
+
+  constexpr std::size_t kPoses = 12;
+  Random random(0xc1u + baked.sample_count());
+  Mismatch primary, rays;
+  std::size_t sampled_misses = 0, sampled_escapes = 0, cluster_bones = 0;
+  std::vector<Affine3> pose(baked.bones);
+  for (std::size_t k = 0; k < kPoses; ++k) {
+    const std::size_t s = k * baked.sample_count() / kPoses;
+    const std::size_t far = (s + baked.sample_count() / 2) % baked.sample_count();
+    const std::span<const Affine3> a = baked.sample(s), b = baked.sample(far);
+    const int kind = static_cast<int>(k % 3);  // 0 sampled, 1 halfway, 2 mixed
+    for (std::size_t bone = 0; bone < baked.bones; ++bone) {
+      if (kind == 0) pose[bone] = a[bone];
+      if (kind == 2) pose[bone] = bone % 2 == 0 ? a[bone] : b[bone];
+      if (kind == 1) {
+        const std::span<const Affine3> next = baked.sample((s + 1) % baked.sample_count());
+        for (std::size_t r = 0; r < 3; ++r) pose[bone].rows[r] = 0.5f * (a[bone].rows[r] + next[bone].rows[r]);
+      }
+    }
+    ASSERT_TRUE(scene.set_bones(0, pose).ok());
+    auto stats = scene.prepare_frame(rt::FrameOptions{}, jobs);
+    ASSERT_TRUE(stats.ok()) << stats.status().message();
+    if (kind == 0) {
+      sampled_misses += stats->cluster_misses;
+      sampled_escapes += stats->escaped_checks;
+      cluster_bones += stats->cluster_bones;
+    }
+    const std::vector<SoupTriangle> soup = testing_support::world_triangles(scene);
+    const Aabb posed = bounds_of(scene.instances()[0].positions);
+    const auto cameras = cameras_around(posed, subject.up_axis);
+    const bool big = soup.size() > 20'000;
+    const int packet_rays = std::array<int, 4>{8, 64, 256, 512}[k % 4];
+    for (const TriangleTest test : kTests) {
+      compare_primary(scene, soup, cameras[k % cameras.size()], big ? 32 : 64, test, jobs, primary, packet_rays);
+    }
+    compare_random(scene, soup, posed, std::clamp<std::size_t>(100'000'000 / (soup.size() * kPoses), 100, 1000),
+                   random, rays);
+  }
+  EXPECT_EQ(sampled_misses, 0u) << "a sampled pose left the cluster its bone picked";
+  EXPECT_EQ(sampled_escapes, 0u) << "a sampled pose left its fuzzy boxes";
+  EXPECT_GT(cluster_bones, 0u) << "no bone used a cluster's tree";
+  EXPECT_EQ(primary.wrong, 0u) << primary.checked << " primary rays; first: " << primary.first;
+  EXPECT_EQ(rays.wrong, 0u) << rays.checked << " random rays; first: " << rays.first;
+}
+
 // The paper's larger Cally variants (sinew-editor subdivide): every level
 // traces like brute force. A smaller budget than the suite above (one clip's
 // poses, small images, few random rays), as the reference costs grow with

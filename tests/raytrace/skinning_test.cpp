@@ -247,7 +247,7 @@ struct RandomChecks {
   std::vector<Affine3> bone_from_world;
   std::vector<float> tolerance;
   std::vector<std::uint8_t> expected;
-  EscapeCheckInput input() const { return {begin, checks, bone_from_world, tolerance, {}}; }
+  EscapeCheckInput input() const { return {begin, checks, bone_from_world, tolerance, {}, {}, {}}; }
 };
 
 RandomChecks random_checks(std::mt19937& rng, const SkinnedMesh& mesh, const std::vector<Affine3>& bones,
@@ -388,7 +388,7 @@ SkinnedMesh one_vertex_mesh(const HandBuiltScene& s, const Vec3& p) {
 TEST(SkinningEscape, HandBuiltChecks) {
   const HandBuiltScene s = hand_built_scene();
   ASSERT_FALSE(is_finite(s.bone_from_world[3]));  // the premise of the zero-scale cases
-  const EscapeCheckInput escape{s.begin, s.checks, s.bone_from_world, s.tolerance, {}};
+  const EscapeCheckInput escape{s.begin, s.checks, s.bone_from_world, s.tolerance, {}, {}, {}};
   JobSystem two(2);
   for (const SkinningPath path : available_paths()) {
     for (JobSystem* jobs : {static_cast<JobSystem*>(nullptr), &two}) {
@@ -412,7 +412,7 @@ TEST(SkinningEscape, ToleranceIsPerBone) {
                                   check_of(2, in_bone2 + Vec3(0.1f, -0.5f, -0.5f), in_bone2 + 0.5f)};
   std::vector<std::uint32_t> begin{0, 2};
   const SkinnedMesh mesh = one_vertex_mesh(s, p);
-  const EscapeCheckInput escape{begin, checks, s.bone_from_world, s.tolerance, {}};
+  const EscapeCheckInput escape{begin, checks, s.bone_from_world, s.tolerance, {}, {}, {}};
   const Skinned out = run_skinning(mesh, s.bones, SkinningPath::kAuto, nullptr, false, &escape);
   EXPECT_EQ(out.escaped, (std::vector<std::uint8_t>{1, 0}));
   EXPECT_EQ(out.result.escaped_checks, 1u);
@@ -425,7 +425,7 @@ TEST(SkinningEscape, BoneWithoutTransformEscapes) {
   std::vector<VertexCheck> checks{check_of(5, Vec3(-1e30f), Vec3(1e30f)), check_of(1, p - 0.5f, p + 0.5f)};
   std::vector<std::uint32_t> begin{0, 2};
   const SkinnedMesh mesh = one_vertex_mesh(s, p);
-  const EscapeCheckInput escape{begin, checks, s.bone_from_world, s.tolerance, {}};
+  const EscapeCheckInput escape{begin, checks, s.bone_from_world, s.tolerance, {}, {}, {}};
   const Skinned out = run_skinning(mesh, s.bones, SkinningPath::kAuto, nullptr, false, &escape);
   EXPECT_EQ(out.escaped, (std::vector<std::uint8_t>{1, 0}));
   EXPECT_EQ(out.result.escaped_checks, 1u);
