@@ -1,9 +1,11 @@
 #include "character/pack.h"
 
 #include <cmath>
+#include <cstddef>
 #include <cstring>
 #include <utility>
 
+#include "raytrace/fuzzy/fuzzy_bake.h"
 #include "runtime/mesh/mesh_checks.h"
 #include "runtime/pack/pack_writer.h"
 #include "runtime/pack/section_codec.h"
@@ -26,7 +28,26 @@ constexpr SectionId kItems = make_section_id("FITM");
 constexpr SectionId kVertexCheckBegin = make_section_id("FVCB");
 constexpr SectionId kVertexChecks = make_section_id("FVCK");
 constexpr SectionId kTriangleChecks = make_section_id("FTCK");
+// Pose-space clusters (FuzzyBakeOptions::pose_clusters), written only by a
+// bake that clustered: a pack without them has none of these sections and
+// is byte for byte what it was before they existed. The clusters' trees
+// follow the bones' in FNOD and FITM, which such a pack writes as version
+// kClusteredTreesVersion: a reader that predates clusters refuses it as a
+// version it does not read, rather than finding nodes no bone tree covers.
+constexpr SectionId kClusterHeader = make_section_id("FCHD");
+constexpr SectionId kBoneClusterBegin = make_section_id("FCLB");
+constexpr SectionId kClusters = make_section_id("FCLS");
+constexpr SectionId kCheckRank = make_section_id("FCKR");
+constexpr SectionId kClusterBoxes = make_section_id("FCLX");
+constexpr SectionId kFeatureBoneBegin = make_section_id("FFBB");
+constexpr SectionId kFeatureBones = make_section_id("FFBN");
+constexpr SectionId kClusterCentres = make_section_id("FCCN");
+// Every cluster section but the header, which says the others are there.
+constexpr SectionId kClusterArrays[] = {kBoneClusterBegin, kClusters,     kCheckRank,     kClusterBoxes,
+                                        kFeatureBoneBegin, kFeatureBones, kClusterCentres};
 constexpr std::uint32_t kSectionVersion = 1;
+// FNOD and FITM of a pack with clusters: the bones' trees, then the clusters'.
+constexpr std::uint32_t kClusteredTreesVersion = 2;
 // LIMT version 1 held the limits as JSON text; version 2 is binary, so
 // loading a pack parses no JSON (JSON stays the editor's authoring format).
 constexpr std::uint32_t kLimitsVersion = 2;
@@ -166,6 +187,23 @@ struct FuzzyHeader {
   double mean_items_per_leaf;
 };
 static_assert(sizeof(FuzzyHeader) == 56 && std::is_trivially_copyable_v<FuzzyHeader>);
+
+// The cluster header (FCHD): the scalars of the cluster data and the
+// clustering's figures. clustering_ms is a timing and, like the other
+// timings, stays out of the fuzzy sections; it is not stored at all, since
+// the provenance (PROV) has no room for it without changing every pack's
+// bytes, so a loaded pack reports 0.
+struct ClusterHeader {
+  float feature_translation_scale;  // FuzzyCharacterData::feature_translation_scale, finite and > 0
+  std::uint32_t clusters_per_bone;  // FuzzyBakeOptions::pose_clusters, 1 to rt::kMaxPoseClusters
+  std::uint32_t cluster_count;      // FCLS entries
+  std::uint8_t reserved[4];         // zero
+  double cluster_fuzzy_area;        // FuzzyBakeStats::cluster_fuzzy_area
+};
+static_assert(sizeof(ClusterHeader) == 24 && std::is_trivially_copyable_v<ClusterHeader>);
+static_assert(offsetof(ClusterHeader, clusters_per_bone) == 4 && offsetof(ClusterHeader, cluster_count) == 8 &&
+              offsetof(ClusterHeader, reserved) == 12 && offsetof(ClusterHeader, cluster_fuzzy_area) == 16,
+              "no padding: every byte of FCHD is a named field");
 
 template <typename T>
 std::span<const std::byte> bytes_of(std::span<const T> values) {
@@ -396,14 +434,17 @@ Expected<std::span<const T>> view_section(const PackReader& reader, SectionId id
   return *view;
 }
 
-Status check_version(const PackReader& reader, SectionId id) {
+Status check_version(const PackReader& reader, SectionId id, std::uint32_t version = kSectionVersion,
+                     std::string_view why = "") {
   const SectionInfo* info = reader.find(id);
   if (info == nullptr) {
     return make_error(ErrorCode::kNotFound, reader.name(), section_id_name(id), "", "section missing");
   }
-  if (info->version != kSectionVersion) {
+  if (info->version != version) {
     return make_error(ErrorCode::kUnsupportedVersion, reader.name(), section_id_name(id) + ".version",
-                      std::to_string(info->version), "this build reads version " + std::to_string(kSectionVersion));
+                      std::to_string(info->version),
+                      "this build reads version " + std::to_string(version) + (why.empty() ? "" : " ") +
+                          std::string(why));
   }
   return {};
 }
@@ -453,13 +494,33 @@ Expected<PackWriter> character_pack_writer(const PackContents& c) {
     SINEW_RETURN_IF_ERROR(w.add_section(kFuzzyHeader, kSectionVersion, std::as_bytes(std::span(&h, 1))));
     SINEW_RETURN_IF_ERROR(w.add_section(kTriangleBone, kSectionVersion, bytes_of<std::uint16_t>(f.triangle_bone)));
     SINEW_RETURN_IF_ERROR(w.add_section(kBoneTrees, kSectionVersion, bytes_of<rt::BoneTree>(f.bone_trees)));
-    SINEW_RETURN_IF_ERROR(w.add_section(kNodes, kSectionVersion, bytes_of<rt::KdNode>(f.nodes)));
-    SINEW_RETURN_IF_ERROR(w.add_section(kItems, kSectionVersion, bytes_of<std::uint32_t>(f.items)));
+    const std::uint32_t trees_version = f.bone_cluster_begin.empty() ? kSectionVersion : kClusteredTreesVersion;
+    SINEW_RETURN_IF_ERROR(w.add_section(kNodes, trees_version, bytes_of<rt::KdNode>(f.nodes)));
+    SINEW_RETURN_IF_ERROR(w.add_section(kItems, trees_version, bytes_of<std::uint32_t>(f.items)));
     SINEW_RETURN_IF_ERROR(
         w.add_section(kVertexCheckBegin, kSectionVersion, bytes_of<std::uint32_t>(f.vertex_check_begin)));
     SINEW_RETURN_IF_ERROR(w.add_section(kVertexChecks, kSectionVersion, bytes_of<rt::VertexCheck>(f.vertex_checks)));
     SINEW_RETURN_IF_ERROR(w.add_section(kTriangleChecks, kSectionVersion,
                                         bytes_of<std::array<std::uint32_t, 3>>(f.triangle_checks)));
+    // A clustering bake always has the per-bone offsets, even when no bone
+    // got clusters (then FCLS, FCLX and FCCN are empty).
+    if (!f.bone_cluster_begin.empty()) {
+      ClusterHeader ch{};
+      ch.feature_translation_scale = f.feature_translation_scale;
+      ch.clusters_per_bone = f.stats.clusters_per_bone;
+      ch.cluster_count = static_cast<std::uint32_t>(f.clusters.size());
+      ch.cluster_fuzzy_area = f.stats.cluster_fuzzy_area;
+      SINEW_RETURN_IF_ERROR(w.add_section(kClusterHeader, kSectionVersion, std::as_bytes(std::span(&ch, 1))));
+      SINEW_RETURN_IF_ERROR(
+          w.add_section(kBoneClusterBegin, kSectionVersion, bytes_of<std::uint32_t>(f.bone_cluster_begin)));
+      SINEW_RETURN_IF_ERROR(w.add_section(kClusters, kSectionVersion, bytes_of<rt::BoneCluster>(f.clusters)));
+      SINEW_RETURN_IF_ERROR(w.add_section(kCheckRank, kSectionVersion, bytes_of<std::uint32_t>(f.check_rank)));
+      SINEW_RETURN_IF_ERROR(w.add_section(kClusterBoxes, kSectionVersion, bytes_of<Aabb>(f.cluster_boxes)));
+      SINEW_RETURN_IF_ERROR(
+          w.add_section(kFeatureBoneBegin, kSectionVersion, bytes_of<std::uint32_t>(f.feature_bone_begin)));
+      SINEW_RETURN_IF_ERROR(w.add_section(kFeatureBones, kSectionVersion, bytes_of<std::uint16_t>(f.feature_bones)));
+      SINEW_RETURN_IF_ERROR(w.add_section(kClusterCentres, kSectionVersion, bytes_of<float>(f.cluster_centres)));
+    }
   }
   return w;
 }
@@ -526,11 +587,30 @@ Expected<Pack> Pack::load(PackReader reader) {
     SectionDecoder d = decoder(r, kProvenance);
     SINEW_ASSIGN_OR_RETURN(pack.provenance_, decode_provenance(d));
   }
+  // Cluster sections refine the fuzzy data: without its header, or without
+  // the fuzzy data itself, they mean nothing, and ignoring them would hide a
+  // damaged pack.
+  const bool has_cluster_header = r.contains(kClusterHeader);
+  for (SectionId id : kClusterArrays) {
+    if (r.contains(id) && !has_cluster_header) {
+      return make_error(ErrorCode::kNotFound, r.name(), section_id_name(kClusterHeader), "",
+                        "section missing: the pack has the cluster section " + section_id_name(id) +
+                            " but not the cluster header");
+    }
+  }
+  if (has_cluster_header && !r.contains(kFuzzyHeader)) {
+    return make_error(ErrorCode::kNotFound, r.name(), section_id_name(kFuzzyHeader), "",
+                      "section missing: the pack has cluster sections (FCHD) but no fuzzy data");
+  }
   if (!r.contains(kFuzzyHeader)) return pack;
 
-  for (SectionId id : {kFuzzyHeader, kTriangleBone, kBoneTrees, kNodes, kItems, kVertexCheckBegin, kVertexChecks,
-                       kTriangleChecks}) {
+  for (SectionId id : {kFuzzyHeader, kTriangleBone, kBoneTrees, kVertexCheckBegin, kVertexChecks, kTriangleChecks}) {
     SINEW_RETURN_IF_ERROR(check_version(r, id));
+  }
+  for (SectionId id : {kNodes, kItems}) {
+    SINEW_RETURN_IF_ERROR(has_cluster_header
+                              ? check_version(r, id, kClusteredTreesVersion, "in a pack with clusters (FCHD)")
+                              : check_version(r, id, kSectionVersion, "in a pack without clusters (no FCHD)"));
   }
   FuzzyHeader h{};
   {
@@ -579,8 +659,68 @@ Expected<Pack> Pack::load(PackReader reader) {
   SINEW_ASSIGN_OR_RETURN(v.vertex_checks, view_section<rt::VertexCheck>(r, kVertexChecks));
   using Corners = std::array<std::uint32_t, 3>;
   SINEW_ASSIGN_OR_RETURN(v.triangle_checks, view_section<Corners>(r, kTriangleChecks));
+  ClusterHeader ch{};
+  if (has_cluster_header) {
+    SINEW_RETURN_IF_ERROR(check_version(r, kClusterHeader));
+    for (SectionId id : kClusterArrays) SINEW_RETURN_IF_ERROR(check_version(r, id));
+    {
+      SectionDecoder d = decoder(r, kClusterHeader);
+      SINEW_RETURN_IF_ERROR(d.get(ch, "header"));
+      SINEW_RETURN_IF_ERROR(d.finish());
+    }
+    // The scale divides every frame's feature (pose_clusters.h): the
+    // validation below checks it too, but a header field is reported as one.
+    if (!(std::isfinite(ch.feature_translation_scale) && ch.feature_translation_scale > 0.0f)) {
+      return make_error(ErrorCode::kInvalidData, r.name(), "FCHD.feature_translation_scale",
+                        std::to_string(ch.feature_translation_scale), "not finite and positive");
+    }
+    if (ch.clusters_per_bone == 0 || ch.clusters_per_bone > rt::kMaxPoseClusters) {
+      return make_error(ErrorCode::kInvalidData, r.name(), "FCHD.clusters_per_bone",
+                        std::to_string(ch.clusters_per_bone),
+                        "outside [1, " + std::to_string(rt::kMaxPoseClusters) + "] (rt::kMaxPoseClusters)");
+    }
+    if (!(std::isfinite(ch.cluster_fuzzy_area) && ch.cluster_fuzzy_area >= 0.0)) {
+      return make_error(ErrorCode::kInvalidData, r.name(), "FCHD.cluster_fuzzy_area",
+                        std::to_string(ch.cluster_fuzzy_area), "not finite and >= 0");
+    }
+    for (const std::uint8_t byte : ch.reserved) {
+      if (byte != 0) {
+        return make_error(ErrorCode::kInvalidData, r.name(), "FCHD.reserved", std::to_string(byte), "not 0");
+      }
+    }
+    SINEW_ASSIGN_OR_RETURN(v.bone_cluster_begin, view_section<std::uint32_t>(r, kBoneClusterBegin));
+    SINEW_ASSIGN_OR_RETURN(v.clusters, view_section<rt::BoneCluster>(r, kClusters));
+    SINEW_ASSIGN_OR_RETURN(v.check_rank, view_section<std::uint32_t>(r, kCheckRank));
+    SINEW_ASSIGN_OR_RETURN(v.cluster_boxes, view_section<Aabb>(r, kClusterBoxes));
+    SINEW_ASSIGN_OR_RETURN(v.feature_bone_begin, view_section<std::uint32_t>(r, kFeatureBoneBegin));
+    SINEW_ASSIGN_OR_RETURN(v.feature_bones, view_section<std::uint16_t>(r, kFeatureBones));
+    SINEW_ASSIGN_OR_RETURN(v.cluster_centres, view_section<float>(r, kClusterCentres));
+    v.feature_translation_scale = ch.feature_translation_scale;
+    if (ch.cluster_count != v.clusters.size()) {
+      return make_error(ErrorCode::kInvalidData, r.name(), "FCHD.cluster_count", std::to_string(ch.cluster_count),
+                        "differs from the " + std::to_string(v.clusters.size()) + " clusters of FCLS");
+    }
+    // The validation checks the cluster arrays only when one of them has
+    // entries; a clustering bake always has the per-bone offsets.
+    if (v.bone_cluster_begin.size() != std::size_t{v.bone_count} + 1) {
+      return make_error(ErrorCode::kInvalidData, r.name(), "FCLB.size",
+                        std::to_string(v.bone_cluster_begin.size()) + " offsets",
+                        "expected one per bone + 1 (" + std::to_string(std::size_t{v.bone_count} + 1) + ")");
+    }
+  }
   if (Status s = rt::validate_fuzzy_character(pack.model_.mesh, v); !s.ok()) {
     return make_error(s.code(), r.name(), "fuzzy " + std::string(s.field()), s.value(), s.detail());
+  }
+  if (has_cluster_header) {
+    // The offsets are validated now: no bone has more clusters than the bake asked for.
+    for (std::uint32_t b = 0; b < v.bone_count; ++b) {
+      const std::uint32_t count = v.bone_cluster_begin[b + 1] - v.bone_cluster_begin[b];
+      if (count > ch.clusters_per_bone) {
+        return make_error(ErrorCode::kInvalidData, r.name(), "FCLB[" + std::to_string(b) + "]",
+                          std::to_string(count) + " clusters",
+                          "more than FCHD.clusters_per_bone (" + std::to_string(ch.clusters_per_bone) + ")");
+      }
+    }
   }
   rt::FuzzyBakeStats& st = pack.stats_;
   st.sample_count = h.sample_count;
@@ -598,6 +738,11 @@ Expected<Pack> Pack::load(PackReader reader) {
   st.sampling_ms = pack.provenance_.sampling_ms;
   st.assignment_ms = pack.provenance_.assignment_ms;
   st.build_ms = pack.provenance_.build_ms;
+  if (has_cluster_header) {
+    st.clusters_per_bone = ch.clusters_per_bone;
+    st.cluster_count = ch.cluster_count;
+    st.cluster_fuzzy_area = ch.cluster_fuzzy_area;
+  }
   pack.has_fuzzy_ = true;
   return pack;
 }

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <fstream>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -261,6 +262,8 @@ class CorruptPack : public testing::Test {
   static void TearDownTestSuite() {
     delete baked_;
     delete bytes_;
+    baked_ = nullptr;
+    bytes_ = nullptr;
   }
 
   // The pack with section `id`'s payload replaced by mutate(payload)
@@ -486,6 +489,285 @@ TEST_F(CorruptPack, RandomDamageNeverCrashes) {
   }
   EXPECT_GT(refused, 0);
   RecordProperty("accepted", accepted);
+}
+
+
+// --- pose-space clusters -----------------------------------------------------------
+
+// The cluster sections (FCHD and the arrays after it) of a bake with
+// FuzzyBakeOptions::pose_clusters.
+const SectionId kClusterSections[] = {make_section_id("FCHD"), make_section_id("FCLB"), make_section_id("FCLS"),
+                                      make_section_id("FCKR"), make_section_id("FCLX"), make_section_id("FFBB"),
+                                      make_section_id("FFBN"), make_section_id("FCCN")};
+
+// The pack without the sections `drop`, everything else as it was.
+std::vector<std::byte> without_sections(std::span<const std::byte> bytes, std::span<const SectionId> drop) {
+  auto reader = PackReader::from_bytes(bytes, "pristine");
+  EXPECT_TRUE(reader.ok());
+  if (!reader.ok()) return {};
+  PackWriter w;
+  for (const SectionInfo& s : reader->sections()) {
+    if (std::find(drop.begin(), drop.end(), s.id) != drop.end()) continue;
+    EXPECT_TRUE(w.add_section(s.id, s.version, reader->section_bytes(s)).ok());
+  }
+  auto out = w.serialize();
+  EXPECT_TRUE(out.ok());
+  return out.ok() ? std::move(*out) : std::vector<std::byte>{};
+}
+
+template <typename T>
+void expect_same_array(std::span<const T> loaded, const std::vector<T>& baked, const char* name) {
+  ASSERT_EQ(loaded.size(), baked.size()) << name;
+  EXPECT_EQ(std::memcmp(loaded.data(), baked.data(), baked.size() * sizeof(T)), 0) << name << " differs";
+}
+
+// The mannequin (two bones blended at every joint, so most bones have
+// feature bones) over 40 arbitrary poses, in at most 4 clusters a bone.
+// It keeps its pack in CorruptPack's slots, which repack() reads: the two
+// suites run one after the other, each setting them up and freeing them.
+class ClusterPack : public CorruptPack {
+ protected:
+  static void SetUpTestSuite() {
+    JobSystem jobs(2);
+    auto model = content::make_mannequin();
+    ASSERT_TRUE(model.ok());
+    character::BakeRequest request;
+    request.pose_space.mode = anim::PoseSpaceMode::kArbitrary;
+    request.pose_space.samples = 40;
+    request.pose_space.seed = 7;
+    request.fuzzy.pose_clusters = 4;
+    baked_ = new Baked(bake(std::move(*model), jobs, request));
+    bytes_ = new std::vector<std::byte>(pack_bytes(*baked_));
+  }
+  static void TearDownTestSuite() { CorruptPack::TearDownTestSuite(); }
+
+  // The first cluster of a bone, and that bone.
+  static std::pair<std::uint32_t, std::uint32_t> first_cluster() {
+    const rt::FuzzyCharacterData& f = baked_->fuzzy;
+    for (std::uint32_t b = 0; b < f.bone_count; ++b) {
+      if (f.bone_cluster_begin[b] != f.bone_cluster_begin[b + 1]) return {f.bone_cluster_begin[b], b};
+    }
+    ADD_FAILURE() << "no bone has clusters";
+    return {0, 0};
+  }
+
+  static void expect_rejected_with(const std::vector<std::byte>& bytes, ErrorCode code, const std::string& field) {
+    auto pack = character::Pack::from_bytes(bytes, "corrupt.pack");
+    ASSERT_FALSE(pack.ok()) << "a corrupt " << field << " was accepted";
+    EXPECT_EQ(pack.status().code(), code) << pack.status().message();
+    EXPECT_NE(pack.status().message().find("corrupt.pack"), std::string::npos) << pack.status().message();
+    EXPECT_NE(pack.status().message().find(field), std::string::npos) << pack.status().message();
+  }
+};
+
+TEST_F(ClusterPack, TheClusterArraysRoundTripElementForElement) {
+  const rt::FuzzyCharacterData& f = baked_->fuzzy;
+  ASSERT_FALSE(f.clusters.empty()) << "the test bake should cluster";
+  ASSERT_EQ(f.stats.clusters_per_bone, 4u);
+  auto pack = character::Pack::from_bytes(*bytes_, "clusters.pack");
+  ASSERT_TRUE(pack.ok()) << pack.status().message();
+  const rt::FuzzyCharacterView& v = pack->fuzzy();
+  ASSERT_TRUE(v.has_clusters());
+  expect_same_array(v.bone_cluster_begin, f.bone_cluster_begin, "bone_cluster_begin");
+  expect_same_array(v.clusters, f.clusters, "clusters");
+  expect_same_array(v.check_rank, f.check_rank, "check_rank");
+  expect_same_array(v.cluster_boxes, f.cluster_boxes, "cluster_boxes");
+  expect_same_array(v.feature_bone_begin, f.feature_bone_begin, "feature_bone_begin");
+  expect_same_array(v.feature_bones, f.feature_bones, "feature_bones");
+  expect_same_array(v.cluster_centres, f.cluster_centres, "cluster_centres");
+  // The cluster trees live in the node and item arrays after the bones'.
+  expect_same_array(v.nodes, f.nodes, "nodes");
+  expect_same_array(v.items, f.items, "items");
+  EXPECT_EQ(v.feature_translation_scale, f.feature_translation_scale);
+  for (std::uint32_t b = 0; b < f.bone_count; ++b) {
+    EXPECT_EQ(v.bone_clusters(b).size(), f.view().bone_clusters(b).size()) << "bone " << b;
+  }
+  const rt::FuzzyBakeStats& st = pack->fuzzy_stats();
+  EXPECT_EQ(st.clusters_per_bone, 4u);
+  EXPECT_EQ(st.cluster_count, f.clusters.size());
+  EXPECT_EQ(st.cluster_count, f.stats.cluster_count);
+  EXPECT_EQ(st.cluster_fuzzy_area, f.stats.cluster_fuzzy_area);
+  EXPECT_EQ(st.clustering_ms, 0.0) << "timings are not stored in the fuzzy sections";
+  // Used in place, like the rest of the fuzzy data.
+  const auto mapped = pack->reader().bytes();
+  EXPECT_GE(static_cast<const void*>(v.cluster_boxes.data()), static_cast<const void*>(mapped.data()));
+  EXPECT_LT(static_cast<const void*>(v.cluster_boxes.data()), static_cast<const void*>(mapped.data() + mapped.size()));
+  // And it renders as the in-memory bake does (the scene uses clusters by default).
+  JobSystem jobs(2);
+  const Image in_memory = render(baked_->model, f.view(), jobs);
+  EXPECT_TRUE(render(pack->model(), v, jobs) == in_memory) << "rendering from the pack differs from the in-memory bake";
+  // The same inputs give the same bytes.
+  EXPECT_TRUE(pack_bytes(*baked_) == *bytes_);
+}
+
+// A bake without clusters writes none of the cluster sections, so its pack
+// is what the writer made before they existed; a clustering bake writes all.
+TEST_F(ClusterPack, APackWithoutClustersHasNoClusterSections) {
+  JobSystem jobs(2);
+  auto model = content::make_mannequin();
+  ASSERT_TRUE(model.ok());
+  const Baked plain = bake(std::move(*model), jobs);
+  ASSERT_TRUE(plain.fuzzy.bone_cluster_begin.empty());
+  const auto bytes = pack_bytes(plain);
+  auto reader = PackReader::from_bytes(bytes, "plain");
+  ASSERT_TRUE(reader.ok());
+  for (const SectionId id : kClusterSections) EXPECT_FALSE(reader->contains(id)) << section_id_name(id);
+  auto pack = character::Pack::from_bytes(bytes, "plain.pack");
+  ASSERT_TRUE(pack.ok()) << pack.status().message();
+  EXPECT_FALSE(pack->fuzzy().has_clusters());
+  EXPECT_TRUE(pack->fuzzy().bone_cluster_begin.empty());
+  EXPECT_EQ(pack->fuzzy_stats().clusters_per_bone, 0u);
+  EXPECT_EQ(pack->fuzzy_stats().cluster_count, 0u);
+
+  auto clustered = PackReader::from_bytes(*bytes_, "clustered");
+  ASSERT_TRUE(clustered.ok());
+  for (const SectionId id : kClusterSections) EXPECT_TRUE(clustered->contains(id)) << section_id_name(id);
+  // A pack with clusters writes its trees (the bones', then the clusters')
+  // as FNOD and FITM version 2, so a reader that predates the clusters
+  // refuses it by version; without the cluster sections this build does
+  // the same rather than read nodes no bone tree covers.
+  EXPECT_EQ(reader->find(make_section_id("FNOD"))->version, 1u);
+  EXPECT_EQ(clustered->find(make_section_id("FNOD"))->version, 2u);
+  EXPECT_EQ(clustered->find(make_section_id("FITM"))->version, 2u);
+  expect_rejected_with(without_sections(*bytes_, kClusterSections), ErrorCode::kUnsupportedVersion, "FNOD.version");
+}
+
+TEST_F(ClusterPack, ThePristineClusterPackLoads) {
+  auto pack = character::Pack::from_bytes(*bytes_, "pristine.pack");
+  ASSERT_TRUE(pack.ok()) << pack.status().message();
+  EXPECT_TRUE(pack->fuzzy().has_clusters());
+}
+
+TEST_F(ClusterPack, AClusterBoxRangePastTheEndIsRefused) {
+  const std::uint32_t q = first_cluster().first;
+  rt::BoneCluster bad = baked_->fuzzy.clusters[q];
+  bad.box_begin = static_cast<std::uint32_t>(baked_->fuzzy.cluster_boxes.size());
+  expect_rejected_with(repack(make_section_id("FCLS"), [&](auto& p) { overwrite(p, q, bad); }),
+                       ErrorCode::kInvalidData, "clusters[" + std::to_string(q) + "].box_begin");
+  bad = baked_->fuzzy.clusters[q];
+  bad.centre_begin = static_cast<std::uint32_t>(baked_->fuzzy.cluster_centres.size());
+  expect_rejected_with(repack(make_section_id("FCLS"), [&](auto& p) { overwrite(p, q, bad); }),
+                       ErrorCode::kInvalidData, "clusters[" + std::to_string(q) + "].centre_begin");
+}
+
+TEST_F(ClusterPack, NanClusterBoxesAndCentresAreRefused) {
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const std::size_t i = baked_->fuzzy.cluster_boxes.size() / 2;
+  Aabb box = baked_->fuzzy.cluster_boxes[i];
+  box.upper.z = nan;
+  expect_rejected_with(repack(make_section_id("FCLX"), [&](auto& p) { overwrite(p, i, box); }),
+                       ErrorCode::kInvalidData, "cluster_boxes[" + std::to_string(i) + "]");
+  const std::uint32_t c = baked_->fuzzy.clusters[first_cluster().first].centre_begin;
+  expect_rejected_with(repack(make_section_id("FCCN"), [&](auto& p) { overwrite(p, c, nan); }),
+                       ErrorCode::kInvalidData, "cluster_centres[" + std::to_string(c) + "]");
+}
+
+TEST_F(ClusterPack, ACheckRankOutOfRangeIsRefused) {
+  const rt::FuzzyCharacterData& f = baked_->fuzzy;
+  const std::uint32_t bone = first_cluster().second;
+  std::size_t c = 0;
+  while (c < f.vertex_checks.size() && f.vertex_checks[c].bone != bone) ++c;
+  ASSERT_LT(c, f.vertex_checks.size());
+  expect_rejected_with(repack(make_section_id("FCKR"), [&](auto& p) { overwrite(p, c, std::uint32_t{0x7fffffffu}); }),
+                       ErrorCode::kInvalidData, "check_rank[" + std::to_string(c) + "]");
+  // One rank short: one rank per check.
+  expect_rejected_with(repack(make_section_id("FCKR"), [](auto& p) { p.resize(p.size() - 4); }),
+                       ErrorCode::kInvalidData, "check_rank");
+}
+
+TEST_F(ClusterPack, BadOffsetsAndFeatureBonesAreRefused) {
+  const rt::FuzzyCharacterData& f = baked_->fuzzy;
+  expect_rejected_with(repack(make_section_id("FCLB"),
+                              [&](auto& p) { overwrite(p, f.bone_count, std::uint32_t{0xffffu}); }),
+                       ErrorCode::kInvalidData, "bone_cluster_begin");
+  // An empty FCLB beside a header that says the bake clustered.
+  expect_rejected_with(repack(make_section_id("FCLB"), [](auto& p) { p.clear(); }), ErrorCode::kInvalidData,
+                       "FCLB");
+  expect_rejected_with(repack(make_section_id("FFBB"), [](auto& p) { overwrite(p, 0, std::uint32_t{1}); }),
+                       ErrorCode::kInvalidData, "feature_bone_begin");
+  ASSERT_FALSE(f.feature_bones.empty());
+  expect_rejected_with(repack(make_section_id("FFBN"), [](auto& p) { overwrite(p, 0, std::uint16_t{60000}); }),
+                       ErrorCode::kInvalidData, "feature_bones[0]");
+}
+
+TEST_F(ClusterPack, AMissingClusterSectionIsRefusedByName) {
+  for (const SectionId id : kClusterSections) {
+    if (id == make_section_id("FCHD")) continue;
+    const SectionId drop[] = {id};
+    expect_rejected_with(without_sections(*bytes_, drop), ErrorCode::kNotFound, section_id_name(id));
+  }
+  // Cluster sections without their header.
+  const SectionId header[] = {make_section_id("FCHD")};
+  expect_rejected_with(without_sections(*bytes_, header), ErrorCode::kNotFound, "FCHD");
+  // A cluster section of a version this build does not read.
+  expect_rejected_with(testing_support::repack_section(*bytes_, make_section_id("FCLS"), [](auto&) {}, 2u),
+                       ErrorCode::kUnsupportedVersion, "FCLS.version");
+  // Cluster sections in a pack without fuzzy data.
+  const SectionId fuzzy[] = {make_section_id("FZHD"), make_section_id("FTBN"), make_section_id("FBTR"),
+                             make_section_id("FNOD"), make_section_id("FITM"), make_section_id("FVCB"),
+                             make_section_id("FVCK"), make_section_id("FTCK")};
+  expect_rejected_with(without_sections(*bytes_, fuzzy), ErrorCode::kNotFound, "FZHD");
+}
+
+// FCHD: scale (float, bytes 0-3), clusters_per_bone (4-7), cluster_count
+// (8-11), reserved (12-15), cluster_fuzzy_area (double, 16-23).
+TEST_F(ClusterPack, ABadClusterHeaderIsRefused) {
+  const SectionId header = make_section_id("FCHD");
+  const auto with = [&](std::size_t offset, auto value) {
+    return repack(header, [&](auto& p) {
+      ASSERT_LE(offset + sizeof(value), p.size());
+      std::memcpy(p.data() + offset, &value, sizeof(value));
+    });
+  };
+  const auto clusters = static_cast<std::uint32_t>(baked_->fuzzy.clusters.size());
+  expect_rejected_with(with(8, clusters + 1), ErrorCode::kInvalidData, "FCHD.cluster_count");
+  expect_rejected_with(with(8, clusters - 1), ErrorCode::kInvalidData, "FCHD.cluster_count");
+  expect_rejected_with(with(0, std::numeric_limits<float>::quiet_NaN()), ErrorCode::kInvalidData,
+                       "FCHD.feature_translation_scale");
+  expect_rejected_with(with(0, 0.0f), ErrorCode::kInvalidData, "FCHD.feature_translation_scale");
+  expect_rejected_with(with(0, std::numeric_limits<float>::infinity()), ErrorCode::kInvalidData,
+                       "FCHD.feature_translation_scale");
+  expect_rejected_with(with(4, std::uint32_t{0}), ErrorCode::kInvalidData, "FCHD.clusters_per_bone");
+  expect_rejected_with(with(4, rt::kMaxPoseClusters + 1), ErrorCode::kInvalidData, "FCHD.clusters_per_bone");
+  // Fewer than a bone has.
+  std::uint32_t most = 0;
+  for (std::uint32_t b = 0; b < baked_->fuzzy.bone_count; ++b) {
+    most = std::max(most, baked_->fuzzy.bone_cluster_begin[b + 1] - baked_->fuzzy.bone_cluster_begin[b]);
+  }
+  ASSERT_GE(most, 2u);
+  expect_rejected_with(with(4, most - 1), ErrorCode::kInvalidData, "FCHD.clusters_per_bone");
+  expect_rejected_with(with(13, std::uint8_t{1}), ErrorCode::kInvalidData, "FCHD.reserved");
+  expect_rejected_with(with(16, -1.0), ErrorCode::kInvalidData, "FCHD.cluster_fuzzy_area");
+  expect_rejected_with(repack(header, [](auto& p) { p.push_back(std::byte{0}); }), ErrorCode::kInvalidData,
+                       "FCHD");
+  expect_rejected_with(repack(header, [](auto& p) { p.resize(20); }), ErrorCode::kTruncated, "FCHD.header");
+  // A scale that is finite and positive but not the bake's still loads: only
+  // the choice of cluster changes, never what a ray can reach.
+  auto other_scale = character::Pack::from_bytes(with(0, 3.5f), "scale.pack");
+  ASSERT_TRUE(other_scale.ok()) << other_scale.status().message();
+  EXPECT_EQ(other_scale->fuzzy().feature_translation_scale, 3.5f);
+}
+
+// Random damage to the cluster sections: refused or safe to render.
+TEST_F(ClusterPack, RandomDamageToClusterSectionsNeverCrashes) {
+  std::mt19937 random(4321);
+  JobSystem jobs(1);
+  int refused = 0;
+  for (const SectionId id : kClusterSections) {
+    for (int trial = 0; trial < 12; ++trial) {
+      const auto bytes = repack(id, [&](std::vector<std::byte>& p) {
+        if (p.empty()) return;
+        for (int k = 0; k < 3; ++k) p[random() % p.size()] = static_cast<std::byte>(random() & 0xffu);
+      });
+      auto pack = character::Pack::from_bytes(bytes, "damaged.pack");
+      if (!pack.ok()) {
+        ++refused;
+        continue;
+      }
+      render(pack->model(), pack->fuzzy(), jobs, /*strict=*/false);
+    }
+  }
+  EXPECT_GT(refused, 0);
 }
 
 }  // namespace
