@@ -58,6 +58,7 @@ struct BakeOptions {
   bool merge_rigid_bones = rt::FuzzyBakeOptions{}.merge_rigid_bones;
   float sah_intersection_cost = rt::FuzzyBakeOptions{}.kd.intersection_cost;
   bool sah_intersection_cost_given = false;  // else the bake's size-based default
+  std::optional<std::uint32_t> pose_clusters;  // else the bake's size-based default
   int threads = 0;
   std::size_t max_memory_bytes = character::BakeRequest{}.max_memory_bytes;
   GltfImportOptions gltf;
@@ -106,6 +107,11 @@ struct BakeFlags {
                                        "(default 0.15, 0.05 from 25,000 triangles, tuned for\n"
                                        "256-ray packets; 1.5 builds deeper trees, which suit\n"
                                        "--packet-rays 1)")),
+        pose_clusters(l.option("--pose-clusters", "K",
+                               "per bone up to K clusters of its poses, each with a tighter\n"
+                               "tree the bone uses in the poses nearest it (0-64; default 16\n"
+                               "from 25,000 triangles, else 0: none; docs/RAYTRACE.md,\n"
+                               "\"Pose-space clusters\")")),
         threads(l.option("--threads", "N", "worker threads (default 0: all cores)")),
         max_memory_mib(l.option("--max-memory-mib", "M",
                                 "refuse a bake whose working set would exceed M MiB\n"
@@ -129,6 +135,7 @@ struct BakeFlags {
   const std::optional<std::string>& candidates;
   const std::optional<std::string>& rigid_bones;
   const std::optional<std::string>& sah_intersection_cost;
+  const std::optional<std::string>& pose_clusters;
   const std::optional<std::string>& threads;
   const std::optional<std::string>& max_memory_mib;
   ImportLimitFlags import_limits;
@@ -252,6 +259,10 @@ Expected<BakeOptions> parse_bake_options(const std::vector<std::string>& args, c
     SINEW_ASSIGN_OR_RETURN(const double cost, cli::parse_double("--sah-intersection-cost", *v, 0.01, 100.0));
     o.sah_intersection_cost = static_cast<float>(cost);
     o.sah_intersection_cost_given = true;
+  }
+  if (const std::optional<std::string>& v = f.pose_clusters) {
+    SINEW_ASSIGN_OR_RETURN(const std::int64_t k, cli::parse_int("--pose-clusters", *v, 0, rt::kMaxPoseClusters));
+    o.pose_clusters = static_cast<std::uint32_t>(k);
   }
   if (const std::optional<std::string>& v = f.threads) {
     SINEW_ASSIGN_OR_RETURN(o.threads, cli::parse_threads("--threads", *v));
@@ -457,6 +468,9 @@ Json inspect_json(const character::Pack& pack) {
                   {"mean_leaf_depth", leaves ? depth_sum / static_cast<double>(leaves) : 0.0},
                   {"merge_rigid_bones", st.merge_rigid_bones},
                   {"merged_bones", st.merged_bones},
+                  {"clusters_per_bone", st.clusters_per_bone},
+                  {"clusters", f.clusters.size()},
+                  {"cluster_fuzzy_area_ratio", st.rest_area > 0.0 ? st.cluster_fuzzy_area / st.rest_area : 0.0},
                   {"bones", bones}};
   return out;
 }
@@ -496,6 +510,10 @@ void print_inspect(const Json& j, std::ostream& out) {
                                                    " bones merged into their parents' trees"
                                              : std::string("rigid bones kept"))
       << "\n";
+  if (f["clusters"].get<std::size_t>() > 0) {
+    out << "pose-space clusters: " << f["clusters"] << " (up to " << f["clusters_per_bone"]
+        << " a bone), fuzzy area " << f["cluster_fuzzy_area_ratio"] << "x the rest pose's averaged over each bone's clusters\n";
+  }
 }
 
 // The process's peak resident set so far (getrusage), in KiB; 0 if unknown.
@@ -554,6 +572,8 @@ int run_bake(const std::vector<std::string>& args, std::ostream& out, std::ostre
   request.fuzzy.merge_rigid_bones = o.merge_rigid_bones;
   request.fuzzy.kd.intersection_cost = o.sah_intersection_cost;
   request.fuzzy.fine_mesh_cost = !o.sah_intersection_cost_given;
+  request.fuzzy.pose_clusters = o.pose_clusters.value_or(0);
+  request.fuzzy.fine_mesh_clusters = !o.pose_clusters.has_value();
   request.max_memory_bytes = o.max_memory_bytes;
   request.fuzzy.memory_budget_bytes = std::min(request.fuzzy.memory_budget_bytes, o.max_memory_bytes / 4);
   if (!o.limits_path.empty()) {
@@ -606,6 +626,12 @@ int run_bake(const std::vector<std::string>& args, std::ostream& out, std::ostre
       << (st.rest_area > 0.0 ? st.fuzzy_area / st.rest_area : 0.0) << "x rest, " << std::setprecision(2)
       << st.mean_items_per_leaf << " triangles per leaf, " << rigid_bones_text(st) << ", " << std::setprecision(0)
       << ms_since(start) << " ms\n";
+  if (st.clusters_per_bone > 0) {
+    out << "pose-space clusters: " << st.cluster_count << " (up to " << st.clusters_per_bone << " a bone), fuzzy area "
+        << std::setprecision(3) << (st.rest_area > 0.0 ? st.cluster_fuzzy_area / st.rest_area : 0.0)
+        << "x rest averaged over each bone's clusters, " << std::setprecision(0) << st.clustering_ms
+        << " ms clustering and their boxes\n";
+  }
   if (whole) {
     SceneSavingsOptions run = o.scene_report_run;
     run.threads = o.threads;

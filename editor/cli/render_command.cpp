@@ -78,7 +78,8 @@ struct RenderFlags {
         ground(l.option("--ground", "on|off", "the ground quad under the model (default on)")),
         pose_clusters(l.option("--pose-clusters", "K",
                                "pose-space clusters per bone in the bake, each a tighter tree\n"
-                               "(0-64, default 0: none; in-memory bakes, a pack has its own)")),
+                               "(0-64; default 16 from 25,000 triangles, else 0: none;\n"
+                               "in-memory bakes, a pack has its own)")),
         clusters(l.option("--clusters", "on|off", "bones use the clusters the bake or pack has (default on)")),
         import_limits(l) {}
 
@@ -413,7 +414,8 @@ Expected<RenderOutputs> render_model(const RenderOptions& options) {
   if (!pack || !pack->has_fuzzy()) {
     character::BakeRequest request;
     request.pose_space = options.pose_space;
-    request.fuzzy.pose_clusters = options.pose_clusters;
+    request.fuzzy.pose_clusters = options.pose_clusters.value_or(0);
+    request.fuzzy.fine_mesh_clusters = !options.pose_clusters.has_value();
     if (!options.limits_path.empty()) {
       SINEW_ASSIGN_OR_RETURN(request.limits, anim::load_joint_limits(options.limits_path, model.skeleton));
     }

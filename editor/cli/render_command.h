@@ -68,7 +68,7 @@ struct RenderOptions {
   // In-memory bakes only (a pack has its own): pose-space clusters per bone
   // (rt::FuzzyBakeOptions::pose_clusters, 0: none); and whether bones use
   // the clusters a bake or pack has (rt::FrameOptions::pose_clusters).
-  std::uint32_t pose_clusters = 0;
+  std::optional<std::uint32_t> pose_clusters;  // else the bake's size-based default
   bool use_clusters = true;
   bool ground = true;  // the ground quad under the model (--ground off: characters alone)
   // Called with one line per step (import, bake, frames, write); null: quiet.

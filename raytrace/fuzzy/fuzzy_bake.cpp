@@ -608,7 +608,7 @@ using ClusterMembers = std::vector<std::vector<std::uint32_t>>;
 // Clusters each bone's samples by its feature and lays out the clusters,
 // their centres and the check ranks; the boxes are grown by
 // grow_cluster_boxes and the trees built by build_cluster_trees.
-ClusterMembers plan_clusters(const Samples& samples, const FuzzyBakeOptions& options, float translation_scale,
+ClusterMembers plan_clusters(const Samples& samples, std::uint32_t clusters_per_bone, float translation_scale,
                              JobSystem& jobs, FuzzyCharacterData& out) {
   const std::uint32_t bone_count = out.bone_count;
   cluster_feature_bones(samples.mesh, out.vertex_check_begin, out.vertex_checks, bone_count, out.feature_bone_begin,
@@ -616,9 +616,21 @@ ClusterMembers plan_clusters(const Samples& samples, const FuzzyBakeOptions& opt
   out.feature_translation_scale = translation_scale;
   std::vector<std::uint32_t> triangles(bone_count, 0);
   for (const std::uint16_t b : out.triangle_bone) ++triangles[b];
+  // A box per cluster only for the checks whose vertex another bone moves
+  // (about half at 855,552 triangles); the others keep their full box.
   std::vector<std::uint32_t> checks(bone_count, 0);
-  out.check_rank.resize(out.vertex_checks.size());
-  for (std::size_t c = 0; c < out.vertex_checks.size(); ++c) out.check_rank[c] = checks[out.vertex_checks[c].bone]++;
+  out.check_rank.assign(out.vertex_checks.size(), kSharedCheckBox);
+  const SkinnedMesh& mesh = samples.mesh;
+  for (std::size_t v = 0; v < mesh.vertex_count(); ++v) {
+    for (std::uint32_t c = out.vertex_check_begin[v]; c < out.vertex_check_begin[v + 1]; ++c) {
+      const std::uint32_t b = out.vertex_checks[c].bone;
+      bool moved_by_another = false;
+      for (std::size_t k = 0; k < static_cast<std::size_t>(kMaxInfluences); ++k) {
+        moved_by_another = moved_by_another || (mesh.weights[v][k] != 0.0f && mesh.joints[v][k] != b);
+      }
+      if (moved_by_another) out.check_rank[c] = checks[b]++;
+    }
+  }
 
   // Per bone: k-means over its samples' features (bones in parallel).
   ClusterMembers members(bone_count);
@@ -636,7 +648,7 @@ ClusterMembers plan_clusters(const Samples& samples, const FuzzyBakeOptions& opt
         cluster_feature(samples.bone_from_pose(s)[b], samples.pose(s), feature_bones, translation_scale,
                         features.data() + s * dims);
       }
-      counts[b] = cluster_points(features, sample_count, dims, options.pose_clusters, members[b], centres[b]);
+      counts[b] = cluster_points(features, sample_count, dims, clusters_per_bone, members[b], centres[b]);
       // One cluster is the full tree again.
       if (counts[b] < 2) {
         counts[b] = 0;
@@ -671,14 +683,16 @@ Status grow_cluster_boxes(const Samples& samples, const ClusterMembers& members,
     for (std::size_t v = r.begin; v < r.end; ++v) {
       const std::uint32_t first = out.vertex_check_begin[v], last = out.vertex_check_begin[v + 1];
       bool clustered = false;
-      for (std::uint32_t c = first; c < last; ++c) clustered = clustered || !members[out.vertex_checks[c].bone].empty();
+      for (std::uint32_t c = first; c < last; ++c) {
+        clustered = clustered || (!members[out.vertex_checks[c].bone].empty() && out.check_rank[c] != kSharedCheckBox);
+      }
       if (!clustered) continue;
       for (std::size_t s = s0; s < s1; ++s) {
         const Vec3 p = skin_point(samples.mesh, v, samples.pose(s));
         const Affine3* bone_from_pose = samples.bone_from_pose(s);
         for (std::uint32_t c = first; c < last; ++c) {
           const std::uint32_t b = out.vertex_checks[c].bone;
-          if (members[b].empty()) continue;
+          if (members[b].empty() || out.check_rank[c] == kSharedCheckBox) continue;
           const BoneCluster& cluster = out.clusters[out.bone_cluster_begin[b] + members[b][s]];
           out.cluster_boxes[cluster.box_begin + out.check_rank[c]].extend(bone_from_pose[b].transform_point(p));
         }
@@ -700,7 +714,10 @@ Status build_cluster_trees(const SkinnedMesh& mesh, const KdBuildOptions& kd, Jo
   }
   const auto cluster_box = [&](const BoneCluster& cluster, std::uint32_t t) {
     Aabb box;
-    for (const std::uint32_t c : out.triangle_checks[t]) box.extend(out.cluster_boxes[cluster.box_begin + out.check_rank[c]]);
+    for (const std::uint32_t c : out.triangle_checks[t]) {
+      box.extend(out.check_rank[c] == kSharedCheckBox ? out.vertex_checks[c].box
+                                                     : out.cluster_boxes[cluster.box_begin + out.check_rank[c]]);
+    }
     return box;
   };
   std::vector<std::uint32_t> cluster_bone(out.clusters.size());
@@ -834,7 +851,11 @@ Expected<FuzzyCharacterData> bake_fuzzy_character(const FuzzyBakeInput& input,
   const std::uint32_t chunk_bones = static_cast<std::uint32_t>(
       std::clamp<std::size_t>(options.memory_budget_bytes / bytes_per_bone, 1, bone_count));
   const std::uint32_t chunk_count = (bone_count + chunk_bones - 1) / chunk_bones;
-  const std::uint32_t sweeps = chunk_count + 1 + (options.pose_clusters > 0 ? 1 : 0);
+  const std::uint32_t clusters_per_bone =
+      options.pose_clusters == 0 && options.fine_mesh_clusters && triangle_count >= kFineMeshTriangles
+          ? kFineMeshPoseClusters
+          : options.pose_clusters;
+  const std::uint32_t sweeps = chunk_count + 1 + (clusters_per_bone > 0 ? 1 : 0);
   Progress progress(options, static_cast<double>(samples.count()) * sweeps);
 
   {
@@ -872,14 +893,14 @@ Expected<FuzzyCharacterData> bake_fuzzy_character(const FuzzyBakeInput& input,
   SINEW_RETURN_IF_ERROR(grow_check_boxes(samples, pad, jobs, progress, out));
   stats.sampling_ms += ms_since(sampling_start);
   ClusterMembers cluster_members;
-  if (options.pose_clusters > 0) {
+  if (clusters_per_bone > 0) {
     const auto clustering_start = Clock::now();
     const float scale = padding_distance(mesh, 1.0f);
-    cluster_members = plan_clusters(samples, options, scale > 0.0f ? scale : 1.0f, jobs, out);
+    cluster_members = plan_clusters(samples, clusters_per_bone, scale > 0.0f ? scale : 1.0f, jobs, out);
     SINEW_RETURN_IF_ERROR(grow_cluster_boxes(samples, cluster_members, pad, jobs, progress, out));
     memory.hold(bytes_of(out.cluster_boxes) + bytes_of(out.check_rank));
     stats.clustering_ms = ms_since(clustering_start);
-    stats.clusters_per_bone = options.pose_clusters;
+    stats.clusters_per_bone = clusters_per_bone;
   }
   memory.release(bytes_of(inverses));
   inverses = std::vector<Affine3>{};  // `samples` is not used past this point
@@ -895,7 +916,7 @@ Expected<FuzzyCharacterData> bake_fuzzy_character(const FuzzyBakeInput& input,
   SINEW_RETURN_IF_ERROR(progress.report("build", kSweepShare));
   const auto build_start = Clock::now();
   SINEW_RETURN_IF_ERROR(build_bone_trees(triangle_boxes, options, jobs, out));
-  if (options.pose_clusters > 0) {
+  if (clusters_per_bone > 0) {
     SINEW_RETURN_IF_ERROR(build_cluster_trees(mesh, tree_build_options(options, triangle_count), jobs, out));
   }
   memory.hold(bytes_of(out.nodes) + bytes_of(out.items) + bytes_of(out.bone_trees));

@@ -59,7 +59,7 @@ static_assert(sizeof(VertexCheck) == 28);
 // cluster's boxes, or the bone falls back to its full tree.
 struct BoneCluster {
   BoneTree tree;                  // a slice of the character's node and item arrays, the bone's triangles
-  std::uint32_t box_begin = 0;    // into cluster_boxes: one box per check of the bone, by check_rank
+  std::uint32_t box_begin = 0;    // into cluster_boxes: one box per boxed check of the bone, by check_rank
   std::uint32_t centre_begin = 0; // into cluster_centres: 12 floats per feature bone of the bone
 };
 static_assert(sizeof(BoneCluster) == 56);
@@ -69,6 +69,9 @@ static_assert(sizeof(BoneCluster) == 56);
 // divided by `translation_scale` (the bind-pose bounds' diagonal) so that a
 // move across the model weighs about as a turn of a radian.
 inline constexpr std::size_t kClusterFeatureFloats = 12;
+
+// FuzzyCharacterView::check_rank of a check without boxes of its own per cluster.
+inline constexpr std::uint32_t kSharedCheckBox = 0xFFFFFFFFu;
 
 struct FuzzyCharacterView {
   std::uint32_t bone_count = 0;
@@ -82,7 +85,11 @@ struct FuzzyCharacterView {
   // Pose-space clusters; all empty without them.
   std::span<const std::uint32_t> bone_cluster_begin;  // per bone + 1: CSR into clusters
   std::span<const BoneCluster> clusters;
-  std::span<const std::uint32_t> check_rank;          // per vertex check: its index among its bone's checks
+  // Per vertex check: its index among its bone's checks with a box per
+  // cluster, or kSharedCheckBox for a check whose vertex only its bone
+  // weights (rigid in the bone's frame: one box, the full one, serves
+  // every cluster).
+  std::span<const std::uint32_t> check_rank;
   std::span<const Aabb> cluster_boxes;
   std::span<const std::uint32_t> feature_bone_begin;  // per bone + 1: CSR into feature_bones
   std::span<const std::uint16_t> feature_bones;
@@ -94,6 +101,11 @@ struct FuzzyCharacterView {
     return {nodes.subspan(b.node_begin, b.node_count), items.subspan(b.item_begin, b.item_count), b.bounds};
   }
   bool has_clusters() const { return !clusters.empty(); }
+  // The box `cluster` holds vertex check `check` to.
+  const Aabb& cluster_check_box(const BoneCluster& cluster, std::uint32_t check) const {
+    const std::uint32_t rank = check_rank[check];
+    return rank == kSharedCheckBox ? vertex_checks[check].box : cluster_boxes[cluster.box_begin + rank];
+  }
   std::span<const BoneCluster> bone_clusters(std::uint32_t bone) const {
     if (bone_cluster_begin.empty()) return {};
     return clusters.subspan(bone_cluster_begin[bone], bone_cluster_begin[bone + 1] - bone_cluster_begin[bone]);

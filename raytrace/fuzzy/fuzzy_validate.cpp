@@ -177,7 +177,7 @@ Status validate_offsets(std::span<const std::uint32_t> begin, std::size_t count,
 // feature bones, check ranks, every cluster's box and centre ranges in
 // bounds, finite centres, boxes without NaN. Their trees are checked with
 // the bones'.
-Status validate_cluster_arrays(const FuzzyCharacterView& fuzzy, std::span<const std::uint32_t> bone_checks) {
+Status validate_cluster_arrays(const FuzzyCharacterView& fuzzy) {
   const std::uint32_t bones = fuzzy.bone_count;
   SINEW_RETURN_IF_ERROR(validate_offsets(fuzzy.bone_cluster_begin, bones, fuzzy.clusters.size(), "bone_cluster_begin"));
   SINEW_RETURN_IF_ERROR(validate_offsets(fuzzy.feature_bone_begin, bones, fuzzy.feature_bones.size(), "feature_bone_begin"));
@@ -194,11 +194,19 @@ Status validate_cluster_arrays(const FuzzyCharacterView& fuzzy, std::span<const 
     return bad_character("check_rank", std::to_string(fuzzy.check_rank.size()),
                          "expected one rank per vertex check (" + std::to_string(fuzzy.vertex_checks.size()) + ")");
   }
+  // The checks of each bone with boxes of their own per cluster: what a
+  // cluster's box range must hold and every rank must stay below.
+  std::vector<std::uint32_t> boxed(bones, 0);
+  for (std::size_t c = 0; c < fuzzy.check_rank.size(); ++c) {
+    if (fuzzy.check_rank[c] != kSharedCheckBox) ++boxed[fuzzy.vertex_checks[c].bone];
+  }
   for (std::size_t c = 0; c < fuzzy.check_rank.size(); ++c) {
     const std::uint32_t b = fuzzy.vertex_checks[c].bone;
-    if (fuzzy.check_rank[c] >= bone_checks[b] && fuzzy.bone_cluster_begin[b] != fuzzy.bone_cluster_begin[b + 1]) {
+    if (fuzzy.check_rank[c] != kSharedCheckBox && fuzzy.check_rank[c] >= boxed[b] &&
+        fuzzy.bone_cluster_begin[b] != fuzzy.bone_cluster_begin[b + 1]) {
       return bad_character("check_rank[" + std::to_string(c) + "]", std::to_string(fuzzy.check_rank[c]),
-                           "not below the " + std::to_string(bone_checks[b]) + " checks of bone " + std::to_string(b));
+                           "not below the " + std::to_string(boxed[b]) + " checks of bone " + std::to_string(b) +
+                               " with boxes per cluster");
     }
   }
   for (std::uint32_t b = 0; b < bones; ++b) {
@@ -206,9 +214,9 @@ Status validate_cluster_arrays(const FuzzyCharacterView& fuzzy, std::span<const 
     for (std::uint32_t q = fuzzy.bone_cluster_begin[b]; q < fuzzy.bone_cluster_begin[b + 1]; ++q) {
       const BoneCluster& cluster = fuzzy.clusters[q];
       const std::string where = "clusters[" + std::to_string(q) + "]";
-      if (std::size_t{cluster.box_begin} + bone_checks[b] > fuzzy.cluster_boxes.size()) {
+      if (std::size_t{cluster.box_begin} + boxed[b] > fuzzy.cluster_boxes.size()) {
         return bad_character(where + ".box_begin", std::to_string(cluster.box_begin),
-                             "the bone's " + std::to_string(bone_checks[b]) + " check boxes run past cluster_boxes (" +
+                             "the bone's " + std::to_string(boxed[b]) + " check boxes run past cluster_boxes (" +
                                  std::to_string(fuzzy.cluster_boxes.size()) + ")");
       }
       if (std::size_t{cluster.centre_begin} + dims > fuzzy.cluster_centres.size()) {
@@ -258,7 +266,7 @@ Status validate_tree_contents(const FuzzyCharacterView& fuzzy) {
                                                   [&](std::uint32_t t) {
                                                     Aabb box;
                                                     for (const std::uint32_t c : fuzzy.triangle_checks[t]) {
-                                                      box.extend(fuzzy.cluster_boxes[cluster.box_begin + fuzzy.check_rank[c]]);
+                                                      box.extend(fuzzy.cluster_check_box(cluster, c));
                                                     }
                                                     return box;
                                                   }));
@@ -325,13 +333,11 @@ Status validate_fuzzy_character(const SkinnedMesh& mesh, const FuzzyCharacterVie
       }
     }
   }
-  std::vector<std::uint32_t> bone_checks(fuzzy.bone_count, 0);
-  for (const VertexCheck& check : fuzzy.vertex_checks) ++bone_checks[check.bone];
   const bool any_cluster_array = !fuzzy.bone_cluster_begin.empty() || !fuzzy.clusters.empty() ||
                                  !fuzzy.check_rank.empty() || !fuzzy.cluster_boxes.empty() ||
                                  !fuzzy.feature_bone_begin.empty() || !fuzzy.feature_bones.empty() ||
                                  !fuzzy.cluster_centres.empty();
-  if (any_cluster_array) SINEW_RETURN_IF_ERROR(validate_cluster_arrays(fuzzy, bone_checks));
+  if (any_cluster_array) SINEW_RETURN_IF_ERROR(validate_cluster_arrays(fuzzy));
   return validate_tree_contents(fuzzy);
 }
 

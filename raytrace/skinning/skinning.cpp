@@ -140,7 +140,8 @@ std::size_t count_escapes(const EscapeCheckInput& e, [[maybe_unused]] std::span<
   const auto box_of = [&](const VertexCheck& check, std::size_t c) -> const Aabb& {
     if (bone_boxes.empty()) return check.box;
     const Aabb* boxes_of_bone = bone_boxes[check.bone];
-    return boxes_of_bone != nullptr ? boxes_of_bone[check_rank[c]] : check.box;
+    const std::uint32_t rank = check_rank[c];
+    return boxes_of_bone != nullptr && rank != kSharedCheckBox ? boxes_of_bone[rank] : check.box;
   };
   const std::size_t end = std::min(r.end, check_begin.empty() ? 0 : check_begin.size() - 1);
   // This chunk's row of bone boxes, when asked for and sized as documented.

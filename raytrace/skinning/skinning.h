@@ -63,7 +63,8 @@ struct EscapeCheckInput {
   // Optional (empty: every check against its own box): per bone, the boxes
   // its checks are held to instead, indexed by check_rank (the bone's
   // pose-space cluster's, FuzzyCharacterView::cluster_boxes), or null for
-  // the checks' own. check_rank has one entry per check when given.
+  // the checks' own. check_rank has one entry per check when given; a
+  // check ranked kSharedCheckBox keeps its own box.
   std::span<const Aabb* const> bone_boxes;
   std::span<const std::uint32_t> check_rank;
 };

@@ -942,7 +942,7 @@ TEST(FuzzyBakeClusters, EverySampledPoseLiesInTheClusterItsBonesPick) {
         const int k = runtime_cluster(fuzzy, rig, s, b);
         ASSERT_GE(k, 0);
         const BoneCluster& cluster = fuzzy.bone_clusters(b)[static_cast<std::size_t>(k)];
-        const Aabb& box = data.cluster_boxes[cluster.box_begin + data.check_rank[c]];
+        const Aabb& box = fuzzy.cluster_check_box(cluster, c);
         const glm::dvec3 p = apply(ref.bone_from_pose[s][b], ref.skinned[s][v]);
         ASSERT_TRUE(box_contains(box, p)) << "sample " << s << " vertex " << v << " bone " << b << " cluster " << k;
         for (int a = 0; a < 3; ++a) {
