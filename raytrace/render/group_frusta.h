@@ -48,6 +48,7 @@ class GroupFrusta {
     sides_.fill(0);
     far_.fill(0);
     bound_groups_ = 0;
+    slab_groups_ = 0;
   }
 
   // Group g's frustum around the directions q of `lanes` (structure of
@@ -166,25 +167,51 @@ class GroupFrusta {
     if (!row_basis(c, sign * Vec3(f[0][i1] - f[0][i0], f[1][i1] - f[1][i0], f[2][i1] - f[2][i0]), u, v)) return;
     const float big = std::numeric_limits<float>::max();
     Float8 a_lo(big), a_hi(-big), b_lo(big), b_hi(-big), far(0.0f);
+    const auto grow = [](float x) { return 0x1.0p-16f * (1.0f + std::fabs(x)); };
+    // Each group's own slab in this basis too (slab_groups_, reached()).
+    slab_groups_ = 0;
+    const float u1 = l1(u), v1 = l1(v), c1 = l1(c);
     for (std::uint64_t m = groups; m != 0; m &= m - 1) {
       const int g = std::countr_zero(m);
       const std::uint32_t l = lanes(g);
+      // A group without lanes has no rays: an empty slab cuts everything.
+      slab_[0][g] = big;
+      slab_[1][g] = -big;
+      slab_[2][g] = big;
+      slab_[3][g] = -big;
+      slab_far_[g] = kFar ? -big : big;
       if (l == 0) continue;
       const Mask8 use = Mask8::from_bits(l);
       Float8 a, b, dc;
       if (!slopes(directions(g, l), use, c, u, v, a, b, dc)) return;
-      a_lo = min(a_lo, select(use, a, Float8(big)));
-      a_hi = max(a_hi, select(use, a, Float8(-big)));
-      b_lo = min(b_lo, select(use, b, Float8(big)));
-      b_hi = max(b_hi, select(use, b, Float8(-big)));
+      const Float8 ga_lo = select(use, a, Float8(big)), ga_hi = select(use, a, Float8(-big));
+      const Float8 gb_lo = select(use, b, Float8(big)), gb_hi = select(use, b, Float8(-big));
+      a_lo = min(a_lo, ga_lo);
+      a_hi = max(a_hi, ga_hi);
+      b_lo = min(b_lo, gb_lo);
+      b_hi = max(b_hi, gb_hi);
+      const float ranges[4] = {reduce_min(ga_lo), reduce_max(ga_hi), reduce_min(gb_lo), reduce_max(gb_hi)};
+      for (int i = 0; i < 4; ++i) {
+        const float grown = i % 2 == 0 ? ranges[i] - grow(ranges[i]) : ranges[i] + grow(ranges[i]);
+        slab_[i][g] = grown;
+        // |n|_1 of the side's plane (u or v minus grown times c), as set_plane.
+        slab_scale_[i][g] = 1.001f * ((i < 2 ? u1 : v1) + std::fabs(grown) * c1);
+      }
       if constexpr (kFar) {
         alignas(32) float r[8] = {};
         reach(g, r);
-        far = max(far, select(use, Float8::load(r) * dc, zero));
+        const Float8 group_far = select(use, Float8::load(r) * dc, zero);
+        far = max(far, group_far);
+        const float offset = reduce_max(group_far) * (1.0f + 0x1.0p-16f);
+        slab_far_[g] = std::isfinite(offset) ? offset : big;
       }
     }
+    slab_basis_[0] = c;
+    slab_basis_[1] = u;
+    slab_basis_[2] = v;
+    slab_far_scale_ = 1.001f * c1;
+    slab_groups_ = groups;
     const float alo = reduce_min(a_lo), ahi = reduce_max(a_hi), blo = reduce_min(b_lo), bhi = reduce_max(b_hi);
-    const auto grow = [](float x) { return 0x1.0p-16f * (1.0f + std::fabs(x)); };
     const Vec3 planes[4] = {u - (ahi + grow(ahi)) * c, (alo - grow(alo)) * c - u, v - (bhi + grow(bhi)) * c,
                             (blo - grow(blo)) * c - v};
     // Lane i: plane i (the unused lanes' zero normals never cut).
@@ -235,6 +262,7 @@ class GroupFrusta {
       const Float8 margin(0x1.0p-12f * (corners + apex_magnitude_));
       const Float8 limit = Float8::load(bound_scale_) * margin + Float8::load(bound_offset_);
       if ((d > limit).bits() != 0) return 0;
+      if (slabs_on_ && (groups & ~slab_groups_) == 0) return slabs_uncut(groups, corners, x0, x1, x2);
     }
     return uncut(groups, corners, [&](Float8 nx, Float8 ny, Float8 nz) {
       const auto side = [&](const Vec3& x) { return (nx * Float8(x.x) + ny * Float8(x.y)) + nz * Float8(x.z); };
@@ -242,7 +270,51 @@ class GroupFrusta {
     });
   }
 
+ // Whether reached() tests triangles against the groups' slabs in the
+  // packet's basis (set_bound) rather than their own frusta.
+  void use_slabs(bool on) { slabs_on_ = on; }
+  // The groups set_bound gave slabs.
+  std::uint64_t slab_groups() const { return slab_groups_; }
+
  private:
+  // The groups of `groups` whose slab in the packet's basis (c, u, v) no
+  // side cuts off: a side plane u - s c has distance u.x - s (c.x) from a
+  // point x (relative to the apex), so the three corners' coordinates in
+  // the basis are taken once per triangle and each block of eight groups
+  // costs a product and a difference per corner and side, where its own
+  // frusta cost a dot product (render/large_packet.h, shadow packets).
+  std::uint64_t slabs_uncut(std::uint64_t groups, float corners, const Vec3& x0, const Vec3& x1,
+                            const Vec3& x2) const {
+    const Vec3& c = slab_basis_[0];
+    const Vec3& u = slab_basis_[1];
+    const Vec3& v = slab_basis_[2];
+    const Float8 margin(0x1.0p-12f * (corners + apex_magnitude_));
+    const Float8 z0(glm::dot(c, x0)), z1(glm::dot(c, x1)), z2(glm::dot(c, x2));
+    const Float8 a0(glm::dot(u, x0)), a1(glm::dot(u, x1)), a2(glm::dot(u, x2));
+    const Float8 b0(glm::dot(v, x0)), b1(glm::dot(v, x1)), b2(glm::dot(v, x2));
+    const Float8 z_min = min(min(z0, z1), z2);
+    std::uint64_t out = 0;
+    for (int base = 0; base < groups_; base += 8) {
+      const std::uint64_t part = (groups >> base) & 0xFFu;
+      if (part == 0) continue;
+      const Float8 a_lo = Float8::load(&slab_[0][base]), a_hi = Float8::load(&slab_[1][base]);
+      const Float8 b_lo = Float8::load(&slab_[2][base]), b_hi = Float8::load(&slab_[3][base]);
+      // Beyond the high side: every corner's u.x - a_hi (c.x) past the margin.
+      const Float8 beyond_a_hi = min(min(a0 - a_hi * z0, a1 - a_hi * z1), a2 - a_hi * z2);
+      const Float8 beyond_a_lo = min(min(a_lo * z0 - a0, a_lo * z1 - a1), a_lo * z2 - a2);
+      const Float8 beyond_b_hi = min(min(b0 - b_hi * z0, b1 - b_hi * z1), b2 - b_hi * z2);
+      const Float8 beyond_b_lo = min(min(b_lo * z0 - b0, b_lo * z1 - b1), b_lo * z2 - b2);
+      const Mask8 cut = (beyond_a_hi > Float8::load(&slab_scale_[1][base]) * margin) |
+                        (beyond_a_lo > Float8::load(&slab_scale_[0][base]) * margin) |
+                        (beyond_b_hi > Float8::load(&slab_scale_[3][base]) * margin) |
+                        (beyond_b_lo > Float8::load(&slab_scale_[2][base]) * margin) |
+                        (z_min > Float8::load(&slab_far_[base]) + Float8(slab_far_scale_) * margin);
+      out |= (part & ~static_cast<std::uint64_t>(cut.bits())) << base;
+    }
+    return out;
+  }
+  static float l1(const Vec3& w) { return std::fabs(w.x) + std::fabs(w.y) + std::fabs(w.z); }
+
   // The groups of `groups` that no plane of theirs cuts off, eight at a
   // time: nearest(nx, ny, nz) is the shape's least signed distance
   // n . (p - apex) to each group's plane n, and a plane cuts the shape off
@@ -419,6 +491,16 @@ class GroupFrusta {
   alignas(32) float bound_scale_[8] = {};
   alignas(32) float bound_offset_[8] = {};
   std::uint64_t bound_groups_ = 0;
+  // Per group its slab in the packet's basis (set_bound): slopes along u
+  // (lo, hi) and v (lo, hi) grown as the planes', each side's |n|_1, and the
+  // far offset along c (max float: none).
+  bool slabs_on_ = false;
+  std::uint64_t slab_groups_ = 0;
+  Vec3 slab_basis_[3] = {Vec3(0.0f), Vec3(0.0f), Vec3(0.0f)};  // c, u, v
+  alignas(32) std::array<std::array<float, kMaxGroups>, 4> slab_{};
+  alignas(32) std::array<std::array<float, kMaxGroups>, 4> slab_scale_{};
+  alignas(32) std::array<float, kMaxGroups> slab_far_{};
+  float slab_far_scale_ = 0.0f;
 };
 
 }  // namespace sinew::rt

@@ -371,6 +371,11 @@ class LargeQuery {
       return;
     }
     frusta_.reset(common_origin_at_, groups_);
+    // Shadow packets: the groups' slabs in the packet's basis
+    // (GroupFrusta::use_slabs), cheaper per triangle than their own frusta
+    // and built with the packet's bound (docs/RAYTRACE.md, "Shadow slabs").
+    slabs_ = kAnyHit;
+    frusta_.use_slabs(slabs_);
   }
 
   // The groups of `groups` whose frustum (or grid slabs) may reach the
@@ -397,8 +402,11 @@ class LargeQuery {
     } else {
       // A lane's points end at t_max (an infinite one: no far plane).
       const auto reach = [&](int g, float* out) { std::copy_n(group_[g].t_limit, kLanes, out); };
-      frusta_.template set_groups<true>(unbuilt, 1.0f, directions, lanes, reach);
       frusta_.template set_bound<true>(built, 1.0f, directions, lanes, reach);
+      // The groups' own frusta only where the packet's slabs are off.
+      if (!slabs_ || (built & ~frusta_.slab_groups()) != 0) {
+        frusta_.template set_groups<true>(unbuilt, 1.0f, directions, lanes, reach);
+      }
     }
     frusta_built_ = built;
   }
@@ -928,6 +936,7 @@ class LargeQuery {
   std::array<Vec3, 3> grid_basis_{};  // forward, right, up
   float visit_slack_ = 0.0f;       // run(): a bound on every lane's slack in an object's box clip
   bool frusta_on_ = false;         // grid_ (when on) or frusta_ pick each leaf triangle's groups
+  bool slabs_ = false;             // frusta_ tests the groups' slabs in the packet's basis
   GroupMask frusta_built_ = 0;  // the groups whose frustum frusta_ holds
   TraversalCounters counters_;
 };

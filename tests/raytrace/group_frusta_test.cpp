@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -199,10 +200,13 @@ TEST(GroupFrusta, EveryHitTriangleIsReachedBySegmentsFromTheApex) {
 // (set_bound) tested before the groups': a triangle some lane hits is still
 // reached by that lane's group, from an apex near and far from the origin,
 // for rays and for segments ending at their lane's reach (far plane), and
-// with lanes missing from the groups.
+// with lanes missing from the groups; with the groups' own frusta and with
+// their slabs in the packet's basis alone (use_slabs, shadow packets).
 TEST(GroupFrusta, ThePacketFrustumNeverCullsATriangleALaneHits) {
+  for (const bool slabs : {false, true}) {
+  SCOPED_TRACE(slabs ? "slabs" : "own frusta");
   std::mt19937 g(11);
-  int tried = 0, hit = 0, culled = 0;
+  int tried = 0, hit = 0, culled = 0, some_groups = 0;
   for (const bool segments : {false, true}) {
     for (const float offset : {0.0f, 60.0f, 4000.0f}) {
       for (int packet = 0; packet < 20; ++packet) {
@@ -233,15 +237,20 @@ TEST(GroupFrusta, ThePacketFrustumNeverCullsATriangleALaneHits) {
         }
         rt::GroupFrusta<64> frusta;
         frusta.reset(apex, 64);
+        frusta.use_slabs(slabs);
         const auto directions = [&](int group) -> const float (&)[3][8] { return q[group]; };
         const auto lanes_of = [&](int group) { return lanes[group]; };
         const auto reach_of = [&](int group, float* out) { std::copy(reach[group], reach[group] + 8, out); };
+        // With slabs the groups' own frusta are not built: the slabs alone cull.
         if (segments) {
-          frusta.set_groups<true>(~std::uint64_t{0}, 1.0f, directions, lanes_of, reach_of);
+          if (!slabs) frusta.set_groups<true>(~std::uint64_t{0}, 1.0f, directions, lanes_of, reach_of);
           frusta.set_bound<true>(~std::uint64_t{0}, 1.0f, directions, lanes_of, reach_of);
         } else {
-          frusta.set_groups<false>(~std::uint64_t{0}, 1.0f, directions, lanes_of, reach_of);
+          if (!slabs) frusta.set_groups<false>(~std::uint64_t{0}, 1.0f, directions, lanes_of, reach_of);
           frusta.set_bound<false>(~std::uint64_t{0}, 1.0f, directions, lanes_of, reach_of);
+        }
+        if (slabs) {
+          ASSERT_EQ(frusta.slab_groups(), ~std::uint64_t{0});
         }
         for (int trial = 0; trial < 300; ++trial) {
           // About a lane's ray, or beside the packet by up to its width.
@@ -258,6 +267,7 @@ TEST(GroupFrusta, ThePacketFrustumNeverCullsATriangleALaneHits) {
           const std::uint64_t reached = frusta.reached(p0, p1, p2, ~std::uint64_t{0});
           ++tried;
           if (reached == 0) ++culled;
+          if (reached != 0 && std::popcount(reached) < 32) ++some_groups;
           for (int lane = 0; lane < 512; ++lane) {
             if (!(lanes[lane / 8] >> (lane % 8) & 1u) || !hits(rays[static_cast<std::size_t>(lane)], p0, p1, p2)) {
               continue;
@@ -273,6 +283,9 @@ TEST(GroupFrusta, ThePacketFrustumNeverCullsATriangleALaneHits) {
   }
   EXPECT_GT(hit, tried / 10);
   EXPECT_GT(culled, tried / 5) << culled << " of " << tried;
+  // The groups cull, not only the packet: many reached triangles reach few groups.
+  EXPECT_GT(some_groups, tried / 10) << some_groups << " of " << tried;
+  }
 }
 
 TEST(GroupFrusta, TrianglesBeyondTheRaysEndsAreCulledByTheFarPlane) {
