@@ -734,6 +734,21 @@ int run_embree_bench(const std::vector<std::string>& args, const std::string& co
   std::printf("  %zu triangles (%d subdivision levels), %zu bones\n", model.mesh.triangle_count(), o.subdivide,
               model.skeleton.joint_count());
   doc["triangles"] = model.mesh.triangle_count();
+  // Which structure Sinew's rows trace: the bake's default (pose-space
+  // clusters from rt::kFineMeshTriangles, docs/RAYTRACE.md).
+  const rt::FuzzyBakeStats& bake_stats = bake.fuzzy.stats;
+  const double rest = bake_stats.rest_area > 0.0 ? bake_stats.rest_area : 1.0;
+  if (bake_stats.cluster_count > 0) {
+    std::printf("  Sinew's trees: up to %u pose-space clusters a bone (%u in all), fuzzy area %.2fx the rest boxes' "
+                "averaged over each bone's clusters (%.2fx with one tree a bone)\n",
+                bake_stats.clusters_per_bone, bake_stats.cluster_count, bake_stats.cluster_fuzzy_area / rest,
+                bake_stats.fuzzy_area / rest);
+  } else {
+    std::printf("  Sinew's trees: one a bone (no pose-space clusters), fuzzy area %.2fx the rest boxes'\n",
+                bake_stats.fuzzy_area / rest);
+  }
+  doc["pose_clusters"] = bake_stats.cluster_count;
+  doc["clusters_per_bone"] = bake_stats.clusters_per_bone;
 
   std::vector<std::string> best_rows;  // the best Embree row of each configuration, for the note
   for (const std::string& clip_name : o.clips) {

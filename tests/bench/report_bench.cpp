@@ -293,6 +293,11 @@ std::string embree_markdown(const Run& r) {
                doc.value("subdivide", 0), thousands(number(doc, "instances")).c_str(),
                doc.contains("size") ? doc["size"][0].get<int>() : 0, doc.contains("size") ? doc["size"][1].get<int>() : 0,
                doc.value("frames", 0));
+  if (doc.value("pose_clusters", 0u) > 0) {
+    md += format("Sinew's bone trees: up to %u pose-space clusters a bone, %u in all (the default from 25,000 "
+                 "triangles; RAYTRACE.md, \"Pose-space clusters\").\n\n",
+                 doc.value("clusters_per_bone", 0u), doc.value("pose_clusters", 0u));
+  }
   md += "```sh\n" + r.command + "\n```\n";
   if (!doc.value("embree", false)) md += "\nEmbree was not found when this was built: only Sinew and the exact kd-tree ran.\n";
   bool widths = false;
