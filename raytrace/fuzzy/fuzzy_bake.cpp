@@ -531,6 +531,30 @@ std::vector<Aabb> triangle_fuzzy_boxes(const FuzzyCharacterData& out) {
 // ---------------------------------------------------------------------------
 // Bone trees
 
+// `count` kd-trees in parallel, tree i over the boxes fill(i, boxes) puts
+// in `boxes` (none when it puts none); the first error, if any.
+template <class Fill>
+Expected<std::vector<std::optional<KdTree>>> build_trees(std::size_t count, const KdBuildOptions& kd,
+                                                         JobSystem& jobs, Fill&& fill) {
+  std::vector<std::optional<KdTree>> trees(count);
+  std::vector<Status> errors(count);
+  jobs.parallel_for(0, count, 1, [&](Range r) {
+    for (std::size_t i = r.begin; i < r.end; ++i) {
+      std::vector<Aabb> boxes;
+      fill(i, boxes);
+      if (boxes.empty()) continue;
+      Expected<KdTree> tree = build_kd_tree(boxes, kd);
+      if (tree.ok()) {
+        trees[i] = std::move(tree).value();
+      } else {
+        errors[i] = std::move(tree).status();
+      }
+    }
+  });
+  for (const Status& error : errors) SINEW_RETURN_IF_ERROR(error);
+  return trees;
+}
+
 KdBuildOptions tree_build_options(const FuzzyBakeOptions& options, std::size_t triangle_count) {
   KdBuildOptions kd = options.kd;
   if (options.fine_mesh_cost && triangle_count >= kFineMeshTriangles) kd.intersection_cost = kFineMeshIntersectionCost;
@@ -553,23 +577,13 @@ Status build_bone_trees(std::span<const Aabb> triangle_boxes, const FuzzyBakeOpt
   }
 
   const KdBuildOptions kd = tree_build_options(options, out.triangle_bone.size());
-  std::vector<std::optional<KdTree>> trees(bone_count);
-  std::vector<Status> errors(bone_count);
-  jobs.parallel_for(0, bone_count, 1, [&](Range r) {
-    for (std::size_t b = r.begin; b < r.end; ++b) {
-      if (begin[b] == begin[b + 1]) continue;
-      std::vector<Aabb> boxes;
-      boxes.reserve(begin[b + 1] - begin[b]);
-      for (std::uint32_t i = begin[b]; i < begin[b + 1]; ++i) boxes.push_back(triangle_boxes[triangles[i]]);
-      Expected<KdTree> tree = build_kd_tree(boxes, kd);
-      if (tree.ok()) {
-        trees[b] = std::move(tree).value();
-      } else {
-        errors[b] = std::move(tree).status();
-      }
-    }
-  });
-  for (const Status& error : errors) SINEW_RETURN_IF_ERROR(error);
+  SINEW_ASSIGN_OR_RETURN(const std::vector<std::optional<KdTree>> trees,
+                         build_trees(bone_count, kd, jobs, [&](std::size_t b, std::vector<Aabb>& boxes) {
+                           boxes.reserve(begin[b + 1] - begin[b]);
+                           for (std::uint32_t i = begin[b]; i < begin[b + 1]; ++i) {
+                             boxes.push_back(triangle_boxes[triangles[i]]);
+                           }
+                         }));
 
   // Concatenate in bone order: node indices are tree-relative, item indices
   // become triangle ids.
@@ -724,21 +738,12 @@ Status build_cluster_trees(const SkinnedMesh& mesh, const KdBuildOptions& kd, Jo
   for (std::uint32_t b = 0; b < bone_count; ++b) {
     for (std::uint32_t q = out.bone_cluster_begin[b]; q < out.bone_cluster_begin[b + 1]; ++q) cluster_bone[q] = b;
   }
-  std::vector<std::optional<KdTree>> trees(out.clusters.size());
-  std::vector<Status> errors(out.clusters.size());
-  jobs.parallel_for(0, out.clusters.size(), 1, [&](Range r) {
-    for (std::size_t q = r.begin; q < r.end; ++q) {
-      std::vector<Aabb> boxes;
-      for (const std::uint32_t t : bone_triangles[cluster_bone[q]]) boxes.push_back(cluster_box(out.clusters[q], t));
-      Expected<KdTree> tree = build_kd_tree(boxes, kd);
-      if (tree.ok()) {
-        trees[q] = std::move(tree).value();
-      } else {
-        errors[q] = std::move(tree).status();
-      }
-    }
-  });
-  for (const Status& error : errors) SINEW_RETURN_IF_ERROR(error);
+  SINEW_ASSIGN_OR_RETURN(const std::vector<std::optional<KdTree>> trees,
+                         build_trees(out.clusters.size(), kd, jobs, [&](std::size_t q, std::vector<Aabb>& boxes) {
+                           for (const std::uint32_t t : bone_triangles[cluster_bone[q]]) {
+                             boxes.push_back(cluster_box(out.clusters[q], t));
+                           }
+                         }));
   for (std::size_t q = 0; q < out.clusters.size(); ++q) {
     BoneTree& bt = out.clusters[q].tree;
     const std::vector<std::uint32_t>& triangles = bone_triangles[cluster_bone[q]];

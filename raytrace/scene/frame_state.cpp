@@ -30,6 +30,19 @@ Aabb grown(const Aabb& box, float by) {
   return {box.lower - Vec3(by), box.upper + Vec3(by)};
 }
 
+// The escape check of the frame's bones, each held to its cluster's boxes
+// where it has one.
+EscapeCheckInput escape_input(InstanceFrame& frame, const FuzzyCharacterView& fuzzy) {
+  const bool clustered = frame.cluster_bones > 0 && frame.bone_check_boxes.size() == frame.bone_from_world.size();
+  return {fuzzy.vertex_check_begin,
+          fuzzy.vertex_checks,
+          frame.bone_from_world,
+          frame.tolerance,
+          frame.chunk_bone_boxes,
+          clustered ? std::span<const Aabb* const>(frame.bone_check_boxes) : std::span<const Aabb* const>{},
+          clustered ? fuzzy.check_rank : std::span<const std::uint32_t>{}};
+}
+
 }  // namespace
 
 void update_bone_frames(InstanceFrame& frame, const FuzzyCharacterView& fuzzy) {
@@ -95,15 +108,7 @@ void skin_instance(InstanceFrame& frame, const SkinnedMesh& mesh, const PackedIn
   frame.escaped.resize(fuzzy.vertex_checks.size());
   frame.chunk_bone_boxes.resize(exact_boxes ? skinning_chunk_count(mesh.vertex_count()) * frame.bone_from_world.size()
                                             : 0);
-  const bool clustered = frame.cluster_bones > 0 && frame.bone_check_boxes.size() == frame.bone_from_world.size();
-  const EscapeCheckInput escape{fuzzy.vertex_check_begin,
-                                fuzzy.vertex_checks,
-                                frame.bone_from_world,
-                                frame.tolerance,
-                                frame.chunk_bone_boxes,
-                                clustered ? std::span<const Aabb* const>(frame.bone_check_boxes)
-                                          : std::span<const Aabb* const>{},
-                                clustered ? fuzzy.check_rank : std::span<const std::uint32_t>{}};
+  const EscapeCheckInput escape = escape_input(frame, fuzzy);
   const SkinningTargets targets{frame.positions, frame.normals, frame.escaped};
   const SkinningResult result = skin_vertices(mesh, influences, frame.skinning, targets, &escape, &jobs, path);
   frame.escaped_checks = result.escaped_checks;
@@ -124,16 +129,7 @@ void settle_bone_clusters(InstanceFrame& frame, const FuzzyCharacterView& fuzzy,
     missed = true;
   }
   if (!missed) return;
-  const bool clustered = frame.cluster_bones > 0;
-  const EscapeCheckInput escape{fuzzy.vertex_check_begin,
-                                fuzzy.vertex_checks,
-                                frame.bone_from_world,
-                                frame.tolerance,
-                                frame.chunk_bone_boxes,
-                                clustered ? std::span<const Aabb* const>(frame.bone_check_boxes)
-                                          : std::span<const Aabb* const>{},
-                                clustered ? fuzzy.check_rank : std::span<const std::uint32_t>{}};
-  frame.escaped_checks = check_escapes(escape, frame.positions, frame.escaped, &jobs);
+  frame.escaped_checks = check_escapes(escape_input(frame, fuzzy), frame.positions, frame.escaped, &jobs);
 }
 
 void compute_bone_boxes(InstanceFrame& frame, const FuzzyCharacterView& fuzzy, bool exact) {
