@@ -726,12 +726,10 @@ Status build_cluster_trees(const SkinnedMesh& mesh, const KdBuildOptions& kd, Jo
   for (std::size_t t = 0; t < out.triangle_bone.size(); ++t) {
     bone_triangles[out.triangle_bone[t]].push_back(static_cast<std::uint32_t>(t));
   }
+  const FuzzyCharacterView view = out.view();
   const auto cluster_box = [&](const BoneCluster& cluster, std::uint32_t t) {
     Aabb box;
-    for (const std::uint32_t c : out.triangle_checks[t]) {
-      box.extend(out.check_rank[c] == kSharedCheckBox ? out.vertex_checks[c].box
-                                                     : out.cluster_boxes[cluster.box_begin + out.check_rank[c]]);
-    }
+    for (const std::uint32_t c : out.triangle_checks[t]) box.extend(view.cluster_check_box(cluster, c));
     return box;
   };
   std::vector<std::uint32_t> cluster_bone(out.clusters.size());
