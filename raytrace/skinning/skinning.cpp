@@ -122,9 +122,19 @@ struct BoneColumns {};
 std::vector<BoneColumns> bone_columns(const EscapeCheckInput&) { return {}; }
 #endif
 
-// `columns`: bone_columns(e).
+// Asks for the `lines` cache lines 2 KB past `p`.
+template <typename T>
+void prefetch_ahead([[maybe_unused]] const T* p, [[maybe_unused]] int lines = 1) {
+#if SINEW_ESCAPE_SSE
+  constexpr std::size_t kAhead = 2048;
+  const char* at = reinterpret_cast<const char*>(p) + kAhead;
+  for (int i = 0; i < lines; ++i) _mm_prefetch(at + 64 * i, _MM_HINT_T0);
+#endif
+}
+
+// `columns`: bone_columns(e); `blocks`: whether the AVX2 block check may run.
 std::size_t count_escapes(const EscapeCheckInput& e, [[maybe_unused]] std::span<const BoneColumns> columns,
-                          std::span<const Vec3> positions, std::span<std::uint8_t> escaped, Range r) {
+                          std::span<const Vec3> positions, std::span<std::uint8_t> escaped, Range r, bool blocks) {
   // Local copies of the spans: the byte stores into `escaped` may alias
   // anything, and locals spare the reloads of pointers and sizes after each.
   const std::span<const std::uint32_t> check_begin = e.vertex_check_begin;
@@ -176,7 +186,61 @@ std::size_t count_escapes(const EscapeCheckInput& e, [[maybe_unused]] std::span<
 #endif
 
   std::size_t count = 0;
+  // Eight vertices with one check each, all against one bone, are checked
+  // eight at a time (the AVX2 block check: 92% of the blocks at 855,552
+  // triangles, where the check by check loop spent about 30 cycles a
+  // check); other blocks, and blocks with a position that is not finite, go
+  // check by check below.
+  constexpr std::size_t kBlock = detail::kAvx2Lanes;
+  const auto check_block = [&](std::size_t v) -> bool {
+    const std::size_t c0 = check_begin[v];
+    if (c0 + kBlock > checks.size()) return false;
+    const std::uint32_t bone = checks[c0].bone;
+    if (bone >= bone_limit) return false;
+    // The arrays this reads stream in vertex order but each address waits
+    // for the load before it (begin, check, rank, cluster box): prefetched
+    // 2 KB ahead, the block check took 17% less (perf samples, 855,552
+    // triangles, 1 thread).
+    prefetch_ahead(check_begin.data() + v);
+    prefetch_ahead(checks.data() + c0, 4);
+    if (!bone_boxes.empty() && bone_boxes[bone] != nullptr) {
+      prefetch_ahead(check_rank.data() + c0);
+      const std::uint32_t rank = check_rank[c0];
+      if (rank != kSharedCheckBox) prefetch_ahead(bone_boxes[bone] + rank, 3);
+    }
+    const float* lane_boxes[kBlock];
+    for (std::size_t i = 0; i < kBlock; ++i) {
+      if (check_begin[v + i + 1] != c0 + i + 1 || checks[c0 + i].bone != bone) return false;
+      lane_boxes[i] = &box_of(checks[c0 + i], c0 + i).lower.x;
+    }
+    float lower[3];
+    float upper[3];
+    const std::uint32_t result = detail::escape_block_avx2(&positions[v].x, &bone_from_world[bone].rows[0].x,
+                                                           tolerance[bone], lane_boxes, lower, upper);
+    if ((result & detail::kEscapeBlockFinite) == 0) return false;
+    for (std::size_t i = 0; i < kBlock; ++i) {
+      const std::uint8_t out = static_cast<std::uint8_t>((result >> i) & 1u);
+      count += out;
+      if (c0 + i < escaped.size()) escaped[c0 + i] = out;
+    }
+    if (boxes == nullptr) return true;
+#if SINEW_ESCAPE_SSE
+    if (bone != run_bone) {
+      end_run();
+      run_bone = bone;
+    }
+    run_lower = _mm_min_ps(_mm_setr_ps(lower[0], lower[1], lower[2], 0.0f), run_lower);
+    run_upper = _mm_max_ps(_mm_setr_ps(upper[0], upper[1], upper[2], 0.0f), run_upper);
+#else
+    boxes[bone].extend(Aabb{Vec3(lower[0], lower[1], lower[2]), Vec3(upper[0], upper[1], upper[2])});
+#endif
+    return true;
+  };
   for (std::size_t v = r.begin; v < end; ++v) {
+    if (blocks && v % kBlock == 0 && v + kBlock <= end && check_block(v)) {
+      v += kBlock - 1;
+      continue;
+    }
     const std::size_t first = std::min<std::size_t>(check_begin[v], checks.size());
     const std::size_t last = std::min<std::size_t>(check_begin[v + 1], checks.size());
     const Vec3 world = positions[v];
@@ -299,7 +363,8 @@ SkinningResult skin_vertices(const SkinnedMesh& mesh, const PackedInfluences& in
   const auto run_chunk = [&](Range r) {
     skin_range(arrays, r, use_avx2);
     if (escape != nullptr) {
-      chunk_escapes[r.begin / kChunkVertices] = count_escapes(*escape, columns, positions, targets.escaped, r);
+      chunk_escapes[r.begin / kChunkVertices] =
+          count_escapes(*escape, columns, positions, targets.escaped, r, use_avx2);
     }
   };
   if (jobs != nullptr) {
@@ -320,8 +385,9 @@ std::size_t check_escapes(const EscapeCheckInput& escape, std::span<const Vec3> 
   const std::size_t chunk_count = (vertex_count + kChunkVertices - 1) / kChunkVertices;
   std::vector<std::size_t> chunk_escapes(chunk_count, 0);
   const std::vector<BoneColumns> columns = bone_columns(escape);
+  const bool blocks = avx2_skinning_available();
   const auto run_chunk = [&](Range r) {
-    chunk_escapes[r.begin / kChunkVertices] = count_escapes(escape, columns, positions, escaped, r);
+    chunk_escapes[r.begin / kChunkVertices] = count_escapes(escape, columns, positions, escaped, r, blocks);
   };
   if (jobs != nullptr) {
     jobs->parallel_for(0, vertex_count, kChunkVertices, run_chunk);

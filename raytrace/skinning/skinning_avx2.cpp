@@ -141,11 +141,100 @@ void skin_range_avx2(const SkinningArrays& a, std::size_t begin, std::size_t end
   }
 }
 
+namespace {
+
+// Eight rows of four floats as four registers of eight: the rows side by
+// side in each half (row i in lane i), then a 4x4 transpose per half.
+void transpose8x4(const __m128 rows[8], __m256 cols[4]) {
+  __m256 x[4];
+  for (int i = 0; i < 4; ++i) x[i] = _mm256_insertf128_ps(_mm256_castps128_ps256(rows[i]), rows[i + 4], 1);
+  const __m256 t0 = _mm256_unpacklo_ps(x[0], x[1]);
+  const __m256 t1 = _mm256_unpackhi_ps(x[0], x[1]);
+  const __m256 t2 = _mm256_unpacklo_ps(x[2], x[3]);
+  const __m256 t3 = _mm256_unpackhi_ps(x[2], x[3]);
+  cols[0] = _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(1, 0, 1, 0));
+  cols[1] = _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(3, 2, 3, 2));
+  cols[2] = _mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(1, 0, 1, 0));
+  cols[3] = _mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(3, 2, 3, 2));
+}
+
+float min_of(__m256 v) {
+  __m128 m = _mm_min_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps(v, 1));
+  m = _mm_min_ps(m, _mm_movehl_ps(m, m));
+  m = _mm_min_ss(m, _mm_shuffle_ps(m, m, 1));
+  return _mm_cvtss_f32(m);
+}
+
+float max_of(__m256 v) {
+  __m128 m = _mm_max_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps(v, 1));
+  m = _mm_max_ps(m, _mm_movehl_ps(m, m));
+  m = _mm_max_ss(m, _mm_shuffle_ps(m, m, 1));
+  return _mm_cvtss_f32(m);
+}
+
+}  // namespace
+
+std::uint32_t escape_block_avx2(const float* positions, const float* bone_from_world, float tolerance,
+                                const float* const boxes[kAvx2Lanes], float lower[3], float upper[3]) {
+  const Vec3x8 p = load_xyz8(positions);
+  // Lane by lane the scalar check's ((m0 x + m1 y) + m2 z) + m3 per row,
+  // with separate products and sums: the same bits.
+  __m256 q[3];
+  for (int r = 0; r < 3; ++r) {
+    const float* row = bone_from_world + 4 * r;
+    q[r] = _mm256_add_ps(_mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(_mm256_set1_ps(row[0]), p.x),
+                                                     _mm256_mul_ps(_mm256_set1_ps(row[1]), p.y)),
+                                       _mm256_mul_ps(_mm256_set1_ps(row[2]), p.z)),
+                         _mm256_set1_ps(row[3]));
+  }
+  // Each box as (lower x y z, upper x) and, from lower z on, (lower z,
+  // upper x y z): both loads inside its six floats.
+  __m128 low_rows[8];
+  __m128 high_rows[8];
+  for (std::size_t i = 0; i < kAvx2Lanes; ++i) {
+    low_rows[i] = _mm_loadu_ps(boxes[i]);
+    high_rows[i] = _mm_loadu_ps(boxes[i] + 2);
+  }
+  __m256 low[4];
+  __m256 high[4];
+  transpose8x4(low_rows, low);
+  transpose8x4(high_rows, high);
+  const __m256 tol = _mm256_set1_ps(tolerance);
+  const __m256 zero = _mm256_setzero_ps();
+  __m256 in = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
+  for (int axis = 0; axis < 3; ++axis) {
+    const __m256 inside = _mm256_and_ps(_mm256_cmp_ps(q[axis], _mm256_sub_ps(low[axis], tol), _CMP_GE_OQ),
+                                        _mm256_cmp_ps(q[axis], _mm256_add_ps(high[axis + 1], tol), _CMP_LE_OQ));
+    const __m256 finite = _mm256_cmp_ps(_mm256_sub_ps(q[axis], q[axis]), zero, _CMP_EQ_OQ);
+    in = _mm256_and_ps(in, _mm256_and_ps(inside, finite));
+  }
+  std::uint32_t result = static_cast<std::uint32_t>(~_mm256_movemask_ps(in)) & 0xFFu;
+  const __m256 finite_p =
+      _mm256_and_ps(_mm256_and_ps(_mm256_cmp_ps(_mm256_sub_ps(p.x, p.x), zero, _CMP_EQ_OQ),
+                                  _mm256_cmp_ps(_mm256_sub_ps(p.y, p.y), zero, _CMP_EQ_OQ)),
+                    _mm256_cmp_ps(_mm256_sub_ps(p.z, p.z), zero, _CMP_EQ_OQ));
+  if (_mm256_movemask_ps(finite_p) == 0xFF) {
+    result |= kEscapeBlockFinite;
+    lower[0] = min_of(p.x);
+    lower[1] = min_of(p.y);
+    lower[2] = min_of(p.z);
+    upper[0] = max_of(p.x);
+    upper[1] = max_of(p.y);
+    upper[2] = max_of(p.z);
+  }
+  return result;
+}
+
 bool avx2_kernel_compiled() { return true; }
 
 #else  // not compiled for AVX2: the dispatcher never calls the kernel
 
 void skin_range_avx2(const SkinningArrays&, std::size_t, std::size_t) {}
+
+std::uint32_t escape_block_avx2(const float*, const float*, float, const float* const[kAvx2Lanes], float[3],
+                                float[3]) {
+  return 0;
+}
 
 bool avx2_kernel_compiled() { return false; }
 

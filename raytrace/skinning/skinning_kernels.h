@@ -36,6 +36,18 @@ inline constexpr std::size_t kAvx2Lanes = 8;
 // Call only when avx2_kernel_compiled() and the CPU has AVX2 and FMA.
 void skin_range_avx2(const SkinningArrays& arrays, std::size_t begin, std::size_t end);
 
+// The escape check (skinning.h, EscapeCheckInput) of 8 consecutive vertices
+// that have one check each, all against the same bone: `positions` their 24
+// floats, `bone_from_world` that bone's 12, `boxes[i]` lane i's box as 6
+// floats (lower x y z, upper x y z). Returns the lanes that escaped as bits
+// 0-7, each lane's answer bit for bit the scalar check's (the same products
+// and sums in the same order, no FMA), and bit 8 set when all 24 position
+// floats are finite; then `lower` and `upper` get the box of the 8 points.
+// Call only when avx2_kernel_compiled() and the CPU has AVX2 and FMA.
+std::uint32_t escape_block_avx2(const float* positions, const float* bone_from_world, float tolerance,
+                                const float* const boxes[kAvx2Lanes], float lower[3], float upper[3]);
+inline constexpr std::uint32_t kEscapeBlockFinite = 1u << 8;
+
 // Whether skinning_avx2.cpp was compiled with AVX2 and FMA enabled.
 bool avx2_kernel_compiled();
 
