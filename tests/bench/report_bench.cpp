@@ -634,8 +634,9 @@ std::string document(const Options& o, const Report& report, const std::string& 
     md += pasted_markdown(*trade);
     md += failure_line(*trade);
     if (!plots.tradeoff.empty()) {
-      md += "\n![triangle tests and node visits per ray against holes, each sample count labelled with its fps; each "
-            "mode's Pareto front](" +
+      md += "\n![left: triangle tests and node visits per ray against holes, each sample count labelled with its "
+            "fps, each mode's Pareto front; right: the same work against pack size for each pose-space cluster "
+            "count K](" +
             plots.tradeoff + ")\n";
     }
     md += "\n";

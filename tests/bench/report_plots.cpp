@@ -220,8 +220,30 @@ std::vector<std::string> tradeoff_data(const Json& doc, std::string& data) {
   return drawn;
 }
 
-std::string tradeoff_script(const std::string& dat, const std::string& png, const std::vector<std::string>& modes) {
-  std::string s = std::string(kTerminal) + "set output '" + png + "'\n" +
+// The clusters' study: per K its pack size in MB, work per ray, K and fps.
+bool cluster_data(const Json& doc, std::string& data, std::string& title) {
+  bool any = false;
+  for (const Json& row : doc.value("clusters", Json::array())) {
+    const double mb = number(row, "pack_bytes") / 1e6;
+    const double work = number(row, "work_per_ray");
+    if (!std::isfinite(mb) || !std::isfinite(work)) continue;
+    data += value(mb) + " " + value(work) + " " + value(number(row, "clusters_per_bone")) + " " +
+            value(number(row, "fps")) + "\n";
+    any = true;
+  }
+  char text[160];
+  std::snprintf(text, sizeof text, "Pose-space clusters, Cally at %.0f triangles: each point a K, labelled K / fps",
+                number(doc, "cluster_triangles"));
+  title = text;
+  return any;
+}
+
+// `cluster_dat` empty: the sweep alone; else a second panel for the
+// clusters' study.
+std::string tradeoff_script(const std::string& dat, const std::string& png, const std::vector<std::string>& modes,
+                            const std::string& cluster_dat = {}, const std::string& cluster_title = {}) {
+  std::string s = std::string(cluster_dat.empty() ? kTerminal : "set terminal pngcairo noenhanced size 1600,640 font 'sans,11'\n") +
+                  "set output '" + png + "'\n" + (cluster_dat.empty() ? "" : "set multiplot layout 1,2\n") +
                   "set title \"Work against accuracy (padding 0): each point a sample count, labelled samples / fps;\\n"
                   "rings and lines: each mode's Pareto front\"\n"
                   "set logscale x\nset grid\nset key outside below\n"
@@ -235,7 +257,14 @@ std::string tradeoff_script(const std::string& dat, const std::string& png, cons
          std::to_string(i + 1) + " notitle, ''" + points +
          " using 1:2:(sprintf('%d / %.0f', $3, $4)) with labels offset char 0.8,0.6 font ',7' notitle";
   }
-  return s + "\n";
+  s += "\n";
+  if (cluster_dat.empty()) return s;
+  s += "unset logscale\nset title '" + cluster_title + "'\nset key off\n"
+       "set xlabel 'character pack size, MB'\n"
+       "set ylabel 'triangle tests + kd-tree node visits per ray (deterministic)'\n"
+       "plot '" + cluster_dat + "' using 1:2 with linespoints lw 2 pt 7 lc 1, '' using 1:2:(sprintf('%d / %.0f', $3, $4)) "
+       "with labels offset char 0.8,0.6 font ',8'\nunset multiplot\n";
+  return s;
 }
 
 // --- scaling ------------------------------------------------------------------------
@@ -352,9 +381,13 @@ PlotResult make_plots(const PlotInputs& inputs, const std::string& image_dir, co
   if (const Json* trade = input(inputs, "tradeoff")) {
     std::string data;
     const std::vector<std::string> modes = tradeoff_data(*trade, data);
+    std::string clusters, cluster_title;
+    const bool with_clusters = cluster_data(*trade, clusters, cluster_title);
     if (!modes.empty()) {
       const auto [dat, gp, png, href] = paths("tradeoff");
-      render("tradeoff", data, tradeoff_script(dat, png, modes), result.tradeoff);
+      const std::string cluster_dat = with_clusters ? "plot_tradeoff_clusters.dat" : "";
+      if (with_clusters && !write_file(in_data(cluster_dat), clusters, result.note)) result.failed = true;
+      render("tradeoff", data, tradeoff_script(dat, png, modes, cluster_dat, cluster_title), result.tradeoff);
     }
   }
 

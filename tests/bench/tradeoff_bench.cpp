@@ -25,6 +25,7 @@
 #include "character/framing.h"
 #include "character/pack.h"
 #include "content/mannequin/mannequin.h"
+#include "editor/mesh/subdivide.h"
 #include "raytrace/camera/camera.h"
 #include "raytrace/render/renderer.h"
 #include "raytrace/scene/scene.h"
@@ -68,6 +69,10 @@ struct Options {
   int frames = 11;  // walk frames per fps measurement
   int threads = 2;
   int crack_subdivisions = 4;
+  // The pose-space clusters' side study: the model subdivided this many
+  // times (clusters only pay on fine meshes), baked with each K.
+  std::vector<int> cluster_counts{0, 4, 8, 16, 32};
+  int cluster_level = 3;
   bool quick = false;
   std::string shared = SINEW_SHARED_DIR;
   std::string json_path;
@@ -84,6 +89,9 @@ std::vector<BenchFlag> flags() {
       {"--modes", "LIST", "arbitrary,limits,clips,clip (default all four; clip = the walk alone)"},
       {"--padding", "LIST", "fuzzy box padding, a fraction of the rest-pose box diagonal\n(default 0,0.01,0.05)"},
       {"--held-out", "N", "held-out poses per mode for escapes and holes (default 500)"},
+      {"--clusters", "LIST", "pose-space clusters per bone for the clusters' study (default 0,4,8,16,32;\n"
+                             "none: skip it)"},
+      {"--cluster-level", "L", "subdivision levels of the model in the clusters' study (default 3)"},
       size_flag("512x512"),
       threads_flag("2"),
       shared_flag(),
@@ -105,6 +113,8 @@ Status read_options(const BenchArgs& parsed, Options& o) {
     o.hole_width = o.hole_height = 32;
     o.frames = 3;
     o.crack_subdivisions = 3;
+    o.cluster_counts = {0, 16};
+    o.cluster_level = 2;
   }
   if (const auto text = parsed.value("--model")) {
     SINEW_ASSIGN_OR_RETURN(const int i, cli::parse_choice("--model", *text, {"cally", "mannequin"}));
@@ -133,6 +143,15 @@ Status read_options(const BenchArgs& parsed, Options& o) {
     std::sort(o.paddings.begin(), o.paddings.end());
   }
   SINEW_RETURN_IF_ERROR(parsed.read("--held-out", 1, 1000000, o.held_out));
+  if (const auto text = parsed.value("--clusters")) {
+    if (*text == "none") {
+      o.cluster_counts.clear();
+    } else {
+      SINEW_ASSIGN_OR_RETURN(o.cluster_counts,
+                             parse_int_list("--clusters", *text, 0, static_cast<int>(rt::kMaxPoseClusters)));
+    }
+  }
+  SINEW_RETURN_IF_ERROR(parsed.read("--cluster-level", 0, editor::kMaxSubdivisionLevels, o.cluster_level));
   SINEW_RETURN_IF_ERROR(parsed.read_size(16384, o.width, o.height));
   SINEW_RETURN_IF_ERROR(parsed.read_threads(o.threads));
   SINEW_RETURN_IF_ERROR(parsed.read("--shared", o.shared));
@@ -260,6 +279,9 @@ struct WalkResult {
   // Triangle tests plus kd-tree node visits per traced ray: the whole
   // deterministic cost the trees leave, the trade plot's speed axis.
   double work_per_ray = 0.0;
+  double skinning_ms = 0.0;      // median "skinning" phase (with the escape check)
+  double cluster_bones = 0.0;    // mean bones on a pose-space cluster's tree a frame
+  double cluster_misses = 0.0;   // mean bones a frame whose cluster a vertex left
   GateResult gate;
 };
 
@@ -288,8 +310,10 @@ Expected<WalkResult> measure_walk(const BenchModel& m, const rt::FuzzyCharacterV
   for (int f = 0; f < o.frames; ++f) {
     SINEW_RETURN_IF_ERROR(pose_instances(m.model, walk, f / kFramesPerSecond, stage));
     const Clock::time_point prepare_start = Clock::now();
-    SINEW_RETURN_IF_ERROR(status_of(stage.scene.prepare_frame(frame_options, jobs, &timers)));
+    SINEW_ASSIGN_OR_RETURN(const rt::FrameStats frame_stats, stage.scene.prepare_frame(frame_options, jobs, &timers));
     const double prepare_ms = ms_since(prepare_start);
+    result.cluster_bones += static_cast<double>(frame_stats.cluster_bones) / o.frames;
+    result.cluster_misses += static_cast<double>(frame_stats.cluster_misses) / o.frames;
     if (!shared.camera) {
       const Aabb posed = character::posed_bounds(stage.scene);
       shared.light = character::default_light(posed, stage.up);
@@ -313,6 +337,7 @@ Expected<WalkResult> measure_walk(const BenchModel& m, const rt::FuzzyCharacterV
   }
   result.frame_ms = median_of(frame_ms);
   result.boxes_ms = phase_ms(timers, "boxes");
+  result.skinning_ms = phase_ms(timers, "skinning");
   result.tests_per_ray = rays > 0 ? static_cast<double>(triangle_tests) / static_cast<double>(rays) : 0.0;
   result.work_per_ray = rays > 0 ? static_cast<double>(triangle_tests + node_visits) / static_cast<double>(rays) : 0.0;
   return result;
@@ -473,6 +498,27 @@ struct SideRow {
   GateResult gate;
 };
 
+// One K of the pose-space clusters' study.
+struct ClusterRow {
+  int clusters_per_bone = 0;
+  std::uint32_t cluster_count = 0;
+  double bake_ms = 0.0;
+  std::size_t pack_bytes = 0;
+  double fuzzy_area_ratio = 0.0;    // the full trees'
+  double cluster_area_ratio = 0.0;  // averaged over each bone's clusters
+  WalkResult walk;
+  double fps() const { return walk.frame_ms > 0.0 ? 1000.0 / walk.frame_ms : 0.0; }
+};
+
+Json cluster_json(const ClusterRow& r) {
+  return {{"clusters_per_bone", r.clusters_per_bone}, {"clusters", r.cluster_count},
+          {"bake_ms", r.bake_ms},                     {"pack_bytes", r.pack_bytes},
+          {"fuzzy_area_ratio", r.fuzzy_area_ratio},   {"cluster_area_ratio", r.cluster_area_ratio},
+          {"fps", r.fps()},                           {"tests_per_ray", r.walk.tests_per_ray},
+          {"work_per_ray", r.walk.work_per_ray},      {"skinning_ms", r.walk.skinning_ms},
+          {"cluster_bones", r.walk.cluster_bones},    {"cluster_misses", r.walk.cluster_misses}};
+}
+
 // --- report --------------------------------------------------------------------
 
 std::string padding_text(double padding) { return general(padding); }
@@ -544,6 +590,8 @@ struct Report {
   std::vector<std::pair<std::string, std::optional<KneePoint>>> knees;
   std::vector<SideRow> triangle_tests;
   std::vector<SideRow> bone_boxes;
+  std::vector<ClusterRow> clusters;
+  std::size_t cluster_triangles = 0;
   std::size_t triangles = 0;
   double wall_s = 0.0;
 };
@@ -642,6 +690,37 @@ std::string markdown(const Report& rep) {
   for (const SideRow& s : rep.bone_boxes) {
     line("| " + s.name + " | " + fixed(s.boxes_ms, 3) + " | " + fixed(s.fps, 1) + " |");
   }
+  if (!rep.clusters.empty()) {
+    line("");
+    line("### Pose-space clusters");
+    line("");
+    line("Model " + rep.model + " subdivided " + std::to_string(o.cluster_level) + " times (" +
+         std::to_string(rep.cluster_triangles) + " triangles), the default bake (every clip, keys and 1/30 s) with K "
+         "pose-space clusters per bone (`FuzzyBakeOptions::pose_clusters`, docs/RAYTRACE.md \"Pose-space "
+         "clusters\"; 0 = the paper's one tree a bone), the walk measured as in the sweep. `clusters` counts them over "
+         "all bones (bones whose triangles never move get none); `area` is the full trees' fuzzy area over the rest "
+         "pose's, `cl. area` the same averaged over each bone's clusters (what a frame's trees hold); `skin ms` is the "
+         "median skinning phase with the escape check, which reads the clusters' boxes; `on cl.` the bones a frame "
+         "on a cluster's tree and `misses` those a frame whose vertex left its cluster (back on the full tree, the "
+         "check run again). A cluster changes no image: a bone whose vertices leave its cluster's boxes falls back "
+         "to its full tree, so holes and escapes are those of K = 0; K trades pack size and bake time for work per "
+         "ray.");
+    line("");
+    line("| K | clusters | bake ms | pack bytes | area | cl. area | fps | tests/ray | work/ray | skin ms | on cl. | "
+         "misses |");
+    line("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    for (const ClusterRow& r : rep.clusters) {
+      if (!r.walk.gate.passed()) {
+        line("| " + std::to_string(r.clusters_per_bone) + " | FAILED | | | | | | | | | | |");
+        continue;
+      }
+      line("| " + std::to_string(r.clusters_per_bone) + " | " + std::to_string(r.cluster_count) + " | " +
+           fixed(r.bake_ms, 0) + " | " + std::to_string(r.pack_bytes) + " | " + fixed(r.fuzzy_area_ratio, 2) + " | " +
+           fixed(r.cluster_area_ratio, 2) + " | " + fixed(r.fps(), 1) + " | " + fixed(r.walk.tests_per_ray, 2) +
+           " | " + fixed(r.walk.work_per_ray, 2) + " | " + fixed(r.walk.skinning_ms, 2) + " | " +
+           fixed(r.walk.cluster_bones, 1) + " | " + fixed(r.walk.cluster_misses, 2) + " |");
+    }
+  }
   for (const std::string& note : rep.notes) line("\n" + note);
   return md;
 }
@@ -687,6 +766,12 @@ Json report_json(const Report& rep) {
   doc["bone_boxes"] = Json::array();
   for (const SideRow& s : rep.bone_boxes) {
     doc["bone_boxes"].push_back({{"mode", s.name}, {"boxes_ms", s.boxes_ms}, {"fps", s.fps}});
+  }
+  doc["cluster_level"] = o.cluster_level;
+  doc["cluster_triangles"] = rep.cluster_triangles;
+  doc["clusters"] = Json::array();
+  for (const ClusterRow& r : rep.clusters) {
+    if (r.walk.gate.passed()) doc["clusters"].push_back(cluster_json(r));
   }
   doc["notes"] = rep.notes;
   doc["wall_s"] = rep.wall_s;
@@ -1005,6 +1090,68 @@ int run_tradeoff_bench(const std::vector<std::string>& args, const std::string& 
     if (!row) continue;
     std::printf("  %-10s %9.3f %7.1f\n", name.c_str(), row->boxes_ms, row->fps);
     rep.bone_boxes.push_back(*row);
+  }
+
+  // --- pose-space clusters on the subdivided model ---
+  if (!o.cluster_counts.empty()) {
+    std::fprintf(stderr, "  [%.0f s] pose-space clusters\n", ms_since(run_start) / 1000.0);
+    auto finer = editor::subdivide(m.model, o.cluster_level);
+    if (!finer.ok()) {
+      std::fprintf(stderr, "sinew-bench tradeoff: subdivide: %s\n", finer.status().message().c_str());
+      return 1;
+    }
+    BenchModel fine = m;
+    fine.model = std::move(*finer);
+    rep.cluster_triangles = fine.model.mesh.triangle_count();
+    WalkShared fine_walk;
+    std::printf("\n  pose-space clusters (%s subdivided %d times: %zu triangles; default bake, fast test)\n",
+                m.name.c_str(), o.cluster_level, rep.cluster_triangles);
+    std::printf("  %4s %8s %8s %11s %7s %8s %7s %7s %8s %7s %6s %6s\n", "K", "clusters", "bake ms", "pack bytes",
+                "area", "cl.area", "fps", "tst/ry", "work/ry", "skin ms", "on cl", "misses");
+    for (const int k : o.cluster_counts) {
+      character::BakeRequest request;
+      request.fuzzy.pose_clusters = static_cast<std::uint32_t>(k);
+      request.fuzzy.fine_mesh_clusters = false;  // K = 0 is the paper's structure here
+      const Clock::time_point bake_start = Clock::now();
+      auto bake_k = character::bake_in_memory(fine.model, request, jobs);
+      if (!bake_k.ok()) {
+        std::fprintf(stderr, "sinew-bench tradeoff: clusters %d: %s\n", k, bake_k.status().message().c_str());
+        exit_code = 1;
+        continue;
+      }
+      ClusterRow row;
+      row.clusters_per_bone = k;
+      row.bake_ms = ms_since(bake_start);
+      const rt::FuzzyBakeStats& stats = bake_k->fuzzy.stats;
+      row.cluster_count = stats.cluster_count;
+      row.fuzzy_area_ratio = stats.rest_area > 0.0 ? stats.fuzzy_area / stats.rest_area : 0.0;
+      row.cluster_area_ratio =
+          stats.rest_area > 0.0 ? (k > 0 ? stats.cluster_fuzzy_area : stats.fuzzy_area) / stats.rest_area : 0.0;
+      auto bytes = pack_size(fine, ModeSpec{}, request, *bake_k);
+      auto walked = bytes.ok() ? measure_walk(fine, bake_k->fuzzy.view(), o, rt::FrameOptions{},
+                                              rt::TriangleTest::kFast, jobs, fine_walk)
+                               : Expected<WalkResult>(bytes.status());
+      if (!walked.ok()) {
+        std::fprintf(stderr, "sinew-bench tradeoff: clusters %d: %s\n", k, walked.status().message().c_str());
+        exit_code = 1;
+        continue;
+      }
+      row.pack_bytes = *bytes;
+      row.walk = *walked;
+      if (!row.walk.gate.passed()) {
+        std::printf("  %4d FAILED (first walk frame differs from brute force on %llu of %llu pixels)\n", k,
+                    static_cast<unsigned long long>(row.walk.gate.mismatched),
+                    static_cast<unsigned long long>(row.walk.gate.checked));
+        exit_code = 1;
+      } else {
+        std::printf("  %4d %8u %8.0f %11zu %7.2f %8.2f %7.1f %7.2f %8.2f %7.2f %6.1f %6.2f\n", k, row.cluster_count,
+                    row.bake_ms, row.pack_bytes, row.fuzzy_area_ratio, row.cluster_area_ratio, row.fps(),
+                    row.walk.tests_per_ray, row.walk.work_per_ray, row.walk.skinning_ms, row.walk.cluster_bones,
+                    row.walk.cluster_misses);
+      }
+      std::fflush(stdout);
+      rep.clusters.push_back(row);
+    }
   }
 
   rep.wall_s = ms_since(run_start) / 1000.0;
