@@ -65,14 +65,11 @@ struct Matrix3x4x8 {
   __m256 m[12];
 };
 
-// Row r of the 8 lanes' bones as 4 column registers (cols[c] = B_lane[r][c]):
-// two 128-bit row loads per register and a 4x4 transpose in each half.
-void load_bone_row8(const float* const lane_bones[8], int r, __m256 cols[4]) {
+// Eight rows of four floats as four registers of eight: the rows side by
+// side in each half (row i in lane i), then a 4x4 transpose per half.
+void transpose8x4(const __m128 rows[8], __m256 cols[4]) {
   __m256 x[4];
-  for (int i = 0; i < 4; ++i) {
-    x[i] = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(lane_bones[i] + 4 * r)),
-                                _mm_loadu_ps(lane_bones[i + 4] + 4 * r), 1);
-  }
+  for (int i = 0; i < 4; ++i) x[i] = _mm256_insertf128_ps(_mm256_castps128_ps256(rows[i]), rows[i + 4], 1);
   const __m256 t0 = _mm256_unpacklo_ps(x[0], x[1]);
   const __m256 t1 = _mm256_unpackhi_ps(x[0], x[1]);
   const __m256 t2 = _mm256_unpacklo_ps(x[2], x[3]);
@@ -81,6 +78,13 @@ void load_bone_row8(const float* const lane_bones[8], int r, __m256 cols[4]) {
   cols[1] = _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(3, 2, 3, 2));
   cols[2] = _mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(1, 0, 1, 0));
   cols[3] = _mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(3, 2, 3, 2));
+}
+
+// Row r of the 8 lanes' bones as 4 column registers (cols[c] = B_lane[r][c]).
+void load_bone_row8(const float* const lane_bones[8], int r, __m256 cols[4]) {
+  __m128 rows[8];
+  for (int i = 0; i < 8; ++i) rows[i] = _mm_loadu_ps(lane_bones[i] + 4 * r);
+  transpose8x4(rows, cols);
 }
 
 // Group g's slots are whole registers: one load of the slot's weights, and
@@ -142,21 +146,6 @@ void skin_range_avx2(const SkinningArrays& a, std::size_t begin, std::size_t end
 }
 
 namespace {
-
-// Eight rows of four floats as four registers of eight: the rows side by
-// side in each half (row i in lane i), then a 4x4 transpose per half.
-void transpose8x4(const __m128 rows[8], __m256 cols[4]) {
-  __m256 x[4];
-  for (int i = 0; i < 4; ++i) x[i] = _mm256_insertf128_ps(_mm256_castps128_ps256(rows[i]), rows[i + 4], 1);
-  const __m256 t0 = _mm256_unpacklo_ps(x[0], x[1]);
-  const __m256 t1 = _mm256_unpackhi_ps(x[0], x[1]);
-  const __m256 t2 = _mm256_unpacklo_ps(x[2], x[3]);
-  const __m256 t3 = _mm256_unpackhi_ps(x[2], x[3]);
-  cols[0] = _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(1, 0, 1, 0));
-  cols[1] = _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(3, 2, 3, 2));
-  cols[2] = _mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(1, 0, 1, 0));
-  cols[3] = _mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(3, 2, 3, 2));
-}
 
 float min_of(__m256 v) {
   __m128 m = _mm_min_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps(v, 1));
