@@ -14,6 +14,7 @@
 #include "tests/bench/paper_bench.h"
 #include "tests/bench/raytrace_bench.h"
 #include "tests/bench/report_bench.h"
+#include "tests/bench/structures_bench.h"
 #include "tests/bench/tradeoff_bench.h"
 
 namespace {
@@ -41,6 +42,7 @@ int main(int argc, char** argv) {
   line.command("paper", "the paper's Tables 1 and 2 on Cally");
   line.command("raytrace", "ray tracer frame phases, and fuzzy vs exact kd-tree trace time");
   line.command("report", "every issue-7 benchmark; writes docs/BENCHMARKS.md");
+  line.command("structures", "the paper's one tree a bone against pose-space clusters, per model and mesh size");
   line.command("tradeoff",
                "speed against accuracy: samples, pose spaces, padding, held-out escapes and holes,\n"
                "fallback cost, fast vs watertight, exact vs cheap boxes");
@@ -67,5 +69,6 @@ int main(int argc, char** argv) {
   if (what == "paper") return sinew::bench::run_paper_bench(args, command_line(argc, argv));
   if (what == "raytrace") return sinew::bench::run_raytrace_bench(args, command_line(argc, argv));
   if (what == "report") return sinew::bench::run_report_bench(args, command_line(argc, argv));
+  if (what == "structures") return sinew::bench::run_structures_bench(args, command_line(argc, argv));
   return sinew::bench::run_tradeoff_bench(args, command_line(argc, argv));
 }

@@ -24,6 +24,7 @@
 #include "tests/bench/paper_bench.h"
 #include "tests/bench/raytrace_bench.h"
 #include "tests/bench/report_plots.h"
+#include "tests/bench/structures_bench.h"
 #include "tests/bench/tradeoff_bench.h"
 
 namespace sinew::bench {
@@ -34,7 +35,7 @@ namespace fs = std::filesystem;
 
 // --- options -------------------------------------------------------------------
 
-const std::vector<std::string> kAllSections = {"paper", "embree", "demo", "tradeoff", "scaling"};
+const std::vector<std::string> kAllSections = {"paper", "embree", "structures", "demo", "tradeoff", "scaling"};
 
 struct Options {
   bool quick = false;
@@ -49,7 +50,8 @@ std::vector<BenchFlag> bench_flags() {
       {"--quick", "", "a smoke run under 5 minutes on 2 cores (default --out build/report-quick)"},
       {"--out", "DIR", "where BENCHMARKS.md, img/ and bench-data/ go (default: the source tree's docs/)"},
       {"--sections", "LIST",
-       "paper,embree,demo,tradeoff,scaling (default all); the other sections are kept\n"
+       "paper,embree,structures,demo,tradeoff,scaling (default all); the other sections are\n"
+       "kept "
        "from the last report written to the same --out"},
       shared_flag(),
   };
@@ -66,7 +68,7 @@ Status read_options(const BenchArgs& parsed, Options& o) {
     SINEW_ASSIGN_OR_RETURN(o.sections, cli::parse_list("--sections", *text));
     for (const std::string& s : o.sections) {
       if (std::find(kAllSections.begin(), kAllSections.end(), s) == kAllSections.end()) {
-        return invalid_argument("--sections", s, "unknown section (expected paper, embree, demo, tradeoff or scaling)");
+        return invalid_argument("--sections", s, "unknown section (expected paper, embree, structures, demo, tradeoff or scaling)");
       }
     }
   }
@@ -630,6 +632,11 @@ std::string document(const Options& o, const Report& report, const std::string& 
     md += "\n";
   }
   if (const Run* demo = report.find("demo")) md += demo_markdown(*demo);
+  if (const Run* structures = report.find("structures")) {
+    md += pasted_markdown(*structures);
+    md += failure_line(*structures);
+    md += "\n";
+  }
   if (const Run* trade = report.find("tradeoff")) {
     md += pasted_markdown(*trade);
     md += failure_line(*trade);
@@ -749,6 +756,11 @@ void run_all(const Options& o, const std::string& data_dir, Report& report) {
                                            "--threads", "1"}
                 : std::vector<std::string>{"--subdivide", "4", "--clips", "walk", "--frames", "8", "--threads", "1,2"};
     report.runs.push_back(run_bench("embree", "embree-large", with_common(large), false, data_dir, run_embree_bench));
+  }
+  if (wanted(o, "structures")) {
+    report.runs.push_back(run_bench("structures", "structures",
+                                    with_common(o.quick ? std::vector<std::string>{"--quick"} : std::vector<std::string>{}),
+                                    true, data_dir, run_structures_bench));
   }
   if (wanted(o, "demo")) {
     // The demo takes no --shared: its characters are procedural.
