@@ -121,7 +121,13 @@ class BruteForceGate {
         double t = 0.0, min_bary = 0.0;  // another triangle at the same t: does the ray really hit it there?
         const bool real = exact_hit(ours, ray, t, min_bary) && min_bary >= -kGrazeBarycentric &&
                           std::fabs(t - static_cast<double>(ref.t)) <= tol;
-        return real ? Verdict::kSame : Verdict::kDifferent;
+        if (real) return Verdict::kSame;
+        // The reference's own hit on an edge: the ray passes through the
+        // edge, and the triangle across it at the same t is a tie that the
+        // float test may settle either way (its barycentrics are those of
+        // another triangle, so its distance past the edge is on another
+        // scale).
+        return grazed(ref, ray) ? Verdict::kGraze : Verdict::kDifferent;
       }
       // Different depths: the nearer one must be a graze the other missed.
       const Hit& nearer = ours.t < ref.t ? ours : ref;
