@@ -286,7 +286,7 @@ std::string markdown(const std::vector<Row>& rows, const std::vector<std::string
          fixed(r.update_ms, 2) + " | " + fixed(r.primary_tests, 2) + " / " + fixed(r.primary_visits, 2) + " | " +
          fixed(r.shadow_tests, 2) + " / " + fixed(r.shadow_visits, 2) + " | " + fixed(r.frame_ms, 2) + " | " +
          fixed(static_cast<double>(r.frame_bytes) / 1e6, 1) + " | " + std::to_string(r.gate.checked) + " px ok" +
-         (r.gate.grazes > 0 ? ", " + std::to_string(r.gate.grazes) + " edge grazes" : "") + " |");
+         (r.gate.grazes > 0 ? ", " + std::to_string(r.gate.grazes) + (r.gate.grazes == 1 ? " edge graze" : " edge grazes") : "") + " |");
   }
   for (const std::string& note : notes) line("\n" + note);
   return md;
