@@ -24,12 +24,12 @@ sinew_cli_convention_test(demo $<TARGET_FILE:sinew-demo> "" --frames nope "--fra
 sinew_cli_convention_test(image_diff $<TARGET_FILE:sinew-image-diff> "a.png b.png" --max-channel-diff 300
   "--max-channel-diff = 300: expected an integer from 0 to 255")
 set(bench $<TARGET_FILE:sinew-bench>)
-foreach(benchmark animation bake demo embree paper raytrace report tradeoff)
+foreach(benchmark animation bake demo embree paper raytrace report structures tradeoff)
   if(benchmark STREQUAL "report")
     sinew_cli_convention_test(bench_${benchmark} "${bench}" ${benchmark} --sections nope "--sections = nope")
   elseif(benchmark STREQUAL "animation")
     sinew_cli_convention_test(bench_${benchmark} "${bench}" ${benchmark} --frames 0 "--frames = 0: expected an integer")
-  elseif(benchmark MATCHES "^(bake|demo|tradeoff)$")
+  elseif(benchmark MATCHES "^(bake|demo|structures|tradeoff)$")
     sinew_cli_convention_test(bench_${benchmark} "${bench}" ${benchmark} --threads -1
       "--threads = -1: expected an integer from 0 to 1024")
   else()
