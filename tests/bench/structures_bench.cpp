@@ -25,6 +25,7 @@
 #include "tests/bench/bench_support.h"
 #include "tests/bench/brute_force_gate.h"
 #include "tests/bench/table_numbers.h"
+#include "tests/bench/walk_measure.h"
 
 namespace sinew::bench {
 namespace {
@@ -32,7 +33,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 using Json = nlohmann::ordered_json;
 
-constexpr double kFramesPerSecond = 30.0;
 constexpr int kGateStride = 7;
 
 struct Options {
@@ -126,22 +126,7 @@ struct Row {
   GateResult gate;
 };
 
-std::size_t frame_bytes(const rt::InstanceFrame& f) {
-  const auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
-  return bytes(f.skinning) + bytes(f.bone_from_world) + bytes(f.bone_usable) + bytes(f.tolerance) +
-         bytes(f.bone_carry) + bytes(f.bone_world_boxes) + bytes(f.positions) + bytes(f.normals) + bytes(f.escaped) +
-         bytes(f.chunk_bone_boxes) + bytes(f.bone_cluster) + bytes(f.bone_check_boxes) +
-         bytes(f.escaped_triangles);
-}
-
-double phase_median(const PhaseTimers& timers, std::string_view phase) {
-  for (const PhaseSummary& s : timers.summarize()) {
-    if (s.name == phase) return s.median_ms;
-  }
-  return 0.0;
-}
-
-Expected<Row> measure(const Subject& s, int clusters, const Options& o, JobSystem& jobs) {
+Expected<Row> measure(const Subject& s, int clusters, const Options& o, JobSystem& jobs, WalkFraming& framing) {
   Row row;
   row.model = s.name;
   row.triangles = s.model.mesh.triangle_count();
@@ -167,52 +152,16 @@ Expected<Row> measure(const Subject& s, int clusters, const Options& o, JobSyste
     row.pack_bytes = bytes.size();
   }
 
-  BenchStage stage;
-  SINEW_RETURN_IF_ERROR(stage_instances(s.model, bake.fuzzy.view(), 1, stage));
-  const anim::Clip& clip = s.model.clips[s.clip];
-  rt::RenderSettings settings;
-  settings.shadows = true;
-  settings.light.kind = rt::Light::Kind::kPoint;
-  std::vector<std::uint8_t> color(4 * static_cast<std::size_t>(o.width) * static_cast<std::size_t>(o.height));
-  rt::FrameBuffers buffers;
-  buffers.width = o.width;
-  buffers.height = o.height;
-  buffers.color_rgba8 = color;
-  rt::Renderer renderer;
-  PrimaryHitRenderer hits(o.width, o.height);
-  std::optional<rt::PinholeCamera> camera;
-  PhaseTimers timers;
-  std::vector<double> frame_ms, update_ms;
-  rt::TraversalCounters primary, shadow;
-  for (int f = 0; f < o.frames; ++f) {
-    SINEW_RETURN_IF_ERROR(pose_instances(s.model, clip, f / kFramesPerSecond, stage));
-    PhaseTimers frame_timers;
-    const Clock::time_point prepare_start = Clock::now();
-    SINEW_RETURN_IF_ERROR(status_of(stage.scene.prepare_frame(rt::FrameOptions{}, jobs, &frame_timers)));
-    const double prepare_ms = ms_since(prepare_start);
-    update_ms.push_back(phase_median(frame_timers, "skinning") + phase_median(frame_timers, "boxes") +
-                        phase_median(frame_timers, "fallback") + phase_median(frame_timers, "top level"));
-    if (!camera) {
-      const Aabb posed = character::posed_bounds(stage.scene);
-      settings.light.position = character::default_light(posed, stage.up);
-      SINEW_ASSIGN_OR_RETURN(camera, rt::PinholeCamera::create(
-                                         character::default_camera(posed, stage.up, o.width, o.height), o.width,
-                                         o.height));
-    }
-    const Clock::time_point render_start = Clock::now();
-    SINEW_ASSIGN_OR_RETURN(const rt::RenderStats stats, renderer.render(stage.scene, *camera, settings, buffers, jobs));
-    frame_ms.push_back(prepare_ms + ms_since(render_start));
-    for (auto [sum, add] : {std::pair{&primary, &stats.primary}, std::pair{&shadow, &stats.shadow}}) {
-      sum->rays += add->rays;
-      sum->node_visits += add->node_visits;
-      sum->triangle_tests += add->triangle_tests;
-    }
-    if (f == 0) {
-      const BruteForceGate gate(stage.scene, *camera, kGateStride);
-      SINEW_ASSIGN_OR_RETURN(const std::span<const Hit> primary_hits, hits.render(stage.scene, *camera, settings, jobs));
-      row.gate = gate.check(primary_hits);
-    }
-  }
+  WalkRequest walk;
+  walk.frames = o.frames;
+  walk.width = o.width;
+  walk.height = o.height;
+  walk.gate_stride = kGateStride;
+  SINEW_ASSIGN_OR_RETURN(const WalkMeasure walked,
+                         measure_walk(s.model, bake.fuzzy.view(), s.model.clips[s.clip], walk, jobs, framing));
+  const rt::TraversalCounters& primary = walked.primary;
+  const rt::TraversalCounters& shadow = walked.shadow;
+  row.gate = walked.gate;
   const auto per_ray = [](std::uint64_t n, std::uint64_t rays) {
     return rays > 0 ? static_cast<double>(n) / static_cast<double>(rays) : 0.0;
   };
@@ -220,9 +169,10 @@ Expected<Row> measure(const Subject& s, int clusters, const Options& o, JobSyste
   row.primary_visits = per_ray(primary.node_visits, primary.rays);
   row.shadow_tests = per_ray(shadow.triangle_tests, shadow.rays);
   row.shadow_visits = per_ray(shadow.node_visits, shadow.rays);
-  row.update_ms = median_of(update_ms);
-  row.frame_ms = median_of(frame_ms);
-  row.frame_bytes = frame_bytes(stage.scene.instances()[0]);
+  row.update_ms = walked.phase_ms("skinning") + walked.phase_ms("boxes") + walked.phase_ms("fallback") +
+                  walked.phase_ms("top level");
+  row.frame_ms = walked.median_frame_ms();
+  row.frame_bytes = walked.frame_bytes;
   return row;
 }
 
@@ -356,8 +306,9 @@ int run_structures_bench(const std::vector<std::string>& args, const std::string
   std::printf("  %-16s %8s %9s %8s %7s %15s %9s %15s %15s %9s %8s\n", "model", "tris", "structure", "pack MB",
               "bake s", "area", "update", "primary t/v", "shadow t/v", "frame ms", "frame MB");
   for (const Subject& s : subjects) {
+    WalkFraming framing;  // one camera and brute-force reference for both structures
     for (const int k : {0, o.clusters}) {
-      auto row = measure(s, k, o, jobs);
+      auto row = measure(s, k, o, jobs, framing);
       if (!row.ok()) {
         std::fprintf(stderr, "sinew-bench structures: %s, %d clusters: %s\n", s.name.c_str(), k,
                      row.status().message().c_str());

@@ -37,6 +37,7 @@
 #include "tests/bench/bench_support.h"
 #include "tests/bench/brute_force_gate.h"
 #include "tests/bench/table_numbers.h"
+#include "tests/bench/walk_measure.h"
 #include "tests/support/brute_force.h"
 
 namespace sinew::bench {
@@ -45,7 +46,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 using Json = nlohmann::ordered_json;
 
-constexpr double kFramesPerSecond = 30.0;
 constexpr double kKneeHoleFraction = 1e-4;
 constexpr int kWalkGateStride = 7;
 // The bake's random modes use seed 1 (PoseSpaceDesc's default); the held-out
@@ -249,25 +249,7 @@ Expected<std::vector<std::vector<Affine3>>> held_out_poses(const BenchModel& m, 
   return poses;
 }
 
-// --- rendering helpers ---------------------------------------------------------
-
-double phase_ms(const PhaseTimers& timers, std::string_view phase) {
-  for (const PhaseSummary& s : timers.summarize()) {
-    if (s.name == phase) return s.median_ms;
-  }
-  return 0.0;
-}
-
 // --- the walk: fps -------------------------------------------------------------
-
-// What every fps measurement shares: the camera and light framed on the
-// walk's first frame, and that frame's brute-force reference (the skinned
-// triangles do not depend on the bake, so one reference serves them all).
-struct WalkShared {
-  std::optional<rt::PinholeCamera> camera;
-  Vec3 light{0.0f};
-  std::unique_ptr<BruteForceGate> gate;
-};
 
 struct WalkResult {
   double frame_ms = 0.0;  // median of prepare_frame + render
@@ -285,61 +267,31 @@ struct WalkResult {
   GateResult gate;
 };
 
-Expected<WalkResult> measure_walk(const BenchModel& m, const rt::FuzzyCharacterView& fuzzy, const Options& o,
-                                  const rt::FrameOptions& frame_options, rt::TriangleTest test, JobSystem& jobs,
-                                  WalkShared& shared) {
-  BenchStage stage;
-  SINEW_RETURN_IF_ERROR(stage_instances(m.model, fuzzy, 1, stage));
-  const anim::Clip& walk = m.model.clips[m.walk_clip];
-  rt::RenderSettings settings;
-  settings.triangle_test = test;
-  settings.shadows = true;
-  settings.light.kind = rt::Light::Kind::kPoint;
-  std::vector<std::uint8_t> color(4 * static_cast<std::size_t>(o.width) * static_cast<std::size_t>(o.height));
-  rt::FrameBuffers buffers;
-  buffers.width = o.width;
-  buffers.height = o.height;
-  buffers.color_rgba8 = color;
-  rt::Renderer renderer;
-  PrimaryHitRenderer hits(o.width, o.height);
-
+// The walk (walk_measure.h) at the sweep's size and frame count.
+Expected<WalkResult> walk_of(const BenchModel& m, const rt::FuzzyCharacterView& fuzzy, const Options& o,
+                             const rt::FrameOptions& frame_options, rt::TriangleTest test, JobSystem& jobs,
+                             WalkFraming& framing) {
+  WalkRequest request;
+  request.frames = o.frames;
+  request.width = o.width;
+  request.height = o.height;
+  request.frame_options = frame_options;
+  request.test = test;
+  request.gate_stride = kWalkGateStride;
+  SINEW_ASSIGN_OR_RETURN(const WalkMeasure walked,
+                         measure_walk(m.model, fuzzy, m.model.clips[m.walk_clip], request, jobs, framing));
   WalkResult result;
-  std::vector<double> frame_ms;
-  PhaseTimers timers;
-  std::uint64_t rays = 0, triangle_tests = 0, node_visits = 0;
-  for (int f = 0; f < o.frames; ++f) {
-    SINEW_RETURN_IF_ERROR(pose_instances(m.model, walk, f / kFramesPerSecond, stage));
-    const Clock::time_point prepare_start = Clock::now();
-    SINEW_ASSIGN_OR_RETURN(const rt::FrameStats frame_stats, stage.scene.prepare_frame(frame_options, jobs, &timers));
-    const double prepare_ms = ms_since(prepare_start);
-    result.cluster_bones += static_cast<double>(frame_stats.cluster_bones) / o.frames;
-    result.cluster_misses += static_cast<double>(frame_stats.cluster_misses) / o.frames;
-    if (!shared.camera) {
-      const Aabb posed = character::posed_bounds(stage.scene);
-      shared.light = character::default_light(posed, stage.up);
-      SINEW_ASSIGN_OR_RETURN(shared.camera, rt::PinholeCamera::create(
-                                                character::default_camera(posed, stage.up, o.width, o.height),
-                                                o.width, o.height));
-    }
-    settings.light.position = shared.light;
-    const Clock::time_point render_start = Clock::now();
-    SINEW_ASSIGN_OR_RETURN(const rt::RenderStats stats,
-                           renderer.render(stage.scene, *shared.camera, settings, buffers, jobs));
-    frame_ms.push_back(prepare_ms + ms_since(render_start));
-    rays += stats.primary.rays + stats.shadow.rays;
-    triangle_tests += stats.primary.triangle_tests + stats.shadow.triangle_tests;
-    node_visits += stats.primary.node_visits + stats.shadow.node_visits;
-    if (f == 0) {
-      if (!shared.gate) shared.gate = std::make_unique<BruteForceGate>(stage.scene, *shared.camera, kWalkGateStride);
-      SINEW_ASSIGN_OR_RETURN(const std::span<const Hit> primary, hits.render(stage.scene, *shared.camera, settings, jobs));
-      result.gate = shared.gate->check(primary);
-    }
-  }
-  result.frame_ms = median_of(frame_ms);
-  result.boxes_ms = phase_ms(timers, "boxes");
-  result.skinning_ms = phase_ms(timers, "skinning");
-  result.tests_per_ray = rays > 0 ? static_cast<double>(triangle_tests) / static_cast<double>(rays) : 0.0;
-  result.work_per_ray = rays > 0 ? static_cast<double>(triangle_tests + node_visits) / static_cast<double>(rays) : 0.0;
+  result.frame_ms = walked.median_frame_ms();
+  result.boxes_ms = walked.phase_ms("boxes");
+  result.skinning_ms = walked.phase_ms("skinning");
+  const std::uint64_t rays = walked.primary.rays + walked.shadow.rays;
+  const std::uint64_t tests = walked.primary.triangle_tests + walked.shadow.triangle_tests;
+  const std::uint64_t visits = walked.primary.node_visits + walked.shadow.node_visits;
+  result.tests_per_ray = rays > 0 ? static_cast<double>(tests) / static_cast<double>(rays) : 0.0;
+  result.work_per_ray = rays > 0 ? static_cast<double>(tests + visits) / static_cast<double>(rays) : 0.0;
+  result.cluster_bones = walked.cluster_bones;
+  result.cluster_misses = walked.cluster_misses;
+  result.gate = walked.gate;
   return result;
 }
 
@@ -417,7 +369,7 @@ Expected<HeldOutResult> measure_held_out(const BenchModel& m, const rt::FuzzyCha
     SINEW_RETURN_IF_ERROR(status_of(hits.render(scene, *state.cameras[i], settings, jobs)));
     on_sum += ms_since(on_start);
     off_sum += off_ms;
-    fallback_sum += phase_ms(timers, "fallback");
+    fallback_sum += phase_median(timers, "fallback");
   }
   const double n = static_cast<double>(std::max<std::size_t>(1, state.poses.size()));
   r.escaped_fraction = escaped_sum / n;
@@ -459,7 +411,7 @@ Expected<std::size_t> pack_size(const BenchModel& m, const ModeSpec& spec, const
 }
 
 Expected<SweepRow> run_configuration(const BenchModel& m, const Options& o, ModeState& state, int samples,
-                                     double padding, JobSystem& jobs, WalkShared& walk) {
+                                     double padding, JobSystem& jobs, WalkFraming& walk) {
   SweepRow row;
   row.mode = state.spec.name;
   row.samples = samples;
@@ -477,7 +429,7 @@ Expected<SweepRow> run_configuration(const BenchModel& m, const Options& o, Mode
   row.tris_per_leaf = stats.mean_items_per_leaf;
   SINEW_ASSIGN_OR_RETURN(row.pack_bytes, pack_size(m, state.spec, request, bake));
 
-  SINEW_ASSIGN_OR_RETURN(const WalkResult walked, measure_walk(m, bake.fuzzy.view(), o, rt::FrameOptions{},
+  SINEW_ASSIGN_OR_RETURN(const WalkResult walked, walk_of(m, bake.fuzzy.view(), o, rt::FrameOptions{},
                                                                rt::TriangleTest::kFast, jobs, walk));
   row.fps = walked.frame_ms > 0.0 ? 1000.0 / walked.frame_ms : 0.0;
   row.tests_per_ray = walked.tests_per_ray;
@@ -945,7 +897,7 @@ int run_tradeoff_bench(const std::vector<std::string>& args, const std::string& 
   std::fflush(stdout);
 
   JobSystem jobs(o.threads);
-  WalkShared walk_shared;
+  WalkFraming walk_shared;
   int exit_code = 0;
 
   // --- the sweep ---
@@ -1049,7 +1001,7 @@ int run_tradeoff_bench(const std::vector<std::string>& args, const std::string& 
                              rt::BoneBoxMode boxes) -> std::optional<SideRow> {
     rt::FrameOptions frame_options;
     frame_options.bone_boxes = boxes;
-    auto walked = measure_walk(m, bake->fuzzy.view(), o, frame_options, test, jobs, walk_shared);
+    auto walked = walk_of(m, bake->fuzzy.view(), o, frame_options, test, jobs, walk_shared);
     if (!walked.ok()) {
       std::fprintf(stderr, "sinew-bench tradeoff: %s: %s\n", name.c_str(), walked.status().message().c_str());
       exit_code = 1;
@@ -1103,7 +1055,7 @@ int run_tradeoff_bench(const std::vector<std::string>& args, const std::string& 
     BenchModel fine = m;
     fine.model = std::move(*finer);
     rep.cluster_triangles = fine.model.mesh.triangle_count();
-    WalkShared fine_walk;
+    WalkFraming fine_walk;
     std::printf("\n  pose-space clusters (%s subdivided %d times: %zu triangles; default bake, fast test)\n",
                 m.name.c_str(), o.cluster_level, rep.cluster_triangles);
     std::printf("  %4s %8s %8s %11s %7s %8s %7s %7s %8s %7s %6s %6s\n", "K", "clusters", "bake ms", "pack bytes",
@@ -1128,7 +1080,7 @@ int run_tradeoff_bench(const std::vector<std::string>& args, const std::string& 
       row.cluster_area_ratio =
           stats.rest_area > 0.0 ? (k > 0 ? stats.cluster_fuzzy_area : stats.fuzzy_area) / stats.rest_area : 0.0;
       auto bytes = pack_size(fine, ModeSpec{}, request, *bake_k);
-      auto walked = bytes.ok() ? measure_walk(fine, bake_k->fuzzy.view(), o, rt::FrameOptions{},
+      auto walked = bytes.ok() ? walk_of(fine, bake_k->fuzzy.view(), o, rt::FrameOptions{},
                                               rt::TriangleTest::kFast, jobs, fine_walk)
                                : Expected<WalkResult>(bytes.status());
       if (!walked.ok()) {
