@@ -183,6 +183,16 @@ std::size_t count_escapes(const EscapeCheckInput& e, [[maybe_unused]] std::span<
     run_lower = _mm_set1_ps(std::numeric_limits<float>::infinity());
     run_upper = _mm_set1_ps(-std::numeric_limits<float>::infinity());
   };
+  // Grows `bone`'s run by the box [lower, upper] (x, y, z, 0 each).
+  // min_ps(a, b) is a < b ? a : b: the run's side stays on ties and NaNs.
+  const auto extend_run = [&](std::size_t bone, __m128 lower, __m128 upper) {
+    if (bone != run_bone) {
+      end_run();
+      run_bone = bone;
+    }
+    run_lower = _mm_min_ps(lower, run_lower);
+    run_upper = _mm_max_ps(upper, run_upper);
+  };
 #endif
 
   std::size_t count = 0;
@@ -225,12 +235,7 @@ std::size_t count_escapes(const EscapeCheckInput& e, [[maybe_unused]] std::span<
     }
     if (boxes == nullptr) return true;
 #if SINEW_ESCAPE_SSE
-    if (bone != run_bone) {
-      end_run();
-      run_bone = bone;
-    }
-    run_lower = _mm_min_ps(_mm_setr_ps(lower[0], lower[1], lower[2], 0.0f), run_lower);
-    run_upper = _mm_max_ps(_mm_setr_ps(upper[0], upper[1], upper[2], 0.0f), run_upper);
+    extend_run(bone, _mm_setr_ps(lower[0], lower[1], lower[2], 0.0f), _mm_setr_ps(upper[0], upper[1], upper[2], 0.0f));
 #else
     boxes[bone].extend(Aabb{Vec3(lower[0], lower[1], lower[2]), Vec3(upper[0], upper[1], upper[2])});
 #endif
@@ -272,15 +277,7 @@ std::size_t count_escapes(const EscapeCheckInput& e, [[maybe_unused]] std::span<
 #endif
 #if SINEW_ESCAPE_SSE
     const __m128 point = _mm_setr_ps(world.x, world.y, world.z, 0.0f);
-    const auto extend_box = [&](std::size_t bone) {
-      if (bone != run_bone) {
-        end_run();
-        run_bone = bone;
-      }
-      // min_ps(a, b) is a < b ? a : b: the run's side stays on ties and NaNs.
-      run_lower = _mm_min_ps(point, run_lower);
-      run_upper = _mm_max_ps(point, run_upper);
-    };
+    const auto extend_box = [&](std::size_t bone) { extend_run(bone, point, point); };
 #else
     const auto extend_box = [&](std::size_t bone) { boxes[bone].extend(world); };
 #endif

@@ -50,9 +50,8 @@ std::vector<BenchFlag> bench_flags() {
       {"--quick", "", "a smoke run under 5 minutes on 2 cores (default --out build/report-quick)"},
       {"--out", "DIR", "where BENCHMARKS.md, img/ and bench-data/ go (default: the source tree's docs/)"},
       {"--sections", "LIST",
-       "paper,embree,structures,demo,tradeoff,scaling (default all); the other sections are\n"
-       "kept "
-       "from the last report written to the same --out"},
+       "paper,embree,structures,demo,tradeoff,scaling (default all); the other sections\n"
+       "are kept from the last report written to the same --out"},
       shared_flag(),
   };
 }
