@@ -25,6 +25,12 @@ constexpr SectionId kTriangleBone = make_section_id("FTBN");
 constexpr SectionId kBoneTrees = make_section_id("FBTR");
 constexpr SectionId kNodes = make_section_id("FNOD");
 constexpr SectionId kItems = make_section_id("FITM");
+// BVH bone trees (FuzzyBakeOptions::bone_trees = kBvh): their nodes in FBVN
+// instead of FNOD, which such a pack does not write; its FITM (each
+// triangle once per tree) is version kBvhTreesVersion, so a reader that
+// predates BVHs refuses it by version rather than reading BVH items as
+// kd-tree leaves.
+constexpr SectionId kBvhNodes = make_section_id("FBVN");
 constexpr SectionId kVertexCheckBegin = make_section_id("FVCB");
 constexpr SectionId kVertexChecks = make_section_id("FVCK");
 constexpr SectionId kTriangleChecks = make_section_id("FTCK");
@@ -48,6 +54,8 @@ constexpr SectionId kClusterArrays[] = {kBoneClusterBegin, kClusters,     kCheck
 constexpr std::uint32_t kSectionVersion = 1;
 // FNOD and FITM of a pack with clusters: the bones' trees, then the clusters'.
 constexpr std::uint32_t kClusteredTreesVersion = 2;
+// FITM of a pack with BVH bone trees (FBVN), with or without clusters.
+constexpr std::uint32_t kBvhTreesVersion = 3;
 // LIMT version 1 held the limits as JSON text; version 2 is binary, so
 // loading a pack parses no JSON (JSON stays the editor's authoring format).
 constexpr std::uint32_t kLimitsVersion = 2;
@@ -494,9 +502,14 @@ Expected<PackWriter> character_pack_writer(const PackContents& c) {
     SINEW_RETURN_IF_ERROR(w.add_section(kFuzzyHeader, kSectionVersion, std::as_bytes(std::span(&h, 1))));
     SINEW_RETURN_IF_ERROR(w.add_section(kTriangleBone, kSectionVersion, bytes_of<std::uint16_t>(f.triangle_bone)));
     SINEW_RETURN_IF_ERROR(w.add_section(kBoneTrees, kSectionVersion, bytes_of<rt::BoneTree>(f.bone_trees)));
-    const std::uint32_t trees_version = f.bone_cluster_begin.empty() ? kSectionVersion : kClusteredTreesVersion;
-    SINEW_RETURN_IF_ERROR(w.add_section(kNodes, trees_version, bytes_of<rt::KdNode>(f.nodes)));
-    SINEW_RETURN_IF_ERROR(w.add_section(kItems, trees_version, bytes_of<std::uint32_t>(f.items)));
+    if (f.tree_kind == rt::BoneTreeKind::kBvh) {
+      SINEW_RETURN_IF_ERROR(w.add_section(kBvhNodes, kSectionVersion, bytes_of<rt::BvhNode>(f.bvh_nodes)));
+      SINEW_RETURN_IF_ERROR(w.add_section(kItems, kBvhTreesVersion, bytes_of<std::uint32_t>(f.items)));
+    } else {
+      const std::uint32_t trees_version = f.bone_cluster_begin.empty() ? kSectionVersion : kClusteredTreesVersion;
+      SINEW_RETURN_IF_ERROR(w.add_section(kNodes, trees_version, bytes_of<rt::KdNode>(f.nodes)));
+      SINEW_RETURN_IF_ERROR(w.add_section(kItems, trees_version, bytes_of<std::uint32_t>(f.items)));
+    }
     SINEW_RETURN_IF_ERROR(
         w.add_section(kVertexCheckBegin, kSectionVersion, bytes_of<std::uint32_t>(f.vertex_check_begin)));
     SINEW_RETURN_IF_ERROR(w.add_section(kVertexChecks, kSectionVersion, bytes_of<rt::VertexCheck>(f.vertex_checks)));
@@ -607,10 +620,20 @@ Expected<Pack> Pack::load(PackReader reader) {
   for (SectionId id : {kFuzzyHeader, kTriangleBone, kBoneTrees, kVertexCheckBegin, kVertexChecks, kTriangleChecks}) {
     SINEW_RETURN_IF_ERROR(check_version(r, id));
   }
-  for (SectionId id : {kNodes, kItems}) {
-    SINEW_RETURN_IF_ERROR(has_cluster_header
-                              ? check_version(r, id, kClusteredTreesVersion, "in a pack with clusters (FCHD)")
-                              : check_version(r, id, kSectionVersion, "in a pack without clusters (no FCHD)"));
+  const bool has_bvhs = r.contains(kBvhNodes);
+  if (has_bvhs) {
+    if (r.contains(kNodes)) {
+      return make_error(ErrorCode::kInvalidData, r.name(), section_id_name(kNodes), "",
+                        "a pack with BVH bone trees (FBVN) has no kd-tree nodes");
+    }
+    SINEW_RETURN_IF_ERROR(check_version(r, kBvhNodes));
+    SINEW_RETURN_IF_ERROR(check_version(r, kItems, kBvhTreesVersion, "in a pack with BVH bone trees (FBVN)"));
+  } else {
+    for (SectionId id : {kNodes, kItems}) {
+      SINEW_RETURN_IF_ERROR(has_cluster_header
+                                ? check_version(r, id, kClusteredTreesVersion, "in a pack with clusters (FCHD)")
+                                : check_version(r, id, kSectionVersion, "in a pack without clusters (no FCHD)"));
+    }
   }
   FuzzyHeader h{};
   {
@@ -653,7 +676,12 @@ Expected<Pack> Pack::load(PackReader reader) {
   v.bone_count = h.bone_count;
   SINEW_ASSIGN_OR_RETURN(v.triangle_bone, view_section<std::uint16_t>(r, kTriangleBone));
   SINEW_ASSIGN_OR_RETURN(v.bone_trees, view_section<rt::BoneTree>(r, kBoneTrees));
-  SINEW_ASSIGN_OR_RETURN(v.nodes, view_section<rt::KdNode>(r, kNodes));
+  if (has_bvhs) {
+    v.tree_kind = rt::BoneTreeKind::kBvh;
+    SINEW_ASSIGN_OR_RETURN(v.bvh_nodes, view_section<rt::BvhNode>(r, kBvhNodes));
+  } else {
+    SINEW_ASSIGN_OR_RETURN(v.nodes, view_section<rt::KdNode>(r, kNodes));
+  }
   SINEW_ASSIGN_OR_RETURN(v.items, view_section<std::uint32_t>(r, kItems));
   SINEW_ASSIGN_OR_RETURN(v.vertex_check_begin, view_section<std::uint32_t>(r, kVertexCheckBegin));
   SINEW_ASSIGN_OR_RETURN(v.vertex_checks, view_section<rt::VertexCheck>(r, kVertexChecks));

@@ -59,6 +59,8 @@ struct BakeOptions {
   float sah_intersection_cost = rt::FuzzyBakeOptions{}.kd.intersection_cost;
   bool sah_intersection_cost_given = false;  // else the bake's size-based default
   std::optional<std::uint32_t> pose_clusters;  // else the bake's size-based default
+  rt::BoneTreeKind bone_trees = rt::FuzzyBakeOptions{}.bone_trees;
+  int bvh_leaf = rt::BvhBuildOptions{}.max_leaf_items;
   int threads = 0;
   std::size_t max_memory_bytes = character::BakeRequest{}.max_memory_bytes;
   GltfImportOptions gltf;
@@ -112,6 +114,11 @@ struct BakeFlags {
                                "tree the bone uses in the poses nearest it (0-64; default 16\n"
                                "from 25,000 triangles, else 0: none; docs/RAYTRACE.md,\n"
                                "\"Pose-space clusters\")")),
+        bone_trees(l.option("--bone-trees", "kd|bvh",
+                            "the bone trees' structure: the paper's kd-trees, or BVHs\n"
+                            "listing each triangle once (docs/RAYTRACE.md, \"Bone trees:\n"
+                            "kd-tree or BVH\"; default kd)")),
+        bvh_leaf(l.option("--bvh-leaf", "N", "with --bone-trees bvh: at most N triangles a leaf (default 32)")),
         threads(l.option("--threads", "N", "worker threads (default 0: all cores)")),
         max_memory_mib(l.option("--max-memory-mib", "M",
                                 "refuse a bake whose working set would exceed M MiB\n"
@@ -136,6 +143,8 @@ struct BakeFlags {
   const std::optional<std::string>& rigid_bones;
   const std::optional<std::string>& sah_intersection_cost;
   const std::optional<std::string>& pose_clusters;
+  const std::optional<std::string>& bone_trees;
+  const std::optional<std::string>& bvh_leaf;
   const std::optional<std::string>& threads;
   const std::optional<std::string>& max_memory_mib;
   ImportLimitFlags import_limits;
@@ -264,6 +273,14 @@ Expected<BakeOptions> parse_bake_options(const std::vector<std::string>& args, c
     SINEW_ASSIGN_OR_RETURN(const std::int64_t k, cli::parse_int("--pose-clusters", *v, 0, rt::kMaxPoseClusters));
     o.pose_clusters = static_cast<std::uint32_t>(k);
   }
+  if (const std::optional<std::string>& v = f.bone_trees) {
+    SINEW_ASSIGN_OR_RETURN(const int c, cli::parse_choice("--bone-trees", *v, {"kd", "bvh"}));
+    o.bone_trees = c == 0 ? rt::BoneTreeKind::kKdTree : rt::BoneTreeKind::kBvh;
+  }
+  if (const std::optional<std::string>& v = f.bvh_leaf) {
+    SINEW_ASSIGN_OR_RETURN(const std::int64_t n, cli::parse_int("--bvh-leaf", *v, 1, 1 << 20));
+    o.bvh_leaf = static_cast<int>(n);
+  }
   if (const std::optional<std::string>& v = f.threads) {
     SINEW_ASSIGN_OR_RETURN(o.threads, cli::parse_threads("--threads", *v));
   }
@@ -380,6 +397,28 @@ struct TreeFigures {
 };
 
 // Depths of one bone's tree (iterative: loaded trees are already validated).
+TreeFigures tree_figures(const rt::BvhView& tree) {
+  TreeFigures f;
+  if (tree.nodes.empty()) return f;
+  std::vector<std::pair<std::uint32_t, int>> stack{{0u, 0}};
+  double depth_sum = 0.0;
+  while (!stack.empty()) {
+    const auto [node, depth] = stack.back();
+    stack.pop_back();
+    f.max_depth = std::max(f.max_depth, depth);
+    const rt::BvhNode& n = tree.nodes[node];
+    if (n.is_leaf()) {
+      ++f.leaves;
+      depth_sum += depth;
+      continue;
+    }
+    stack.push_back({n.first, depth + 1});
+    stack.push_back({n.first + 1, depth + 1});
+  }
+  f.mean_depth_of_leaves = f.leaves ? depth_sum / static_cast<double>(f.leaves) : 0.0;
+  return f;
+}
+
 TreeFigures tree_figures(const rt::KdTreeView& tree) {
   TreeFigures f;
   if (tree.nodes.empty()) return f;
@@ -450,7 +489,8 @@ Json inspect_json(const character::Pack& pack) {
   double depth_sum = 0.0;
   std::size_t leaves = 0;
   for (std::uint32_t b = 0; b < f.bone_count; ++b) {
-    const TreeFigures t = tree_figures(f.bone_tree(b));
+    const TreeFigures t =
+        f.has_bvhs() ? tree_figures(f.bvh_view(f.bone_trees[b])) : tree_figures(f.bone_tree(b));
     max_depth = std::max(max_depth, t.max_depth);
     depth_sum += t.mean_depth_of_leaves * static_cast<double>(t.leaves);
     leaves += t.leaves;
@@ -462,7 +502,8 @@ Json inspect_json(const character::Pack& pack) {
                   {"rest_area", st.rest_area},
                   {"fuzzy_area_ratio", st.rest_area > 0.0 ? st.fuzzy_area / st.rest_area : 0.0},
                   {"triangles_per_leaf", st.mean_items_per_leaf},
-                  {"nodes", f.nodes.size()},
+                  {"bone_trees", f.has_bvhs() ? "bvh" : "kd"},
+                  {"nodes", f.has_bvhs() ? f.bvh_nodes.size() : f.nodes.size()},
                   {"leaf_items", f.items.size()},
                   {"max_depth", max_depth},
                   {"mean_leaf_depth", leaves ? depth_sum / static_cast<double>(leaves) : 0.0},
@@ -574,6 +615,8 @@ int run_bake(const std::vector<std::string>& args, std::ostream& out, std::ostre
   request.fuzzy.fine_mesh_cost = !o.sah_intersection_cost_given;
   request.fuzzy.pose_clusters = o.pose_clusters.value_or(0);
   request.fuzzy.fine_mesh_clusters = !o.pose_clusters.has_value();
+  request.fuzzy.bone_trees = o.bone_trees;
+  request.fuzzy.bvh.max_leaf_items = o.bvh_leaf;
   request.max_memory_bytes = o.max_memory_bytes;
   request.fuzzy.memory_budget_bytes = std::min(request.fuzzy.memory_budget_bytes, o.max_memory_bytes / 4);
   if (!o.limits_path.empty()) {

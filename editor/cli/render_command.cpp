@@ -81,6 +81,8 @@ struct RenderFlags {
                                "(0-64; default 16 from 25,000 triangles, else 0: none;\n"
                                "in-memory bakes, a pack has its own)")),
         clusters(l.option("--clusters", "on|off", "bones use the clusters the bake or pack has (default on)")),
+        bone_trees(l.option("--bone-trees", "kd|bvh",
+                            "the bake's bone trees (default kd; in-memory bakes, a pack has its own)")),
         import_limits(l) {}
 
   const std::vector<std::string>& model;
@@ -108,6 +110,7 @@ struct RenderFlags {
   const std::optional<std::string>& ground;
   const std::optional<std::string>& pose_clusters;
   const std::optional<std::string>& clusters;
+  const std::optional<std::string>& bone_trees;
   ImportLimitFlags import_limits;
 };
 
@@ -225,6 +228,10 @@ Status parse_run(const RenderFlags& f, RenderOptions& o) {
   }
   if (const std::optional<std::string>& text = f.clusters) {
     SINEW_ASSIGN_OR_RETURN(o.use_clusters, cli::parse_on_off("--clusters", *text));
+  }
+  if (const std::optional<std::string>& text = f.bone_trees) {
+    SINEW_ASSIGN_OR_RETURN(const int c, cli::parse_choice("--bone-trees", *text, {"kd", "bvh"}));
+    o.bone_trees = c == 0 ? rt::BoneTreeKind::kKdTree : rt::BoneTreeKind::kBvh;
   }
   if (const std::optional<std::string>& text = f.ground) {
     SINEW_ASSIGN_OR_RETURN(o.ground, cli::parse_on_off("--ground", *text));
@@ -416,6 +423,7 @@ Expected<RenderOutputs> render_model(const RenderOptions& options) {
     request.pose_space = options.pose_space;
     request.fuzzy.pose_clusters = options.pose_clusters.value_or(0);
     request.fuzzy.fine_mesh_clusters = !options.pose_clusters.has_value();
+    request.fuzzy.bone_trees = options.bone_trees;
     if (!options.limits_path.empty()) {
       SINEW_ASSIGN_OR_RETURN(request.limits, anim::load_joint_limits(options.limits_path, model.skeleton));
     }

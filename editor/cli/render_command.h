@@ -69,6 +69,7 @@ struct RenderOptions {
   // (rt::FuzzyBakeOptions::pose_clusters, 0: none); and whether bones use
   // the clusters a bake or pack has (rt::FrameOptions::pose_clusters).
   std::optional<std::uint32_t> pose_clusters;  // else the bake's size-based default
+  rt::BoneTreeKind bone_trees = rt::FuzzyBakeOptions{}.bone_trees;  // in-memory bakes only
   bool use_clusters = true;
   bool ground = true;  // the ground quad under the model (--ground off: characters alone)
   // Called with one line per step (import, bake, frames, write); null: quiet.

@@ -157,8 +157,28 @@ std::vector<Aabb> leaf_cells(const rt::KdTreeView& tree) {
   return cells;
 }
 
+std::vector<Aabb> bvh_leaf_boxes(const rt::BvhView& tree) {
+  std::vector<Aabb> boxes;
+  for (const rt::BvhNode& node : tree.nodes) {
+    if (node.is_leaf()) boxes.push_back(node.box);
+  }
+  return boxes;
+}
+
 std::vector<std::uint32_t> leaf_heat(const rt::FuzzyCharacterView& fuzzy, std::size_t triangle_count) {
   std::vector<std::uint32_t> heat(triangle_count, 0);
+  if (fuzzy.has_bvhs()) {
+    for (const rt::BoneTree& bt : fuzzy.bone_trees) {
+      const rt::BvhView tree = fuzzy.bvh_view(bt);
+      for (const rt::BvhNode& node : tree.nodes) {
+        if (!node.is_leaf()) continue;
+        for (std::uint32_t i = node.first; i < node.first + node.count && i < tree.items.size(); ++i) {
+          if (tree.items[i] < heat.size()) heat[tree.items[i]] = node.count;
+        }
+      }
+    }
+    return heat;
+  }
   for (std::uint32_t b = 0; b < fuzzy.bone_trees.size(); ++b) {
     const rt::KdTreeView tree = fuzzy.bone_tree(b);
     for (const rt::KdNode& node : tree.nodes) {
@@ -177,8 +197,9 @@ std::vector<std::uint32_t> leaf_heat(const rt::FuzzyCharacterView& fuzzy, std::s
 void draw_bone_boxes(const ImageRef& image, const Projection& projection, const rt::FuzzyCharacterView& fuzzy,
                      std::uint32_t bone, const Affine3& skinning) {
   if (bone >= fuzzy.bone_trees.size()) return;
-  const rt::KdTreeView tree = fuzzy.bone_tree(bone);
-  for (const Aabb& cell : leaf_cells(tree)) draw_box(image, projection, cell, skinning, kLeafBoxColor);
+  const std::vector<Aabb> cells = fuzzy.has_bvhs() ? bvh_leaf_boxes(fuzzy.bvh_view(fuzzy.bone_trees[bone]))
+                                                   : leaf_cells(fuzzy.bone_tree(bone));
+  for (const Aabb& cell : cells) draw_box(image, projection, cell, skinning, kLeafBoxColor);
   // The root box last so that it stays visible where the cells touch it.
   draw_box(image, projection, fuzzy.bone_trees[bone].bounds, skinning, kRootBoxColor);
 }

@@ -80,6 +80,9 @@ void draw_box(const ImageRef& image, const Projection& projection, const Aabb& b
 // path), in the tree's frame.
 std::vector<Aabb> leaf_cells(const rt::KdTreeView& tree);
 
+// A BVH bone tree's leaf boxes (each holds its triangles' fuzzy boxes).
+std::vector<Aabb> bvh_leaf_boxes(const rt::BvhView& tree);
+
 // Per triangle: the largest item count among the leaves listing it (0 for
 // triangles in no leaf), from one walk over every bone tree.
 std::vector<std::uint32_t> leaf_heat(const rt::FuzzyCharacterView& fuzzy, std::size_t triangle_count);

@@ -143,6 +143,15 @@ Status validate_input(const FuzzyBakeInput& input, const FuzzyBakeOptions& optio
     return invalid_argument("pose_clusters", std::to_string(options.pose_clusters),
                             "at most " + std::to_string(kMaxPoseClusters));
   }
+  if (options.bone_trees != BoneTreeKind::kKdTree && options.bone_trees != BoneTreeKind::kBvh) {
+    return invalid_argument("bone_trees", std::to_string(static_cast<int>(options.bone_trees)), "not kd or bvh");
+  }
+  if (options.bone_trees == BoneTreeKind::kBvh && (options.bvh.max_leaf_items < 1 || options.bvh.bins < 2 ||
+                                                   options.bvh.bins > 256)) {
+    return invalid_argument("bvh", std::to_string(options.bvh.max_leaf_items) + " items a leaf, " +
+                                       std::to_string(options.bvh.bins) + " bins",
+                            "a leaf holds at least 1 item; bins in [2, 256]");
+  }
   return check_skinned_mesh(MeshOrigin{}, *input.mesh, bones);
 }
 
@@ -531,19 +540,60 @@ std::vector<Aabb> triangle_fuzzy_boxes(const FuzzyCharacterData& out) {
 // ---------------------------------------------------------------------------
 // Bone trees
 
-// `count` kd-trees in parallel, tree i over the boxes fill(i, boxes) puts
-// in `boxes` (none when it puts none); the first error, if any.
+// The trees of a bake, of the kind FuzzyBakeOptions::bone_trees asks for.
+struct TreeBuild {
+  BoneTreeKind kind = BoneTreeKind::kKdTree;
+  KdBuildOptions kd;
+  BvhBuildOptions bvh;
+};
+
+// One bone's (or cluster's) tree before concatenation: items index the
+// boxes it was built over.
+struct BuiltTree {
+  std::vector<KdNode> kd_nodes;
+  std::vector<BvhNode> bvh_nodes;
+  std::vector<std::uint32_t> items;
+  Aabb bounds;
+  std::uint64_t full_leaves = 0;
+  std::uint64_t item_refs = 0;
+  int max_depth = 0;
+};
+
+Expected<BuiltTree> build_tree(std::span<const Aabb> boxes, const TreeBuild& build) {
+  BuiltTree t;
+  if (build.kind == BoneTreeKind::kBvh) {
+    SINEW_ASSIGN_OR_RETURN(BoxBvh bvh, build_box_bvh(boxes, build.bvh));
+    t.bounds = bvh.view().bounds;
+    t.full_leaves = bvh.stats.leaf_count;
+    t.item_refs = bvh.stats.item_count;
+    t.max_depth = bvh.stats.max_depth;
+    t.bvh_nodes = std::move(bvh.nodes);
+    t.items = std::move(bvh.items);
+    return t;
+  }
+  SINEW_ASSIGN_OR_RETURN(KdTree kd, build_kd_tree(boxes, build.kd));
+  t.bounds = kd.bounds;
+  t.full_leaves = kd.stats.leaf_count - kd.stats.empty_leaf_count;
+  t.item_refs = kd.stats.item_refs;
+  t.max_depth = kd.stats.max_depth;
+  t.kd_nodes = std::move(kd.nodes);
+  t.items = std::move(kd.items);
+  return t;
+}
+
+// `count` trees in parallel, tree i over the boxes fill(i, boxes) puts in
+// `boxes` (none when it puts none); the first error, if any.
 template <class Fill>
-Expected<std::vector<std::optional<KdTree>>> build_trees(std::size_t count, const KdBuildOptions& kd,
-                                                         JobSystem& jobs, Fill&& fill) {
-  std::vector<std::optional<KdTree>> trees(count);
+Expected<std::vector<std::optional<BuiltTree>>> build_trees(std::size_t count, const TreeBuild& build,
+                                                            JobSystem& jobs, Fill&& fill) {
+  std::vector<std::optional<BuiltTree>> trees(count);
   std::vector<Status> errors(count);
   jobs.parallel_for(0, count, 1, [&](Range r) {
     for (std::size_t i = r.begin; i < r.end; ++i) {
       std::vector<Aabb> boxes;
       fill(i, boxes);
       if (boxes.empty()) continue;
-      Expected<KdTree> tree = build_kd_tree(boxes, kd);
+      Expected<BuiltTree> tree = build_tree(boxes, build);
       if (tree.ok()) {
         trees[i] = std::move(tree).value();
       } else {
@@ -555,10 +605,35 @@ Expected<std::vector<std::optional<KdTree>>> build_trees(std::size_t count, cons
   return trees;
 }
 
-KdBuildOptions tree_build_options(const FuzzyBakeOptions& options, std::size_t triangle_count) {
-  KdBuildOptions kd = options.kd;
-  if (options.fine_mesh_cost && triangle_count >= kFineMeshTriangles) kd.intersection_cost = kFineMeshIntersectionCost;
-  return kd;
+// Appends `tree` (built over `triangles`' boxes, in that order) to the
+// character's arrays as the slice `bt`: node indices stay tree-relative,
+// item indices become triangle ids.
+void append_tree(const BuiltTree& tree, std::span<const std::uint32_t> triangles, FuzzyCharacterData& out,
+                 BoneTree& bt) {
+  const bool bvh = out.tree_kind == BoneTreeKind::kBvh;
+  bt.node_begin = static_cast<std::uint32_t>(bvh ? out.bvh_nodes.size() : out.nodes.size());
+  bt.node_count = static_cast<std::uint32_t>(bvh ? tree.bvh_nodes.size() : tree.kd_nodes.size());
+  bt.item_begin = static_cast<std::uint32_t>(out.items.size());
+  bt.item_count = static_cast<std::uint32_t>(tree.items.size());
+  bt.bounds = tree.bounds;
+  if (bvh) {
+    out.bvh_nodes.insert(out.bvh_nodes.end(), tree.bvh_nodes.begin(), tree.bvh_nodes.end());
+  } else {
+    out.nodes.insert(out.nodes.end(), tree.kd_nodes.begin(), tree.kd_nodes.end());
+  }
+  for (std::uint32_t item : tree.items) out.items.push_back(triangles[item]);
+}
+
+std::uint32_t tree_node_count(const FuzzyCharacterData& out) {
+  return static_cast<std::uint32_t>(out.tree_kind == BoneTreeKind::kBvh ? out.bvh_nodes.size() : out.nodes.size());
+}
+
+TreeBuild tree_build_options(const FuzzyBakeOptions& options, std::size_t triangle_count) {
+  TreeBuild build{options.bone_trees, options.kd, options.bvh};
+  if (options.fine_mesh_cost && triangle_count >= kFineMeshTriangles) {
+    build.kd.intersection_cost = kFineMeshIntersectionCost;
+  }
+  return build;
 }
 
 Status build_bone_trees(std::span<const Aabb> triangle_boxes, const FuzzyBakeOptions& options,
@@ -576,38 +651,34 @@ Status build_bone_trees(std::span<const Aabb> triangle_boxes, const FuzzyBakeOpt
     }
   }
 
-  const KdBuildOptions kd = tree_build_options(options, out.triangle_bone.size());
-  SINEW_ASSIGN_OR_RETURN(const std::vector<std::optional<KdTree>> trees,
-                         build_trees(bone_count, kd, jobs, [&](std::size_t b, std::vector<Aabb>& boxes) {
+  const TreeBuild build = tree_build_options(options, out.triangle_bone.size());
+  out.tree_kind = build.kind;
+  SINEW_ASSIGN_OR_RETURN(const std::vector<std::optional<BuiltTree>> trees,
+                         build_trees(bone_count, build, jobs, [&](std::size_t b, std::vector<Aabb>& boxes) {
                            boxes.reserve(begin[b + 1] - begin[b]);
                            for (std::uint32_t i = begin[b]; i < begin[b + 1]; ++i) {
                              boxes.push_back(triangle_boxes[triangles[i]]);
                            }
                          }));
 
-  // Concatenate in bone order: node indices are tree-relative, item indices
-  // become triangle ids.
+  // Concatenate in bone order.
   out.bone_trees.assign(bone_count, BoneTree{});
   std::uint64_t full_leaves = 0;
   std::uint64_t item_refs = 0;
   for (std::uint32_t b = 0; b < bone_count; ++b) {
     BoneTree& bt = out.bone_trees[b];
     bt.triangle_count = begin[b + 1] - begin[b];
-    bt.node_begin = static_cast<std::uint32_t>(out.nodes.size());
+    bt.node_begin = tree_node_count(out);
     bt.item_begin = static_cast<std::uint32_t>(out.items.size());
     bt.bounds = Aabb::empty();
     if (!trees[b]) continue;
-    const KdTree& tree = *trees[b];
-    bt.node_count = static_cast<std::uint32_t>(tree.nodes.size());
-    bt.item_count = static_cast<std::uint32_t>(tree.items.size());
-    bt.bounds = tree.bounds;
-    out.nodes.insert(out.nodes.end(), tree.nodes.begin(), tree.nodes.end());
-    for (std::uint32_t item : tree.items) out.items.push_back(triangles[begin[b] + item]);
-    full_leaves += tree.stats.leaf_count - tree.stats.empty_leaf_count;
-    item_refs += tree.stats.item_refs;
-    out.stats.max_depth = std::max(out.stats.max_depth, tree.stats.max_depth);
+    const BuiltTree& tree = *trees[b];
+    append_tree(tree, std::span(triangles).subspan(begin[b], bt.triangle_count), out, bt);
+    full_leaves += tree.full_leaves;
+    item_refs += tree.item_refs;
+    out.stats.max_depth = std::max(out.stats.max_depth, tree.max_depth);
   }
-  out.stats.node_count = static_cast<std::uint32_t>(out.nodes.size());
+  out.stats.node_count = tree_node_count(out);
   out.stats.mean_items_per_leaf =
       full_leaves ? static_cast<double>(item_refs) / static_cast<double>(full_leaves) : 0.0;
   return {};
@@ -719,7 +790,7 @@ Status grow_cluster_boxes(const Samples& samples, const ClusterMembers& members,
 
 // A tree per cluster over its bone's triangles and their cluster boxes,
 // appended after the full trees; and the clusters' fuzzy area.
-Status build_cluster_trees(const SkinnedMesh& mesh, const KdBuildOptions& kd, JobSystem& jobs,
+Status build_cluster_trees(const SkinnedMesh& mesh, const TreeBuild& build, JobSystem& jobs,
                            FuzzyCharacterData& out) {
   const std::uint32_t bone_count = out.bone_count;
   std::vector<std::vector<std::uint32_t>> bone_triangles(bone_count);
@@ -736,8 +807,8 @@ Status build_cluster_trees(const SkinnedMesh& mesh, const KdBuildOptions& kd, Jo
   for (std::uint32_t b = 0; b < bone_count; ++b) {
     for (std::uint32_t q = out.bone_cluster_begin[b]; q < out.bone_cluster_begin[b + 1]; ++q) cluster_bone[q] = b;
   }
-  SINEW_ASSIGN_OR_RETURN(const std::vector<std::optional<KdTree>> trees,
-                         build_trees(out.clusters.size(), kd, jobs, [&](std::size_t q, std::vector<Aabb>& boxes) {
+  SINEW_ASSIGN_OR_RETURN(const std::vector<std::optional<BuiltTree>> trees,
+                         build_trees(out.clusters.size(), build, jobs, [&](std::size_t q, std::vector<Aabb>& boxes) {
                            for (const std::uint32_t t : bone_triangles[cluster_bone[q]]) {
                              boxes.push_back(cluster_box(out.clusters[q], t));
                            }
@@ -746,13 +817,7 @@ Status build_cluster_trees(const SkinnedMesh& mesh, const KdBuildOptions& kd, Jo
     BoneTree& bt = out.clusters[q].tree;
     const std::vector<std::uint32_t>& triangles = bone_triangles[cluster_bone[q]];
     bt.triangle_count = static_cast<std::uint32_t>(triangles.size());
-    bt.node_begin = static_cast<std::uint32_t>(out.nodes.size());
-    bt.item_begin = static_cast<std::uint32_t>(out.items.size());
-    bt.node_count = static_cast<std::uint32_t>(trees[q]->nodes.size());
-    bt.item_count = static_cast<std::uint32_t>(trees[q]->items.size());
-    bt.bounds = trees[q]->bounds;
-    out.nodes.insert(out.nodes.end(), trees[q]->nodes.begin(), trees[q]->nodes.end());
-    for (const std::uint32_t item : trees[q]->items) out.items.push_back(triangles[item]);
+    append_tree(*trees[q], triangles, out, bt);
   }
   // Each triangle's area averaged over its bone's clusters.
   double area = 0.0;
@@ -771,7 +836,7 @@ Status build_cluster_trees(const SkinnedMesh& mesh, const KdBuildOptions& kd, Jo
   }
   out.stats.cluster_fuzzy_area = area;
   out.stats.cluster_count = static_cast<std::uint32_t>(out.clusters.size());
-  out.stats.node_count = static_cast<std::uint32_t>(out.nodes.size());
+  out.stats.node_count = tree_node_count(out);
   return {};
 }
 

@@ -76,6 +76,11 @@ struct FuzzyBakeOptions {
   // single rays and 8-ray packets are slower.
   KdBuildOptions kd{.traversal_cost = 1.0f, .intersection_cost = 0.15f, .empty_bonus = 0.2f, .max_leaf_items = 1,
                     .max_depth = 0};
+  // The bone trees' structure (docs/RAYTRACE.md, "Bone trees: kd-tree or
+  // BVH"): the paper's kd-trees (built by `kd`) or BVHs over the same fuzzy
+  // boxes (built by `bvh`), each triangle listed once.
+  BoneTreeKind bone_trees = BoneTreeKind::kKdTree;
+  BvhBuildOptions bvh;
   // When set, a mesh of kFineMeshTriangles or more builds with
   // kFineMeshIntersectionCost instead of kd.intersection_cost: where the
   // triangles are about a pixel, a packet meets a leaf's triangles a few at

@@ -17,6 +17,7 @@
 #include <span>
 #include <vector>
 
+#include "raytrace/bvh/box_bvh.h"
 #include "raytrace/kdtree/kd_tree.h"
 #include "runtime/core/status.h"
 #include "runtime/math/aabb.h"
@@ -27,7 +28,14 @@ struct SkinnedMesh;
 
 namespace sinew::rt {
 
-// One bone's fuzzy kd-tree: a slice of the character's node and item arrays.
+// The structure over a bone's fuzzy boxes (FuzzyBakeOptions::bone_trees):
+// the paper's kd-tree, or a BVH listing each triangle once (raytrace/bvh/
+// box_bvh.h, docs/RAYTRACE.md "Bone trees: kd-tree or BVH"). One kind for
+// every tree of a character.
+enum class BoneTreeKind : std::uint8_t { kKdTree = 0, kBvh = 1 };
+
+// One bone's fuzzy tree: a slice of the character's node array (kd-tree
+// nodes, or BVH nodes when the character's trees are BVHs) and item array.
 // Items are triangle ids of the mesh. `bounds` is the fuzzy root box (the
 // union of the bone's triangles' fuzzy boxes, in the bone's frame).
 struct BoneTree {
@@ -77,7 +85,9 @@ struct FuzzyCharacterView {
   std::uint32_t bone_count = 0;
   std::span<const std::uint16_t> triangle_bone;             // per triangle: its bone
   std::span<const BoneTree> bone_trees;                     // per bone
-  std::span<const KdNode> nodes;                            // all bones' nodes
+  BoneTreeKind tree_kind = BoneTreeKind::kKdTree;
+  std::span<const KdNode> nodes;                            // all bones' kd-tree nodes (empty with BVHs)
+  std::span<const BvhNode> bvh_nodes;                       // all bones' BVH nodes (empty with kd-trees)
   std::span<const std::uint32_t> items;                     // all bones' leaf items
   std::span<const std::uint32_t> vertex_check_begin;        // per vertex + 1: CSR into vertex_checks
   std::span<const VertexCheck> vertex_checks;
@@ -96,9 +106,15 @@ struct FuzzyCharacterView {
   std::span<const float> cluster_centres;
   float feature_translation_scale = 1.0f;
 
+  bool has_bvhs() const { return tree_kind == BoneTreeKind::kBvh; }
+  // Kd-trees only (has_bvhs() false).
   KdTreeView bone_tree(std::uint32_t bone) const { return tree_view(bone_trees[bone]); }
   KdTreeView tree_view(const BoneTree& b) const {
     return {nodes.subspan(b.node_begin, b.node_count), items.subspan(b.item_begin, b.item_count), b.bounds};
+  }
+  // BVHs only (has_bvhs() true).
+  BvhView bvh_view(const BoneTree& b) const {
+    return {bvh_nodes.subspan(b.node_begin, b.node_count), items.subspan(b.item_begin, b.item_count), b.bounds};
   }
   bool has_clusters() const { return !clusters.empty(); }
   // The box `cluster` holds vertex check `check` to.
@@ -151,7 +167,9 @@ struct FuzzyCharacterData {
   std::uint32_t bone_count = 0;
   std::vector<std::uint16_t> triangle_bone;
   std::vector<BoneTree> bone_trees;
+  BoneTreeKind tree_kind = BoneTreeKind::kKdTree;
   std::vector<KdNode> nodes;
+  std::vector<BvhNode> bvh_nodes;
   std::vector<std::uint32_t> items;
   std::vector<std::uint32_t> vertex_check_begin;
   std::vector<VertexCheck> vertex_checks;
@@ -167,7 +185,7 @@ struct FuzzyCharacterData {
   FuzzyBakeStats stats;
 
   FuzzyCharacterView view() const {
-    return {bone_count,         triangle_bone, bone_trees,         nodes,         items,
+    return {bone_count,         triangle_bone, bone_trees,         tree_kind,     nodes,         bvh_nodes, items,
             vertex_check_begin, vertex_checks, triangle_checks,    bone_cluster_begin,
             clusters,           check_rank,    cluster_boxes,      feature_bone_begin,
             feature_bones,      cluster_centres, feature_translation_scale};

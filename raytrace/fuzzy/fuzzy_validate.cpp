@@ -96,6 +96,98 @@ bool listed_where_needed(const KdTreeView& tree, std::uint32_t node_index, std::
          (!above || listed_where_needed(tree, node.above_child(), item, above_box));
 }
 
+// A BVH bone tree against the bone's triangles: node links (children
+// adjacent, after their parent, inside the slice), depth, leaf ranges that
+// partition the items, each triangle of the bone listed exactly once, and
+// boxes that hold what lies below them: each leaf's box its items' fuzzy
+// boxes (box_of), each inner node's box its children's. Containment is
+// transitive, so a walk that enters every node box a ray passes within its
+// slack of reaches every triangle whose fuzzy box the ray passes.
+template <class BoxOf>
+Status validate_bvh(const FuzzyCharacterView& fuzzy, const BvhView& tree, std::uint32_t b,
+                    std::span<const std::uint32_t> bone_triangles, const std::string& where, BoxOf&& box_of) {
+  const auto node_field = [&](std::size_t n) { return where + ".bvh_nodes[" + std::to_string(n) + "]"; };
+  for (std::size_t n = 0; n < tree.nodes.size(); ++n) {
+    if (has_nan(tree.nodes[n].box)) return bad_character(node_field(n) + ".box", "NaN", "box is not a number");
+  }
+  if (tree.items.size() != bone_triangles.size()) {
+    return bad_character(where + ".item_count", std::to_string(tree.items.size()),
+                         "a BVH lists each of the bone's " + std::to_string(bone_triangles.size()) +
+                             " triangles once");
+  }
+  // As many items as the bone has triangles, each of bone b: with no
+  // triangle twice, every triangle of the bone is listed.
+  std::vector<std::uint32_t> sorted(tree.items.begin(), tree.items.end());
+  std::sort(sorted.begin(), sorted.end());
+  if (const auto twice = std::adjacent_find(sorted.begin(), sorted.end()); twice != sorted.end()) {
+    return bad_character(where + " triangle " + std::to_string(*twice), std::to_string(b),
+                         "listed twice in one BVH (and another of the bone's triangles not at all)");
+  }
+  struct Pending {
+    std::uint32_t node;
+    int depth;
+  };
+  std::vector<Pending> stack;
+  if (!tree.nodes.empty()) stack.push_back({0, 0});
+  std::size_t visited = 0;
+  std::size_t items_listed = 0;
+  std::vector<std::uint8_t> item_listed(tree.items.size(), 0);
+  while (!stack.empty()) {
+    const Pending p = stack.back();
+    stack.pop_back();
+    if (++visited > tree.nodes.size()) return bad_character(where, "", "BVH nodes form a cycle");
+    if (p.depth > kMaxTraversalDepth) {
+      return bad_character(where, std::to_string(p.depth), "BVH deeper than the traversal supports");
+    }
+    const BvhNode& node = tree.nodes[p.node];
+    if (node.is_leaf()) {
+      if (std::size_t{node.first} + node.count > tree.items.size()) {
+        return bad_character(node_field(p.node), std::to_string(node.first), "leaf items outside the item array");
+      }
+      for (std::uint32_t i = node.first; i < node.first + node.count; ++i) {
+        if (item_listed[i]++ != 0) {
+          return bad_character(node_field(p.node), std::to_string(i), "an item listed by two leaves");
+        }
+        ++items_listed;
+        const std::uint32_t t = tree.items[i];
+        if (t >= fuzzy.triangle_bone.size()) {
+          return bad_character(where + ".items[" + std::to_string(i) + "]", std::to_string(t),
+                               "not a triangle of the mesh");
+        }
+        if (fuzzy.triangle_bone[t] != b) {
+          return bad_character(where + ".items[" + std::to_string(i) + "]", std::to_string(t),
+                               "a triangle of bone " + std::to_string(fuzzy.triangle_bone[t]));
+        }
+        if (i > node.first && !(tree.items[i - 1] < t)) {
+          return bad_character(node_field(p.node), std::to_string(t), "leaf items must increase");
+        }
+        if (!node.box.contains(box_of(t))) {
+          return bad_character(where + " triangle " + std::to_string(t), std::to_string(b),
+                               "the triangle's fuzzy box leaves its BVH leaf's box");
+        }
+      }
+      continue;
+    }
+    if (node.first <= p.node || std::size_t{node.first} + 1 >= tree.nodes.size()) {
+      return bad_character(node_field(p.node), std::to_string(node.first), "child index outside the tree");
+    }
+    for (std::uint32_t c = node.first; c <= node.first + 1; ++c) {
+      if (!node.box.contains(tree.nodes[c].box)) {
+        return bad_character(node_field(c), std::to_string(c), "a child's box leaves its parent's");
+      }
+      stack.push_back({c, p.depth + 1});
+    }
+  }
+  if (items_listed != tree.items.size()) {
+    return bad_character(where + ".items", std::to_string(items_listed) + " listed",
+                         "the leaves must list all " + std::to_string(tree.items.size()) + " items");
+  }
+  if (!tree.nodes.empty() && !tree.bounds.contains(tree.nodes.front().box)) {
+    return bad_character(where + ".bounds", std::to_string(b), "the root's box leaves the tree's bounds");
+  }
+  return {};
+}
+
 // One tree of bone b (its full tree or a cluster's) against the mesh: its
 // slice starts where the previous one ended, its leaf items are increasing
 // triangles of b, and every triangle of b is inside its root box and listed
@@ -113,7 +205,8 @@ Status validate_tree_slice(const FuzzyCharacterView& fuzzy, const BoneTree& bt, 
                              std::to_string(item_at) + ")");
   }
   if (has_nan(bt.bounds)) return bad_character(where + ".bounds", "NaN", "box is not a number");
-  if (std::size_t{bt.node_begin} + bt.node_count > fuzzy.nodes.size() ||
+  const std::size_t node_total = fuzzy.has_bvhs() ? fuzzy.bvh_nodes.size() : fuzzy.nodes.size();
+  if (std::size_t{bt.node_begin} + bt.node_count > node_total ||
       std::size_t{bt.item_begin} + bt.item_count > fuzzy.items.size()) {
     return bad_character(where, std::to_string(bt.node_begin), "slice outside the node or item array");
   }
@@ -127,6 +220,7 @@ Status validate_tree_slice(const FuzzyCharacterView& fuzzy, const BoneTree& bt, 
     return bad_character(where + ".node_count", std::to_string(bt.node_count),
                          "a bone has a tree exactly when triangles are assigned to it");
   }
+  if (fuzzy.has_bvhs()) return validate_bvh(fuzzy, fuzzy.bvh_view(bt), b, bone_triangles, where, box_of);
   const KdTreeView tree = fuzzy.tree_view(bt);
   SINEW_RETURN_IF_ERROR(validate_tree(tree, static_cast<std::uint32_t>(fuzzy.triangle_bone.size()), where));
   for (std::size_t n = 0; n < tree.nodes.size(); ++n) {
@@ -273,9 +367,10 @@ Status validate_tree_contents(const FuzzyCharacterView& fuzzy) {
       }
     }
   }
-  if (node_at != fuzzy.nodes.size() || item_at != fuzzy.items.size()) {
+  const std::size_t node_total = fuzzy.has_bvhs() ? fuzzy.bvh_nodes.size() : fuzzy.nodes.size();
+  if (node_at != node_total || item_at != fuzzy.items.size()) {
     return bad_character("bone_trees", std::to_string(node_at) + " nodes, " + std::to_string(item_at) + " items",
-                         "the slices must cover the " + std::to_string(fuzzy.nodes.size()) + " nodes and " +
+                         "the slices must cover the " + std::to_string(node_total) + " nodes and " +
                              std::to_string(fuzzy.items.size()) + " items");
   }
   return {};
@@ -332,6 +427,14 @@ Status validate_fuzzy_character(const SkinnedMesh& mesh, const FuzzyCharacterVie
                              "not the corner vertex's check in the triangle's bone");
       }
     }
+  }
+  if (fuzzy.tree_kind != BoneTreeKind::kKdTree && fuzzy.tree_kind != BoneTreeKind::kBvh) {
+    return bad_character("tree_kind", std::to_string(static_cast<int>(fuzzy.tree_kind)), "not a kd-tree or a BVH");
+  }
+  if (fuzzy.has_bvhs() ? !fuzzy.nodes.empty() : !fuzzy.bvh_nodes.empty()) {
+    return bad_character(fuzzy.has_bvhs() ? "nodes" : "bvh_nodes",
+                         std::to_string(fuzzy.has_bvhs() ? fuzzy.nodes.size() : fuzzy.bvh_nodes.size()),
+                         "a character's trees are all kd-trees or all BVHs");
   }
   const bool any_cluster_array = !fuzzy.bone_cluster_begin.empty() || !fuzzy.clusters.empty() ||
                                  !fuzzy.check_rank.empty() || !fuzzy.cluster_boxes.empty() ||

@@ -584,15 +584,15 @@ class LargeQuery {
         return;
       }
       const Vec3x8 inv{Float8::load(gr.inv[0]), Float8::load(gr.inv[1]), Float8::load(gr.inv[2])};
-      enter_tree(entry, tree, g, gr.origin(), gr.direction(), inv, eps);
+      enter_tree(entry, tree.bounds, g, gr.origin(), gr.direction(), inv, eps);
     });
     walk_tree(tree, entry, leaf);
   }
 
   void visit_bone(const InstanceFrame& frame, std::uint32_t bone, GroupMask groups) {
     const Scene::Character& character = scene_ref().characters()[frame.character];
-    const KdTreeView tree = frame.bone_tree(character.fuzzy, bone);
-    if (tree.empty()) return;
+    const BoneTree& tree = frame.bone_tree(character.fuzzy, bone);
+    if (tree.node_count == 0) return;
     const Affine3& to_bone = frame.bone_from_world[bone];
     const InstanceFrame::BoneCarry& carry = frame.bone_carry[bone];
     // Each group's rays in the bone frame (Affine3::transform_point /
@@ -627,7 +627,7 @@ class LargeQuery {
         return;
       }
       const Vec3x8 inv{Float8(1.0f) / d.x, Float8(1.0f) / d.y, Float8(1.0f) / d.z};
-      enter_tree(entry, tree, g, o, d, inv, eps);
+      enter_tree(entry, tree.bounds, g, o, d, inv, eps);
     });
     const SkinnedMesh& mesh = *character.mesh;
     const auto leaf = [&](std::span<const std::uint32_t> triangles, GroupMask groups_here) {
@@ -637,7 +637,11 @@ class LargeQuery {
                             frame.instance_id};
       });
     };
-    walk_tree(tree, entry, leaf);
+    if (character.fuzzy.has_bvhs()) {
+      walk_bvh(character.fuzzy.bvh_view(tree), entry, leaf);
+    } else {
+      walk_tree(character.fuzzy.tree_view(tree), entry, leaf);
+    }
   }
 
   // Entering a tree: the groups' lanes clipped to its root box, their rays
@@ -650,11 +654,11 @@ class LargeQuery {
 
   // Group g's rays o + t d in the tree's frame (reciprocals inv, lane
   // slack eps).
-  void enter_tree(TreeEntry& entry, const KdTreeView& tree, int g, const Vec3x8& o, const Vec3x8& d,
+  void enter_tree(TreeEntry& entry, const Aabb& bounds, int g, const Vec3x8& o, const Vec3x8& d,
                   const Vec3x8& inv, Float8 eps) {
     VisitGroup& vg = visit_[g];
     Float8 t0 = Float8::load(vg.t0), t1 = Float8::load(vg.t1);
-    vg.lanes = clip_lanes(tree.bounds, eps, o, d, inv, vg.lanes, t0, t1);
+    vg.lanes = clip_lanes(bounds, eps, o, d, inv, vg.lanes, t0, t1);
     if (vg.lanes == 0) return;
     t0.store(vg.t0);
     t1.store(vg.t1);
@@ -701,37 +705,7 @@ class LargeQuery {
   template <class LeafFn>
   void traverse(const KdTreeView& tree, const IntervalBound& bound, const IntervalBound::Growth& grow, GroupMask groups,
                 LeafFn& leaf) {
-    // The packet's limit is the largest of its groups' (group_limit), and
-    // a group's changes only when one of its lanes records a hit: only
-    // those groups are looked at again (a closest-hit packet's groups stay
-    // alive throughout).
-    alignas(32) std::array<float, kMaxPacketGroups> group_limits;
-    float cached = kInf;
-    const int blocks = (groups_ + kLanes - 1) / kLanes;
-    const auto packet_max = [&] {
-      Float8 m(-kInf);
-      for (int i = 0; i < blocks; ++i) m = max(m, Float8::load(&group_limits[static_cast<std::size_t>(i * kLanes)]));
-      return reduce_max(m);
-    };
-    if constexpr (!kAnyHit) {
-      group_limits.fill(-kInf);
-      for_each_bit(groups & alive_groups_, [&](int g) { group_limits[g] = group_limit(g, visit_.data()); });
-      cached = packet_max();
-      limits_lowered_ = 0;
-    }
-    const auto limit = [&]() {
-      if constexpr (kAnyHit) {
-        return bound.t_hi();
-      } else {
-        if (limits_lowered_ != 0) {
-          for_each_bit(limits_lowered_ & groups & alive_groups_,
-                       [&](int g) { group_limits[g] = group_limit(g, visit_.data()); });
-          limits_lowered_ = 0;
-          cached = packet_max();
-        }
-        return cached;
-      }
-    };
+    PacketLimit limit(*this, groups, bound);
     std::array<Cell, kMaxTraversalDepth + 2> stack;
     std::size_t top = 0;
     Cell cur{{tree.bounds.lower.x, tree.bounds.lower.y, tree.bounds.lower.z},
@@ -788,26 +762,114 @@ class LargeQuery {
             continue;
           }
         } else if (node.item_count() > 0) {
-          // Each group's lanes clipped to the cell exactly, as their single
-          // rays would be (grown by each lane's own slack).
-          GroupMask reaching = 0;
-          const Aabb cell = cur.box();
-          // With group frusta each triangle picks its groups itself, more
-          // tightly than the cell would.
-          if (frusta_on_) reaching = groups & alive_groups_;
-          for_each_bit(frusta_on_ ? GroupMask{0} : groups & alive_groups_, [&](int g) {
-            const VisitGroup& vg = visit_[g];
-            Float8 t0 = Float8::load(vg.t0), t1 = Float8::load(vg.t1);
-            if constexpr (!kAnyHit) t1 = min(t1, Float8::load(group_[g].t_limit));
-            leaf_lanes_[g] = clip_lanes(cell, Float8::load(vg.lane_eps), vg.origin(), vg.direction(),
-                                        vg.inverse(), vg.lanes & live_[g], t0, t1);
-            if (leaf_lanes_[g] != 0) reaching |= GroupMask{1} << g;
-          });
-          if (reaching != 0 && leaf(tree.items.subspan(node.first_item(), node.item_count()), reaching)) return;
+          if (visit_leaf(cur.box(), tree.items.subspan(node.first_item(), node.item_count()), groups, leaf)) return;
         }
       }
       if (top == 0) return;
       cur = stack[--top];
+    }
+  }
+
+  // The packet's limit for pruning a walk's nodes: for any-hit rays the
+  // bound's far end; for closest-hit rays the largest of its groups'
+  // (group_limit), and a group's changes only when one of its lanes records
+  // a hit, so only those groups are looked at again (a closest-hit
+  // packet's groups stay alive throughout).
+  class PacketLimit {
+   public:
+    PacketLimit(LargeQuery& q, GroupMask groups, const IntervalBound& bound) : q_(q), groups_(groups), bound_(bound) {
+      if constexpr (!kAnyHit) {
+        limits_.fill(-kInf);
+        for_each_bit(groups_ & q_.alive_groups_, [&](int g) { limits_[g] = q_.group_limit(g, q_.visit_.data()); });
+        cached_ = packet_max();
+        q_.limits_lowered_ = 0;
+      }
+    }
+    float operator()() {
+      if constexpr (kAnyHit) {
+        return bound_.t_hi();
+      } else {
+        if (q_.limits_lowered_ != 0) {
+          for_each_bit(q_.limits_lowered_ & groups_ & q_.alive_groups_,
+                       [&](int g) { limits_[g] = q_.group_limit(g, q_.visit_.data()); });
+          q_.limits_lowered_ = 0;
+          cached_ = packet_max();
+        }
+        return cached_;
+      }
+    }
+
+   private:
+    float packet_max() const {
+      Float8 m(-kInf);
+      const int blocks = (q_.groups_ + kLanes - 1) / kLanes;
+      for (int i = 0; i < blocks; ++i) m = max(m, Float8::load(&limits_[static_cast<std::size_t>(i * kLanes)]));
+      return reduce_max(m);
+    }
+    LargeQuery& q_;
+    GroupMask groups_;
+    const IntervalBound& bound_;
+    alignas(32) std::array<float, kMaxPacketGroups> limits_;
+    float cached_ = kInf;
+  };
+
+  // A leaf (a kd-tree cell, or a BVH leaf's box: every item's fuzzy box
+  // inside it) reached by the packet: without group frusta each group's
+  // lanes are clipped to `cell` exactly, as their single rays would be
+  // (grown by each lane's own slack); with them each triangle picks its
+  // groups itself, more tightly than the cell would. Returns true to stop.
+  template <class LeafFn>
+  bool visit_leaf(const Aabb& cell, std::span<const std::uint32_t> items, GroupMask groups, LeafFn& leaf) {
+    GroupMask reaching = 0;
+    if (frusta_on_) reaching = groups & alive_groups_;
+    for_each_bit(frusta_on_ ? GroupMask{0} : groups & alive_groups_, [&](int g) {
+      const VisitGroup& vg = visit_[g];
+      Float8 t0 = Float8::load(vg.t0), t1 = Float8::load(vg.t1);
+      if constexpr (!kAnyHit) t1 = min(t1, Float8::load(group_[g].t_limit));
+      leaf_lanes_[g] = clip_lanes(cell, Float8::load(vg.lane_eps), vg.origin(), vg.direction(), vg.inverse(),
+                                  vg.lanes & live_[g], t0, t1);
+      if (leaf_lanes_[g] != 0) reaching |= GroupMask{1} << g;
+    });
+    return reaching != 0 && leaf(items, reaching);
+  }
+
+  // Front to back over the BVH nodes the packet's bound reaches (each
+  // node's box grown as the kd walk grows its cells), the child the bound
+  // enters first first; at a leaf, as the kd walk's.
+  template <class LeafFn>
+  void walk_bvh(const BvhView& tree, const TreeEntry& entry, LeafFn& leaf) {
+    if (entry.groups == 0) return;
+    const IntervalBound bound(entry.ranges.ranges());
+    tree_groups_ = entry.groups;
+    const IntervalBound::Growth grow = bound.grow_for(tree.bounds, entry.eps);
+    const GroupMask groups = entry.groups;
+    PacketLimit limit(*this, groups, bound);
+    struct Pending {
+      std::uint32_t node;
+      float t;
+    };
+    std::array<Pending, kMaxTraversalDepth + 2> stack;
+    std::size_t top = 0;
+    const float t_root = bound.entry(tree.nodes[0].box, grow, limit());
+    if (t_root == kInf) return;
+    stack[top++] = {0, t_root};
+    while (top > 0) {
+      const Pending e = stack[--top];
+      if (e.t > limit()) continue;
+      ++counters_.node_visits;
+      const BvhNode& node = tree.nodes[e.node];
+      if (node.is_leaf()) {
+        if (visit_leaf(node.box, tree.items.subspan(node.first, node.count), groups, leaf)) return;
+        continue;
+      }
+      const float t_limit = limit();
+      const float ta = bound.entry(tree.nodes[node.first].box, grow, t_limit);
+      const float tb = bound.entry(tree.nodes[node.first + 1].box, grow, t_limit);
+      const bool a_first = ta <= tb;
+      const Pending near{a_first ? node.first : node.first + 1, a_first ? ta : tb};
+      const Pending far{a_first ? node.first + 1 : node.first, a_first ? tb : ta};
+      if (far.t <= t_limit) stack[top++] = far;
+      if (near.t <= t_limit) stack[top++] = near;
     }
   }
 

@@ -294,6 +294,76 @@ bool traverse_packet(const KdTreeView& tree, const FrameRays& r, std::uint32_t i
   }
 }
 
+// Front-to-back walk of one BVH for the lanes in `mask` over their intervals
+// `start` (clipped to the root's box by the caller): a lane enters each
+// node whose box, grown by its eps, its interval reaches before its best
+// hit; of two children both entered, the one with the nearer entry over
+// the packet's lanes goes first. Unlike the kd walk the lanes do not keep
+// their single ray's order (a BVH's siblings overlap, so no order is the
+// rays' own); each still reaches every node its single ray reaches, and
+// tests each of the bone's triangles at most once. `leaf(items, lanes)`
+// returns true to stop (every lane answered).
+template <class LeafFn>
+bool traverse_packet_bvh(const BvhView& tree, const FrameRays& r, std::uint32_t mask, const Intervals& start,
+                         const float* t_limit, const std::uint32_t& live, std::uint64_t& visits, LeafFn& leaf) {
+  struct alignas(32) Pending {
+    float t0[kLanes];
+    std::uint32_t node;
+    std::uint32_t mask;
+  };
+  std::array<Pending, kMaxTraversalDepth + 2> stack;
+  std::size_t top = 0;
+  std::uint32_t index = 0;
+  const __m256 t0 = _mm256_load_ps(start.t0);
+  const __m256 t1 = _mm256_load_ps(start.t1);
+  const auto nearest = [](const Intervals& span, std::uint32_t lanes) {
+    float m = kInf;
+    for (std::uint32_t rest = lanes; rest != 0; rest &= rest - 1) m = std::min(m, span.t0[std::countr_zero(rest)]);
+    return m;
+  };
+  for (;;) {
+    ++visits;
+    const BvhNode& node = tree.nodes[index];
+    if (node.is_leaf()) {
+      if (leaf(tree.items.subspan(node.first, node.count), mask & live)) return true;
+    } else {
+      Intervals a, b;
+      const __m256 limited = _mm256_min_ps(_mm256_loadu_ps(t_limit), t1);
+      _mm256_store_ps(a.t0, t0);
+      _mm256_store_ps(a.t1, limited);
+      b = a;
+      const std::uint32_t lanes = mask & live;
+      const std::uint32_t in_a = clip_lanes(tree.nodes[node.first].box, r.eps, r, lanes, a);
+      const std::uint32_t in_b = clip_lanes(tree.nodes[node.first + 1].box, r.eps, r, lanes, b);
+      if (in_a != 0 && in_b != 0) {
+        const bool a_first = nearest(a, in_a) <= nearest(b, in_b);
+        Pending& far = stack[top++];
+        std::memcpy(far.t0, a_first ? b.t0 : a.t0, sizeof far.t0);
+        far.node = a_first ? node.first + 1 : node.first;
+        far.mask = a_first ? in_b : in_a;
+        index = a_first ? node.first : node.first + 1;
+        mask = a_first ? in_a : in_b;
+        continue;
+      }
+      if ((in_a | in_b) != 0) {
+        index = in_a != 0 ? node.first : node.first + 1;
+        mask = in_a | in_b;
+        continue;
+      }
+    }
+    for (;;) {
+      if (top == 0) return false;
+      const Pending& e = stack[--top];
+      const __m256 ahead = _mm256_cmp_ps(_mm256_load_ps(e.t0), _mm256_loadu_ps(t_limit), _CMP_LE_OQ);
+      mask = static_cast<std::uint32_t>(_mm256_movemask_ps(ahead)) & e.mask & live;
+      if (mask != 0) {
+        index = e.node;
+        break;
+      }
+    }
+  }
+}
+
 // Per object, the triangles already tested and by which lanes: a triangle
 // whose fuzzy box straddles splits is listed in several leaves, and a lane
 // may reach it through each. Direct-mapped on the id's low bits like the
@@ -477,7 +547,7 @@ class PacketQuery {
 
   bool visit_bone(const InstanceFrame& frame, std::uint32_t bone, std::uint32_t lanes, Intervals& span) {
     const Scene::Character& character = scene_.characters()[frame.character];
-    const KdTreeView tree = frame.bone_tree(character.fuzzy, bone);
+    const BoneTree& tree = frame.bone_tree(character.fuzzy, bone);
     const Affine3& to_bone = frame.bone_from_world[bone];
     const InstanceFrame::BoneCarry& carry = frame.bone_carry[bone];
     // Per lane Affine3::transform_point / transform_vector, term by term in
@@ -529,7 +599,12 @@ class PacketQuery {
       }
       return false;
     };
-    return traverse_packet(tree, local, 0, mask, span, t_limit_, live_, counters_.node_visits, leaf);
+    if (character.fuzzy.has_bvhs()) {
+      return traverse_packet_bvh(character.fuzzy.bvh_view(tree), local, mask, span, t_limit_, live_,
+                                 counters_.node_visits, leaf);
+    }
+    return traverse_packet(character.fuzzy.tree_view(tree), local, 0, mask, span, t_limit_, live_,
+                           counters_.node_visits, leaf);
   }
 
   bool visit_static(const Scene::StaticMesh& mesh, std::uint32_t lanes, const Intervals& span) {

@@ -97,6 +97,53 @@ bool traverse_tree(const KdTreeView& tree, const Vec3& o, const Vec3& d, const V
   }
 }
 
+// Front-to-back walk of one BVH over [t0, t1] with every node box grown by
+// `eps` (the kd walk's thickened planes, for boxes): a child is entered
+// whenever the ray passes within eps of its box, the nearer entry first;
+// nodes whose entry lies beyond `t_limit` (read on every pop) are pruned.
+// The caller has clipped [t0, t1] to the root's box. `leaf` returns true to
+// stop (any hit).
+template <class LeafFn>
+bool traverse_bvh(const BvhView& tree, const Vec3& o, const Vec3& d, const Vec3& inv, float eps, float t0, float t1,
+                  const float& t_limit, std::uint64_t& visits, LeafFn&& leaf) {
+  struct Pending {
+    std::uint32_t node;
+    float t;
+  };
+  std::array<Pending, kMaxTraversalDepth + 2> stack;
+  std::size_t top = 0;
+  std::uint32_t index = 0;
+  for (;;) {
+    ++visits;
+    const BvhNode& node = tree.nodes[index];
+    if (node.is_leaf()) {
+      if (leaf(tree.items.subspan(node.first, node.count))) return true;
+    } else {
+      float a0 = t0, a1 = std::min(t1, t_limit), b0 = t0, b1 = a1;
+      const bool a = clip_to_box(tree.nodes[node.first].box, eps, o, d, inv, a0, a1);
+      const bool b = clip_to_box(tree.nodes[node.first + 1].box, eps, o, d, inv, b0, b1);
+      if (a && b) {
+        const bool a_first = a0 <= b0;
+        stack[top++] = a_first ? Pending{node.first + 1, b0} : Pending{node.first, a0};
+        index = a_first ? node.first : node.first + 1;
+        continue;
+      }
+      if (a || b) {
+        index = a ? node.first : node.first + 1;
+        continue;
+      }
+    }
+    for (;;) {
+      if (top == 0) return false;
+      const Pending& entry = stack[--top];
+      if (entry.t <= t_limit) {
+        index = entry.node;
+        break;
+      }
+    }
+  }
+}
+
 // One query: the world ray, its per-ray triangle-test data, and the best hit
 // (closest-hit) or the first hit (any-hit).
 template <TriangleTest kTest, bool kAnyHit>
@@ -174,7 +221,7 @@ class Query {
 
   bool visit_bone(const InstanceFrame& frame, std::uint32_t bone, float t0, float t1) {
     const Scene::Character& character = scene_.characters()[frame.character];
-    const KdTreeView tree = frame.bone_tree(character.fuzzy, bone);
+    const BoneTree& tree = frame.bone_tree(character.fuzzy, bone);
     const Affine3& to_bone = frame.bone_from_world[bone];
     const Vec3 o = to_bone.transform_point(ray_.origin);
     const Vec3 d = to_bone.transform_vector(ray_.direction);
@@ -189,18 +236,22 @@ class Query {
     const Vec3 inv(1.0f / d.x, 1.0f / d.y, 1.0f / d.z);
     if (!clip_to_box(tree.bounds, eps, o, d, inv, t0, t1)) return false;
     const SkinnedMesh& mesh = *character.mesh;
-    return traverse_tree(tree, o, d, inv, eps, t0, t1, t_limit_, counters_.node_visits,
-                         [&](std::span<const std::uint32_t> triangles) {
-                           for (const std::uint32_t t : triangles) {
-                             if (mailbox_.seen(t)) continue;
-                             const auto& v = mesh.triangles[t];
-                             if (test(frame.positions[v[0]], frame.positions[v[1]], frame.positions[v[2]], t,
-                                      frame.instance_id)) {
-                               return true;
-                             }
-                           }
-                           return false;
-                         });
+    const auto leaf = [&](std::span<const std::uint32_t> triangles) {
+      for (const std::uint32_t t : triangles) {
+        if (mailbox_.seen(t)) continue;
+        const auto& v = mesh.triangles[t];
+        if (test(frame.positions[v[0]], frame.positions[v[1]], frame.positions[v[2]], t, frame.instance_id)) {
+          return true;
+        }
+      }
+      return false;
+    };
+    if (character.fuzzy.has_bvhs()) {
+      return traverse_bvh(character.fuzzy.bvh_view(tree), o, d, inv, eps, t0, t1, t_limit_, counters_.node_visits,
+                          leaf);
+    }
+    return traverse_tree(character.fuzzy.tree_view(tree), o, d, inv, eps, t0, t1, t_limit_, counters_.node_visits,
+                         leaf);
   }
 
   bool visit_static(const Scene::StaticMesh& mesh, float t0, float t1) {

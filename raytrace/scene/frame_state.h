@@ -54,10 +54,11 @@ struct InstanceFrame {
   std::size_t cluster_bones = 0;   // bones on a cluster's tree this frame
   std::size_t cluster_misses = 0;  // bones whose cluster a vertex left: back on their full tree
 
-  // The tree bone b is traversed with this frame.
-  KdTreeView bone_tree(const FuzzyCharacterView& fuzzy, std::uint32_t bone) const {
+  // The tree bone b is traversed with this frame (a kd-tree or a BVH, as
+  // fuzzy.tree_kind says).
+  const BoneTree& bone_tree(const FuzzyCharacterView& fuzzy, std::uint32_t bone) const {
     const std::int32_t q = bone < bone_cluster.size() ? bone_cluster[bone] : -1;
-    return q < 0 ? fuzzy.bone_tree(bone) : fuzzy.tree_view(fuzzy.clusters[static_cast<std::size_t>(q)].tree);
+    return q < 0 ? fuzzy.bone_trees[bone] : fuzzy.clusters[static_cast<std::size_t>(q)].tree;
   }
 
   std::vector<std::uint32_t> escaped_triangles;  // triangle ids routed through the fallback

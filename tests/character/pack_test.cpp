@@ -774,5 +774,176 @@ TEST_F(ClusterPack, RandomDamageToClusterSectionsNeverCrashes) {
   EXPECT_GT(refused, 0);
 }
 
+// --- BVH bone trees --------------------------------------------------------------
+
+// The mannequin over 40 arbitrary poses with BVH bone trees (leaves of at
+// most 4, so that the small meshes have inner nodes) and 4 clusters a bone:
+// every BVH section of a pack. Like ClusterPack it keeps its pack in
+// CorruptPack's slots.
+class BvhPack : public ClusterPack {
+ protected:
+  static void SetUpTestSuite() {
+    JobSystem jobs(2);
+    auto model = content::make_mannequin();
+    ASSERT_TRUE(model.ok());
+    character::BakeRequest request;
+    request.pose_space.mode = anim::PoseSpaceMode::kArbitrary;
+    request.pose_space.samples = 40;
+    request.pose_space.seed = 7;
+    request.fuzzy.pose_clusters = 4;
+    request.fuzzy.bone_trees = rt::BoneTreeKind::kBvh;
+    request.fuzzy.bvh.max_leaf_items = 4;
+    baked_ = new Baked(bake(std::move(*model), jobs, request));
+    bytes_ = new std::vector<std::byte>(pack_bytes(*baked_));
+  }
+  static void TearDownTestSuite() { CorruptPack::TearDownTestSuite(); }
+
+  // The first node of the pack's BVH nodes that is (or is not) a leaf.
+  static std::size_t first_node(bool leaf) {
+    const std::vector<rt::BvhNode>& nodes = baked_->fuzzy.bvh_nodes;
+    for (std::size_t n = 0; n < nodes.size(); ++n) {
+      if (nodes[n].is_leaf() == leaf) return n;
+    }
+    ADD_FAILURE() << "no " << (leaf ? "leaf" : "inner node");
+    return 0;
+  }
+
+  // Where leaf `node`'s first item lies in the pack's item array (its
+  // tree's slice offset plus the tree-relative index).
+  static std::size_t leaf_item_index(std::size_t node) {
+    const rt::FuzzyCharacterData& f = baked_->fuzzy;
+    std::vector<rt::BoneTree> trees(f.bone_trees.begin(), f.bone_trees.end());
+    for (const rt::BoneCluster& c : f.clusters) trees.push_back(c.tree);
+    for (const rt::BoneTree& t : trees) {
+      if (node >= t.node_begin && node < std::size_t{t.node_begin} + t.node_count) {
+        return t.item_begin + f.bvh_nodes[node].first;
+      }
+    }
+    ADD_FAILURE() << "node " << node << " in no tree";
+    return 0;
+  }
+};
+
+TEST_F(BvhPack, TheTreesRoundTripAndRenderAsTheInMemoryBake) {
+  const rt::FuzzyCharacterData& f = baked_->fuzzy;
+  ASSERT_EQ(f.tree_kind, rt::BoneTreeKind::kBvh);
+  ASSERT_TRUE(f.nodes.empty());
+  ASSERT_FALSE(f.bvh_nodes.empty());
+  ASSERT_FALSE(f.clusters.empty());
+  auto pack = character::Pack::from_bytes(*bytes_, "bvh.pack");
+  ASSERT_TRUE(pack.ok()) << pack.status().message();
+  const rt::FuzzyCharacterView& v = pack->fuzzy();
+  EXPECT_TRUE(v.has_bvhs());
+  EXPECT_TRUE(v.nodes.empty());
+  expect_same_array(v.bvh_nodes, f.bvh_nodes, "bvh_nodes");
+  expect_same_array(v.items, f.items, "items");
+  expect_same_array(v.bone_trees, f.bone_trees, "bone_trees");
+  expect_same_array(v.clusters, f.clusters, "clusters");
+  // Each tree lists each of its bone's triangles once.
+  for (const rt::BoneTree& bt : f.bone_trees) EXPECT_EQ(bt.item_count, bt.triangle_count);
+  for (const rt::BoneCluster& c : f.clusters) EXPECT_EQ(c.tree.item_count, c.tree.triangle_count);
+  const auto mapped = pack->reader().bytes();
+  EXPECT_GE(static_cast<const void*>(v.bvh_nodes.data()), static_cast<const void*>(mapped.data()));
+  EXPECT_LT(static_cast<const void*>(v.bvh_nodes.data()), static_cast<const void*>(mapped.data() + mapped.size()));
+  JobSystem jobs(2);
+  const Image in_memory = render(baked_->model, f.view(), jobs);
+  EXPECT_TRUE(render(pack->model(), v, jobs) == in_memory) << "rendering from the pack differs from the in-memory bake";
+  EXPECT_TRUE(pack_bytes(*baked_) == *bytes_);
+}
+
+// FBVN instead of FNOD, and FITM as version 3: a reader that predates BVHs
+// refuses the pack by FITM's version (or FNOD's absence), never reads BVH
+// items as kd leaves; this build refuses mixtures.
+TEST_F(BvhPack, ItsSectionsAndVersionsTellItApart) {
+  auto reader = PackReader::from_bytes(*bytes_, "bvh");
+  ASSERT_TRUE(reader.ok());
+  EXPECT_TRUE(reader->contains(make_section_id("FBVN")));
+  EXPECT_FALSE(reader->contains(make_section_id("FNOD")));
+  EXPECT_EQ(reader->find(make_section_id("FITM"))->version, 3u);
+  EXPECT_EQ(reader->find(make_section_id("FBVN"))->version, 1u);
+  expect_rejected_with(testing_support::repack_section(*bytes_, make_section_id("FITM"), [](auto&) {}, 2u),
+                       ErrorCode::kUnsupportedVersion, "FITM.version");
+  expect_rejected_with(testing_support::repack_section(*bytes_, make_section_id("FBVN"), [](auto&) {}, 2u),
+                       ErrorCode::kUnsupportedVersion, "FBVN.version");
+  // Without FBVN the items read as a kd pack's, whose nodes are missing.
+  const SectionId bvh[] = {make_section_id("FBVN")};
+  expect_rejected_with(without_sections(*bytes_, bvh), ErrorCode::kNotFound, "FNOD");
+  // Both kinds of node.
+  PackWriter w;
+  for (const SectionInfo& s : reader->sections()) ASSERT_TRUE(w.add_section(s.id, s.version, reader->section_bytes(s)).ok());
+  const rt::KdNode leaf = rt::KdNode::leaf(0, 1);
+  ASSERT_TRUE(w.add_section(make_section_id("FNOD"), 2, std::as_bytes(std::span(&leaf, 1))).ok());
+  auto both = w.serialize();
+  ASSERT_TRUE(both.ok());
+  expect_rejected_with(*both, ErrorCode::kInvalidData, "FNOD");
+}
+
+TEST_F(BvhPack, BadNodeLinksAndLeafRangesAreRefused) {
+  const SectionId nodes = make_section_id("FBVN");
+  const std::size_t inner = first_node(false);
+  rt::BvhNode bad = baked_->fuzzy.bvh_nodes[inner];
+  bad.first = 0xfffffff0u;
+  expect_rejected_with(repack(nodes, [&](auto& p) { overwrite(p, inner, bad); }), ErrorCode::kInvalidData,
+                       "child index outside the tree");
+  bad.first = static_cast<std::uint32_t>(inner);  // itself: a cycle
+  expect_rejected_with(repack(nodes, [&](auto& p) { overwrite(p, inner, bad); }), ErrorCode::kInvalidData,
+                       "child index outside the tree");
+  const std::size_t leaf = first_node(true);
+  bad = baked_->fuzzy.bvh_nodes[leaf];
+  bad.first = 0xfffffff0u;
+  expect_rejected_with(repack(nodes, [&](auto& p) { overwrite(p, leaf, bad); }), ErrorCode::kInvalidData,
+                       "leaf items outside the item array");
+  bad = baked_->fuzzy.bvh_nodes[leaf];
+  bad.box.lower.x = std::numeric_limits<float>::quiet_NaN();
+  expect_rejected_with(repack(nodes, [&](auto& p) { overwrite(p, leaf, bad); }), ErrorCode::kInvalidData,
+                       "bvh_nodes[" + std::to_string(leaf) + "].box");
+}
+
+// The conservativeness a walk relies on: a leaf's box holds its triangles'
+// fuzzy boxes and a parent's box its children's; each triangle listed once.
+TEST_F(BvhPack, BoxesThatLeaveTheirParentsOrTrianglesAreRefused) {
+  const SectionId nodes = make_section_id("FBVN");
+  const std::size_t leaf = first_node(true);
+  rt::BvhNode bad = baked_->fuzzy.bvh_nodes[leaf];
+  // Shrunk to its lower corner on x: its triangles' boxes stick out.
+  bad.box.upper.x = bad.box.lower.x;
+  expect_rejected_with(repack(nodes, [&](auto& p) { overwrite(p, leaf, bad); }), ErrorCode::kInvalidData,
+                       "leaves its BVH leaf's box");
+  // Grown past its parent's box.
+  bad = baked_->fuzzy.bvh_nodes[leaf];
+  bad.box.upper.x += 1.0f;
+  expect_rejected_with(repack(nodes, [&](auto& p) { overwrite(p, leaf, bad); }), ErrorCode::kInvalidData,
+                       "a child's box leaves its parent's");
+  // One triangle listed twice (and its neighbour in the item array not at all).
+  const rt::BvhNode& l = baked_->fuzzy.bvh_nodes[leaf];
+  ASSERT_GE(l.count, 2u);
+  const SectionId items = make_section_id("FITM");
+  const std::size_t first_item = leaf_item_index(leaf);
+  const std::uint32_t twin = baked_->fuzzy.items[first_item];
+  expect_rejected_with(repack(items, [&](auto& p) { overwrite(p, first_item + 1, twin); }), ErrorCode::kInvalidData,
+                       "listed twice");
+}
+
+TEST_F(BvhPack, RandomDamageToTheTreesNeverCrashes) {
+  std::mt19937 random(99);
+  JobSystem jobs(1);
+  int refused = 0;
+  for (const SectionId id : {make_section_id("FBVN"), make_section_id("FITM"), make_section_id("FBTR")}) {
+    for (int trial = 0; trial < 16; ++trial) {
+      const auto bytes = repack(id, [&](std::vector<std::byte>& p) {
+        if (p.empty()) return;
+        for (int k = 0; k < 3; ++k) p[random() % p.size()] = static_cast<std::byte>(random() & 0xffu);
+      });
+      auto pack = character::Pack::from_bytes(bytes, "damaged.pack");
+      if (!pack.ok()) {
+        ++refused;
+        continue;
+      }
+      render(pack->model(), pack->fuzzy(), jobs, /*strict=*/false);
+    }
+  }
+  EXPECT_GT(refused, 0);
+}
+
 }  // namespace
 }  // namespace sinew::editor

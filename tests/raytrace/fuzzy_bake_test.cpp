@@ -981,9 +981,21 @@ TEST(FuzzyBakeClusters, ThreadCountDoesNotChangeTheClusters) {
 // A scene on the clusters: sampled poses use cluster trees and never miss;
 // poses far outside the pose space miss, fall back to the full trees (and
 // the escape fallback), and still trace exactly as brute force.
-TEST(FuzzyBakeClusters, ScenesUseClusterTreesAndStayExactOutsideThePoseSpace) {
+// With either kind of bone tree (docs/RAYTRACE.md "Bone trees: kd-tree or BVH").
+class FuzzyBakeTreeKinds : public ::testing::TestWithParam<BoneTreeKind> {};
+
+INSTANTIATE_TEST_SUITE_P(FuzzyBake, FuzzyBakeTreeKinds, ::testing::Values(BoneTreeKind::kKdTree, BoneTreeKind::kBvh),
+                         [](const ::testing::TestParamInfo<BoneTreeKind>& kind) {
+                           return kind.param == BoneTreeKind::kBvh ? std::string("Bvh") : std::string("KdTree");
+                         });
+
+TEST_P(FuzzyBakeTreeKinds, ScenesUseClusterTreesAndStayExactOutsideThePoseSpace) {
   const Rig rig = arm_rig(5, 40, 33);
-  const FuzzyCharacterData data = bake_ok(rig, with_clusters(6));
+  FuzzyBakeOptions options = with_clusters(6);
+  options.bone_trees = GetParam();
+  options.bvh.max_leaf_items = 3;
+  const FuzzyCharacterData data = bake_ok(rig, options);
+  ASSERT_EQ(data.tree_kind, GetParam());
   Scene scene;
   auto character = scene.add_character(rig.mesh, data.view());
   ASSERT_TRUE(character.ok()) << character.status().message();
@@ -1023,6 +1035,84 @@ TEST(FuzzyBakeClusters, ScenesUseClusterTreesAndStayExactOutsideThePoseSpace) {
   }
   EXPECT_GT(misses, 0u) << "the wild poses should leave some cluster";
   EXPECT_EQ(wrong, 0u) << "of " << checked << " rays";
+}
+
+// Every BVH (each bone's full tree and each cluster's) lists its bone's
+// triangles exactly once, and every node box on a triangle's path holds the
+// triangle's fuzzy box for that tree (the union of its corners' boxes, the
+// cluster's where the cluster has its own): what makes a walk that enters
+// every box a ray passes reach every triangle the ray may hit.
+TEST(FuzzyBakeBvh, EveryTreeListsItsBonesTrianglesOnceInsideEveryBoxAbove) {
+  const Rig rig = arm_rig(5, 60, 35);
+  FuzzyBakeOptions options = with_clusters(4);
+  options.bone_trees = BoneTreeKind::kBvh;
+  options.bvh.max_leaf_items = 2;
+  const FuzzyCharacterData data = bake_ok(rig, options);
+  const FuzzyCharacterView view = data.view();
+  ASSERT_TRUE(view.has_bvhs());
+  EXPECT_TRUE(data.nodes.empty());
+  ASSERT_TRUE(validate_fuzzy_character(rig.mesh, view).ok());
+  ASSERT_FALSE(data.clusters.empty());
+  struct Tree {
+    const BoneTree* slice;
+    std::uint32_t bone;
+    const BoneCluster* cluster;  // null: the full tree
+  };
+  std::vector<Tree> trees;
+  // The bones' full trees, then the clusters' (in bone order).
+  for (std::uint32_t b = 0; b < data.bone_count; ++b) trees.push_back({&data.bone_trees[b], b, nullptr});
+  for (std::uint32_t b = 0; b < data.bone_count; ++b) {
+    for (const BoneCluster& c : view.bone_clusters(b)) trees.push_back({&c.tree, b, &c});
+  }
+  std::uint32_t node_cursor = 0, item_cursor = 0;
+  int inner_nodes = 0;
+  for (const Tree& tree : trees) {
+    EXPECT_EQ(tree.slice->node_begin, node_cursor);
+    EXPECT_EQ(tree.slice->item_begin, item_cursor);
+    node_cursor += tree.slice->node_count;
+    item_cursor += tree.slice->item_count;
+    std::multiset<std::uint32_t> own;
+    for (std::size_t t = 0; t < data.triangle_bone.size(); ++t) {
+      if (data.triangle_bone[t] == tree.bone) own.insert(static_cast<std::uint32_t>(t));
+    }
+    const BvhView bvh = view.bvh_view(*tree.slice);
+    std::multiset<std::uint32_t> listed;
+    // Depth first with each node's ancestors' boxes.
+    std::vector<std::pair<std::uint32_t, std::vector<Aabb>>> stack;
+    if (!bvh.empty()) stack.push_back({0u, {}});
+    while (!stack.empty()) {
+      auto [n, above] = stack.back();
+      stack.pop_back();
+      const BvhNode& node = bvh.nodes[n];
+      above.push_back(node.box);
+      if (!node.is_leaf()) {
+        ++inner_nodes;
+        stack.push_back({node.first, above});
+        stack.push_back({node.first + 1, above});
+        continue;
+      }
+      for (std::uint32_t i = node.first; i < node.first + node.count; ++i) {
+        const std::uint32_t t = bvh.items[i];
+        listed.insert(t);
+        Aabb box;
+        for (const std::uint32_t c : data.triangle_checks[t]) {
+          box.extend(tree.cluster ? view.cluster_check_box(*tree.cluster, c) : data.vertex_checks[c].box);
+        }
+        for (const Aabb& a : above) {
+          for (int axis = 0; axis < 3; ++axis) {
+            EXPECT_LE(a.lower[axis], box.lower[axis]) << "triangle " << t << " of bone " << tree.bone;
+            EXPECT_GE(a.upper[axis], box.upper[axis]) << "triangle " << t << " of bone " << tree.bone;
+          }
+        }
+      }
+    }
+    EXPECT_EQ(listed, own) << "bone " << tree.bone << (tree.cluster ? " (a cluster)" : " (full)");
+  }
+  EXPECT_EQ(node_cursor, data.bvh_nodes.size());
+  EXPECT_EQ(item_cursor, data.items.size());
+  EXPECT_GT(inner_nodes, 0);
+  EXPECT_EQ(data.stats.node_count, data.bvh_nodes.size());
+  EXPECT_LE(data.stats.mean_items_per_leaf, 2.0);
 }
 
 TEST(FuzzyBakeClusters, CorruptClusterDataIsRefusedNamingTheField) {

@@ -300,12 +300,13 @@ TEST_P(RenderOracle, PosesInsideThePoseSpaceMatchBruteForce) {
 // may leave a cluster (the bone goes back to its full tree), and poses
 // mixing two far-apart samples bone by bone leave the pose space (the
 // escape fallback); every one traces as brute force.
-TEST_P(RenderOracle, PoseClusterTreesMatchBruteForce) {
+void expect_cluster_trees_match_brute_force(const Subject& subject, rt::BoneTreeKind trees) {
   JobSystem jobs(2);
-  const Subject subject = GetParam();
   character::BakeRequest request;
   request.fuzzy.pose_clusters = 8;
+  request.fuzzy.bone_trees = trees;
   const Baked baked = bake(subject, jobs, request);
+  ASSERT_EQ(baked.bake.fuzzy.tree_kind, trees);
   ASSERT_GT(baked.bones, 0u);
   ASSERT_GT(baked.sample_count(), 1u);
   ASSERT_FALSE(baked.bake.fuzzy.clusters.empty());
@@ -359,6 +360,16 @@ TEST_P(RenderOracle, PoseClusterTreesMatchBruteForce) {
   EXPECT_GT(cluster_bones, 0u) << "no bone used a cluster's tree";
   EXPECT_EQ(primary.wrong, 0u) << primary.checked << " primary rays; first: " << primary.first;
   EXPECT_EQ(rays.wrong, 0u) << rays.checked << " random rays; first: " << rays.first;
+}
+
+TEST_P(RenderOracle, PoseClusterTreesMatchBruteForce) {
+  expect_cluster_trees_match_brute_force(GetParam(), rt::BoneTreeKind::kKdTree);
+}
+
+// The same with BVH bone trees (docs/RAYTRACE.md "Bone trees: kd-tree or
+// BVH"): each bone's and each cluster's tree a BVH over the same boxes.
+TEST_P(RenderOracle, BvhBoneTreesMatchBruteForce) {
+  expect_cluster_trees_match_brute_force(GetParam(), rt::BoneTreeKind::kBvh);
 }
 
 // The paper's larger Cally variants (sinew-editor subdivide): every level

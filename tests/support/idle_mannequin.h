@@ -19,20 +19,30 @@ struct BakedModel {
   character::InMemoryBake bake;
 };
 
-inline const BakedModel& idle_mannequin() {
-  static const BakedModel m = [] {
-    BakedModel out;
-    out.model = content::make_mannequin().value();
-    character::BakeRequest request;
-    request.pose_space.mode = anim::PoseSpaceMode::kClip;
-    request.pose_space.clips = {"idle"};
-    request.pose_space.samples = 0;
-    request.pose_space.every_frame_30hz = false;
-    JobSystem jobs(2);
-    out.bake = character::bake_in_memory(out.model, request, jobs).value();
-    return out;
-  }();
-  return m;
+inline BakedModel bake_idle_mannequin(rt::BoneTreeKind trees) {
+  BakedModel out;
+  out.model = content::make_mannequin().value();
+  character::BakeRequest request;
+  request.pose_space.mode = anim::PoseSpaceMode::kClip;
+  request.pose_space.clips = {"idle"};
+  request.pose_space.samples = 0;
+  request.pose_space.every_frame_30hz = false;
+  request.fuzzy.bone_trees = trees;
+  // Small leaves, so that the mannequin's BVHs have inner nodes to walk.
+  request.fuzzy.bvh.max_leaf_items = 4;
+  JobSystem jobs(2);
+  out.bake = character::bake_in_memory(out.model, request, jobs).value();
+  return out;
+}
+
+// With the default kd-trees, or with BVH bone trees.
+inline const BakedModel& idle_mannequin(rt::BoneTreeKind trees = rt::BoneTreeKind::kKdTree) {
+  if (trees == rt::BoneTreeKind::kBvh) {
+    static const BakedModel bvh = bake_idle_mannequin(rt::BoneTreeKind::kBvh);
+    return bvh;
+  }
+  static const BakedModel kd = bake_idle_mannequin(rt::BoneTreeKind::kKdTree);
+  return kd;
 }
 
 // The model posed by one clip alone at playback time `t`, placed by `instance`.
