@@ -117,7 +117,7 @@ struct BakeFlags {
         bone_trees(l.option("--bone-trees", "kd|bvh",
                             "the bone trees' structure: the paper's kd-trees, or BVHs\n"
                             "listing each triangle once (docs/RAYTRACE.md, \"Bone trees:\n"
-                            "kd-tree or BVH\"; default kd)")),
+                            "kd-tree or BVH\"; default bvh)")),
         bvh_leaf(l.option("--bvh-leaf", "N", "with --bone-trees bvh: at most N triangles a leaf (default 32)")),
         threads(l.option("--threads", "N", "worker threads (default 0: all cores)")),
         max_memory_mib(l.option("--max-memory-mib", "M",

@@ -82,7 +82,7 @@ struct RenderFlags {
                                "in-memory bakes, a pack has its own)")),
         clusters(l.option("--clusters", "on|off", "bones use the clusters the bake or pack has (default on)")),
         bone_trees(l.option("--bone-trees", "kd|bvh",
-                            "the bake's bone trees (default kd; in-memory bakes, a pack has its own)")),
+                            "the bake's bone trees (default bvh; in-memory bakes, a pack has its own)")),
         import_limits(l) {}
 
   const std::vector<std::string>& model;

@@ -77,9 +77,13 @@ struct FuzzyBakeOptions {
   KdBuildOptions kd{.traversal_cost = 1.0f, .intersection_cost = 0.15f, .empty_bonus = 0.2f, .max_leaf_items = 1,
                     .max_depth = 0};
   // The bone trees' structure (docs/RAYTRACE.md, "Bone trees: kd-tree or
-  // BVH"): the paper's kd-trees (built by `kd`) or BVHs over the same fuzzy
-  // boxes (built by `bvh`), each triangle listed once.
-  BoneTreeKind bone_trees = BoneTreeKind::kKdTree;
+  // BVH"): BVHs over the fuzzy boxes (built by `bvh`), each triangle listed
+  // once, or the paper's kd-trees (built by `kd`). Measured on every model
+  // in shared/content (256-ray packets, 2 threads, 1024x1024, shadows): the
+  // BVHs trace as fast as the kd-trees on the small models and 10-20%
+  // faster from 53,472 triangles on (Cally subdivided), with packs 10-25%
+  // smaller, in the same images.
+  BoneTreeKind bone_trees = BoneTreeKind::kBvh;
   BvhBuildOptions bvh;
   // When set, a mesh of kFineMeshTriangles or more builds with
   // kFineMeshIntersectionCost instead of kd.intersection_cost: where the

@@ -256,7 +256,7 @@ struct Table2Row {
   double assignment_ms = 0.0;
   double build_ms = 0.0;
   double sampling_s = 0.0;  // pose sampling + fuzzy box sampling + bone assignment
-  double build_s = 0.0;     // the kd-trees
+  double build_s = 0.0;     // the bone trees
   double tris_per_leaf = 0.0;
   FpsByThreads fps;
 };
@@ -743,8 +743,12 @@ void run_table2(const character::Model& cally, Run& run) {
         " triangles) subdivided by editor::subdivide at levels " + join_ints(o.levels) +
         " (each level splits every triangle into four). Each level is baked in memory over the pose space " +
         pose_space + " on " + std::to_string(bake_threads) + " thread" + (bake_threads == 1 ? "" : "s") +
-        "; *sampling* = pose sampling + fuzzy box sampling + bone assignment, *build* = the per-bone fuzzy kd-trees "
-        "(the paper's two preprocessing columns). One character on the ground plane is rendered at " +
+        "; *sampling* = pose sampling + fuzzy box sampling + bone assignment, *build* = the per-bone fuzzy trees "
+        "(the paper's two preprocessing columns; " +
+        std::string(rt::FuzzyBakeOptions{}.bone_trees == rt::BoneTreeKind::kBvh
+                        ? "BVHs, Sinew's default, where the paper builds kd-trees: docs/RAYTRACE.md \"Bone trees: kd-tree or BVH\""
+                        : "kd-trees, as the paper's") +
+        "). One character on the ground plane is rendered at " +
         std::to_string(o.width) + "x" + std::to_string(o.height) +
         " with diffuse shading and a point light on " + method_threads(o) + ", at " + std::to_string(o.frames) +
         " times evenly spread over the walk clip; a frame is set_bones + prepare_frame + render, fps = 1000 / median "

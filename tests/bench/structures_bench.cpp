@@ -69,8 +69,8 @@ std::vector<BenchFlag> flags() {
 }
 
 const char* const kDescription =
-    "the paper's one tree a bone against pose-space clusters: pack, bake, fuzzy area, update,\n"
-    "work per ray, frame time, per model and Cally subdivision level\n";
+    "the paper's one kd-tree a bone against pose-space clusters and BVH bone trees: pack, bake,\n"
+    "fuzzy area, update, work per ray, frame time, per model and Cally subdivision level\n";
 
 Status read_options(const BenchArgs& parsed, Options& o) {
   if (parsed.has("--quick")) {
@@ -112,7 +112,8 @@ struct Subject {
 struct Row {
   std::string model;
   std::size_t triangles = 0;
-  int clusters_per_bone = 0;  // 0: the paper's structure
+  int clusters_per_bone = 0;  // 0: one tree a bone (the paper's, with kd-trees)
+  rt::BoneTreeKind trees = rt::BoneTreeKind::kKdTree;
   std::uint32_t cluster_count = 0;
   std::size_t pack_bytes = 0;
   double bake_s = 0.0;
@@ -126,14 +127,36 @@ struct Row {
   GateResult gate;
 };
 
-Expected<Row> measure(const Subject& s, int clusters, const Options& o, JobSystem& jobs, WalkFraming& framing) {
+// The structures each model is measured with, in table order.
+struct Structure {
+  int clusters;  // 0, or Options::clusters
+  rt::BoneTreeKind trees;
+};
+
+std::vector<Structure> structures(const Options& o) {
+  return {{0, rt::BoneTreeKind::kKdTree},
+          {o.clusters, rt::BoneTreeKind::kKdTree},
+          {0, rt::BoneTreeKind::kBvh},
+          {o.clusters, rt::BoneTreeKind::kBvh}};
+}
+
+std::string structure_name(int clusters, rt::BoneTreeKind trees) {
+  const std::string kind = trees == rt::BoneTreeKind::kBvh ? "BVH" : "kd-tree";
+  return clusters == 0 ? "one " + kind + " a bone" : std::to_string(clusters) + " clusters, " + kind + "s";
+}
+
+Expected<Row> measure(const Subject& s, Structure structure, const Options& o, JobSystem& jobs,
+                      WalkFraming& framing) {
+  const int clusters = structure.clusters;
   Row row;
   row.model = s.name;
   row.triangles = s.model.mesh.triangle_count();
   row.clusters_per_bone = clusters;
+  row.trees = structure.trees;
   character::BakeRequest request;
   request.fuzzy.pose_clusters = static_cast<std::uint32_t>(clusters);
-  request.fuzzy.fine_mesh_clusters = false;  // 0 is the paper's structure at every size
+  request.fuzzy.fine_mesh_clusters = false;  // 0 is one tree a bone at every size
+  request.fuzzy.bone_trees = structure.trees;
   const Clock::time_point bake_start = Clock::now();
   SINEW_ASSIGN_OR_RETURN(const character::InMemoryBake bake, character::bake_in_memory(s.model, request, jobs));
   row.bake_s = ms_since(bake_start) / 1000.0;
@@ -180,6 +203,7 @@ Json row_json(const Row& r) {
   return {{"model", r.model},
           {"triangles", r.triangles},
           {"clusters_per_bone", r.clusters_per_bone},
+          {"bone_trees", r.trees == rt::BoneTreeKind::kBvh ? "bvh" : "kd"},
           {"clusters", r.cluster_count},
           {"pack_bytes", r.pack_bytes},
           {"bake_s", r.bake_s},
@@ -201,16 +225,18 @@ std::string markdown(const std::vector<Row>& rows, const std::vector<std::string
                      const std::string& command, const std::string& cpu, const std::string& date) {
   std::string md;
   const auto line = [&md](const std::string& s) { md += s + "\n"; };
-  line("## Structures compared: one tree a bone against pose-space clusters");
+  line("## Structures compared: one tree a bone, pose-space clusters, kd-trees and BVHs");
   line("");
   line("Measured by `" + command + "` on " + cpu + ", " + std::to_string(o.threads) + " threads, " + date +
        " (commit " + git_commit() + "). Each model is baked in memory over every clip's key poses and 30 Hz poses "
-       "(the default pose space) twice: with the paper's one fuzzy kd-tree a bone (`--pose-clusters 0`) and with " +
-       std::to_string(o.clusters) + " pose-space clusters a bone (docs/RAYTRACE.md \"Pose-space clusters\"). `pack` "
+       "(the default pose space) four times: with the paper's one fuzzy kd-tree a bone (`--pose-clusters 0 "
+       "--bone-trees kd`), with " + std::to_string(o.clusters) + " pose-space clusters a bone (docs/RAYTRACE.md "
+       "\"Pose-space clusters\"), and both again with BVH bone trees (`--bone-trees bvh`, the default; docs/RAYTRACE.md "
+       "\"Bone trees: kd-tree or BVH\"). `pack` "
        "is the character pack the editor would write, `bake` the in-memory bake's wall time, `area` the fuzzy box "
        "area over the rest pose's (for clusters: full trees → averaged over each bone's clusters), `update` the median "
        "of skinning with the escape check, bone boxes, fallback and top level, `tests`/`visits` the triangle tests "
-       "and kd-tree node visits per primary and per shadow ray, `frame` the median of prepare_frame + render over " +
+       "and tree node visits per primary and per shadow ray, `frame` the median of prepare_frame + render over " +
        std::to_string(o.frames) + " frames of the walk (or the first clip) at 30 Hz, " + std::to_string(o.width) +
        "x" + std::to_string(o.height) + ", shadows from a point light; `frame MB` what one instance's frame holds "
        "(skinned vertices, escape flags, bone frames and boxes, cluster choices). The first frame of each is "
@@ -222,8 +248,7 @@ std::string markdown(const std::vector<Row>& rows, const std::vector<std::string
        "tests / visits | frame ms | frame MB | brute force |");
   line("|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---|");
   for (const Row& r : rows) {
-    const std::string structure =
-        r.clusters_per_bone == 0 ? "one tree a bone" : std::to_string(r.clusters_per_bone) + " clusters a bone";
+    const std::string structure = structure_name(r.clusters_per_bone, r.trees);
     if (!r.gate.passed()) {  // its numbers would describe a wrong image
       line("| " + r.model + " | " + std::to_string(r.triangles) + " | " + structure + " | | | | | | | | | FAILED: " +
            std::to_string(r.gate.mismatched) + " of " + std::to_string(r.gate.checked) + " px differ |");
@@ -306,18 +331,21 @@ int run_structures_bench(const std::vector<std::string>& args, const std::string
   std::printf("  %-16s %8s %9s %8s %7s %15s %9s %15s %15s %9s %8s\n", "model", "tris", "structure", "pack MB",
               "bake s", "area", "update", "primary t/v", "shadow t/v", "frame ms", "frame MB");
   for (const Subject& s : subjects) {
-    WalkFraming framing;  // one camera and brute-force reference for both structures
-    for (const int k : {0, o.clusters}) {
-      auto row = measure(s, k, o, jobs, framing);
+    WalkFraming framing;  // one camera and brute-force reference for every structure
+    for (const Structure& structure : structures(o)) {
+      const int k = structure.clusters;
+      const bool bvh = structure.trees == rt::BoneTreeKind::kBvh;
+      auto row = measure(s, structure, o, jobs, framing);
       if (!row.ok()) {
-        std::fprintf(stderr, "sinew-bench structures: %s, %d clusters: %s\n", s.name.c_str(), k,
-                     row.status().message().c_str());
+        std::fprintf(stderr, "sinew-bench structures: %s, %s: %s\n", s.name.c_str(),
+                     structure_name(k, structure.trees).c_str(), row.status().message().c_str());
         exit_code = 1;
         continue;
       }
       if (!row->gate.passed()) exit_code = 1;
       std::printf("  %-16s %8zu %9s %8.1f %7.1f %7.2f -> %5.2f %9.2f %7.2f / %5.2f %7.2f / %5.2f %9.2f %8.1f%s\n",
-                  s.name.c_str(), row->triangles, k == 0 ? "paper" : (std::to_string(k) + " cl").c_str(),
+                  s.name.c_str(), row->triangles,
+                  ((k == 0 ? std::string(bvh ? "1" : "paper") : std::to_string(k) + " cl") + (bvh ? " bvh" : "")).c_str(),
                   static_cast<double>(row->pack_bytes) / 1e6, row->bake_s, row->fuzzy_area, row->cluster_area,
                   row->update_ms, row->primary_tests, row->primary_visits, row->shadow_tests, row->shadow_visits,
                   row->frame_ms, static_cast<double>(row->frame_bytes) / 1e6,
@@ -343,6 +371,7 @@ int run_structures_bench(const std::vector<std::string>& args, const std::string
       doc["rows"].push_back(row_json(r));
     } else {
       doc["failed"].push_back({{"model", r.model}, {"clusters_per_bone", r.clusters_per_bone},
+                               {"bone_trees", r.trees == rt::BoneTreeKind::kBvh ? "bvh" : "kd"},
                                {"mismatched", r.gate.mismatched}, {"checked", r.gate.checked}});
     }
   }

@@ -133,9 +133,11 @@ void check_round_trip(character::Model model) {
   EXPECT_EQ(pack->fuzzy_stats().sample_count, baked.fuzzy.stats.sample_count);
   // The fuzzy data is used in place: the view points into the mapping.
   const auto mapped = pack->reader().bytes();
-  EXPECT_GE(static_cast<const void*>(pack->fuzzy().nodes.data()), static_cast<const void*>(mapped.data()));
-  EXPECT_LT(static_cast<const void*>(pack->fuzzy().nodes.data()),
-            static_cast<const void*>(mapped.data() + mapped.size()));
+  ASSERT_EQ(pack->fuzzy().tree_kind, baked.fuzzy.tree_kind);
+  const void* nodes = pack->fuzzy().has_bvhs() ? static_cast<const void*>(pack->fuzzy().bvh_nodes.data())
+                                               : static_cast<const void*>(pack->fuzzy().nodes.data());
+  EXPECT_GE(nodes, static_cast<const void*>(mapped.data()));
+  EXPECT_LT(nodes, static_cast<const void*>(mapped.data() + mapped.size()));
   const Image from_pack = render(pack->model(), pack->fuzzy(), jobs);
   EXPECT_TRUE(from_pack == in_memory) << "rendering from the pack differs from the in-memory bake";
   std::size_t hits = 0;
@@ -256,7 +258,10 @@ class CorruptPack : public testing::Test {
     JobSystem jobs(2);
     auto model = content::make_mannequin();
     ASSERT_TRUE(model.ok());
-    baked_ = new Baked(bake(std::move(*model), jobs));
+    // The kd-trees' sections (FNOD); BvhPack below corrupts the BVHs'.
+    character::BakeRequest request;
+    request.fuzzy.bone_trees = rt::BoneTreeKind::kKdTree;
+    baked_ = new Baked(bake(std::move(*model), jobs, request));
     bytes_ = new std::vector<std::byte>(pack_bytes(*baked_));
   }
   static void TearDownTestSuite() {
@@ -536,6 +541,7 @@ class ClusterPack : public CorruptPack {
     request.pose_space.samples = 40;
     request.pose_space.seed = 7;
     request.fuzzy.pose_clusters = 4;
+    request.fuzzy.bone_trees = rt::BoneTreeKind::kKdTree;
     baked_ = new Baked(bake(std::move(*model), jobs, request));
     bytes_ = new std::vector<std::byte>(pack_bytes(*baked_));
   }
@@ -606,7 +612,9 @@ TEST_F(ClusterPack, APackWithoutClustersHasNoClusterSections) {
   JobSystem jobs(2);
   auto model = content::make_mannequin();
   ASSERT_TRUE(model.ok());
-  const Baked plain = bake(std::move(*model), jobs);
+  character::BakeRequest kd;
+  kd.fuzzy.bone_trees = rt::BoneTreeKind::kKdTree;  // as the fixture's pack
+  const Baked plain = bake(std::move(*model), jobs, kd);
   ASSERT_TRUE(plain.fuzzy.bone_cluster_begin.empty());
   const auto bytes = pack_bytes(plain);
   auto reader = PackReader::from_bytes(bytes, "plain");

@@ -15,6 +15,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <map>
 #include <string>
 #include <thread>
 #include <vector>
@@ -99,7 +100,8 @@ TEST_F(PackCommands, BakeWritesAPackThatValidatesAndInspects) {
   const CommandRun text = run(run_inspect, {pack});
   ASSERT_EQ(text.code, 0);
   EXPECT_NE(text.out.find("pose space: arbitrary"), std::string::npos) << text.out;
-  EXPECT_NE(text.out.find("FNOD"), std::string::npos);
+  EXPECT_NE(text.out.find("FBVN"), std::string::npos) << "the default bone trees are BVHs";
+  EXPECT_EQ(text.out.find("FNOD"), std::string::npos);
 }
 
 TEST_F(PackCommands, SourceDateEpochMakesBakesByteIdentical) {
@@ -140,7 +142,8 @@ TEST_F(PackCommands, AFailedBakeLeavesTheExistingPackAlone) {
 TEST_F(PackCommands, SahIntersectionCostShapesTheBoneTrees) {
   const std::string dir = fresh_dir("sah");
   const auto bake_and_inspect = [&](const std::string& name, std::vector<std::string> extra) {
-    std::vector<std::string> args = {kCesiumMan, "-o", dir + "/" + name, "--samples", "8", "--threads", "2"};
+    std::vector<std::string> args = {kCesiumMan, "-o", dir + "/" + name, "--samples", "8", "--threads", "2",
+                                     "--bone-trees", "kd"};
     args.insert(args.end(), extra.begin(), extra.end());
     const CommandRun bake = run(run_bake, args);
     EXPECT_EQ(bake.code, 0) << bake.err;
@@ -156,6 +159,38 @@ TEST_F(PackCommands, SahIntersectionCostShapesTheBoneTrees) {
   EXPECT_GT(single_ray["nodes"].get<std::size_t>(), packet["nodes"].get<std::size_t>());
   EXPECT_LT(single_ray["triangles_per_leaf"].get<double>(), packet["triangles_per_leaf"].get<double>());
   EXPECT_DOUBLE_EQ(single_ray["fuzzy_area"].get<double>(), packet["fuzzy_area"].get<double>());
+}
+
+// --bone-trees picks the structure the pack holds (BVHs by default), and
+// both render the same image from the pack.
+TEST_F(PackCommands, BoneTreesPicksTheStructure) {
+  const std::string dir = fresh_dir("bone_trees");
+  std::map<std::string, nlohmann::json> fuzzy;
+  for (const std::string kind : {"", "kd", "bvh"}) {
+    std::vector<std::string> args = {kCesiumMan, "-o", dir + "/" + (kind.empty() ? "default" : kind) + ".pack",
+                                     "--samples", "8", "--threads", "2"};
+    if (!kind.empty()) args.insert(args.end(), {"--bone-trees", kind});
+    const CommandRun bake = run(run_bake, args);
+    ASSERT_EQ(bake.code, 0) << bake.err;
+    const std::string pack = dir + "/" + (kind.empty() ? "default" : kind) + ".pack";
+    EXPECT_EQ(run(run_validate, {pack}).code, 0);
+    const CommandRun inspect = run(run_inspect, {pack, "--json"});
+    ASSERT_EQ(inspect.code, 0) << inspect.err;
+    fuzzy[kind] = nlohmann::json::parse(inspect.out)["fuzzy"];
+  }
+  EXPECT_EQ(fuzzy[""]["bone_trees"], "bvh");
+  EXPECT_EQ(fuzzy["bvh"]["bone_trees"], "bvh");
+  EXPECT_EQ(fuzzy["kd"]["bone_trees"], "kd");
+  EXPECT_EQ(fuzzy[""]["nodes"], fuzzy["bvh"]["nodes"]);
+  EXPECT_DOUBLE_EQ(fuzzy["kd"]["fuzzy_area"].get<double>(), fuzzy["bvh"]["fuzzy_area"].get<double>());
+  // A BVH leaf holds at most --bvh-leaf triangles.
+  ASSERT_EQ(run(run_bake, {kCesiumMan, "-o", dir + "/small.pack", "--samples", "8", "--bvh-leaf", "2"}).code, 0);
+  const CommandRun small = run(run_inspect, {dir + "/small.pack", "--json"});
+  EXPECT_LE(nlohmann::json::parse(small.out)["fuzzy"]["triangles_per_leaf"].get<double>(), 2.0);
+  const CommandRun bad = run(run_bake, {kCesiumMan, "-o", dir + "/bad.pack", "--bone-trees", "octree"});
+  EXPECT_NE(bad.code, 0);
+  EXPECT_NE(bad.err.find("--bone-trees"), std::string::npos) << bad.err;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/bad.pack"));
 }
 
 // Renders `o` from the source model and from the pack baked from it: every

@@ -574,6 +574,8 @@ void expect_identical(const FuzzyCharacterData& a, const FuzzyCharacterData& b) 
   expect_same_bytes(a.triangle_bone, b.triangle_bone, "triangle_bone");
   expect_same_bytes(a.bone_trees, b.bone_trees, "bone_trees");
   expect_same_bytes(a.nodes, b.nodes, "nodes");
+  expect_same_bytes(a.bvh_nodes, b.bvh_nodes, "bvh_nodes");
+  EXPECT_EQ(a.tree_kind, b.tree_kind);
   expect_same_bytes(a.items, b.items, "items");
   expect_same_bytes(a.vertex_check_begin, b.vertex_check_begin, "vertex_check_begin");
   expect_same_bytes(a.vertex_checks, b.vertex_checks, "vertex_checks");
@@ -620,16 +622,18 @@ TEST(FuzzyBakeTrees, FineMeshesBuildWithTheFineMeshCost) {
   ASSERT_LT(fine.mesh.triangle_count(), kFineMeshTriangles);
   ASSERT_GE(finer.mesh.triangle_count(), kFineMeshTriangles);
 
-  FuzzyBakeOptions fixed;
+  FuzzyBakeOptions kd_trees;
+  kd_trees.bone_trees = BoneTreeKind::kKdTree;
+  FuzzyBakeOptions fixed = kd_trees;
   fixed.fine_mesh_cost = false;
   FuzzyBakeOptions explicit_fine = fixed;
   explicit_fine.kd.intersection_cost = kFineMeshIntersectionCost;
-  const FuzzyCharacterData by_default = bake_ok(finer, FuzzyBakeOptions{});
+  const FuzzyCharacterData by_default = bake_ok(finer, kd_trees);
   expect_identical(by_default, bake_ok(finer, explicit_fine));
   // The two costs build different trees here, so the comparison above can fail.
   EXPECT_NE(by_default.stats.node_count, bake_ok(finer, fixed).stats.node_count);
   // Below the threshold the default keeps kd.intersection_cost.
-  expect_identical(bake_ok(fine, FuzzyBakeOptions{}), bake_ok(fine, fixed));
+  expect_identical(bake_ok(fine, kd_trees), bake_ok(fine, fixed));
 }
 
 TEST(FuzzyBakeMemory, TheBudgetBoundsTheBoxStorage) {
@@ -668,7 +672,9 @@ TEST_P(FuzzyBakeModes, BoneTreesHoldExactlyTheirBonesTriangles) {
                                 glm::translate(glm::dmat4(1.0), glm::dvec3(rng.uniform(-50, 50), 0, 0))));
   }
   rig.samples = samples;
-  const FuzzyCharacterData data = bake_ok(rig, with_candidates(GetParam()));
+  FuzzyBakeOptions options = with_candidates(GetParam());
+  options.bone_trees = BoneTreeKind::kKdTree;  // the BVHs: FuzzyBakeBvh below
+  const FuzzyCharacterData data = bake_ok(rig, options);
   const FuzzyCharacterView view = data.view();
   ASSERT_EQ(data.bone_trees.size(), 5u);
   EXPECT_EQ(view.bone_count, 5u);
@@ -962,25 +968,6 @@ TEST(FuzzyBakeClusters, EverySampledPoseLiesInTheClusterItsBonesPick) {
   EXPECT_GT(held, 0u);
 }
 
-TEST(FuzzyBakeClusters, ThreadCountDoesNotChangeTheClusters) {
-  const Rig rig = arm_rig(5, 40, 32);
-  const FuzzyCharacterData a = bake_ok(rig, with_clusters(5), 1);
-  const FuzzyCharacterData b = bake_ok(rig, with_clusters(5), 3);
-  expect_identical(a, b);  // the cluster arrays too
-  // Without clusters the bake is the one it always was.
-  const FuzzyCharacterData none = bake_ok(rig, FuzzyBakeOptions{}, 2);
-  EXPECT_TRUE(none.clusters.empty());
-  EXPECT_TRUE(none.cluster_boxes.empty());
-  ASSERT_GT(a.nodes.size(), none.nodes.size());
-  expect_same_bytes(std::vector<KdNode>(a.nodes.begin(), a.nodes.begin() + static_cast<std::ptrdiff_t>(none.nodes.size())),
-                    none.nodes, "the full trees' nodes come first, as without clusters");
-  expect_same_bytes(a.bone_trees, none.bone_trees, "full trees with and without clusters");
-  expect_same_bytes(a.vertex_checks, none.vertex_checks, "checks with and without clusters");
-}
-
-// A scene on the clusters: sampled poses use cluster trees and never miss;
-// poses far outside the pose space miss, fall back to the full trees (and
-// the escape fallback), and still trace exactly as brute force.
 // With either kind of bone tree (docs/RAYTRACE.md "Bone trees: kd-tree or BVH").
 class FuzzyBakeTreeKinds : public ::testing::TestWithParam<BoneTreeKind> {};
 
@@ -989,6 +976,37 @@ INSTANTIATE_TEST_SUITE_P(FuzzyBake, FuzzyBakeTreeKinds, ::testing::Values(BoneTr
                            return kind.param == BoneTreeKind::kBvh ? std::string("Bvh") : std::string("KdTree");
                          });
 
+TEST_P(FuzzyBakeTreeKinds, ThreadCountDoesNotChangeTheClusters) {
+  const Rig rig = arm_rig(5, 40, 32);
+  FuzzyBakeOptions options = with_clusters(5);
+  options.bone_trees = GetParam();
+  const FuzzyCharacterData a = bake_ok(rig, options, 1);
+  const FuzzyCharacterData b = bake_ok(rig, options, 3);
+  expect_identical(a, b);  // the cluster arrays too
+  // Without clusters the bake is the one it always was.
+  FuzzyBakeOptions plain;
+  plain.bone_trees = GetParam();
+  const FuzzyCharacterData none = bake_ok(rig, plain, 2);
+  EXPECT_TRUE(none.clusters.empty());
+  EXPECT_TRUE(none.cluster_boxes.empty());
+  if (GetParam() == BoneTreeKind::kBvh) {
+    ASSERT_GT(a.bvh_nodes.size(), none.bvh_nodes.size());
+    expect_same_bytes(std::vector<BvhNode>(a.bvh_nodes.begin(),
+                                           a.bvh_nodes.begin() + static_cast<std::ptrdiff_t>(none.bvh_nodes.size())),
+                      none.bvh_nodes, "the full trees' nodes come first, as without clusters");
+  } else {
+    ASSERT_GT(a.nodes.size(), none.nodes.size());
+    expect_same_bytes(
+        std::vector<KdNode>(a.nodes.begin(), a.nodes.begin() + static_cast<std::ptrdiff_t>(none.nodes.size())),
+        none.nodes, "the full trees' nodes come first, as without clusters");
+  }
+  expect_same_bytes(a.bone_trees, none.bone_trees, "full trees with and without clusters");
+  expect_same_bytes(a.vertex_checks, none.vertex_checks, "checks with and without clusters");
+}
+
+// A scene on the clusters: sampled poses use cluster trees and never miss;
+// poses far outside the pose space miss, fall back to the full trees (and
+// the escape fallback), and still trace exactly as brute force.
 TEST_P(FuzzyBakeTreeKinds, ScenesUseClusterTreesAndStayExactOutsideThePoseSpace) {
   const Rig rig = arm_rig(5, 40, 33);
   FuzzyBakeOptions options = with_clusters(6);
