@@ -213,7 +213,7 @@ std::string embree_label(const Contender& c) {
 
 std::string contender_name(const Contender& c) {
   switch (c.kind) {
-    case Kind::kSinew: return "sinew fuzzy kd";
+    case Kind::kSinew: return kSinewContender;
     case Kind::kEmbree: return "embree " + embree_label(c);
     case Kind::kExact: return "exact SAH kd rebuild";
   }
@@ -738,15 +738,17 @@ int run_embree_bench(const std::vector<std::string>& args, const std::string& co
   // clusters from rt::kFineMeshTriangles, docs/RAYTRACE.md).
   const rt::FuzzyBakeStats& bake_stats = bake.fuzzy.stats;
   const double rest = bake_stats.rest_area > 0.0 ? bake_stats.rest_area : 1.0;
+  const char* const kind = bake.fuzzy.tree_kind == rt::BoneTreeKind::kBvh ? "BVHs" : "kd-trees";
   if (bake_stats.cluster_count > 0) {
-    std::printf("  Sinew's trees: up to %u pose-space clusters a bone (%u in all), fuzzy area %.2fx the rest boxes' "
-                "averaged over each bone's clusters (%.2fx with one tree a bone)\n",
-                bake_stats.clusters_per_bone, bake_stats.cluster_count, bake_stats.cluster_fuzzy_area / rest,
+    std::printf("  Sinew's trees: %s, up to %u pose-space clusters a bone (%u in all), fuzzy area %.2fx the rest "
+                "boxes' averaged over each bone's clusters (%.2fx with one tree a bone)\n",
+                kind, bake_stats.clusters_per_bone, bake_stats.cluster_count, bake_stats.cluster_fuzzy_area / rest,
                 bake_stats.fuzzy_area / rest);
   } else {
-    std::printf("  Sinew's trees: one a bone (no pose-space clusters), fuzzy area %.2fx the rest boxes'\n",
+    std::printf("  Sinew's trees: %s, one a bone (no pose-space clusters), fuzzy area %.2fx the rest boxes'\n", kind,
                 bake_stats.fuzzy_area / rest);
   }
+  doc["bone_trees"] = bake.fuzzy.tree_kind == rt::BoneTreeKind::kBvh ? "bvh" : "kd";
   doc["pose_clusters"] = bake_stats.cluster_count;
   doc["clusters_per_bone"] = bake_stats.clusters_per_bone;
 

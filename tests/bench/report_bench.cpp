@@ -310,7 +310,7 @@ std::string embree_markdown(const Run& r) {
                  cell(phase_ms(shared, "animation"), 3).c_str(), cell(phase_ms(shared, "skinning"), 3).c_str());
     md += "| contender | build ms | primary ms | shadow ms | trace ms | shade ms | total ms | Sinew ÷ this: build | "
           "trace | total | brute force (first frame) |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|\n";
-    const Json* sinew = contender(config, "sinew fuzzy kd");
+    const Json* sinew = contender(config, kSinewContender);
     const Json sinew_phases = sinew && sinew->contains("phases") ? (*sinew)["phases"] : Json();
     for (const Json* row : embree_table_rows(config)) {
       const Json& c = *row;
@@ -428,14 +428,14 @@ double table2_fps(const Json& row, const char* threads, const char* kind) {
 
 // Sinew's total over the named contender's, for one configuration.
 double total_ratio(const Json& config, const std::string& other) {
-  const Json* s = contender(config, "sinew fuzzy kd");
+  const Json* s = contender(config, kSinewContender);
   const Json* o = contender(config, other);
   if (!s || !o || !s->contains("phases") || !o->contains("phases")) return std::nan("");
   return phase_ms((*s)["phases"], "total") / phase_ms((*o)["phases"], "total");
 }
 
 double trace_ratio(const Json& config, const std::string& other) {
-  const Json* s = contender(config, "sinew fuzzy kd");
+  const Json* s = contender(config, kSinewContender);
   const Json* o = contender(config, other);
   if (!s || !o || !s->contains("phases") || !o->contains("phases")) return std::nan("");
   return phase_ms((*s)["phases"], "trace") / phase_ms((*o)["phases"], "trace");
@@ -458,7 +458,7 @@ std::string best_by_mode_ratios(const Json& config) {
 // and bone boxes, plus Sinew's build) over the build of the refit row at
 // its best width. Empty when the run has no refit row.
 std::string update_over_refit(const Json& config) {
-  const Json* s = contender(config, "sinew fuzzy kd");
+  const Json* s = contender(config, kSinewContender);
   if (s == nullptr || !s->contains("phases") || !config.contains("shared")) return "";
   for (const Json& best : config.value("best_embree_by_mode", Json::array())) {
     if (best.value("mode_name", "") != "refit") continue;

@@ -12,6 +12,8 @@
 #include <utility>
 #include <vector>
 
+#include "tests/bench/embree_bench.h"
+
 namespace sinew::bench {
 namespace {
 
@@ -111,7 +113,7 @@ std::string fps_vs_triangles_script(const std::string& dat, const std::string& p
 // --- Sinew against Embree: frame time per contender --------------------------------
 
 std::string short_name(const std::string& name) {
-  if (name == "sinew fuzzy kd") return "Sinew";
+  if (name == kSinewContender) return "Sinew";
   if (name == "exact SAH kd rebuild") return "exact kd";
   // "embree refit rtcIntersect16" -> "Embree refit x16" (the widths' rows).
   static const std::pair<const char*, const char*> kModes[] = {
