@@ -103,9 +103,17 @@ bool listed_where_needed(const KdTreeView& tree, std::uint32_t node_index, std::
 // boxes (box_of), each inner node's box its children's. Containment is
 // transitive, so a walk that enters every node box a ray passes within its
 // slack of reaches every triangle whose fuzzy box the ray passes.
+// Which BVH last listed each triangle (BvhSeen::tree per tree walked): a
+// triangle stamped by the tree being walked is listed twice there.
+struct BvhSeen {
+  std::vector<std::uint32_t> stamp;
+  std::uint32_t tree = 0;
+};
+
 template <class BoxOf>
 Status validate_bvh(const FuzzyCharacterView& fuzzy, const BvhView& tree, std::uint32_t b,
-                    std::span<const std::uint32_t> bone_triangles, const std::string& where, BoxOf&& box_of) {
+                    std::span<const std::uint32_t> bone_triangles, const std::string& where, BvhSeen& seen,
+                    BoxOf&& box_of) {
   const auto node_field = [&](std::size_t n) { return where + ".bvh_nodes[" + std::to_string(n) + "]"; };
   for (std::size_t n = 0; n < tree.nodes.size(); ++n) {
     if (has_nan(tree.nodes[n].box)) return bad_character(node_field(n) + ".box", "NaN", "box is not a number");
@@ -115,14 +123,10 @@ Status validate_bvh(const FuzzyCharacterView& fuzzy, const BvhView& tree, std::u
                          "a BVH lists each of the bone's " + std::to_string(bone_triangles.size()) +
                              " triangles once");
   }
-  // As many items as the bone has triangles, each of bone b: with no
-  // triangle twice, every triangle of the bone is listed.
-  std::vector<std::uint32_t> sorted(tree.items.begin(), tree.items.end());
-  std::sort(sorted.begin(), sorted.end());
-  if (const auto twice = std::adjacent_find(sorted.begin(), sorted.end()); twice != sorted.end()) {
-    return bad_character(where + " triangle " + std::to_string(*twice), std::to_string(b),
-                         "listed twice in one BVH (and another of the bone's triangles not at all)");
-  }
+  // As many items as the bone has triangles (above), each of bone b and
+  // none twice (at the leaves): every triangle of the bone is listed.
+  seen.stamp.resize(fuzzy.triangle_bone.size(), 0);
+  const std::uint32_t stamp = ++seen.tree;
   struct Pending {
     std::uint32_t node;
     int depth;
@@ -158,6 +162,11 @@ Status validate_bvh(const FuzzyCharacterView& fuzzy, const BvhView& tree, std::u
           return bad_character(where + ".items[" + std::to_string(i) + "]", std::to_string(t),
                                "a triangle of bone " + std::to_string(fuzzy.triangle_bone[t]));
         }
+        if (seen.stamp[t] == stamp) {
+          return bad_character(where + " triangle " + std::to_string(t), std::to_string(b),
+                               "listed twice in one BVH (and another of the bone's triangles not at all)");
+        }
+        seen.stamp[t] = stamp;
         if (i > node.first && !(tree.items[i - 1] < t)) {
           return bad_character(node_field(p.node), std::to_string(t), "leaf items must increase");
         }
@@ -197,7 +206,7 @@ Status validate_bvh(const FuzzyCharacterView& fuzzy, const BvhView& tree, std::u
 template <class BoxOf>
 Status validate_tree_slice(const FuzzyCharacterView& fuzzy, const BoneTree& bt, std::uint32_t b,
                            std::span<const std::uint32_t> bone_triangles, const std::string& where,
-                           std::size_t& node_at, std::size_t& item_at, BoxOf&& box_of) {
+                           std::size_t& node_at, std::size_t& item_at, BvhSeen& seen, BoxOf&& box_of) {
   if (bt.node_begin != node_at || bt.item_begin != item_at) {
     return bad_character(where + ".node_begin", std::to_string(bt.node_begin),
                          "the trees' slices must follow each other in order (bones, then clusters) without gaps "
@@ -220,7 +229,7 @@ Status validate_tree_slice(const FuzzyCharacterView& fuzzy, const BoneTree& bt, 
     return bad_character(where + ".node_count", std::to_string(bt.node_count),
                          "a bone has a tree exactly when triangles are assigned to it");
   }
-  if (fuzzy.has_bvhs()) return validate_bvh(fuzzy, fuzzy.bvh_view(bt), b, bone_triangles, where, box_of);
+  if (fuzzy.has_bvhs()) return validate_bvh(fuzzy, fuzzy.bvh_view(bt), b, bone_triangles, where, seen, box_of);
   const KdTreeView tree = fuzzy.tree_view(bt);
   SINEW_RETURN_IF_ERROR(validate_tree(tree, static_cast<std::uint32_t>(fuzzy.triangle_bone.size()), where));
   for (std::size_t n = 0; n < tree.nodes.size(); ++n) {
@@ -339,9 +348,10 @@ Status validate_tree_contents(const FuzzyCharacterView& fuzzy) {
     bone_triangles[fuzzy.triangle_bone[t]].push_back(static_cast<std::uint32_t>(t));
   }
   std::size_t node_at = 0, item_at = 0;
+  BvhSeen seen;
   for (std::uint32_t b = 0; b < fuzzy.bone_count; ++b) {
     SINEW_RETURN_IF_ERROR(validate_tree_slice(fuzzy, fuzzy.bone_trees[b], b, bone_triangles[b],
-                                              "bone_trees[" + std::to_string(b) + "]", node_at, item_at,
+                                              "bone_trees[" + std::to_string(b) + "]", node_at, item_at, seen,
                                               [&](std::uint32_t t) {
                                                 Aabb box;
                                                 for (const std::uint32_t c : fuzzy.triangle_checks[t]) box.extend(fuzzy.vertex_checks[c].box);
@@ -356,7 +366,7 @@ Status validate_tree_contents(const FuzzyCharacterView& fuzzy) {
           return bad_character("clusters[" + std::to_string(q) + "]", std::to_string(b), "clusters of a bone without triangles");
         }
         SINEW_RETURN_IF_ERROR(validate_tree_slice(fuzzy, cluster.tree, b, bone_triangles[b],
-                                                  "clusters[" + std::to_string(q) + "].tree", node_at, item_at,
+                                                  "clusters[" + std::to_string(q) + "].tree", node_at, item_at, seen,
                                                   [&](std::uint32_t t) {
                                                     Aabb box;
                                                     for (const std::uint32_t c : fuzzy.triangle_checks[t]) {
