@@ -397,48 +397,41 @@ struct TreeFigures {
 };
 
 // Depths of one bone's tree (iterative: loaded trees are already validated).
-TreeFigures tree_figures(const rt::BvhView& tree) {
+// Depth figures of a tree whose node n is a leaf when leaf(n) and has the
+// children children(n) otherwise.
+template <class IsLeaf, class Children>
+TreeFigures tree_figures(std::size_t node_count, IsLeaf&& leaf, Children&& children) {
   TreeFigures f;
-  if (tree.nodes.empty()) return f;
+  if (node_count == 0) return f;
   std::vector<std::pair<std::uint32_t, int>> stack{{0u, 0}};
   double depth_sum = 0.0;
   while (!stack.empty()) {
     const auto [node, depth] = stack.back();
     stack.pop_back();
     f.max_depth = std::max(f.max_depth, depth);
-    const rt::BvhNode& n = tree.nodes[node];
-    if (n.is_leaf()) {
+    if (leaf(node)) {
       ++f.leaves;
       depth_sum += depth;
       continue;
     }
-    stack.push_back({n.first, depth + 1});
-    stack.push_back({n.first + 1, depth + 1});
+    const auto [below, above] = children(node);
+    stack.push_back({below, depth + 1});
+    stack.push_back({above, depth + 1});
   }
   f.mean_depth_of_leaves = f.leaves ? depth_sum / static_cast<double>(f.leaves) : 0.0;
   return f;
 }
 
+TreeFigures tree_figures(const rt::BvhView& tree) {
+  return tree_figures(
+      tree.nodes.size(), [&](std::uint32_t n) { return tree.nodes[n].is_leaf(); },
+      [&](std::uint32_t n) { return std::pair{tree.nodes[n].first, tree.nodes[n].first + 1}; });
+}
+
 TreeFigures tree_figures(const rt::KdTreeView& tree) {
-  TreeFigures f;
-  if (tree.nodes.empty()) return f;
-  std::vector<std::pair<std::uint32_t, int>> stack{{0u, 0}};
-  double depth_sum = 0.0;
-  while (!stack.empty()) {
-    const auto [node, depth] = stack.back();
-    stack.pop_back();
-    f.max_depth = std::max(f.max_depth, depth);
-    const rt::KdNode& n = tree.nodes[node];
-    if (n.is_leaf()) {
-      ++f.leaves;
-      depth_sum += depth;
-      continue;
-    }
-    stack.push_back({node + 1, depth + 1});
-    stack.push_back({n.above_child(), depth + 1});
-  }
-  f.mean_depth_of_leaves = f.leaves ? depth_sum / static_cast<double>(f.leaves) : 0.0;
-  return f;
+  return tree_figures(
+      tree.nodes.size(), [&](std::uint32_t n) { return tree.nodes[n].is_leaf(); },
+      [&](std::uint32_t n) { return std::pair{n + 1, tree.nodes[n].above_child()}; });
 }
 
 std::string utc_text(std::int64_t unix_time) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "runtime/mesh/mesh_checks.h"
@@ -23,43 +24,55 @@ Status bad_character(std::string_view field, std::string value, std::string_view
   return make_error(ErrorCode::kInvalidData, "character", field, value, detail);
 }
 
-// Checks what traversal relies on so that a corrupt pack or a mismatched
-// bake cannot make it read out of bounds: node links, leaf item ranges and
-// depth within each bone's slice, item values within the triangle count.
-Status validate_tree(const KdTreeView& tree, std::uint32_t item_limit, const std::string& where) {
+// Depth first over a tree's nodes from the root: `visit(node, push)` checks
+// one node and push(child) queues each child one level deeper. A node
+// reached twice (links that form a cycle) or deeper than the traversal's
+// fixed stack holds is refused, naming the tree (`kind`: "kd-tree", "BVH").
+template <class Visit>
+Status walk_nodes(std::size_t node_count, const std::string& where, std::string_view kind, Visit&& visit) {
   struct Pending {
     std::uint32_t node;
     int depth;
   };
   std::vector<Pending> stack;
-  if (!tree.nodes.empty()) stack.push_back({0, 0});
+  if (node_count != 0) stack.push_back({0, 0});
   std::size_t visited = 0;
   while (!stack.empty()) {
     const Pending p = stack.back();
     stack.pop_back();
-    if (++visited > tree.nodes.size()) return bad_character(where, "", "kd-tree nodes form a cycle");
+    if (++visited > node_count) return bad_character(where, "", std::string(kind) + " nodes form a cycle");
     if (p.depth > kMaxTraversalDepth) {
-      return bad_character(where, std::to_string(p.depth), "kd-tree deeper than the traversal supports");
+      return bad_character(where, std::to_string(p.depth), std::string(kind) + " deeper than the traversal supports");
     }
-    const KdNode& node = tree.nodes[p.node];
+    SINEW_RETURN_IF_ERROR(visit(p.node, [&](std::uint32_t child) { stack.push_back({child, p.depth + 1}); }));
+  }
+  return {};
+}
+
+// Checks what traversal relies on so that a corrupt pack or a mismatched
+// bake cannot make it read out of bounds: node links, leaf item ranges and
+// depth within each bone's slice, item values within the triangle count.
+Status validate_tree(const KdTreeView& tree, std::uint32_t item_limit, const std::string& where) {
+  SINEW_RETURN_IF_ERROR(walk_nodes(tree.nodes.size(), where, "kd-tree", [&](std::uint32_t n, auto&& push) -> Status {
+    const KdNode& node = tree.nodes[n];
     if (node.is_leaf()) {
       if (std::size_t{node.first_item()} + node.item_count() > tree.items.size()) {
-        return bad_character(where + ".nodes[" + std::to_string(p.node) + "]",
-                             std::to_string(node.first_item()), "leaf items outside the item array");
+        return bad_character(where + ".nodes[" + std::to_string(n) + "]", std::to_string(node.first_item()),
+                             "leaf items outside the item array");
       }
-      continue;
+      return {};
     }
-    if (p.node + 1 >= tree.nodes.size() || node.above_child() >= tree.nodes.size() ||
-        node.above_child() <= p.node) {
-      return bad_character(where + ".nodes[" + std::to_string(p.node) + "]",
-                           std::to_string(node.above_child()), "child index outside the tree");
+    if (n + 1 >= tree.nodes.size() || node.above_child() >= tree.nodes.size() || node.above_child() <= n) {
+      return bad_character(where + ".nodes[" + std::to_string(n) + "]", std::to_string(node.above_child()),
+                           "child index outside the tree");
     }
     if (!std::isfinite(node.split())) {
-      return bad_character(where + ".nodes[" + std::to_string(p.node) + "]", "", "split is not finite");
+      return bad_character(where + ".nodes[" + std::to_string(n) + "]", "", "split is not finite");
     }
-    stack.push_back({p.node + 1, p.depth + 1});
-    stack.push_back({node.above_child(), p.depth + 1});
-  }
+    push(n + 1);
+    push(node.above_child());
+    return {};
+  }));
   for (std::size_t i = 0; i < tree.items.size(); ++i) {
     if (tree.items[i] >= item_limit) {
       return bad_character(where + ".items[" + std::to_string(i) + "]", std::to_string(tree.items[i]),
@@ -127,30 +140,17 @@ Status validate_bvh(const FuzzyCharacterView& fuzzy, const BvhView& tree, std::u
   // none twice (at the leaves): every triangle of the bone is listed.
   seen.stamp.resize(fuzzy.triangle_bone.size(), 0);
   const std::uint32_t stamp = ++seen.tree;
-  struct Pending {
-    std::uint32_t node;
-    int depth;
-  };
-  std::vector<Pending> stack;
-  if (!tree.nodes.empty()) stack.push_back({0, 0});
-  std::size_t visited = 0;
   std::size_t items_listed = 0;
   std::vector<std::uint8_t> item_listed(tree.items.size(), 0);
-  while (!stack.empty()) {
-    const Pending p = stack.back();
-    stack.pop_back();
-    if (++visited > tree.nodes.size()) return bad_character(where, "", "BVH nodes form a cycle");
-    if (p.depth > kMaxTraversalDepth) {
-      return bad_character(where, std::to_string(p.depth), "BVH deeper than the traversal supports");
-    }
-    const BvhNode& node = tree.nodes[p.node];
+  SINEW_RETURN_IF_ERROR(walk_nodes(tree.nodes.size(), where, "BVH", [&](std::uint32_t n, auto&& push) -> Status {
+    const BvhNode& node = tree.nodes[n];
     if (node.is_leaf()) {
       if (std::size_t{node.first} + node.count > tree.items.size()) {
-        return bad_character(node_field(p.node), std::to_string(node.first), "leaf items outside the item array");
+        return bad_character(node_field(n), std::to_string(node.first), "leaf items outside the item array");
       }
       for (std::uint32_t i = node.first; i < node.first + node.count; ++i) {
         if (item_listed[i]++ != 0) {
-          return bad_character(node_field(p.node), std::to_string(i), "an item listed by two leaves");
+          return bad_character(node_field(n), std::to_string(i), "an item listed by two leaves");
         }
         ++items_listed;
         const std::uint32_t t = tree.items[i];
@@ -168,25 +168,26 @@ Status validate_bvh(const FuzzyCharacterView& fuzzy, const BvhView& tree, std::u
         }
         seen.stamp[t] = stamp;
         if (i > node.first && !(tree.items[i - 1] < t)) {
-          return bad_character(node_field(p.node), std::to_string(t), "leaf items must increase");
+          return bad_character(node_field(n), std::to_string(t), "leaf items must increase");
         }
         if (!node.box.contains(box_of(t))) {
           return bad_character(where + " triangle " + std::to_string(t), std::to_string(b),
                                "the triangle's fuzzy box leaves its BVH leaf's box");
         }
       }
-      continue;
+      return {};
     }
-    if (node.first <= p.node || std::size_t{node.first} + 1 >= tree.nodes.size()) {
-      return bad_character(node_field(p.node), std::to_string(node.first), "child index outside the tree");
+    if (node.first <= n || std::size_t{node.first} + 1 >= tree.nodes.size()) {
+      return bad_character(node_field(n), std::to_string(node.first), "child index outside the tree");
     }
     for (std::uint32_t c = node.first; c <= node.first + 1; ++c) {
       if (!node.box.contains(tree.nodes[c].box)) {
         return bad_character(node_field(c), std::to_string(c), "a child's box leaves its parent's");
       }
-      stack.push_back({c, p.depth + 1});
+      push(c);
     }
-  }
+    return {};
+  }));
   if (items_listed != tree.items.size()) {
     return bad_character(where + ".items", std::to_string(items_listed) + " listed",
                          "the leaves must list all " + std::to_string(tree.items.size()) + " items");

@@ -283,6 +283,31 @@ class CorruptPack : public testing::Test {
     std::memcpy(payload.data() + index * sizeof(T), &value, sizeof(T));
   }
 
+  // Three random bytes of one of `sections` overwritten, `trials` times
+  // each: every damaged pack is refused or renders (without a strict
+  // check: the sanitizers and the absence of crashes are the test).
+  // Returns how many were refused.
+  static int damaged_packs_refused(std::span<const SectionId> sections, int trials, std::uint32_t seed) {
+    std::mt19937 random(seed);
+    JobSystem jobs(1);
+    int refused = 0;
+    for (const SectionId id : sections) {
+      for (int trial = 0; trial < trials; ++trial) {
+        const auto bytes = repack(id, [&](std::vector<std::byte>& p) {
+          if (p.empty()) return;
+          for (int k = 0; k < 3; ++k) p[random() % p.size()] = static_cast<std::byte>(random() & 0xffu);
+        });
+        auto pack = character::Pack::from_bytes(bytes, "damaged.pack");
+        if (!pack.ok()) {
+          ++refused;
+          continue;
+        }
+        render(pack->model(), pack->fuzzy(), jobs, /*strict=*/false);
+      }
+    }
+    return refused;
+  }
+
   // Loading must fail, naming `section` in the message.
   static void expect_rejected(const std::vector<std::byte>& bytes, const std::string& section) {
     auto pack = character::Pack::from_bytes(bytes, "corrupt.pack");
@@ -532,7 +557,10 @@ void expect_same_array(std::span<const T> loaded, const std::vector<T>& baked, c
 // suites run one after the other, each setting them up and freeing them.
 class ClusterPack : public CorruptPack {
  protected:
-  static void SetUpTestSuite() {
+  static void SetUpTestSuite() { bake_clustered(rt::BoneTreeKind::kKdTree); }
+  // The mannequin over 40 arbitrary poses, 4 clusters a bone, `trees` (BVH
+  // leaves of at most 4 triangles, so that its small meshes have inner nodes).
+  static void bake_clustered(rt::BoneTreeKind trees) {
     JobSystem jobs(2);
     auto model = content::make_mannequin();
     ASSERT_TRUE(model.ok());
@@ -541,7 +569,8 @@ class ClusterPack : public CorruptPack {
     request.pose_space.samples = 40;
     request.pose_space.seed = 7;
     request.fuzzy.pose_clusters = 4;
-    request.fuzzy.bone_trees = rt::BoneTreeKind::kKdTree;
+    request.fuzzy.bone_trees = trees;
+    request.fuzzy.bvh.max_leaf_items = 4;
     baked_ = new Baked(bake(std::move(*model), jobs, request));
     bytes_ = new std::vector<std::byte>(pack_bytes(*baked_));
   }
@@ -762,24 +791,7 @@ TEST_F(ClusterPack, ABadClusterHeaderIsRefused) {
 
 // Random damage to the cluster sections: refused or safe to render.
 TEST_F(ClusterPack, RandomDamageToClusterSectionsNeverCrashes) {
-  std::mt19937 random(4321);
-  JobSystem jobs(1);
-  int refused = 0;
-  for (const SectionId id : kClusterSections) {
-    for (int trial = 0; trial < 12; ++trial) {
-      const auto bytes = repack(id, [&](std::vector<std::byte>& p) {
-        if (p.empty()) return;
-        for (int k = 0; k < 3; ++k) p[random() % p.size()] = static_cast<std::byte>(random() & 0xffu);
-      });
-      auto pack = character::Pack::from_bytes(bytes, "damaged.pack");
-      if (!pack.ok()) {
-        ++refused;
-        continue;
-      }
-      render(pack->model(), pack->fuzzy(), jobs, /*strict=*/false);
-    }
-  }
-  EXPECT_GT(refused, 0);
+  EXPECT_GT(damaged_packs_refused(kClusterSections, 12, 4321), 0);
 }
 
 // --- BVH bone trees --------------------------------------------------------------
@@ -790,20 +802,7 @@ TEST_F(ClusterPack, RandomDamageToClusterSectionsNeverCrashes) {
 // CorruptPack's slots.
 class BvhPack : public ClusterPack {
  protected:
-  static void SetUpTestSuite() {
-    JobSystem jobs(2);
-    auto model = content::make_mannequin();
-    ASSERT_TRUE(model.ok());
-    character::BakeRequest request;
-    request.pose_space.mode = anim::PoseSpaceMode::kArbitrary;
-    request.pose_space.samples = 40;
-    request.pose_space.seed = 7;
-    request.fuzzy.pose_clusters = 4;
-    request.fuzzy.bone_trees = rt::BoneTreeKind::kBvh;
-    request.fuzzy.bvh.max_leaf_items = 4;
-    baked_ = new Baked(bake(std::move(*model), jobs, request));
-    bytes_ = new std::vector<std::byte>(pack_bytes(*baked_));
-  }
+  static void SetUpTestSuite() { bake_clustered(rt::BoneTreeKind::kBvh); }
   static void TearDownTestSuite() { CorruptPack::TearDownTestSuite(); }
 
   // The first node of the pack's BVH nodes that is (or is not) a leaf.
@@ -933,24 +932,8 @@ TEST_F(BvhPack, BoxesThatLeaveTheirParentsOrTrianglesAreRefused) {
 }
 
 TEST_F(BvhPack, RandomDamageToTheTreesNeverCrashes) {
-  std::mt19937 random(99);
-  JobSystem jobs(1);
-  int refused = 0;
-  for (const SectionId id : {make_section_id("FBVN"), make_section_id("FITM"), make_section_id("FBTR")}) {
-    for (int trial = 0; trial < 16; ++trial) {
-      const auto bytes = repack(id, [&](std::vector<std::byte>& p) {
-        if (p.empty()) return;
-        for (int k = 0; k < 3; ++k) p[random() % p.size()] = static_cast<std::byte>(random() & 0xffu);
-      });
-      auto pack = character::Pack::from_bytes(bytes, "damaged.pack");
-      if (!pack.ok()) {
-        ++refused;
-        continue;
-      }
-      render(pack->model(), pack->fuzzy(), jobs, /*strict=*/false);
-    }
-  }
-  EXPECT_GT(refused, 0);
+  const SectionId trees[] = {make_section_id("FBVN"), make_section_id("FITM"), make_section_id("FBTR")};
+  EXPECT_GT(damaged_packs_refused(trees, 16, 99), 0);
 }
 
 }  // namespace
