@@ -274,33 +274,48 @@ TEST(EditorOverlayTest, LeafHeatIsTheLargestLeafOfEachTriangle) {
   auto mannequin = content::make_mannequin();
   ASSERT_TRUE(mannequin.ok());
   JobSystem jobs(2);
-  character::BakeRequest request;
-  request.pose_space.mode = anim::PoseSpaceMode::kClip;
-  request.pose_space.clips = {"walk"};
-  auto baked = character::bake_in_memory(*mannequin, request, jobs);
-  ASSERT_TRUE(baked.ok());
-  const rt::FuzzyCharacterView view = baked->fuzzy.view();
-  const std::size_t triangles = mannequin->mesh.triangle_count();
-  const std::vector<std::uint32_t> heat = leaf_heat(view, triangles);
-  // Reference: every leaf of every tree, per triangle, the hard way.
-  std::vector<std::uint32_t> expected(triangles, 0);
-  std::size_t leaves = 0;
-  for (std::uint32_t b = 0; b < view.bone_count; ++b) {
-    const rt::KdTreeView tree = view.bone_tree(b);
-    for (const rt::KdNode& node : tree.nodes) {
-      if (!node.is_leaf() || node.item_count() == 0) continue;
+  for (const rt::BoneTreeKind kind : {rt::BoneTreeKind::kKdTree, rt::BoneTreeKind::kBvh}) {
+    SCOPED_TRACE(kind == rt::BoneTreeKind::kBvh ? "BVHs" : "kd-trees");
+    character::BakeRequest request;
+    request.pose_space.mode = anim::PoseSpaceMode::kClip;
+    request.pose_space.clips = {"walk"};
+    request.fuzzy.bone_trees = kind;
+    request.fuzzy.bvh.max_leaf_items = 4;
+    auto baked = character::bake_in_memory(*mannequin, request, jobs);
+    ASSERT_TRUE(baked.ok());
+    const rt::FuzzyCharacterView view = baked->fuzzy.view();
+    const std::size_t triangles = mannequin->mesh.triangle_count();
+    const std::vector<std::uint32_t> heat = leaf_heat(view, triangles);
+    // Reference: every leaf of every tree, per triangle, the hard way.
+    std::vector<std::uint32_t> expected(triangles, 0);
+    std::size_t leaves = 0;
+    const auto count_leaf = [&](std::span<const std::uint32_t> items) {
       ++leaves;
-      for (std::uint32_t k = 0; k < node.item_count(); ++k) {
-        std::uint32_t& e = expected[tree.items[node.first_item() + k]];
-        e = std::max(e, node.item_count());
+      for (const std::uint32_t t : items) {
+        expected[t] = std::max(expected[t], static_cast<std::uint32_t>(items.size()));
       }
+    };
+    for (std::uint32_t b = 0; b < view.bone_count; ++b) {
+      if (view.has_bvhs()) {
+        const rt::BvhView tree = view.bvh_view(view.bone_trees[b]);
+        for (const rt::BvhNode& node : tree.nodes) {
+          if (node.is_leaf()) count_leaf(tree.items.subspan(node.first, node.count));
+        }
+        // Every leaf yields its box, inside the root box.
+        for (const Aabb& box : bvh_leaf_boxes(tree)) EXPECT_TRUE(tree.bounds.contains(box));
+        continue;
+      }
+      const rt::KdTreeView tree = view.bone_tree(b);
+      for (const rt::KdNode& node : tree.nodes) {
+        if (node.is_leaf() && node.item_count() > 0) count_leaf(tree.items.subspan(node.first_item(), node.item_count()));
+      }
+      // Every non-empty leaf yields one cell, inside the root box.
+      for (const Aabb& cell : leaf_cells(tree)) EXPECT_TRUE(tree.bounds.contains(cell));
     }
-    // Every non-empty leaf yields one cell, inside the root box.
-    for (const Aabb& cell : leaf_cells(tree)) EXPECT_TRUE(tree.bounds.contains(cell));
+    EXPECT_GT(leaves, 0u);
+    EXPECT_EQ(heat, expected);
+    for (std::size_t t = 0; t < triangles; ++t) EXPECT_GT(heat[t], 0u) << t;  // every triangle is in a leaf
   }
-  EXPECT_GT(leaves, 0u);
-  EXPECT_EQ(heat, expected);
-  for (std::size_t t = 0; t < triangles; ++t) EXPECT_GT(heat[t], 0u) << t;  // every triangle is in a leaf
 }
 
 TEST_F(EditorGuiTest, OrbitTurnsTheCameraAboutItsTarget) {
