@@ -12,6 +12,9 @@
 // * two_bone_baked.pack / two_bone_model.pack: a 2-bone, 36-triangle tube
 //   with one bending clip, baked over the clip's key times; small enough that
 //   the fuzzer mutates mostly structure rather than vertex data.
+// * The baked seeds hold kd-trees (FNOD); mannequin_baked_bvh.pack and
+//   two_bone_baked_bvh.pack the same bakes with BVH bone trees of at most 4
+//   triangles a leaf (FBVN, FITM version 3), the bake's default structure.
 //
 // Every seed must load (a seed that does not would only teach the fuzzer a
 // dead end) and stay under 1 MB. character::Provenance is fixed so the bytes are
@@ -144,9 +147,11 @@ struct Baked {
 };
 
 Expected<Baked> bake(const character::Model& model, const anim::PoseSpaceDesc& space,
-                     std::span<const anim::JointLimit> limits, JobSystem& jobs) {
+                     std::span<const anim::JointLimit> limits, rt::BoneTreeKind trees, JobSystem& jobs) {
   character::BakeRequest request;
   request.pose_space = space;
+  request.fuzzy.bone_trees = trees;
+  request.fuzzy.bvh.max_leaf_items = 4;
   request.limits.assign(limits.begin(), limits.end());
   request.fuzzy.padding = 0.01f;
   SINEW_ASSIGN_OR_RETURN(character::InMemoryBake baked, character::bake_in_memory(model, request, jobs));
@@ -167,15 +172,19 @@ bool write_mannequin(const std::string& dir, JobSystem& jobs) {
   space.mode = anim::PoseSpaceMode::kArbitrary;
   space.samples = 8;
   space.seed = 7;
-  auto baked = bake(*mannequin, space, limits, jobs);
+  auto baked = bake(*mannequin, space, limits, rt::BoneTreeKind::kKdTree, jobs);
   if (!baked.ok()) return report(baked.status());
+  auto bvh = bake(*mannequin, space, limits, rt::BoneTreeKind::kBvh, jobs);
+  if (!bvh.ok()) return report(bvh.status());
 
   character::PackContents contents = contents_for(*mannequin, "mannequin");
   bool ok = emit(dir, "mannequin_model.pack", contents);
   contents.limits = limits;
   contents.fuzzy = &baked->fuzzy;
   contents.pose_space = baked->pose_space;
-  return emit(dir, "mannequin_baked.pack", contents) && ok;
+  ok = emit(dir, "mannequin_baked.pack", contents) && ok;
+  contents.fuzzy = &bvh->fuzzy;
+  return emit(dir, "mannequin_baked_bvh.pack", contents) && ok;
 }
 
 bool write_two_bone(const std::string& dir, JobSystem& jobs) {
@@ -185,14 +194,18 @@ bool write_two_bone(const std::string& dir, JobSystem& jobs) {
   anim::PoseSpaceDesc space;
   space.mode = anim::PoseSpaceMode::kClips;
   space.samples = 0;  // every key time
-  auto baked = bake(*model, space, {}, jobs);
+  auto baked = bake(*model, space, {}, rt::BoneTreeKind::kKdTree, jobs);
   if (!baked.ok()) return report(baked.status());
+  auto bvh = bake(*model, space, {}, rt::BoneTreeKind::kBvh, jobs);
+  if (!bvh.ok()) return report(bvh.status());
 
   character::PackContents contents = contents_for(*model, "two_bone");
   bool ok = emit(dir, "two_bone_model.pack", contents);
   contents.fuzzy = &baked->fuzzy;
   contents.pose_space = baked->pose_space;
-  return emit(dir, "two_bone_baked.pack", contents) && ok;
+  ok = emit(dir, "two_bone_baked.pack", contents) && ok;
+  contents.fuzzy = &bvh->fuzzy;
+  return emit(dir, "two_bone_baked_bvh.pack", contents) && ok;
 }
 
 }  // namespace
