@@ -142,13 +142,18 @@ Status bad_box(std::size_t i) {
 
 }  // namespace
 
-Expected<BoxBvh> build_box_bvh(std::span<const Aabb> boxes, const BvhBuildOptions& options) {
+Status check_bvh_options(const BvhBuildOptions& options) {
   if (options.max_leaf_items < 1) {
     return invalid_argument("max_leaf_items", std::to_string(options.max_leaf_items), "must be at least 1");
   }
   if (options.bins < 2 || options.bins > 256) {
     return invalid_argument("bins", std::to_string(options.bins), "must be in [2, 256]");
   }
+  return {};
+}
+
+Expected<BoxBvh> build_box_bvh(std::span<const Aabb> boxes, const BvhBuildOptions& options) {
+  SINEW_RETURN_IF_ERROR(check_bvh_options(options));
   if (boxes.size() > (std::size_t{1} << 31)) {
     return make_error(ErrorCode::kLimitExceeded, "", "boxes", std::to_string(boxes.size()),
                       "a BVH indexes at most 2^31 boxes");

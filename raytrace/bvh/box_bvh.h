@@ -74,6 +74,11 @@ struct BoxBvh {
 // 2^32 boxes stays within the traversal's kMaxTraversalDepth (96).
 inline constexpr int kBvhSahDepth = 60;
 
+// kInvalidArgument naming the option when `options` cannot build a tree
+// (a leaf of fewer than 1 item, bins outside [2, 256]); what
+// build_box_bvh checks first, for callers that check before costly work.
+Status check_bvh_options(const BvhBuildOptions& options);
+
 // Builds a BVH over the non-empty `boxes` by binned SAH on their centres
 // (median split where the centres do not separate or past kBvhSahDepth).
 // Empty boxes (Aabb::empty()) are left out; none left: no nodes.

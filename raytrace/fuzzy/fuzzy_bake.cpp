@@ -146,11 +146,10 @@ Status validate_input(const FuzzyBakeInput& input, const FuzzyBakeOptions& optio
   if (options.bone_trees != BoneTreeKind::kKdTree && options.bone_trees != BoneTreeKind::kBvh) {
     return invalid_argument("bone_trees", std::to_string(static_cast<int>(options.bone_trees)), "not kd or bvh");
   }
-  if (options.bone_trees == BoneTreeKind::kBvh && (options.bvh.max_leaf_items < 1 || options.bvh.bins < 2 ||
-                                                   options.bvh.bins > 256)) {
-    return invalid_argument("bvh", std::to_string(options.bvh.max_leaf_items) + " items a leaf, " +
-                                       std::to_string(options.bvh.bins) + " bins",
-                            "a leaf holds at least 1 item; bins in [2, 256]");
+  if (options.bone_trees == BoneTreeKind::kBvh) {
+    if (Status s = check_bvh_options(options.bvh); !s.ok()) {
+      return invalid_argument("bvh." + std::string(s.field()), s.value(), s.detail());
+    }
   }
   return check_skinned_mesh(MeshOrigin{}, *input.mesh, bones);
 }
