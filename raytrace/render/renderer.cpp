@@ -153,14 +153,51 @@ Expected<OutputPlanes> output_planes(const FrameBuffers& buffers) {
   return out;
 }
 
+}  // namespace
+
+bool characters_look_fine(const Scene& scene, const PinholeCamera& camera) {
+  // Pixels per unit of image-plane slope, along the image's x and y.
+  const float w = static_cast<float>(camera.width()), h = static_cast<float>(camera.height());
+  const float across = w / (camera.right_offset(w) - camera.right_offset(0.0f));
+  const float down = h / (camera.up_offset(0.0f) - camera.up_offset(h));
+  for (const InstanceFrame& frame : scene.instances()) {
+    Aabb box = Aabb::empty();
+    for (const Aabb& b : frame.bone_world_boxes) box.extend(b);
+    if (!(box.lower.x <= box.upper.x)) continue;
+    float x_lo = std::numeric_limits<float>::infinity(), x_hi = -x_lo, y_lo = x_lo, y_hi = -x_lo;
+    bool in_front = true;
+    for (int corner = 0; corner < 8 && in_front; ++corner) {
+      const Vec3 p((corner & 1) ? box.upper.x : box.lower.x, (corner & 2) ? box.upper.y : box.lower.y,
+                   (corner & 4) ? box.upper.z : box.lower.z);
+      const Vec3 q = p - camera.eye();
+      const float z = glm::dot(q, camera.forward());
+      in_front = z > 0.0f;
+      const float x = glm::dot(q, camera.right()) / z, y = glm::dot(q, camera.up()) / z;
+      x_lo = std::min(x_lo, x);
+      x_hi = std::max(x_hi, x);
+      y_lo = std::min(y_lo, y);
+      y_hi = std::max(y_hi, y);
+    }
+    const std::size_t triangles = scene.characters()[frame.character].mesh->triangles.size();
+    if (!in_front || triangles == 0) continue;
+    const double pixels = static_cast<double>((x_hi - x_lo) * across) * static_cast<double>((y_hi - y_lo) * down);
+    if (pixels <= kFineBoxPixelsPerTriangle * static_cast<double>(triangles)) return true;
+  }
+  return false;
+}
+
+namespace {
+
 // One tile, stage by stage (render/tile_stages.h), timing each phase.
 void render_tile(const Scene& scene, const PinholeCamera& camera, const RenderSettings& settings,
-                 std::span<const Light> lights, const OutputPlanes& out, const Tile& tile, TileRecord& record) {
+                 std::span<const Light> lights, bool fine, const OutputPlanes& out, const Tile& tile,
+                 TileRecord& record) {
   TileScratch& s = tile_scratch();
   int region_x = 1, region_y = 1;
   packet_region_blocks(settings.packet_rays, region_x, region_y);
   s.prepare(tile, region_x, region_y);
   s.split_fine_shadows = settings.split_fine_shadow_packets;
+  s.split_static_shadows = fine;
   const auto t0 = Clock::now();
   generate_camera_rays(camera, s);
   trace_primary(scene, camera, settings.triangle_test, settings.packet_rays, s, record.primary);
@@ -218,8 +255,9 @@ Expected<RenderStats> Renderer::render(const Scene& scene, const PinholeCamera& 
   std::vector<TileRecord> records(static_cast<std::size_t>(tiles_x) * static_cast<std::size_t>(tiles_y));
 
   const auto start = Clock::now();
+  const bool fine = settings.shadows && settings.split_fine_shadow_packets && characters_look_fine(scene, camera);
   jobs.parallel_for_tiles(buffers.width, buffers.height, tile, [&](const Tile& t) {
-    render_tile(scene, camera, settings, lights, out, t, records[static_cast<std::size_t>(t.index)]);
+    render_tile(scene, camera, settings, lights, fine, out, t, records[static_cast<std::size_t>(t.index)]);
   });
   const double wall_ms = ms_since(start);
 

@@ -61,9 +61,12 @@ struct RenderSettings {
   // With packets larger than 8x8 pixels: a packet region whose hits on
   // characters lie on triangles about a pixel across or smaller (two in
   // three neighbouring pixels on different triangles) traces their shadow
-  // rays as 8x8-pixel packets. Same results either way; at 855,552
-  // triangles the shadow rays take a sixth less time, at 3,342 triangles no
-  // region splits (docs/RAYTRACE.md, "Shadow packets on fine meshes").
+  // rays as 8x8-pixel packets, and where some character's triangles look
+  // that fine from the camera (characters_look_fine) so do the static
+  // meshes' shadow rays. Same results either way; at 855,552 triangles the
+  // character's shadow rays take a sixth less time, at 213,888 the ground's
+  // a tenth; at 3,342 triangles nothing splits (docs/RAYTRACE.md, "Shadow
+  // packets on fine meshes").
   bool split_fine_shadow_packets = true;
 };
 
@@ -121,6 +124,20 @@ class Renderer {
                                const RenderSettings& settings, const FrameBuffers& buffers,
                                JobSystem& jobs, PhaseTimers* timers = nullptr);
 };
+
+// Whether some character instance's triangles come out about a pixel
+// across or smaller in `camera`'s image: its world box (the union of its
+// bones' boxes this frame), projected, holds at most
+// kFineBoxPixelsPerTriangle pixels per triangle. The box holds more pixels
+// than the character and half the triangles face away, so that is about a
+// pixel or less per visible triangle. An instance whose box reaches behind
+// the eye counts as coarse (its triangles near the eye are large). With
+// RenderSettings::split_fine_shadow_packets the renderer then traces the
+// static meshes' shadow rays, which pass the characters away from their
+// ends, in 8x8-pixel packets too (docs/RAYTRACE.md, "Shadow packets on fine
+// meshes").
+inline constexpr double kFineBoxPixelsPerTriangle = 2.0;
+bool characters_look_fine(const Scene& scene, const PinholeCamera& camera);
 
 // The shading inputs at a hit, in world space.
 struct SurfacePoint {

@@ -92,6 +92,10 @@ struct TileScratch {
   // 8x8 pixels.
   std::vector<std::uint32_t> shadow_region_begin;
   bool split_fine_shadows = true;
+  // With split_fine_shadows: the static meshes' shadow rays too go in
+  // 8x8-pixel runs, set per frame where some character's triangles come out
+  // about a pixel across (render/renderer.h characters_look_fine).
+  bool split_static_shadows = false;
   // The tile's outputs until shade_and_write stores them (render/output_staging.h).
   OutputStaging staging;
 

@@ -907,41 +907,51 @@ void compact_shadow_rays(TileScratch& s) {
       s.shadow_region_begin.push_back(static_cast<std::uint32_t>(s.shadow_count));
     }
   };
-  s.shadow_region_begin.push_back(0);
-  for (std::size_t r = 0; r < s.regions(); ++r) {
-    const std::size_t b0 = s.region_begin[r], b1 = s.region_begin[r + 1];
-    std::uint32_t statics = 0;
-    for (std::size_t b = b0; b < b1; ++b) statics |= s.shadow_lanes[b] & ~s.block_on_character[b];
-    // The character rays in packets of square x square_rows blocks: the
-    // whole region, or on pixel-sized triangles 8x8-pixel squares. A large
-    // packet's rays all end on the surface, so its leaves near the surface
-    // are reached by every group, and there a finer mesh means more
-    // triangles per group: at 855,552 triangles 8x8-pixel packets take 25
-    // triangle tests a shadow ray where 16x16 take 37.
-    const std::size_t columns = s.region_columns(r);
+  // The rays of the region's blocks [b0, b1) (`columns` to a row) whose
+  // lanes `lanes_of(b)` gives, in packets of square x square_rows blocks.
+  const auto add_squares = [&](std::size_t b0, std::size_t b1, std::size_t columns, std::size_t square,
+                               std::size_t square_rows, auto&& lanes_of) {
     const std::size_t rows = columns == 0 ? 0 : (b1 - b0 + columns - 1) / columns;
-    const bool split = s.split_fine_shadows && columns > kSplitBlocksX && fine_geometry(s, b0, b1);
-    const std::size_t square = split ? kSplitBlocksX : columns;
-    const std::size_t square_rows = split ? kSplitBlocksY : rows;
     for (std::size_t sy = 0; sy < rows; sy += square_rows) {
       for (std::size_t sx = 0; sx < columns; sx += square) {
         for (std::size_t y = sy; y < std::min(rows, sy + square_rows); ++y) {
           for (std::size_t x = sx; x < std::min(columns, sx + square); ++x) {
             const std::size_t b = b0 + y * columns + x;
             if (b >= b1) continue;
-            const std::uint32_t on_character = s.block_on_character[b] & s.shadow_lanes[b];
-            if (on_character != 0) add_block(b, on_character);
+            const std::uint32_t lanes = lanes_of(b);
+            if (lanes != 0) add_block(b, lanes);
           }
         }
         close_run();
       }
     }
+  };
+  s.shadow_region_begin.push_back(0);
+  for (std::size_t r = 0; r < s.regions(); ++r) {
+    const std::size_t b0 = s.region_begin[r], b1 = s.region_begin[r + 1];
+    std::uint32_t statics = 0;
+    for (std::size_t b = b0; b < b1; ++b) statics |= s.shadow_lanes[b] & ~s.block_on_character[b];
+    // The character rays in packets of the whole region, or on pixel-sized
+    // triangles of 8x8-pixel squares. A large packet's rays all end on the
+    // surface, so its leaves near the surface are reached by every group,
+    // and there a finer mesh means more triangles per group: at 855,552
+    // triangles 8x8-pixel packets take 25 triangle tests a shadow ray where
+    // 16x16 take 37.
+    const std::size_t columns = s.region_columns(r);
+    const bool splittable = s.split_fine_shadows && columns > kSplitBlocksX;
+    const std::size_t rows = columns == 0 ? 0 : (b1 - b0 + columns - 1) / columns;
+    const bool split = splittable && fine_geometry(s, b0, b1);
+    add_squares(b0, b1, columns, split ? kSplitBlocksX : columns, split ? kSplitBlocksY : rows,
+                [&](std::size_t b) { return s.block_on_character[b] & s.shadow_lanes[b]; });
     if (statics == 0) continue;
-    for (std::size_t b = b0; b < b1; ++b) {
-      const std::uint32_t on_static = s.shadow_lanes[b] & ~s.block_on_character[b];
-      if (on_static != 0) add_block(b, on_static);
-    }
-    close_run();
+    // The static meshes' rays (a ground's) pass the characters away from
+    // their ends: 8x8-pixel squares pay where the characters' triangles are
+    // about a pixel (TileScratch::split_static_shadows), and cost more
+    // where they are larger (docs/RAYTRACE.md, "Shadow packets on fine
+    // meshes").
+    const bool split_statics = splittable && s.split_static_shadows;
+    add_squares(b0, b1, columns, split_statics ? kSplitBlocksX : columns, split_statics ? kSplitBlocksY : rows,
+                [&](std::size_t b) { return s.shadow_lanes[b] & ~s.block_on_character[b]; });
   }
   // No ray at all: no run.
   if (s.shadow_count == 0) s.shadow_region_begin.clear();

@@ -1399,6 +1399,115 @@ TEST(TileStages, ShadowRaysOfRegionsOnPixelSizedTrianglesRunAsEightByEightPacket
   EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), 256);
 }
 
+// A 16x16-pixel region whose top eight rows lie on a character's
+// pixel-sized triangles and whose bottom eight on the ground, every pixel
+// with a shadow ray to a point light.
+rt::TileScratch half_ground_region(bool split, bool split_statics) {
+  rt::TileScratch s;
+  s.prepare(Tile{0, 0, 16, 16, 0}, 4, 8);
+  s.split_fine_shadows = split;
+  s.split_static_shadows = split_statics;
+  for (std::size_t b = 0; b < s.blocks(); ++b) {
+    const bool on_character = s.pixel_y(b * 8) < 8;
+    s.block_hits[b] = 0xFF;
+    s.block_on_character[b] = on_character ? 0xFF : 0x00;
+    s.shadow_lanes[b] = 0xFF;
+  }
+  for (std::size_t k = 0; k < s.lanes; ++k) {
+    s.triangle[k] = static_cast<std::uint32_t>(k);  // every pixel its own triangle
+    s.instance[k] = 0;
+    s.shadow_lane_x[k] = static_cast<float>(k);
+    s.shadow_lane_y[k] = 1.0f;
+    s.shadow_lane_z[k] = -1.0f;
+  }
+  s.shadows_from_point = true;
+  s.shadow_origin = Vec3(0.0f, 5.0f, 0.0f);
+  s.shadows_aimed_only = false;
+  s.shadows_compacted = false;
+  rt::compact_shadow_rays(s);
+  return s;
+}
+
+// The character's rays run first, then the ground's; the ground's go in
+// 8x8-pixel runs only where the frame's characters look fine
+// (TileScratch::split_static_shadows) and splitting is on at all.
+TEST(TileStages, StaticShadowRaysRunAsEightByEightPacketsWhereCharactersLookFine) {
+  EXPECT_EQ(half_ground_region(true, true).shadow_region_begin, (std::vector<std::uint32_t>{0, 64, 128, 192, 256}));
+  EXPECT_EQ(half_ground_region(true, false).shadow_region_begin, (std::vector<std::uint32_t>{0, 64, 128, 256}));
+  EXPECT_EQ(half_ground_region(false, true).shadow_region_begin, (std::vector<std::uint32_t>{0, 128, 256}));
+  EXPECT_EQ(half_ground_region(false, false).shadow_region_begin, (std::vector<std::uint32_t>{0, 128, 256}));
+
+  // Run r holds the 8x8 quadrant (r % 2, r / 2): the character's two on
+  // top, then the ground's two below, every ray once and its own.
+  const rt::TileScratch s = half_ground_region(true, true);
+  ASSERT_EQ(s.shadow_region_begin.size(), 5u);
+  std::vector<int> seen(256, 0);
+  for (std::size_t run = 0; run < 4; ++run) {
+    for (std::size_t i = s.shadow_region_begin[run]; i < s.shadow_region_begin[run + 1]; ++i) {
+      const std::size_t k = s.shadow_pixel[i];
+      const int x = s.pixel_x(k), y = s.pixel_y(k);
+      EXPECT_EQ(x / 8, static_cast<int>(run % 2)) << "ray " << i;
+      EXPECT_EQ(y / 8, static_cast<int>(run / 2)) << "ray " << i;
+      ++seen[static_cast<std::size_t>(16 * y + x)];
+      EXPECT_EQ(s.sd_x[i], static_cast<float>(k));
+    }
+  }
+  EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), 256);
+}
+
+// One idle mannequin, nothing else.
+std::unique_ptr<rt::Scene> one_mannequin() {
+  const testing_support::BakedModel& m = testing_support::idle_mannequin();
+  auto scene = std::make_unique<rt::Scene>();
+  const std::uint32_t character = scene->add_character(m.model.mesh, m.bake.fuzzy.view()).value();
+  const std::uint32_t instance = scene->add_instance(character).value();
+  EXPECT_TRUE(scene->set_bones(instance, testing_support::clip_pose(m.model, "idle", 0.3, Affine3::identity())).ok());
+  JobSystem jobs(2);
+  EXPECT_TRUE(scene->prepare_frame(rt::FrameOptions{}, jobs).ok());
+  return scene;
+}
+
+// By hand: a camera on the axis through the box's centre, looking along -z,
+// sees the box's near face widest, dx / z_near by dy / z_near in slope, at
+// H / (2 tan(fovy / 2)) pixels per unit of slope on a square image. Image
+// sizes put that at 1.6 and 2.5 pixels per triangle, either side of
+// kFineBoxPixelsPerTriangle (2).
+TEST(Renderer, CharactersLookFineWhereTheirProjectedBoxesHoldAboutAPixelPerTriangle) {
+  const std::unique_ptr<rt::Scene> sc = one_mannequin();
+  Aabb box = Aabb::empty();
+  for (const Aabb& b : sc->instances()[0].bone_world_boxes) box.extend(b);
+  ASSERT_TRUE(box.lower.x < box.upper.x);
+  const double triangles = static_cast<double>(sc->characters()[0].mesh->triangles.size());
+  const Vec3 centre = box.center();
+  const double dx = box.upper.x - box.lower.x, dy = box.upper.y - box.lower.y, dz = box.upper.z - box.lower.z;
+  const double distance = 6.0;  // eye to the box's centre
+  const double z_near = distance - 0.5 * dz;
+  const double fovy = 30.0, tan_half = std::tan(fovy * 0.5 * std::acos(-1.0) / 180.0);
+  const Vec3 eye = centre + Vec3(0.0f, 0.0f, static_cast<float>(distance));
+  for (const double per_triangle : {1.6, 2.5}) {
+    // pixels = (dx / z_near) (dy / z_near) (H / (2 tan))^2 = per_triangle * triangles.
+    const int size = static_cast<int>(
+        std::lround(2.0 * tan_half * z_near * std::sqrt(per_triangle * triangles / (dx * dy))));
+    const double s = size / (2.0 * tan_half);
+    const double expected = (dx / z_near) * (dy / z_near) * s * s / triangles;
+    ASSERT_NEAR(expected, per_triangle, 0.1) << size;
+    const auto camera = rt::PinholeCamera::create({eye, centre, Vec3(0, 1, 0), static_cast<float>(fovy)}, size, size);
+    ASSERT_TRUE(camera.ok());
+    EXPECT_EQ(rt::characters_look_fine(*sc, *camera), expected <= rt::kFineBoxPixelsPerTriangle)
+        << size << " px: " << expected << " pixels per triangle";
+  }
+  // An eye inside the box: coarse, however small the image.
+  const auto inside = rt::PinholeCamera::create({centre, centre - Vec3(0, 0, 1), Vec3(0, 1, 0), 30.0f}, 1, 1);
+  ASSERT_TRUE(inside.ok());
+  EXPECT_FALSE(rt::characters_look_fine(*sc, *inside));
+  // No character at all.
+  const rt::Scene empty;
+  const auto far = rt::PinholeCamera::create({eye, centre, Vec3(0, 1, 0), 30.0f}, 1, 1);
+  ASSERT_TRUE(far.ok());
+  EXPECT_FALSE(rt::characters_look_fine(empty, *far));
+  EXPECT_TRUE(rt::characters_look_fine(*sc, *far));
+}
+
 // Far from the camera the mannequins' triangles are a pixel or less: the
 // regions split, and the image is the single rays' either way.
 TEST(Renderer, SplitShadowPacketsOnFineTrianglesShadeAsSingleRays) {
