@@ -1339,21 +1339,23 @@ Frame render(const rt::Scene& sc, const rt::PinholeCamera& camera, int tile, int
   return f;
 }
 
-// A 16x16-pixel region of 4x8 blocks, every pixel on a character with a
-// shadow ray to a point light, its triangles given per block by `ids`
-// (lane i of block b on triangle 10 * b + ids[i]; triangles of different
-// blocks never meet in a pair).
-rt::TileScratch fine_region(const std::array<std::uint32_t, 8>& ids, bool split) {
+// A 16x16-pixel region of 4x8 blocks, every pixel with a shadow ray to a
+// point light, compacted: pixel k on a character where on_character(k)
+// (else on the ground), on triangle triangle_of(k).
+template <class OnCharacter, class TriangleOf>
+rt::TileScratch compacted_region(bool split, bool split_statics, OnCharacter&& on_character,
+                                 TriangleOf&& triangle_of) {
   rt::TileScratch s;
   s.prepare(Tile{0, 0, 16, 16, 0}, 4, 8);
   s.split_fine_shadows = split;
+  s.split_static_shadows = split_statics;
   for (std::size_t b = 0; b < s.blocks(); ++b) {
     s.block_hits[b] = 0xFF;
-    s.block_on_character[b] = 0xFF;
+    s.block_on_character[b] = on_character(b * 8) ? 0xFF : 0x00;
     s.shadow_lanes[b] = 0xFF;
   }
   for (std::size_t k = 0; k < s.lanes; ++k) {
-    s.triangle[k] = static_cast<std::uint32_t>(10 * (k / 8)) + ids[k % 8];
+    s.triangle[k] = triangle_of(k);
     s.instance[k] = 0;
     s.shadow_lane_x[k] = static_cast<float>(k);
     s.shadow_lane_y[k] = 1.0f;
@@ -1365,6 +1367,32 @@ rt::TileScratch fine_region(const std::array<std::uint32_t, 8>& ids, bool split)
   s.shadows_compacted = false;
   rt::compact_shadow_rays(s);
   return s;
+}
+
+// Every pixel on a character, lane i of block b on triangle 10 * b + ids[i]
+// (triangles of different blocks never meet in a pair).
+rt::TileScratch fine_region(const std::array<std::uint32_t, 8>& ids, bool split) {
+  return compacted_region(
+      split, false, [](std::size_t) { return true; },
+      [&](std::size_t k) { return static_cast<std::uint32_t>(10 * (k / 8)) + ids[k % 8]; });
+}
+
+// Four runs, run r holding the 64 rays of the 8x8 quadrant (r % 2, r / 2),
+// every ray of the region once and its own.
+void expect_quadrant_runs(const rt::TileScratch& s) {
+  ASSERT_EQ(s.shadow_region_begin.size(), 5u);
+  std::vector<int> seen(256, 0);
+  for (std::size_t run = 0; run < 4; ++run) {
+    for (std::size_t i = s.shadow_region_begin[run]; i < s.shadow_region_begin[run + 1]; ++i) {
+      const std::size_t k = s.shadow_pixel[i];
+      const int x = s.pixel_x(k), y = s.pixel_y(k);
+      EXPECT_EQ(x / 8, static_cast<int>(run % 2)) << "ray " << i;
+      EXPECT_EQ(y / 8, static_cast<int>(run / 2)) << "ray " << i;
+      ++seen[static_cast<std::size_t>(16 * y + x)];
+      EXPECT_EQ(s.sd_x[i], static_cast<float>(k));  // the lane's own ray
+    }
+  }
+  EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), 256);
 }
 
 // Lanes 0-3 are a block's top row, 4-7 its bottom row: ten neighbouring
@@ -1382,50 +1410,16 @@ TEST(TileStages, ShadowRaysOfRegionsOnPixelSizedTrianglesRunAsEightByEightPacket
   EXPECT_EQ(fine_region(six, true).shadow_region_begin, whole);
   EXPECT_EQ(fine_region(one, true).shadow_region_begin, whole);
   EXPECT_EQ(fine_region(distinct, false).shadow_region_begin, whole);
-
-  // Each run holds one 8x8 quadrant's 64 rays, every ray once.
-  const rt::TileScratch s = fine_region(distinct, true);
-  std::vector<int> seen(256, 0);
-  for (std::size_t run = 0; run < 4; ++run) {
-    for (std::size_t i = s.shadow_region_begin[run]; i < s.shadow_region_begin[run + 1]; ++i) {
-      const std::size_t k = s.shadow_pixel[i];
-      const int x = s.pixel_x(k), y = s.pixel_y(k);
-      EXPECT_EQ(x / 8, static_cast<int>(run % 2)) << "ray " << i;
-      EXPECT_EQ(y / 8, static_cast<int>(run / 2)) << "ray " << i;
-      ++seen[static_cast<std::size_t>(16 * y + x)];
-      EXPECT_EQ(s.sd_x[i], static_cast<float>(k));  // the lane's own ray
-    }
-  }
-  EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), 256);
+  expect_quadrant_runs(fine_region(distinct, true));
 }
 
-// A 16x16-pixel region whose top eight rows lie on a character's
-// pixel-sized triangles and whose bottom eight on the ground, every pixel
-// with a shadow ray to a point light.
+// The top eight rows on a character's pixel-sized triangles (every pixel
+// its own), the bottom eight on the ground: lanes 0-127 are blocks 0-15, the
+// top four rows of 4x2-pixel blocks.
 rt::TileScratch half_ground_region(bool split, bool split_statics) {
-  rt::TileScratch s;
-  s.prepare(Tile{0, 0, 16, 16, 0}, 4, 8);
-  s.split_fine_shadows = split;
-  s.split_static_shadows = split_statics;
-  for (std::size_t b = 0; b < s.blocks(); ++b) {
-    const bool on_character = s.pixel_y(b * 8) < 8;
-    s.block_hits[b] = 0xFF;
-    s.block_on_character[b] = on_character ? 0xFF : 0x00;
-    s.shadow_lanes[b] = 0xFF;
-  }
-  for (std::size_t k = 0; k < s.lanes; ++k) {
-    s.triangle[k] = static_cast<std::uint32_t>(k);  // every pixel its own triangle
-    s.instance[k] = 0;
-    s.shadow_lane_x[k] = static_cast<float>(k);
-    s.shadow_lane_y[k] = 1.0f;
-    s.shadow_lane_z[k] = -1.0f;
-  }
-  s.shadows_from_point = true;
-  s.shadow_origin = Vec3(0.0f, 5.0f, 0.0f);
-  s.shadows_aimed_only = false;
-  s.shadows_compacted = false;
-  rt::compact_shadow_rays(s);
-  return s;
+  return compacted_region(
+      split, split_statics, [](std::size_t k) { return k < 128; },
+      [](std::size_t k) { return static_cast<std::uint32_t>(k); });
 }
 
 // The character's rays run first, then the ground's; the ground's go in
@@ -1436,23 +1430,8 @@ TEST(TileStages, StaticShadowRaysRunAsEightByEightPacketsWhereCharactersLookFine
   EXPECT_EQ(half_ground_region(true, false).shadow_region_begin, (std::vector<std::uint32_t>{0, 64, 128, 256}));
   EXPECT_EQ(half_ground_region(false, true).shadow_region_begin, (std::vector<std::uint32_t>{0, 128, 256}));
   EXPECT_EQ(half_ground_region(false, false).shadow_region_begin, (std::vector<std::uint32_t>{0, 128, 256}));
-
-  // Run r holds the 8x8 quadrant (r % 2, r / 2): the character's two on
-  // top, then the ground's two below, every ray once and its own.
-  const rt::TileScratch s = half_ground_region(true, true);
-  ASSERT_EQ(s.shadow_region_begin.size(), 5u);
-  std::vector<int> seen(256, 0);
-  for (std::size_t run = 0; run < 4; ++run) {
-    for (std::size_t i = s.shadow_region_begin[run]; i < s.shadow_region_begin[run + 1]; ++i) {
-      const std::size_t k = s.shadow_pixel[i];
-      const int x = s.pixel_x(k), y = s.pixel_y(k);
-      EXPECT_EQ(x / 8, static_cast<int>(run % 2)) << "ray " << i;
-      EXPECT_EQ(y / 8, static_cast<int>(run / 2)) << "ray " << i;
-      ++seen[static_cast<std::size_t>(16 * y + x)];
-      EXPECT_EQ(s.sd_x[i], static_cast<float>(k));
-    }
-  }
-  EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), 256);
+  // The character's two quadrants on top, then the ground's two below.
+  expect_quadrant_runs(half_ground_region(true, true));
 }
 
 // One idle mannequin, nothing else.
