@@ -12,9 +12,9 @@
 // Numerical safety: as group_frusta.h, plane by plane. Each plane holds the
 // slopes of every lane on its side, grown by 2^-16 of the slope (far above
 // the rounding of the slopes and of the plane), and a triangle is cut off
-// only when its corners lie beyond the plane by 2^-12 of the coordinate
+// only when its corners lie beyond the plane by 2^-16 of the coordinate
 // magnitudes (corners and apex), the margin beyond which neither triangle
-// test reports a hit off the triangle.
+// test reports a hit off the triangle (group_frusta.h).
 #pragma once
 
 #include <algorithm>
@@ -151,7 +151,7 @@ class GridFrusta {
   template <class Nearest>
   std::uint64_t uncut(std::uint64_t groups, float corners, Nearest&& nearest) const {
     if (!on_) return groups;
-    const Float8 margin(0x1.0p-12f * (corners + apex_magnitude_));
+    const Float8 margin(0x1.0p-16f * (corners + apex_magnitude_));
     const auto cut = [&](const Planes& p) { return (nearest(p.n) > Float8::load(p.scale) * margin).bits(); };
     if (cut(outer_) != 0) return 0;
     const std::uint64_t columns = ~(cut(column_hi_) | cut(column_lo_)) & ((1u << columns_) - 1u);
