@@ -14,7 +14,7 @@
 // the rounding of the slopes and of the plane), and a triangle is cut off
 // only when its corners lie beyond the plane by 2^-16 of the coordinate
 // magnitudes (corners and apex), the margin beyond which neither triangle
-// test reports a hit off the triangle (group_frusta.h).
+// test reports a hit off the triangle (group_frusta.h cull_margin).
 #pragma once
 
 #include <algorithm>
@@ -23,6 +23,7 @@
 #include <cstdint>
 #include <limits>
 
+#include "raytrace/render/group_frusta.h"
 #include "runtime/math/aabb.h"
 #include "runtime/math/float8.h"
 #include "runtime/math/types.h"
@@ -151,7 +152,7 @@ class GridFrusta {
   template <class Nearest>
   std::uint64_t uncut(std::uint64_t groups, float corners, Nearest&& nearest) const {
     if (!on_) return groups;
-    const Float8 margin(0x1.0p-16f * (corners + apex_magnitude_));
+    const Float8 margin = cull_margin(corners, apex_magnitude_);
     const auto cut = [&](const Planes& p) { return (nearest(p.n) > Float8::load(p.scale) * margin).bits(); };
     if (cut(outer_) != 0) return 0;
     const std::uint64_t columns = ~(cut(column_hi_) | cut(column_lo_)) & ((1u << columns_) - 1u);

@@ -36,6 +36,14 @@
 
 namespace sinew::rt {
 
+// How far beyond a plane a shape must lie to be culled, per unit of the
+// plane's L1 norm: 2^-16 of the coordinate magnitudes involved (its corners'
+// largest and the apex's). Shared by the group frusta and the camera grid
+// (grid_frusta.h); the header comment above says what it covers.
+inline Float8 cull_margin(float corners, float apex_magnitude) {
+  return Float8(0x1.0p-16f * (corners + apex_magnitude));
+}
+
 template <int kMaxGroups>
 class GroupFrusta {
   static_assert(kMaxGroups % 8 == 0);
@@ -263,7 +271,7 @@ class GroupFrusta {
       const Float8 nx = Float8::load(bound_n_[0]), ny = Float8::load(bound_n_[1]), nz = Float8::load(bound_n_[2]);
       const auto side = [&](const Vec3& x) { return (nx * Float8(x.x) + ny * Float8(x.y)) + nz * Float8(x.z); };
       const Float8 d = min(min(side(x0), side(x1)), side(x2));
-      const Float8 margin(0x1.0p-16f * (corners + apex_magnitude_));
+      const Float8 margin = cull_margin(corners, apex_magnitude_);
       const Float8 limit = Float8::load(bound_scale_) * margin + Float8::load(bound_offset_);
       if ((d > limit).bits() != 0) return 0;
       if (slabs_on_ && (groups & ~slab_groups_) == 0) return slabs_uncut(groups, corners, x0, x1, x2);
@@ -292,7 +300,7 @@ class GroupFrusta {
     const Vec3& c = slab_basis_[0];
     const Vec3& u = slab_basis_[1];
     const Vec3& v = slab_basis_[2];
-    const Float8 margin(0x1.0p-16f * (corners + apex_magnitude_));
+    const Float8 margin = cull_margin(corners, apex_magnitude_);
     const Float8 z0(glm::dot(c, x0)), z1(glm::dot(c, x1)), z2(glm::dot(c, x2));
     const Float8 a0(glm::dot(u, x0)), a1(glm::dot(u, x1)), a2(glm::dot(u, x2));
     const Float8 b0(glm::dot(v, x0)), b1(glm::dot(v, x1)), b2(glm::dot(v, x2));
@@ -326,7 +334,7 @@ class GroupFrusta {
   // far plane, beyond its offset). Groups without a frustum are never cut.
   template <class Nearest>
   std::uint64_t uncut(std::uint64_t groups, float corners, Nearest&& nearest) const {
-    const Float8 margin(0x1.0p-16f * (corners + apex_magnitude_));
+    const Float8 margin = cull_margin(corners, apex_magnitude_);
     std::uint64_t out = 0;
     for (int base = 0; base < groups_; base += 8) {
       const std::uint64_t part = (groups >> base) & 0xFFu;
