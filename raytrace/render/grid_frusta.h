@@ -130,16 +130,13 @@ class GridFrusta {
   }
 
   // The groups of `groups` whose column and row may reach `box` (its corner
-  // nearest each plane; an empty or non-finite box is reached by all).
+  // nearest each plane, box_plane_nearest: at least every group a triangle
+  // inside it reaches; an empty or non-finite box is reached by all).
   std::uint64_t box_reached(const Aabb& box, std::uint64_t groups) const {
-    const Vec3 c = 0.5f * (box.lower + box.upper) - apex_;
-    const Vec3 h = 0.5f * (box.upper - box.lower);
+    const Vec3 lo = box.lower - apex_, hi = box.upper - apex_;
     const float corners = std::max(magnitude(box.lower), magnitude(box.upper));
     return uncut(groups, corners, [&](const float (&n)[3][8]) {
-      const Float8 nx = Float8::load(n[0]), ny = Float8::load(n[1]), nz = Float8::load(n[2]);
-      const Float8 centre = (nx * Float8(c.x) + ny * Float8(c.y)) + nz * Float8(c.z);
-      const Float8 reach = (abs(nx) * Float8(h.x) + abs(ny) * Float8(h.y)) + abs(nz) * Float8(h.z);
-      return centre - reach;
+      return box_plane_nearest(Float8::load(n[0]), Float8::load(n[1]), Float8::load(n[2]), lo, hi);
     });
   }
 

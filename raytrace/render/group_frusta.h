@@ -44,6 +44,16 @@ inline Float8 cull_margin(float corners, float apex_magnitude) {
   return Float8(0x1.0p-16f * (corners + apex_magnitude));
 }
 
+// The least of n . x over the box [lo, hi] (relative to an apex) for eight
+// planes n: per axis the nearer corner's product. Rounding is monotone, so
+// it never exceeds (n.x x + n.y y) + n.z z, the sum the triangle culls of
+// GroupFrusta and GridFrusta take at a corner, at any point of the box: a
+// box reaches every group a triangle inside it reaches.
+inline Float8 box_plane_nearest(Float8 nx, Float8 ny, Float8 nz, const Vec3& lo, const Vec3& hi) {
+  const auto nearer = [](Float8 n, float l, float h) { return min(n * Float8(l), n * Float8(h)); };
+  return (nearer(nx, lo.x, hi.x) + nearer(ny, lo.y, hi.y)) + nearer(nz, lo.z, hi.z);
+}
+
 template <int kMaxGroups>
 class GroupFrusta {
   static_assert(kMaxGroups % 8 == 0);
@@ -246,19 +256,25 @@ class GroupFrusta {
   }
 
   // The groups of `groups` whose frustum may reach `box` (an object's box,
-  // before its lanes are clipped to it). A box lies wholly beyond a plane
-  // when its corner nearest the plane does; the same margin as reached()
-  // covers the rounding of that corner's distance. A box that is empty or
-  // not finite is reached by every group (its distances are NaN or inf).
+  // before its lanes are clipped to it; a leaf's current triangles'). A box
+  // lies wholly beyond a plane when its corner nearest the plane does; the
+  // same margin as reached() covers the rounding of that corner's distance,
+  // and box_plane_nearest() takes it as reached() takes a point, so a box reaches
+  // every group a triangle inside it reaches. A box that is empty or not
+  // finite is reached by every group (its distances are NaN or -inf).
   std::uint64_t box_reached(const Aabb& box, std::uint64_t groups) const {
-    const Vec3 c = 0.5f * (box.lower + box.upper) - apex_;
-    const Vec3 h = 0.5f * (box.upper - box.lower);
+    const Vec3 lo = box.lower - apex_, hi = box.upper - apex_;
     const float corners = std::max(magnitude(box.lower), magnitude(box.upper));
-    return uncut(groups, corners, [&](Float8 nx, Float8 ny, Float8 nz) {
-      const Float8 centre = (nx * Float8(c.x) + ny * Float8(c.y)) + nz * Float8(c.z);
-      const Float8 reach = (abs(nx) * Float8(h.x) + abs(ny) * Float8(h.y)) + abs(nz) * Float8(h.z);
-      return centre - reach;
-    });
+    const auto nearest = [&](Float8 nx, Float8 ny, Float8 nz) { return box_plane_nearest(nx, ny, nz, lo, hi); };
+    if (groups != 0 && (groups & ~bound_groups_) == 0) {
+      // The packet's frustum first, as reached() does.
+      const Float8 d = nearest(Float8::load(bound_n_[0]), Float8::load(bound_n_[1]), Float8::load(bound_n_[2]));
+      const Float8 limit =
+          Float8::load(bound_scale_) * cull_margin(corners, apex_magnitude_) + Float8::load(bound_offset_);
+      if ((d > limit).bits() != 0) return 0;
+      if (slabs_on_ && (groups & ~slab_groups_) == 0) return slabs_box_uncut(groups, corners, lo, hi);
+    }
+    return uncut(groups, corners, nearest);
   }
 
   // The groups of `groups` whose frustum the triangle may reach.
@@ -301,9 +317,9 @@ class GroupFrusta {
     const Vec3& u = slab_basis_[1];
     const Vec3& v = slab_basis_[2];
     const Float8 margin = cull_margin(corners, apex_magnitude_);
-    const Float8 z0(glm::dot(c, x0)), z1(glm::dot(c, x1)), z2(glm::dot(c, x2));
-    const Float8 a0(glm::dot(u, x0)), a1(glm::dot(u, x1)), a2(glm::dot(u, x2));
-    const Float8 b0(glm::dot(v, x0)), b1(glm::dot(v, x1)), b2(glm::dot(v, x2));
+    const Float8 z0(dot3(c, x0)), z1(dot3(c, x1)), z2(dot3(c, x2));
+    const Float8 a0(dot3(u, x0)), a1(dot3(u, x1)), a2(dot3(u, x2));
+    const Float8 b0(dot3(v, x0)), b1(dot3(v, x1)), b2(dot3(v, x2));
     const Float8 z_min = min(min(z0, z1), z2);
     std::uint64_t out = 0;
     for (int base = 0; base < groups_; base += 8) {
@@ -325,6 +341,47 @@ class GroupFrusta {
     }
     return out;
   }
+  // slabs_uncut for the box [lo, hi] (relative to the apex): each side's
+  // u.x - s (c.x) is at least u.x's least over the box minus s times c.x's
+  // greatest (least, for s < 0) over it, each the sum dot3 takes at a point
+  // with the nearer corner's products, so the box's bound never exceeds a
+  // point's (rounding is monotone). Looser than the box's own nearest
+  // corner by about |s| times its depth, which is small beside a pixel for
+  // the boxes this sees (a leaf's, an object's).
+  std::uint64_t slabs_box_uncut(std::uint64_t groups, float corners, const Vec3& lo, const Vec3& hi) const {
+    const Vec3& c = slab_basis_[0];
+    const Vec3& u = slab_basis_[1];
+    const Vec3& v = slab_basis_[2];
+    const auto least = [&](const Vec3& w) {
+      return (std::min(w.x * lo.x, w.x * hi.x) + std::min(w.y * lo.y, w.y * hi.y)) + std::min(w.z * lo.z, w.z * hi.z);
+    };
+    const auto most = [&](const Vec3& w) {
+      return (std::max(w.x * lo.x, w.x * hi.x) + std::max(w.y * lo.y, w.y * hi.y)) + std::max(w.z * lo.z, w.z * hi.z);
+    };
+    const Float8 a_least(least(u)), a_most(most(u)), b_least(least(v)), b_most(most(v));
+    const Float8 z_least(least(c)), z_most(most(c));
+    const Float8 zero(0.0f);
+    const Float8 margin = cull_margin(corners, apex_magnitude_);
+    std::uint64_t out = 0;
+    for (int base = 0; base < groups_; base += 8) {
+      const std::uint64_t part = (groups >> base) & 0xFFu;
+      if (part == 0) continue;
+      const Float8 a_lo = Float8::load(&slab_[0][base]), a_hi = Float8::load(&slab_[1][base]);
+      const Float8 b_lo = Float8::load(&slab_[2][base]), b_hi = Float8::load(&slab_[3][base]);
+      // s (c.x) at its greatest: c.x's greatest for s >= 0, its least below.
+      const auto s_z_most = [&](Float8 s) { return s * select(s >= zero, z_most, z_least); };
+      const auto s_z_least = [&](Float8 s) { return s * select(s >= zero, z_least, z_most); };
+      const Mask8 cut = (a_least - s_z_most(a_hi) > Float8::load(&slab_scale_[1][base]) * margin) |
+                        (s_z_least(a_lo) - a_most > Float8::load(&slab_scale_[0][base]) * margin) |
+                        (b_least - s_z_most(b_hi) > Float8::load(&slab_scale_[3][base]) * margin) |
+                        (s_z_least(b_lo) - b_most > Float8::load(&slab_scale_[2][base]) * margin) |
+                        (z_least > Float8::load(&slab_far_[base]) + Float8(slab_far_scale_) * margin);
+      out |= (part & ~static_cast<std::uint64_t>(cut.bits())) << base;
+    }
+    return out;
+  }
+  // A dot product summed as (x + y) + z, the order slabs_box_uncut bounds.
+  static float dot3(const Vec3& a, const Vec3& b) { return (a.x * b.x + a.y * b.y) + a.z * b.z; }
   static float l1(const Vec3& w) { return std::fabs(w.x) + std::fabs(w.y) + std::fabs(w.z); }
 
   // The groups of `groups` that no plane of theirs cuts off, eight at a

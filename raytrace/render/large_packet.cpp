@@ -496,7 +496,7 @@ class LargeQuery {
           visit_small_static(mesh, groups);
           return;
         }
-        const auto leaf = [&](std::span<const std::uint32_t> triangles, GroupMask groups_here) {
+        const auto leaf = [&](std::uint32_t, std::span<const std::uint32_t> triangles, GroupMask groups_here) {
           return test_leaf(triangles, groups_here, [&](std::uint32_t t) {
             const auto& v = mesh.desc.triangles[t];
             return LeafTriangle{&mesh.desc.positions[v[0]], &mesh.desc.positions[v[1]], &mesh.desc.positions[v[2]],
@@ -509,7 +509,7 @@ class LargeQuery {
       case TopLevelObject::Kind::kFallback: {
         const InstanceFrame& frame = scene_ref().instances()[object.index];
         const SkinnedMesh& mesh = *scene_ref().characters()[frame.character].mesh;
-        const auto leaf = [&](std::span<const std::uint32_t> items, GroupMask groups_here) {
+        const auto leaf = [&](std::uint32_t, std::span<const std::uint32_t> items, GroupMask groups_here) {
           return test_leaf(items, groups_here, [&](std::uint32_t item) {
             const std::uint32_t t = frame.escaped_triangles[item];
             const auto& v = mesh.triangles[t];
@@ -534,6 +534,18 @@ class LargeQuery {
     }
   }
 
+  // The box of the triangles of `items` (corners(item): a LeafTriangle).
+  template <class CornersFn>
+  static Aabb triangles_box(std::span<const std::uint32_t> items, CornersFn& corners) {
+    Vec3 lo(kInf), hi(-kInf);
+    for (const std::uint32_t item : items) {
+      const LeafTriangle tri = corners(item);
+      lo = min(lo, min(*tri.p0, min(*tri.p1, *tri.p2)));
+      hi = max(hi, max(*tri.p0, max(*tri.p1, *tri.p2)));
+    }
+    return {lo, hi};
+  }
+
   // A leaf's items for the groups reaching it. `corners(item)` gives the
   // item's triangle (LeafTriangle). With group frusta each item is tested
   // once per object visit, by the groups whose frustum it reaches; without,
@@ -546,7 +558,11 @@ class LargeQuery {
       if (frusta_on_) {
         if (!items_seen_.first_visit(item)) continue;
         const LeafTriangle tri = corners(item);
-        need_ = frusta_reached(*tri.p0, *tri.p1, *tri.p2, groups_here & alive_groups_);
+        // A shadow packet's leaf that one group alone reaches (most leaves
+        // on pixel-sized triangles, where the leaf's box picked its groups):
+        // the group's slab test would cost about what its lane test does.
+        const GroupMask here = groups_here & alive_groups_;
+        need_ = kAnyHit && std::has_single_bit(here) ? here : frusta_reached(*tri.p0, *tri.p1, *tri.p2, here);
         if (need_ == 0) continue;
         for_each_bit(need_, [&](int g) { visit_[g].leaf_lanes = visit_[g].lanes & live_[g]; });
         test_groups(need_, *tri.p0, *tri.p1, *tri.p2, tri.triangle, tri.instance);
@@ -630,12 +646,21 @@ class LargeQuery {
       enter_tree(entry, tree.bounds, g, o, d, inv, eps);
     });
     const SkinnedMesh& mesh = *character.mesh;
-    const auto leaf = [&](std::span<const std::uint32_t> triangles, GroupMask groups_here) {
-      return test_leaf(triangles, groups_here, [&](std::uint32_t t) {
-        const auto& v = mesh.triangles[t];
-        return LeafTriangle{&frame.positions[v[0]], &frame.positions[v[1]], &frame.positions[v[2]], t,
-                            frame.instance_id};
-      });
+    const auto corners = [&](std::uint32_t t) {
+      const auto& v = mesh.triangles[t];
+      return LeafTriangle{&frame.positions[v[0]], &frame.positions[v[1]], &frame.positions[v[2]], t,
+                          frame.instance_id};
+    };
+    const auto leaf = [&](std::uint32_t node, std::span<const std::uint32_t> triangles, GroupMask groups_here) {
+      if (frusta_on_) {
+        // The leaf's triangles as they are this frame (raytrace/scene/leaf_boxes.h):
+        // a leaf no frustum reaches costs one box test, not one per triangle.
+        ensure_frusta(groups_here & alive_groups_);
+        const Aabb box = frame.leaf_boxes.get(bone, node, [&] { return triangles_box(triangles, corners); });
+        groups_here = frusta_box_reached(box, groups_here & alive_groups_);
+        if (groups_here == 0) return false;
+      }
+      return test_leaf(triangles, groups_here, corners);
     };
     if (character.fuzzy.has_bvhs()) {
       walk_bvh(character.fuzzy.bvh_view(tree), entry, leaf);
@@ -762,7 +787,10 @@ class LargeQuery {
             continue;
           }
         } else if (node.item_count() > 0) {
-          if (visit_leaf(cur.box(), tree.items.subspan(node.first_item(), node.item_count()), groups, leaf)) return;
+          if (visit_leaf(cur.box(), cur.node, tree.items.subspan(node.first_item(), node.item_count()), groups,
+                         leaf)) {
+            return;
+          }
         }
       }
       if (top == 0) return;
@@ -819,7 +847,8 @@ class LargeQuery {
   // (grown by each lane's own slack); with them each triangle picks its
   // groups itself, more tightly than the cell would. Returns true to stop.
   template <class LeafFn>
-  bool visit_leaf(const Aabb& cell, std::span<const std::uint32_t> items, GroupMask groups, LeafFn& leaf) {
+  bool visit_leaf(const Aabb& cell, std::uint32_t node, std::span<const std::uint32_t> items, GroupMask groups,
+                  LeafFn& leaf) {
     GroupMask reaching = 0;
     if (frusta_on_) reaching = groups & alive_groups_;
     for_each_bit(frusta_on_ ? GroupMask{0} : groups & alive_groups_, [&](int g) {
@@ -830,7 +859,7 @@ class LargeQuery {
                                   vg.lanes & live_[g], t0, t1);
       if (leaf_lanes_[g] != 0) reaching |= GroupMask{1} << g;
     });
-    return reaching != 0 && leaf(items, reaching);
+    return reaching != 0 && leaf(node, items, reaching);
   }
 
   // Front to back over the BVH nodes the packet's bound reaches (each
@@ -859,7 +888,7 @@ class LargeQuery {
       ++counters_.node_visits;
       const BvhNode& node = tree.nodes[e.node];
       if (node.is_leaf()) {
-        if (visit_leaf(node.box, tree.items.subspan(node.first, node.count), groups, leaf)) return;
+        if (visit_leaf(node.box, e.node, tree.items.subspan(node.first, node.count), groups, leaf)) return;
         continue;
       }
       const float t_limit = limit();

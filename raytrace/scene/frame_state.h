@@ -8,6 +8,7 @@
 
 #include "raytrace/fuzzy/fuzzy_character.h"
 #include "raytrace/kdtree/kd_tree.h"
+#include "raytrace/scene/leaf_boxes.h"
 #include "raytrace/skinning/skinning.h"
 #include "runtime/core/status.h"
 #include "runtime/math/affine.h"
@@ -60,6 +61,10 @@ struct InstanceFrame {
     const std::int32_t q = bone < bone_cluster.size() ? bone_cluster[bone] : -1;
     return q < 0 ? fuzzy.bone_trees[bone] : fuzzy.clusters[static_cast<std::size_t>(q)].tree;
   }
+
+  // The current world boxes of the bone trees' leaves, filled as packets
+  // reach them (leaf_boxes.h); Scene::prepare_frame starts each frame.
+  LeafBoxCache leaf_boxes;
 
   std::vector<std::uint32_t> escaped_triangles;  // triangle ids routed through the fallback
   KdTree fallback;  // world-space tree; items index escaped_triangles

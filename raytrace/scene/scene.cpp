@@ -125,6 +125,7 @@ Expected<FrameStats> Scene::prepare_frame(const FrameOptions& options, JobSystem
     skin_instance(frame, *character.mesh, character.influences, character.fuzzy, options.normals,
                   options.bone_boxes == BoneBoxMode::kExact, options.skinning, jobs);
     settle_bone_clusters(frame, character.fuzzy, jobs);
+    frame.leaf_boxes.prepare(character.fuzzy);
     skinning_ms += ms_since(start);
 
     start = std::chrono::steady_clock::now();

@@ -119,6 +119,11 @@ TEST(GridFrusta, NeverCullAGroupWhoseRayHitsOrEnters) {
         const Vec3 half = size * Vec3(unit(g), unit(g), unit(g));
         const Aabb box{at + shift - half, at + shift + half};
         const std::uint64_t box_reached = grid.box_reached(box, all);
+        // The triangle's own box (a leaf's box, raytrace/scene/leaf_boxes.h)
+        // reaches every group the triangle does.
+        const Aabb around{glm::min(p0, glm::min(p1, p2)), glm::max(p0, glm::max(p1, p2))};
+        ASSERT_EQ(reached & ~grid.box_reached(around, all), 0u)
+            << "groups reach the triangle but not its box; view " << view << " offset " << offset << " trial " << trial;
         ++tried;
         for (int k = 0; k < groups; ++k) {
           ++group_trials;

@@ -201,12 +201,15 @@ TEST(GroupFrusta, EveryHitTriangleIsReachedBySegmentsFromTheApex) {
 // reached by that lane's group, from an apex near and far from the origin,
 // for rays and for segments ending at their lane's reach (far plane), and
 // with lanes missing from the groups; with the groups' own frusta and with
-// their slabs in the packet's basis alone (use_slabs, shadow packets).
+// their slabs in the packet's basis alone (use_slabs, shadow packets). The
+// triangle's box (a leaf's box, raytrace/scene/leaf_boxes.h) reaches every
+// group the triangle reaches, and the boxes are culled too, by the packet
+// and by single groups.
 TEST(GroupFrusta, ThePacketFrustumNeverCullsATriangleALaneHits) {
   for (const bool slabs : {false, true}) {
   SCOPED_TRACE(slabs ? "slabs" : "own frusta");
   std::mt19937 g(11);
-  int tried = 0, hit = 0, culled = 0, some_groups = 0;
+  int tried = 0, hit = 0, culled = 0, some_groups = 0, boxes_culled = 0, boxes_some_groups = 0;
   for (const bool segments : {false, true}) {
     for (const float offset : {0.0f, 60.0f, 4000.0f}) {
       for (int packet = 0; packet < 20; ++packet) {
@@ -268,6 +271,12 @@ TEST(GroupFrusta, ThePacketFrustumNeverCullsATriangleALaneHits) {
           ++tried;
           if (reached == 0) ++culled;
           if (reached != 0 && std::popcount(reached) < 32) ++some_groups;
+          const Aabb box{glm::min(p0, glm::min(p1, p2)), glm::max(p0, glm::max(p1, p2))};
+          const std::uint64_t box_groups = frusta.box_reached(box, ~std::uint64_t{0});
+          ASSERT_EQ(reached & ~box_groups, 0u) << "groups reach the triangle but not its box; apex (" << apex.x << ","
+                                               << apex.y << "," << apex.z << ") packet " << packet << " trial " << trial;
+          if (box_groups == 0) ++boxes_culled;
+          if (box_groups != 0 && std::popcount(box_groups) < 32) ++boxes_some_groups;
           for (int lane = 0; lane < 512; ++lane) {
             if (!(lanes[lane / 8] >> (lane % 8) & 1u) || !hits(rays[static_cast<std::size_t>(lane)], p0, p1, p2)) {
               continue;
@@ -285,6 +294,8 @@ TEST(GroupFrusta, ThePacketFrustumNeverCullsATriangleALaneHits) {
   EXPECT_GT(culled, tried / 5) << culled << " of " << tried;
   // The groups cull, not only the packet: many reached triangles reach few groups.
   EXPECT_GT(some_groups, tried / 10) << some_groups << " of " << tried;
+  EXPECT_GT(boxes_culled, tried / 5) << boxes_culled << " of " << tried;
+  EXPECT_GT(boxes_some_groups, tried / 10) << boxes_some_groups << " of " << tried;
   }
 }
 
