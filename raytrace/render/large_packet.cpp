@@ -192,6 +192,7 @@ class LargeQuery {
     grid_basis_[0] = rays.grid_forward;
     grid_basis_[1] = rays.grid_right;
     grid_basis_[2] = rays.grid_up;
+    group_frusta_ = rays.group_frusta;
     groups_ = std::clamp(rays.groups, 0, kMaxPacketGroups);
     alive_groups_ = 0;
     limits_lowered_ = 0;
@@ -373,8 +374,9 @@ class LargeQuery {
     frusta_.reset(common_origin_at_, groups_);
     // Shadow packets: the groups' slabs in the packet's basis
     // (GroupFrusta::use_slabs), cheaper per triangle than their own frusta
-    // and built with the packet's bound (docs/RAYTRACE.md, "Shadow slabs").
-    slabs_ = kAnyHit;
+    // and built with the packet's bound (docs/RAYTRACE.md, "Shadow slabs"),
+    // unless the packet asks for the groups' own (LargePacketRays::group_frusta).
+    slabs_ = kAnyHit && !group_frusta_;
     frusta_.use_slabs(slabs_);
   }
 
@@ -1028,6 +1030,7 @@ class LargeQuery {
   float visit_slack_ = 0.0f;       // run(): a bound on every lane's slack in an object's box clip
   bool frusta_on_ = false;         // grid_ (when on) or frusta_ pick each leaf triangle's groups
   bool slabs_ = false;             // frusta_ tests the groups' slabs in the packet's basis
+  bool group_frusta_ = false;      // LargePacketRays::group_frusta
   GroupMask frusta_built_ = 0;  // the groups whose frustum frusta_ holds
   TraversalCounters counters_;
 };

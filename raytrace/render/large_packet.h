@@ -53,6 +53,11 @@ struct LargePacketRays {
   // shape are still bounded, only less tightly.
   int grid_columns = 0;
   Vec3 grid_forward{0.0f}, grid_right{0.0f}, grid_up{0.0f};
+  // Rays from one apex with finite ends (shadow rays): each group culls
+  // with its own frustum instead of its slab in the packet's basis, tighter
+  // and dearer per triangle. It pays on pixel-sized triangles, where a
+  // leaf's box leaves it a group or two (docs/RAYTRACE.md, "Leaf boxes").
+  bool group_frusta = false;
 };
 
 // The nearest hits of every active lane, written to 8 * groups entries of

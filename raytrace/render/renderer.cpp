@@ -198,6 +198,7 @@ void render_tile(const Scene& scene, const PinholeCamera& camera, const RenderSe
   s.prepare(tile, region_x, region_y);
   s.split_fine_shadows = settings.split_fine_shadow_packets;
   s.split_static_shadows = fine;
+  s.shadow_group_frusta = fine;
   const auto t0 = Clock::now();
   generate_camera_rays(camera, s);
   trace_primary(scene, camera, settings.triangle_test, settings.packet_rays, s, record.primary);

@@ -96,6 +96,10 @@ struct TileScratch {
   // 8x8-pixel runs, set per frame where some character's triangles come out
   // about a pixel across (render/renderer.h characters_look_fine).
   bool split_static_shadows = false;
+  // Set per frame with split_static_shadows (whatever split_fine_shadows
+  // says): shadow packets cull with their groups' own frusta
+  // (LargePacketRays::group_frusta).
+  bool shadow_group_frusta = false;
   // The tile's outputs until shade_and_write stores them (render/output_staging.h).
   OutputStaging staging;
 

@@ -472,6 +472,7 @@ std::uint64_t trace_shadow_large(const Scene& scene, TriangleTest test, const st
     rays.t_min = zeros.data();
     rays.t_max = &s.s_tmax[i0];
     rays.active = active.data();
+    rays.group_frusta = s.shadow_group_frusta;
     TraversalCounters work;
     occluded_large_packet(scene, rays, test, objects, blocked.data(), &work);
     add_work(counters, work);

@@ -600,8 +600,9 @@ TEST(LargePackets, FindTheSingleRayHits) {
 }
 
 // Shadow rays from a point light to surface points (one origin: group
-// frusta with far planes), the light outside, inside a character's bone box
-// and on the ground; the occlusion of every ray is the single ray's.
+// frusta with far planes, as slabs in the packet's basis or each group's
+// own), the light outside, inside a character's bone box and on the ground;
+// the occlusion of every ray is the single ray's.
 TEST(LargePackets, ShadowRaysToAPointLightMatchSingleRays) {
   const rt::Scene& s = scene();
   std::mt19937 g(5);
@@ -631,10 +632,12 @@ TEST(LargePackets, ShadowRaysToAPointLightMatchSingleRays) {
           d[a][k] = at[a] - light[a];
         }
       }
-      const rt::LargePacketRays rays = arrays.view();
+      rt::LargePacketRays rays = arrays.view();
       std::vector<std::uint32_t> every(objects.size());
       for (std::uint32_t i = 0; i < every.size(); ++i) every[i] = i;
       for (const TriangleTest test : kTests) {
+        // The groups' slabs, or their own frusta (LargePacketRays::group_frusta).
+        rays.group_frusta = p % 2 == 1;
         std::vector<std::uint8_t> blocked(static_cast<std::size_t>(groups));
         rt::occluded_large_packet(s, rays, test, every, blocked.data(), nullptr);
         for (std::size_t k = 0; k < n; ++k) {
