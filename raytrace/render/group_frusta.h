@@ -316,30 +316,17 @@ class GroupFrusta {
     const Vec3& c = slab_basis_[0];
     const Vec3& u = slab_basis_[1];
     const Vec3& v = slab_basis_[2];
-    const Float8 margin = cull_margin(corners, apex_magnitude_);
     const Float8 z0(dot3(c, x0)), z1(dot3(c, x1)), z2(dot3(c, x2));
     const Float8 a0(dot3(u, x0)), a1(dot3(u, x1)), a2(dot3(u, x2));
     const Float8 b0(dot3(v, x0)), b1(dot3(v, x1)), b2(dot3(v, x2));
     const Float8 z_min = min(min(z0, z1), z2);
-    std::uint64_t out = 0;
-    for (int base = 0; base < groups_; base += 8) {
-      const std::uint64_t part = (groups >> base) & 0xFFu;
-      if (part == 0) continue;
-      const Float8 a_lo = Float8::load(&slab_[0][base]), a_hi = Float8::load(&slab_[1][base]);
-      const Float8 b_lo = Float8::load(&slab_[2][base]), b_hi = Float8::load(&slab_[3][base]);
+    return slabs_uncut_by(groups, corners, z_min, [&](Float8 a_lo, Float8 a_hi, Float8 b_lo, Float8 b_hi) {
       // Beyond the high side: every corner's u.x - a_hi (c.x) past the margin.
-      const Float8 beyond_a_hi = min(min(a0 - a_hi * z0, a1 - a_hi * z1), a2 - a_hi * z2);
-      const Float8 beyond_a_lo = min(min(a_lo * z0 - a0, a_lo * z1 - a1), a_lo * z2 - a2);
-      const Float8 beyond_b_hi = min(min(b0 - b_hi * z0, b1 - b_hi * z1), b2 - b_hi * z2);
-      const Float8 beyond_b_lo = min(min(b_lo * z0 - b0, b_lo * z1 - b1), b_lo * z2 - b2);
-      const Mask8 cut = (beyond_a_hi > Float8::load(&slab_scale_[1][base]) * margin) |
-                        (beyond_a_lo > Float8::load(&slab_scale_[0][base]) * margin) |
-                        (beyond_b_hi > Float8::load(&slab_scale_[3][base]) * margin) |
-                        (beyond_b_lo > Float8::load(&slab_scale_[2][base]) * margin) |
-                        (z_min > Float8::load(&slab_far_[base]) + Float8(slab_far_scale_) * margin);
-      out |= (part & ~static_cast<std::uint64_t>(cut.bits())) << base;
-    }
-    return out;
+      return SlabDistances{min(min(a0 - a_hi * z0, a1 - a_hi * z1), a2 - a_hi * z2),
+                           min(min(a_lo * z0 - a0, a_lo * z1 - a1), a_lo * z2 - a2),
+                           min(min(b0 - b_hi * z0, b1 - b_hi * z1), b2 - b_hi * z2),
+                           min(min(b_lo * z0 - b0, b_lo * z1 - b1), b_lo * z2 - b2)};
+    });
   }
   // slabs_uncut for the box [lo, hi] (relative to the apex): each side's
   // u.x - s (c.x) is at least u.x's least over the box minus s times c.x's
@@ -361,21 +348,37 @@ class GroupFrusta {
     const Float8 a_least(least(u)), a_most(most(u)), b_least(least(v)), b_most(most(v));
     const Float8 z_least(least(c)), z_most(most(c));
     const Float8 zero(0.0f);
+    // s (c.x) at its greatest: c.x's greatest for s >= 0, its least below.
+    const auto s_z_most = [&](Float8 s) { return s * select(s >= zero, z_most, z_least); };
+    const auto s_z_least = [&](Float8 s) { return s * select(s >= zero, z_least, z_most); };
+    return slabs_uncut_by(groups, corners, z_least, [&](Float8 a_lo, Float8 a_hi, Float8 b_lo, Float8 b_hi) {
+      return SlabDistances{a_least - s_z_most(a_hi), s_z_least(a_lo) - a_most, b_least - s_z_most(b_hi),
+                           s_z_least(b_lo) - b_most};
+    });
+  }
+  // A shape's least distances past eight groups' slab sides: u high, u
+  // low, v high, v low.
+  struct SlabDistances {
+    Float8 a_hi, a_lo, b_hi, b_lo;
+  };
+  // The groups of `groups`, eight at a time, that no side of their slab
+  // cuts off: distances(a_lo, a_hi, b_lo, b_hi) gives the shape's distances
+  // past the sides of eight groups' slopes, z_min its least depth along c
+  // (for the far plane); each must exceed the margin to cut.
+  template <class Distances>
+  std::uint64_t slabs_uncut_by(std::uint64_t groups, float corners, Float8 z_min, Distances&& distances) const {
     const Float8 margin = cull_margin(corners, apex_magnitude_);
     std::uint64_t out = 0;
     for (int base = 0; base < groups_; base += 8) {
       const std::uint64_t part = (groups >> base) & 0xFFu;
       if (part == 0) continue;
-      const Float8 a_lo = Float8::load(&slab_[0][base]), a_hi = Float8::load(&slab_[1][base]);
-      const Float8 b_lo = Float8::load(&slab_[2][base]), b_hi = Float8::load(&slab_[3][base]);
-      // s (c.x) at its greatest: c.x's greatest for s >= 0, its least below.
-      const auto s_z_most = [&](Float8 s) { return s * select(s >= zero, z_most, z_least); };
-      const auto s_z_least = [&](Float8 s) { return s * select(s >= zero, z_least, z_most); };
-      const Mask8 cut = (a_least - s_z_most(a_hi) > Float8::load(&slab_scale_[1][base]) * margin) |
-                        (s_z_least(a_lo) - a_most > Float8::load(&slab_scale_[0][base]) * margin) |
-                        (b_least - s_z_most(b_hi) > Float8::load(&slab_scale_[3][base]) * margin) |
-                        (s_z_least(b_lo) - b_most > Float8::load(&slab_scale_[2][base]) * margin) |
-                        (z_least > Float8::load(&slab_far_[base]) + Float8(slab_far_scale_) * margin);
+      const SlabDistances d = distances(Float8::load(&slab_[0][base]), Float8::load(&slab_[1][base]),
+                                        Float8::load(&slab_[2][base]), Float8::load(&slab_[3][base]));
+      const Mask8 cut = (d.a_hi > Float8::load(&slab_scale_[1][base]) * margin) |
+                        (d.a_lo > Float8::load(&slab_scale_[0][base]) * margin) |
+                        (d.b_hi > Float8::load(&slab_scale_[3][base]) * margin) |
+                        (d.b_lo > Float8::load(&slab_scale_[2][base]) * margin) |
+                        (z_min > Float8::load(&slab_far_[base]) + Float8(slab_far_scale_) * margin);
       out |= (part & ~static_cast<std::uint64_t>(cut.bits())) << base;
     }
     return out;
