@@ -562,7 +562,8 @@ class LargeQuery {
         const LeafTriangle tri = corners(item);
         // A shadow packet's leaf that one group alone reaches (most leaves
         // on pixel-sized triangles, where the leaf's box picked its groups):
-        // the group's slab test would cost about what its lane test does.
+        // the group's frustum or slab test would cost about what its lane
+        // test does.
         const GroupMask here = groups_here & alive_groups_;
         need_ = kAnyHit && std::has_single_bit(here) ? here : frusta_reached(*tri.p0, *tri.p1, *tri.p2, here);
         if (need_ == 0) continue;
