@@ -265,46 +265,44 @@ class GroupFrusta {
   std::uint64_t box_reached(const Aabb& box, std::uint64_t groups) const {
     const Vec3 lo = box.lower - apex_, hi = box.upper - apex_;
     const float corners = std::max(magnitude(box.lower), magnitude(box.upper));
-    const auto nearest = [&](Float8 nx, Float8 ny, Float8 nz) { return box_plane_nearest(nx, ny, nz, lo, hi); };
-    if (groups != 0 && (groups & ~bound_groups_) == 0) {
-      // The packet's frustum first, as reached() does.
-      const Float8 d = nearest(Float8::load(bound_n_[0]), Float8::load(bound_n_[1]), Float8::load(bound_n_[2]));
-      const Float8 limit =
-          Float8::load(bound_scale_) * cull_margin(corners, apex_magnitude_) + Float8::load(bound_offset_);
-      if ((d > limit).bits() != 0) return 0;
-      if (slabs_on_ && (groups & ~slab_groups_) == 0) return slabs_box_uncut(groups, corners, lo, hi);
-    }
-    return uncut(groups, corners, nearest);
+    return packet_then_groups(
+        groups, corners, [&](Float8 nx, Float8 ny, Float8 nz) { return box_plane_nearest(nx, ny, nz, lo, hi); },
+        [&] { return slabs_box_uncut(groups, corners, lo, hi); });
   }
 
   // The groups of `groups` whose frustum the triangle may reach.
   std::uint64_t reached(const Vec3& p0, const Vec3& p1, const Vec3& p2, std::uint64_t groups) const {
     const Vec3 x0 = p0 - apex_, x1 = p1 - apex_, x2 = p2 - apex_;
     const float corners = std::max({magnitude(p0), magnitude(p1), magnitude(p2)});
-    if (groups != 0 && (groups & ~bound_groups_) == 0) {
-      // The packet's frustum first, its planes side by side: uncut()'s test
-      // and margin for one plane per lane.
-      const Float8 nx = Float8::load(bound_n_[0]), ny = Float8::load(bound_n_[1]), nz = Float8::load(bound_n_[2]);
-      const auto side = [&](const Vec3& x) { return (nx * Float8(x.x) + ny * Float8(x.y)) + nz * Float8(x.z); };
-      const Float8 d = min(min(side(x0), side(x1)), side(x2));
-      const Float8 margin = cull_margin(corners, apex_magnitude_);
-      const Float8 limit = Float8::load(bound_scale_) * margin + Float8::load(bound_offset_);
-      if ((d > limit).bits() != 0) return 0;
-      if (slabs_on_ && (groups & ~slab_groups_) == 0) return slabs_uncut(groups, corners, x0, x1, x2);
-    }
-    return uncut(groups, corners, [&](Float8 nx, Float8 ny, Float8 nz) {
+    const auto nearest = [&](Float8 nx, Float8 ny, Float8 nz) {
       const auto side = [&](const Vec3& x) { return (nx * Float8(x.x) + ny * Float8(x.y)) + nz * Float8(x.z); };
       return min(min(side(x0), side(x1)), side(x2));
-    });
+    };
+    return packet_then_groups(groups, corners, nearest, [&] { return slabs_uncut(groups, corners, x0, x1, x2); });
   }
 
- // Whether reached() tests triangles against the groups' slabs in the
+  // Whether reached() tests triangles against the groups' slabs in the
   // packet's basis (set_bound) rather than their own frusta.
   void use_slabs(bool on) { slabs_on_ = on; }
   // The groups set_bound gave slabs.
   std::uint64_t slab_groups() const { return slab_groups_; }
 
  private:
+  // A shape (nearest: its least signed distance to eight planes) against
+  // the packet's frustum first, its planes side by side with uncut()'s test
+  // and margin, then the groups' slabs (slabs()) or their own frusta.
+  template <class Nearest, class Slabs>
+  std::uint64_t packet_then_groups(std::uint64_t groups, float corners, Nearest&& nearest, Slabs&& slabs) const {
+    if (groups != 0 && (groups & ~bound_groups_) == 0) {
+      const Float8 d = nearest(Float8::load(bound_n_[0]), Float8::load(bound_n_[1]), Float8::load(bound_n_[2]));
+      const Float8 limit =
+          Float8::load(bound_scale_) * cull_margin(corners, apex_magnitude_) + Float8::load(bound_offset_);
+      if ((d > limit).bits() != 0) return 0;
+      if (slabs_on_ && (groups & ~slab_groups_) == 0) return slabs();
+    }
+    return uncut(groups, corners, nearest);
+  }
+
   // The groups of `groups` whose slab in the packet's basis (c, u, v) no
   // side cuts off: a side plane u - s c has distance u.x - s (c.x) from a
   // point x (relative to the apex), so the three corners' coordinates in
