@@ -32,7 +32,8 @@ Aabb grown(const Aabb& box, float by) {
 
 // The escape check of the frame's bones, each held to its cluster's boxes
 // where it has one.
-EscapeCheckInput escape_input(InstanceFrame& frame, const FuzzyCharacterView& fuzzy) {
+EscapeCheckInput escape_input(InstanceFrame& frame, const FuzzyCharacterView& fuzzy,
+                              std::span<const std::uint16_t> rigid_blocks) {
   const bool clustered = frame.cluster_bones > 0 && frame.bone_check_boxes.size() == frame.bone_from_world.size();
   return {fuzzy.vertex_check_begin,
           fuzzy.vertex_checks,
@@ -40,7 +41,8 @@ EscapeCheckInput escape_input(InstanceFrame& frame, const FuzzyCharacterView& fu
           frame.tolerance,
           frame.chunk_bone_boxes,
           clustered ? std::span<const Aabb* const>(frame.bone_check_boxes) : std::span<const Aabb* const>{},
-          clustered ? fuzzy.check_rank : std::span<const std::uint32_t>{}};
+          clustered ? fuzzy.check_rank : std::span<const std::uint32_t>{},
+          rigid_blocks};
 }
 
 }  // namespace
@@ -101,20 +103,21 @@ void choose_bone_clusters(InstanceFrame& frame, const FuzzyCharacterView& fuzzy,
 }
 
 void skin_instance(InstanceFrame& frame, const SkinnedMesh& mesh, const PackedInfluences& influences,
-                   const FuzzyCharacterView& fuzzy, bool normals, bool exact_boxes, SkinningPath path,
-                   JobSystem& jobs) {
+                   const FuzzyCharacterView& fuzzy, std::span<const std::uint16_t> rigid_blocks, bool normals,
+                   bool exact_boxes, SkinningPath path, JobSystem& jobs) {
   frame.positions.resize(mesh.vertex_count());
   frame.normals.resize(normals && !mesh.normals.empty() ? mesh.vertex_count() : 0);
   frame.escaped.resize(fuzzy.vertex_checks.size());
   frame.chunk_bone_boxes.resize(exact_boxes ? skinning_chunk_count(mesh.vertex_count()) * frame.bone_from_world.size()
                                             : 0);
-  const EscapeCheckInput escape = escape_input(frame, fuzzy);
+  const EscapeCheckInput escape = escape_input(frame, fuzzy, rigid_blocks);
   const SkinningTargets targets{frame.positions, frame.normals, frame.escaped};
   const SkinningResult result = skin_vertices(mesh, influences, frame.skinning, targets, &escape, &jobs, path);
   frame.escaped_checks = result.escaped_checks;
 }
 
-void settle_bone_clusters(InstanceFrame& frame, const FuzzyCharacterView& fuzzy, JobSystem& jobs) {
+void settle_bone_clusters(InstanceFrame& frame, const FuzzyCharacterView& fuzzy,
+                          std::span<const std::uint16_t> rigid_blocks, JobSystem& jobs) {
   if (frame.cluster_bones == 0 || frame.escaped_checks == 0) return;
   bool missed = false;
   const std::size_t checks = std::min(frame.escaped.size(), fuzzy.vertex_checks.size());
@@ -129,7 +132,7 @@ void settle_bone_clusters(InstanceFrame& frame, const FuzzyCharacterView& fuzzy,
     missed = true;
   }
   if (!missed) return;
-  frame.escaped_checks = check_escapes(escape_input(frame, fuzzy), frame.positions, frame.escaped, &jobs);
+  frame.escaped_checks = check_escapes(escape_input(frame, fuzzy, rigid_blocks), frame.positions, frame.escaped, &jobs);
 }
 
 void compute_bone_boxes(InstanceFrame& frame, const FuzzyCharacterView& fuzzy, bool exact) {

@@ -86,15 +86,17 @@ void choose_bone_clusters(InstanceFrame& frame, const FuzzyCharacterView& fuzzy,
 
 // Skins positions (and normals) and runs the escape check; with
 // `exact_boxes`, it also gathers the bone boxes compute_bone_boxes merges.
-// `influences` is pack_influences(mesh).
+// `influences` is pack_influences(mesh), `rigid_blocks` the character's
+// find_rigid_check_blocks (rigid_checks.h; empty: every check computed).
 void skin_instance(InstanceFrame& frame, const SkinnedMesh& mesh, const PackedInfluences& influences,
-                   const FuzzyCharacterView& fuzzy, bool normals, bool exact_boxes, SkinningPath path,
-                   JobSystem& jobs);
+                   const FuzzyCharacterView& fuzzy, std::span<const std::uint16_t> rigid_blocks, bool normals,
+                   bool exact_boxes, SkinningPath path, JobSystem& jobs);
 
 // After skin_instance: a bone whose cluster a vertex left goes back to its
 // full tree, and the escape check runs again (positions as they are)
 // against the full boxes of those bones.
-void settle_bone_clusters(InstanceFrame& frame, const FuzzyCharacterView& fuzzy, JobSystem& jobs);
+void settle_bone_clusters(InstanceFrame& frame, const FuzzyCharacterView& fuzzy,
+                          std::span<const std::uint16_t> rigid_blocks, JobSystem& jobs);
 
 // Per bone world boxes: exact (union of the bone's skinned vertices, from
 // the boxes skin_instance gathered with exact_boxes) or cheap (the fuzzy

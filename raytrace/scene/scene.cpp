@@ -31,7 +31,9 @@ Scene& Scene::operator=(Scene&&) noexcept = default;
 
 Expected<std::uint32_t> Scene::add_character(const SkinnedMesh& mesh, const FuzzyCharacterView& fuzzy) {
   SINEW_RETURN_IF_ERROR(validate_fuzzy_character(mesh, fuzzy));
-  characters_.push_back({&mesh, fuzzy, pack_influences(mesh)});
+  characters_.push_back({&mesh, fuzzy, pack_influences(mesh),
+                         find_rigid_check_blocks(mesh, fuzzy.vertex_check_begin, fuzzy.vertex_checks,
+                                                 fuzzy.check_rank)});
   return static_cast<std::uint32_t>(characters_.size() - 1);
 }
 
@@ -122,9 +124,9 @@ Expected<FrameStats> Scene::prepare_frame(const FrameOptions& options, JobSystem
     auto start = std::chrono::steady_clock::now();
     update_bone_frames(frame, character.fuzzy);
     choose_bone_clusters(frame, character.fuzzy, options.pose_clusters);
-    skin_instance(frame, *character.mesh, character.influences, character.fuzzy, options.normals,
-                  options.bone_boxes == BoneBoxMode::kExact, options.skinning, jobs);
-    settle_bone_clusters(frame, character.fuzzy, jobs);
+    skin_instance(frame, *character.mesh, character.influences, character.fuzzy, character.rigid_blocks,
+                  options.normals, options.bone_boxes == BoneBoxMode::kExact, options.skinning, jobs);
+    settle_bone_clusters(frame, character.fuzzy, character.rigid_blocks, jobs);
     frame.leaf_boxes.prepare(character.fuzzy);
     skinning_ms += ms_since(start);
 

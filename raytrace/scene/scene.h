@@ -115,6 +115,7 @@ class Scene {
     const SkinnedMesh* mesh = nullptr;
     FuzzyCharacterView fuzzy;
     PackedInfluences influences;  // the mesh's, packed once for the skinning
+    std::vector<std::uint16_t> rigid_blocks;  // find_rigid_check_blocks, once for the escape check
   };
   struct StaticMesh {
     StaticMeshDesc desc;

@@ -132,9 +132,37 @@ void prefetch_ahead([[maybe_unused]] const T* p, [[maybe_unused]] int lines = 1)
 #endif
 }
 
-// `columns`: bone_columns(e); `blocks`: whether the AVX2 block check may run.
+// Per bone: whether its rigid blocks may skip their checks (EscapeCheckInput::
+// rigid_blocks): its world -> bone transform and its tolerance are finite.
+std::vector<std::uint8_t> rigid_bones_usable(const EscapeCheckInput& e) {
+  std::vector<std::uint8_t> usable(e.rigid_blocks.empty() ? 0 : std::min(e.bone_from_world.size(), e.tolerance.size()));
+  for (std::size_t b = 0; b < usable.size(); ++b) {
+    usable[b] = is_finite(e.bone_from_world[b]) && std::isfinite(e.tolerance[b]) && e.tolerance[b] >= 0.0f;
+  }
+  return usable;
+}
+
+// Whether the 8 positions from v are finite; then their box.
+bool finite_block_box(std::span<const Vec3> positions, std::size_t v, bool avx2, float lower[3], float upper[3]) {
+  if (avx2) return detail::finite_block_box_avx2(&positions[v].x, lower, upper);
+  Aabb box = Aabb::empty();
+  for (std::size_t i = 0; i < detail::kAvx2Lanes; ++i) {
+    const Vec3& p = positions[v + i];
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) return false;
+    box.extend(p);
+  }
+  for (int a = 0; a < 3; ++a) {
+    lower[a] = box.lower[a];
+    upper[a] = box.upper[a];
+  }
+  return true;
+}
+
+// `columns`: bone_columns(e); `rigid_usable`: rigid_bones_usable(e);
+// `blocks`: whether the AVX2 block check may run.
 std::size_t count_escapes(const EscapeCheckInput& e, [[maybe_unused]] std::span<const BoneColumns> columns,
-                          std::span<const Vec3> positions, std::span<std::uint8_t> escaped, Range r, bool blocks) {
+                          std::span<const std::uint8_t> rigid_usable, std::span<const Vec3> positions,
+                          std::span<std::uint8_t> escaped, Range r, bool blocks) {
   // Local copies of the spans: the byte stores into `escaped` may alias
   // anything, and locals spare the reloads of pointers and sizes after each.
   const std::span<const std::uint32_t> check_begin = e.vertex_check_begin;
@@ -196,12 +224,39 @@ std::size_t count_escapes(const EscapeCheckInput& e, [[maybe_unused]] std::span<
 #endif
 
   std::size_t count = 0;
+  constexpr std::size_t kBlock = detail::kAvx2Lanes;
+  static_assert(kBlock == kRigidBlockVertices);
+  // A block whose checks hold by construction (rigid_checks.h): only its
+  // positions' finiteness and box are computed, its flags are 0. Its bone's
+  // checks read nothing of the check arrays but the first begin and the
+  // one past the block's end.
+  const std::span<const std::uint16_t> rigid = e.rigid_blocks;
+  const auto rigid_block = [&](std::size_t v) -> bool {
+    const std::size_t block = v / kBlock;
+    if (block >= rigid.size()) return false;
+    const std::uint16_t bone = rigid[block];
+    if (bone >= rigid_usable.size() || !rigid_usable[bone]) return false;
+    const std::size_t c0 = check_begin[v];
+    if (check_begin[v + kBlock] != c0 + kBlock || c0 + kBlock > checks.size()) return false;
+    float lower[3];
+    float upper[3];
+    if (!finite_block_box(positions, v, blocks, lower, upper)) return false;
+    for (std::size_t i = 0; i < kBlock; ++i) {
+      if (c0 + i < escaped.size()) escaped[c0 + i] = 0;
+    }
+    if (boxes == nullptr) return true;
+#if SINEW_ESCAPE_SSE
+    extend_run(bone, _mm_setr_ps(lower[0], lower[1], lower[2], 0.0f), _mm_setr_ps(upper[0], upper[1], upper[2], 0.0f));
+#else
+    boxes[bone].extend(Aabb{Vec3(lower[0], lower[1], lower[2]), Vec3(upper[0], upper[1], upper[2])});
+#endif
+    return true;
+  };
   // Eight vertices with one check each, all against one bone, are checked
   // eight at a time (the AVX2 block check: 92% of the blocks at 855,552
   // triangles, where the check by check loop spent about 30 cycles a
   // check); other blocks, and blocks with a position that is not finite, go
   // check by check below.
-  constexpr std::size_t kBlock = detail::kAvx2Lanes;
   const auto check_block = [&](std::size_t v) -> bool {
     const std::size_t c0 = check_begin[v];
     if (c0 + kBlock > checks.size()) return false;
@@ -242,7 +297,7 @@ std::size_t count_escapes(const EscapeCheckInput& e, [[maybe_unused]] std::span<
     return true;
   };
   for (std::size_t v = r.begin; v < end; ++v) {
-    if (blocks && v % kBlock == 0 && v + kBlock <= end && check_block(v)) {
+    if (v % kBlock == 0 && v + kBlock <= end && (rigid_block(v) || (blocks && check_block(v)))) {
       v += kBlock - 1;
       continue;
     }
@@ -356,12 +411,14 @@ SkinningResult skin_vertices(const SkinnedMesh& mesh, const PackedInfluences& in
   const std::size_t chunk_count = (vertex_count + kChunkVertices - 1) / kChunkVertices;
   std::vector<std::size_t> chunk_escapes(escape != nullptr ? chunk_count : 0, 0);
   const std::vector<BoneColumns> columns = escape != nullptr ? bone_columns(*escape) : std::vector<BoneColumns>{};
+  const std::vector<std::uint8_t> rigid_usable =
+      escape != nullptr ? rigid_bones_usable(*escape) : std::vector<std::uint8_t>{};
 
   const auto run_chunk = [&](Range r) {
     skin_range(arrays, r, use_avx2);
     if (escape != nullptr) {
       chunk_escapes[r.begin / kChunkVertices] =
-          count_escapes(*escape, columns, positions, targets.escaped, r, use_avx2);
+          count_escapes(*escape, columns, rigid_usable, positions, targets.escaped, r, use_avx2);
     }
   };
   if (jobs != nullptr) {
@@ -382,9 +439,11 @@ std::size_t check_escapes(const EscapeCheckInput& escape, std::span<const Vec3> 
   const std::size_t chunk_count = (vertex_count + kChunkVertices - 1) / kChunkVertices;
   std::vector<std::size_t> chunk_escapes(chunk_count, 0);
   const std::vector<BoneColumns> columns = bone_columns(escape);
+  const std::vector<std::uint8_t> rigid_usable = rigid_bones_usable(escape);
   const bool blocks = avx2_skinning_available();
   const auto run_chunk = [&](Range r) {
-    chunk_escapes[r.begin / kChunkVertices] = count_escapes(escape, columns, positions, escaped, r, blocks);
+    chunk_escapes[r.begin / kChunkVertices] =
+        count_escapes(escape, columns, rigid_usable, positions, escaped, r, blocks);
   };
   if (jobs != nullptr) {
     jobs->parallel_for(0, vertex_count, kChunkVertices, run_chunk);

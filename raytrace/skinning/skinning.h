@@ -19,6 +19,7 @@
 
 #include "raytrace/fuzzy/fuzzy_character.h"
 #include "raytrace/skinning/packed_influences.h"
+#include "raytrace/skinning/rigid_checks.h"
 #include "runtime/math/affine.h"
 #include "runtime/mesh/skinned_mesh.h"
 
@@ -67,6 +68,13 @@ struct EscapeCheckInput {
   // check ranked kSharedCheckBox keeps its own box.
   std::span<const Aabb* const> bone_boxes;
   std::span<const std::uint32_t> check_rank;
+  // Optional (empty: every check computed): per block of eight vertices the
+  // bone its checks are rigid in, or kNotRigid (find_rigid_check_blocks,
+  // rigid_checks.h). Such a block's checks pass without being computed
+  // while its positions are finite and its bone's world -> bone transform
+  // and tolerance are (the answer the computed check gives wherever the
+  // tolerance bounds the rounding, as it is made to).
+  std::span<const std::uint16_t> rigid_blocks;
 };
 
 // The work is split over vertices in chunks of this many (a multiple of

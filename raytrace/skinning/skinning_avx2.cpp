@@ -89,11 +89,28 @@ void load_bone_row8(const float* const lane_bones[8], int r, __m256 cols[4]) {
 
 // Group g's slots are whole registers: one load of the slot's weights, and
 // its joints straight from the slot (no transpose).
+//
+// A group whose one slot is weight 1 on one bone for every lane (rigid
+// vertices: 46% of the groups at 855,552 triangles) takes that bone's
+// entries broadcast, plus zero: fma(1, b, 0) to the bit (-0 + 0 is +0),
+// without the row loads and transposes.
 Matrix3x4x8 blend_bones(const SkinningArrays& a, std::size_t group) {
   Matrix3x4x8 out;
   for (__m256& e : out.m) e = _mm256_setzero_ps();
   const std::size_t first = a.group_slot_begin[group];
   const std::size_t last = a.group_slot_begin[group + 1];
+  if (last == first + 1) {
+    const std::uint16_t* joints = a.slot_joints + first * kAvx2Lanes;
+    const __m256 ones = _mm256_cmp_ps(_mm256_loadu_ps(a.slot_weights + first * kAvx2Lanes), _mm256_set1_ps(1.0f),
+                                      _CMP_EQ_OQ);
+    const __m128i same = _mm_cmpeq_epi16(_mm_loadu_si128(reinterpret_cast<const __m128i*>(joints)),
+                                         _mm_set1_epi16(static_cast<short>(joints[0])));
+    if (_mm256_movemask_ps(ones) == 0xFF && _mm_movemask_epi8(same) == 0xFFFF) {
+      const float* bone = a.bones + kFloatsPerBone * joints[0];
+      for (std::size_t e = 0; e < kFloatsPerBone; ++e) out.m[e] = _mm256_add_ps(_mm256_set1_ps(bone[e]), out.m[e]);
+      return out;
+    }
+  }
   for (std::size_t slot = first; slot < last; ++slot) {
     const __m256 w = _mm256_loadu_ps(a.slot_weights + slot * kAvx2Lanes);
     const std::uint16_t* joints = a.slot_joints + slot * kAvx2Lanes;
@@ -161,6 +178,23 @@ float max_of(__m256 v) {
   return _mm_cvtss_f32(m);
 }
 
+// Whether all 24 coordinates are finite; then the box of the 8 points.
+bool finite_box(const Vec3x8& p, float lower[3], float upper[3]) {
+  const __m256 zero = _mm256_setzero_ps();
+  const __m256 finite =
+      _mm256_and_ps(_mm256_and_ps(_mm256_cmp_ps(_mm256_sub_ps(p.x, p.x), zero, _CMP_EQ_OQ),
+                                  _mm256_cmp_ps(_mm256_sub_ps(p.y, p.y), zero, _CMP_EQ_OQ)),
+                    _mm256_cmp_ps(_mm256_sub_ps(p.z, p.z), zero, _CMP_EQ_OQ));
+  if (_mm256_movemask_ps(finite) != 0xFF) return false;
+  lower[0] = min_of(p.x);
+  lower[1] = min_of(p.y);
+  lower[2] = min_of(p.z);
+  upper[0] = max_of(p.x);
+  upper[1] = max_of(p.y);
+  upper[2] = max_of(p.z);
+  return true;
+}
+
 }  // namespace
 
 std::uint32_t escape_block_avx2(const float* positions, const float* bone_from_world, float tolerance,
@@ -198,20 +232,12 @@ std::uint32_t escape_block_avx2(const float* positions, const float* bone_from_w
     in = _mm256_and_ps(in, _mm256_and_ps(inside, finite));
   }
   std::uint32_t result = static_cast<std::uint32_t>(~_mm256_movemask_ps(in)) & 0xFFu;
-  const __m256 finite_p =
-      _mm256_and_ps(_mm256_and_ps(_mm256_cmp_ps(_mm256_sub_ps(p.x, p.x), zero, _CMP_EQ_OQ),
-                                  _mm256_cmp_ps(_mm256_sub_ps(p.y, p.y), zero, _CMP_EQ_OQ)),
-                    _mm256_cmp_ps(_mm256_sub_ps(p.z, p.z), zero, _CMP_EQ_OQ));
-  if (_mm256_movemask_ps(finite_p) == 0xFF) {
-    result |= kEscapeBlockFinite;
-    lower[0] = min_of(p.x);
-    lower[1] = min_of(p.y);
-    lower[2] = min_of(p.z);
-    upper[0] = max_of(p.x);
-    upper[1] = max_of(p.y);
-    upper[2] = max_of(p.z);
-  }
+  if (finite_box(p, lower, upper)) result |= kEscapeBlockFinite;
   return result;
+}
+
+bool finite_block_box_avx2(const float* positions, float lower[3], float upper[3]) {
+  return finite_box(load_xyz8(positions), lower, upper);
 }
 
 bool avx2_kernel_compiled() { return true; }
@@ -224,6 +250,8 @@ std::uint32_t escape_block_avx2(const float*, const float*, float, const float* 
                                 float[3]) {
   return 0;
 }
+
+bool finite_block_box_avx2(const float*, float[3], float[3]) { return false; }
 
 bool avx2_kernel_compiled() { return false; }
 

@@ -48,6 +48,11 @@ std::uint32_t escape_block_avx2(const float* positions, const float* bone_from_w
                                 const float* const boxes[kAvx2Lanes], float lower[3], float upper[3]);
 inline constexpr std::uint32_t kEscapeBlockFinite = 1u << 8;
 
+// Whether the 24 floats of 8 consecutive positions are all finite; if so
+// `lower` and `upper` get the box of the 8 points (escape_block_avx2's).
+// Call only when avx2_kernel_compiled() and the CPU has AVX2 and FMA.
+bool finite_block_box_avx2(const float* positions, float lower[3], float upper[3]);
+
 // Whether skinning_avx2.cpp was compiled with AVX2 and FMA enabled.
 bool avx2_kernel_compiled();
 

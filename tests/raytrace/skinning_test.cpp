@@ -24,6 +24,7 @@
 #include <random>
 #include <vector>
 
+#include "raytrace/scene/frame_state.h"
 #include "raytrace/skinning/skinning.h"
 #include "runtime/jobs/job_system.h"
 
@@ -247,7 +248,7 @@ struct RandomChecks {
   std::vector<Affine3> bone_from_world;
   std::vector<float> tolerance;
   std::vector<std::uint8_t> expected;
-  EscapeCheckInput input() const { return {begin, checks, bone_from_world, tolerance, {}, {}, {}}; }
+  EscapeCheckInput input() const { return {begin, checks, bone_from_world, tolerance, {}, {}, {}, {}}; }
 };
 
 RandomChecks random_checks(std::mt19937& rng, const SkinnedMesh& mesh, const std::vector<Affine3>& bones,
@@ -388,7 +389,7 @@ SkinnedMesh one_vertex_mesh(const HandBuiltScene& s, const Vec3& p) {
 TEST(SkinningEscape, HandBuiltChecks) {
   const HandBuiltScene s = hand_built_scene();
   ASSERT_FALSE(is_finite(s.bone_from_world[3]));  // the premise of the zero-scale cases
-  const EscapeCheckInput escape{s.begin, s.checks, s.bone_from_world, s.tolerance, {}, {}, {}};
+  const EscapeCheckInput escape{s.begin, s.checks, s.bone_from_world, s.tolerance, {}, {}, {}, {}};
   JobSystem two(2);
   for (const SkinningPath path : available_paths()) {
     for (JobSystem* jobs : {static_cast<JobSystem*>(nullptr), &two}) {
@@ -412,7 +413,7 @@ TEST(SkinningEscape, ToleranceIsPerBone) {
                                   check_of(2, in_bone2 + Vec3(0.1f, -0.5f, -0.5f), in_bone2 + 0.5f)};
   std::vector<std::uint32_t> begin{0, 2};
   const SkinnedMesh mesh = one_vertex_mesh(s, p);
-  const EscapeCheckInput escape{begin, checks, s.bone_from_world, s.tolerance, {}, {}, {}};
+  const EscapeCheckInput escape{begin, checks, s.bone_from_world, s.tolerance, {}, {}, {}, {}};
   const Skinned out = run_skinning(mesh, s.bones, SkinningPath::kAuto, nullptr, false, &escape);
   EXPECT_EQ(out.escaped, (std::vector<std::uint8_t>{1, 0}));
   EXPECT_EQ(out.result.escaped_checks, 1u);
@@ -425,7 +426,7 @@ TEST(SkinningEscape, BoneWithoutTransformEscapes) {
   std::vector<VertexCheck> checks{check_of(5, Vec3(-1e30f), Vec3(1e30f)), check_of(1, p - 0.5f, p + 0.5f)};
   std::vector<std::uint32_t> begin{0, 2};
   const SkinnedMesh mesh = one_vertex_mesh(s, p);
-  const EscapeCheckInput escape{begin, checks, s.bone_from_world, s.tolerance, {}, {}, {}};
+  const EscapeCheckInput escape{begin, checks, s.bone_from_world, s.tolerance, {}, {}, {}, {}};
   const Skinned out = run_skinning(mesh, s.bones, SkinningPath::kAuto, nullptr, false, &escape);
   EXPECT_EQ(out.escaped, (std::vector<std::uint8_t>{1, 0}));
   EXPECT_EQ(out.result.escaped_checks, 1u);
@@ -603,6 +604,171 @@ TEST(SkinningEscape, BlocksOfOneBoneCheckAsCheckByCheck) {
         EXPECT_EQ(merged[b].lower, expected[b].lower) << "bone " << b;
         EXPECT_EQ(merged[b].upper, expected[b].upper) << "bone " << b;
       }
+    }
+  }
+}
+
+// The tolerance the scene gives a bone (frame_state.cpp, update_bone_frames)
+// whose checked rest positions have the box `local`.
+float scene_tolerance(const Affine3& to_world, const Aabb& local) {
+  const auto max_abs = [](const Vec3& v) { return std::max({std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)}); };
+  const Affine3 from_world = inverse(to_world);
+  float norm = 0.0f;
+  for (const Vec4& row : from_world.rows) norm = std::max(norm, std::fabs(row.x) + std::fabs(row.y) + std::fabs(row.z));
+  const Aabb world_box = transform(to_world, local);
+  const float world = std::max(max_abs(world_box.lower), max_abs(world_box.upper));
+  const float local_max = std::max(max_abs(local.lower), max_abs(local.upper));
+  return kFrameRelativeSlack * (norm * world + max_abs(from_world.translation_part()) + local_max);
+}
+
+// Blocks of rigid checks (rigid_checks.h) answer as their computed checks:
+// the same flags, count, positions and chunk bone boxes with and without
+// find_rigid_check_blocks' plan, on both paths and with one or two
+// threads, from unit scale to far from the origin, with the scene's
+// tolerances. Vertices come in runs of one bone, most rigid with a box
+// around their rest position (some a point box), the others moved by two
+// bones with boxes that hold or miss their bone-frame point. Then three
+// bones whose rigid blocks must be computed, and all escape: one skinned
+// to infinity (its world -> bone transform kept finite), one of zero scale
+// (its inverse is not finite) and one whose tolerance is NaN. (Not bone 0:
+// the AVX2 kernel's empty lanes blend it with weight 0, and 0 * inf would
+// poison every group with two slots.)
+TEST(SkinningEscape, RigidBlocksAnswerAsTheirComputedChecks) {
+  std::mt19937 rng(515);
+  constexpr std::size_t kBones = 8;
+  for (const MeshShape& shape : kShapes) {
+    SCOPED_TRACE(shape.position_scale);
+    SCOPED_TRACE(shape.bone_translation);
+    std::vector<Affine3> bones = random_bones(rng, kBones, shape.bone_translation);
+    SkinnedMesh mesh = random_mesh(rng, 2 * kSkinningChunkVertices + 13, kBones, shape, 2);
+    std::uint16_t bone = 0;
+    bool rigid_run = false;
+    std::size_t run_left = 0;
+    for (std::size_t v = 0; v < mesh.vertex_count(); ++v) {
+      if (run_left == 0) {
+        bone = static_cast<std::uint16_t>(rng() % kBones);
+        rigid_run = rng() % 10 < 7;
+        run_left = 8 + rng() % 60;
+      }
+      --run_left;
+      mesh.joints[v] = {bone, static_cast<std::uint16_t>((bone + 1) % kBones), 0, 0, 0, 0, 0, 0};
+      const bool rigid = rigid_run ? rng() % 40 != 0 : rng() % 3 == 0;
+      mesh.weights[v] = rigid ? std::array<float, kMaxInfluences>{1.0f} : std::array<float, kMaxInfluences>{0.5f, 0.5f};
+    }
+    std::vector<std::uint32_t> begin{0};
+    std::vector<VertexCheck> checks;
+    std::vector<Aabb> local(kBones, Aabb::empty());
+    const Skinned skinned = run_skinning(mesh, bones, SkinningPath::kScalar);
+    for (std::size_t v = 0; v < mesh.vertex_count(); ++v) {
+      const std::uint16_t b = mesh.joints[v][0];
+      const Vec3& rest = mesh.positions[v];
+      local[b].extend(rest);
+      Aabb box{rest, rest};
+      if (mesh.weights[v][1] != 0.0f) {
+        const Vec3 q = inverse(bones[b]).transform_point(skinned.positions[v]);
+        const float half = 0.01f * shape.position_scale;
+        box = rng() % 2 == 0 ? Aabb{q - half, q + half} : Aabb{q + 3.0f * half, q + 5.0f * half};
+      } else if (rng() % 2 == 0) {
+        box = Aabb{rest - uniform_vec3(rng, 0.0f, 0.1f), rest + uniform_vec3(rng, 0.0f, 0.1f)};
+      }
+      checks.push_back({b, box});
+      begin.push_back(static_cast<std::uint32_t>(checks.size()));
+    }
+    const std::vector<std::uint16_t> rigid = find_rigid_check_blocks(mesh, begin, checks, {});
+    const auto rigid_count = static_cast<std::size_t>(std::count_if(rigid.begin(), rigid.end(), [](std::uint16_t r) {
+      return r != kNotRigid;
+    }));
+    ASSERT_GT(rigid_count, rigid.size() / 4);
+    // The three bones that must not skip: 3 skinned to infinity, 1 of zero
+    // scale, 2 with a NaN tolerance.
+    std::vector<Affine3> bone_from_world;
+    std::vector<float> tolerance;
+    for (std::size_t b = 0; b < kBones; ++b) {
+      bone_from_world.push_back(inverse(bones[b]));
+      tolerance.push_back(scene_tolerance(bones[b], local[b]));
+    }
+    const Affine3 finite_bone3 = bones[3];
+    bones[3].rows[0].w = std::numeric_limits<float>::infinity();
+    bone_from_world[3] = inverse(finite_bone3);
+    bones[1] = Affine3::from_trs(Vec3(1.0f), Quat(1.0f, 0.0f, 0.0f, 0.0f), Vec3(0.0f));
+    bone_from_world[1] = inverse(bones[1]);
+    ASSERT_FALSE(is_finite(bone_from_world[1]));
+    tolerance[2] = std::numeric_limits<float>::quiet_NaN();
+    const EscapeCheckInput computed{begin, checks, bone_from_world, tolerance, {}, {}, {}, {}};
+    EscapeCheckInput planned = computed;
+    planned.rigid_blocks = rigid;
+    JobSystem two(2);
+    for (const SkinningPath path : available_paths()) {
+      for (JobSystem* jobs : {static_cast<JobSystem*>(nullptr), &two}) {
+        std::vector<Aabb> computed_boxes(skinning_chunk_count(mesh.vertex_count()) * kBones, Aabb{Vec3(-7.0f), Vec3(7.0f)});
+        std::vector<Aabb> planned_boxes = computed_boxes;
+        EscapeCheckInput with_boxes = computed;
+        with_boxes.chunk_bone_boxes = computed_boxes;
+        const Skinned want = run_skinning(mesh, bones, path, jobs, true, &with_boxes);
+        with_boxes = planned;
+        with_boxes.chunk_bone_boxes = planned_boxes;
+        const Skinned got = run_skinning(mesh, bones, path, jobs, true, &with_boxes);
+        ASSERT_EQ(0, std::memcmp(got.positions.data(), want.positions.data(), got.positions.size() * sizeof(Vec3)));
+        EXPECT_EQ(got.escaped, want.escaped);
+        EXPECT_EQ(got.result.escaped_checks, want.result.escaped_checks);
+        for (std::size_t i = 0; i < planned_boxes.size(); ++i) {
+          ASSERT_EQ(planned_boxes[i].lower, computed_boxes[i].lower) << "box " << i;
+          ASSERT_EQ(planned_boxes[i].upper, computed_boxes[i].upper) << "box " << i;
+        }
+        std::vector<std::uint8_t> again(checks.size(), 0xAB);
+        EXPECT_EQ(check_escapes(planned, got.positions, again, jobs), want.result.escaped_checks);
+        EXPECT_EQ(again, want.escaped);
+        // Every check of bones 1, 2 and 3 escapes; of the others, only the
+        // moved vertices' boxes set to miss.
+        std::size_t rigid_escapes = 0;
+        for (std::size_t c = 0; c < checks.size(); ++c) {
+          if (checks[c].bone >= 1 && checks[c].bone <= 3) {
+            ASSERT_EQ(got.escaped[c], 1) << "check " << c;
+          } else if (mesh.weights[c][1] == 0.0f) {
+            rigid_escapes += got.escaped[c];
+          }
+        }
+        EXPECT_EQ(rigid_escapes, 0u);
+        EXPECT_GT(got.result.escaped_checks, 0u);
+      }
+    }
+  }
+}
+
+// A group of eight vertices rigid on one bone takes the AVX2 kernel's
+// broadcast short cut (skinning_avx2.cpp, blend_bones); the same vertices in
+// a group that has a second bone take the general blend. Both give the same
+// bits, signed zeros included (a bone with -0 translation and rows that
+// make -0 products skins the origin to +0 either way).
+TEST(SkinningPaths, RigidGroupsSkinAsMixedGroups) {
+  if (!avx2_skinning_available()) GTEST_SKIP() << "no AVX2+FMA on this CPU";
+  std::mt19937 rng(3);
+  std::vector<Affine3> bones = random_bones(rng, 3, 5.0f);
+  bones[2] = Affine3::from_trs(Vec3(-0.0f), Quat(1.0f, 0.0f, 0.0f, 0.0f), Vec3(-1.0f));
+  for (const std::uint16_t bone : {std::uint16_t{0}, std::uint16_t{2}}) {
+    SkinnedMesh mesh;
+    for (std::size_t group = 0; group < 2; ++group) {
+      for (std::size_t lane = 0; lane < 8; ++lane) {
+        mesh.positions.push_back(lane == 0 ? Vec3(0.0f) : uniform_vec3(rng, -2.0f, 2.0f));
+        mesh.normals.push_back(lane == 0 ? Vec3(0.0f) : glm::normalize(uniform_vec3(rng, 0.1f, 1.0f)));
+        const bool other = group == 1 && lane == 7;
+        mesh.joints.push_back({static_cast<std::uint16_t>(other ? 1 : bone)});
+        mesh.weights.push_back({1.0f});
+      }
+    }
+    // The second group repeats the first's positions but for its last lane.
+    for (std::size_t lane = 0; lane < 7; ++lane) {
+      mesh.positions[8 + lane] = mesh.positions[lane];
+      mesh.normals[8 + lane] = mesh.normals[lane];
+    }
+    const Skinned out = run_skinning(mesh, bones, SkinningPath::kAvx2);
+    for (std::size_t lane = 0; lane < 7; ++lane) {
+      ASSERT_EQ(0, std::memcmp(&out.positions[lane], &out.positions[8 + lane], sizeof(Vec3))) << "lane " << lane;
+      ASSERT_EQ(0, std::memcmp(&out.normals[lane], &out.normals[8 + lane], sizeof(Vec3))) << "lane " << lane;
+    }
+    if (bone == 2) {
+      EXPECT_FALSE(std::signbit(out.positions[0].x));
+      EXPECT_FALSE(std::signbit(out.positions[8].x));
     }
   }
 }

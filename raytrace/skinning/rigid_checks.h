@@ -1,0 +1,41 @@
+// Escape checks that hold by construction, found once per character.
+//
+// A vertex whose only influence is bone b with weight exactly 1 moves
+// rigidly with b: its skinned position is B_b p (the blend of one weight 1
+// is B_b itself, bit for bit, on both skinning paths) and carried back
+// into b's frame it is p again, up to the rounding the check's tolerance
+// covers (frame_state.cpp, update_bone_frames). So its check against b,
+// held to its own box (no cluster boxes: such a check has none, fuzzy_bake.cpp
+// ranks only vertices another bone moves), passes whenever p lies in that
+// box and the skinned position is finite. At 855,552 triangles (Cally
+// subdivided four times) 46% of the checks are such, and 44% of the blocks
+// of eight vertices are nothing else; the escape check spends nothing on
+// them but the finiteness test and the bone box (skinning.cpp).
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "raytrace/fuzzy/fuzzy_character.h"
+#include "runtime/mesh/skinned_mesh.h"
+
+namespace sinew::rt {
+
+// The vertices of a block: the AVX2 skinning and check width.
+inline constexpr std::size_t kRigidBlockVertices = 8;
+inline constexpr std::uint16_t kNotRigid = 0xFFFF;
+
+// Per block of kRigidBlockVertices vertices (the last, partial block
+// included): the bone all its checks are rigid in, when each of its
+// vertices has exactly one check, against that bone, rigid as above (one
+// non-zero weight, exactly 1, on that bone; ranked kSharedCheckBox when
+// `check_rank` is given; its rest position inside the check's box); else
+// kNotRigid. A partial block, a bone >= kNotRigid or arrays shorter than
+// the mesh make kNotRigid.
+std::vector<std::uint16_t> find_rigid_check_blocks(const SkinnedMesh& mesh,
+                                                   std::span<const std::uint32_t> vertex_check_begin,
+                                                   std::span<const VertexCheck> vertex_checks,
+                                                   std::span<const std::uint32_t> check_rank);
+
+}  // namespace sinew::rt
