@@ -226,6 +226,22 @@ std::size_t count_escapes(const EscapeCheckInput& e, [[maybe_unused]] std::span<
   std::size_t count = 0;
   constexpr std::size_t kBlock = detail::kAvx2Lanes;
   static_assert(kBlock == kRigidBlockVertices);
+  // A checked block's flags (bit i: check c0 + i escaped) and its positions'
+  // box, grown into its bone's.
+  const auto finish_block = [&](std::size_t c0, std::uint32_t flags, std::uint32_t bone, const float lower[3],
+                                const float upper[3]) {
+    for (std::size_t i = 0; i < kBlock; ++i) {
+      const std::uint8_t out = static_cast<std::uint8_t>((flags >> i) & 1u);
+      count += out;
+      if (c0 + i < escaped.size()) escaped[c0 + i] = out;
+    }
+    if (boxes == nullptr) return;
+#if SINEW_ESCAPE_SSE
+    extend_run(bone, _mm_setr_ps(lower[0], lower[1], lower[2], 0.0f), _mm_setr_ps(upper[0], upper[1], upper[2], 0.0f));
+#else
+    boxes[bone].extend(Aabb{Vec3(lower[0], lower[1], lower[2]), Vec3(upper[0], upper[1], upper[2])});
+#endif
+  };
   // A block whose checks hold by construction (rigid_checks.h): only its
   // positions' finiteness and box are computed, its flags are 0. Its bone's
   // checks read nothing of the check arrays but the first begin and the
@@ -241,15 +257,7 @@ std::size_t count_escapes(const EscapeCheckInput& e, [[maybe_unused]] std::span<
     float lower[3];
     float upper[3];
     if (!finite_block_box(positions, v, blocks, lower, upper)) return false;
-    for (std::size_t i = 0; i < kBlock; ++i) {
-      if (c0 + i < escaped.size()) escaped[c0 + i] = 0;
-    }
-    if (boxes == nullptr) return true;
-#if SINEW_ESCAPE_SSE
-    extend_run(bone, _mm_setr_ps(lower[0], lower[1], lower[2], 0.0f), _mm_setr_ps(upper[0], upper[1], upper[2], 0.0f));
-#else
-    boxes[bone].extend(Aabb{Vec3(lower[0], lower[1], lower[2]), Vec3(upper[0], upper[1], upper[2])});
-#endif
+    finish_block(c0, 0, bone, lower, upper);
     return true;
   };
   // Eight vertices with one check each, all against one bone, are checked
@@ -283,17 +291,7 @@ std::size_t count_escapes(const EscapeCheckInput& e, [[maybe_unused]] std::span<
     const std::uint32_t result = detail::escape_block_avx2(&positions[v].x, &bone_from_world[bone].rows[0].x,
                                                            tolerance[bone], lane_boxes, lower, upper);
     if ((result & detail::kEscapeBlockFinite) == 0) return false;
-    for (std::size_t i = 0; i < kBlock; ++i) {
-      const std::uint8_t out = static_cast<std::uint8_t>((result >> i) & 1u);
-      count += out;
-      if (c0 + i < escaped.size()) escaped[c0 + i] = out;
-    }
-    if (boxes == nullptr) return true;
-#if SINEW_ESCAPE_SSE
-    extend_run(bone, _mm_setr_ps(lower[0], lower[1], lower[2], 0.0f), _mm_setr_ps(upper[0], upper[1], upper[2], 0.0f));
-#else
-    boxes[bone].extend(Aabb{Vec3(lower[0], lower[1], lower[2]), Vec3(upper[0], upper[1], upper[2])});
-#endif
+    finish_block(c0, result & 0xFFu, bone, lower, upper);
     return true;
   };
   for (std::size_t v = r.begin; v < end; ++v) {
