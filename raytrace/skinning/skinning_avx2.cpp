@@ -91,9 +91,10 @@ void load_bone_row8(const float* const lane_bones[8], int r, __m256 cols[4]) {
 // its joints straight from the slot (no transpose).
 //
 // A group whose one slot is weight 1 on one bone for every lane (rigid
-// vertices: 46% of the groups at 855,552 triangles) takes that bone's
-// entries broadcast, plus zero: fma(1, b, 0) to the bit (-0 + 0 is +0),
-// without the row loads and transposes.
+// vertices: every rigid block of the escape check is one, 44% of the groups
+// at 855,552 triangles) takes that bone's entries broadcast, plus zero:
+// fma(1, b, 0) to the bit (-0 + 0 is +0), without the row loads and
+// transposes.
 Matrix3x4x8 blend_bones(const SkinningArrays& a, std::size_t group) {
   Matrix3x4x8 out;
   for (__m256& e : out.m) e = _mm256_setzero_ps();
