@@ -550,15 +550,18 @@ class LargeQuery {
 
   // A leaf's items for the groups reaching it. `corners(item)` gives the
   // item's triangle (LeafTriangle). With group frusta each item is tested
-  // once per object visit, by the groups whose frustum it reaches; without,
-  // per item (mailboxed by its index) by the groups with lanes in the leaf
-  // left to test it. Returns true when every lane is answered (any hit).
+  // once per object visit, by the groups whose frustum it reaches (a tree
+  // that lists each item once, a BVH, `listed_once`, needs no mailbox for
+  // that); without, per item (mailboxed by its index) by the groups with
+  // lanes in the leaf left to test it. Returns true when every lane is
+  // answered (any hit).
   template <class CornersFn>
-  bool test_leaf(std::span<const std::uint32_t> items, GroupMask groups_here, CornersFn&& corners) {
+  bool test_leaf(std::span<const std::uint32_t> items, GroupMask groups_here, CornersFn&& corners,
+                 bool listed_once = false) {
     if (frusta_on_) ensure_frusta(groups_here & alive_groups_);
     for (const std::uint32_t item : items) {
       if (frusta_on_) {
-        if (!items_seen_.first_visit(item)) continue;
+        if (!listed_once && !items_seen_.first_visit(item)) continue;
         const LeafTriangle tri = corners(item);
         // A shadow packet's leaf that one group alone reaches (most leaves
         // on pixel-sized triangles, where the leaf's box picked its groups):
@@ -663,7 +666,7 @@ class LargeQuery {
         groups_here = frusta_box_reached(box, groups_here & alive_groups_);
         if (groups_here == 0) return false;
       }
-      return test_leaf(triangles, groups_here, corners);
+      return test_leaf(triangles, groups_here, corners, character.fuzzy.has_bvhs());
     };
     if (character.fuzzy.has_bvhs()) {
       walk_bvh(character.fuzzy.bvh_view(tree), entry, leaf);
