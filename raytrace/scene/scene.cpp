@@ -31,9 +31,10 @@ Scene& Scene::operator=(Scene&&) noexcept = default;
 
 Expected<std::uint32_t> Scene::add_character(const SkinnedMesh& mesh, const FuzzyCharacterView& fuzzy) {
   SINEW_RETURN_IF_ERROR(validate_fuzzy_character(mesh, fuzzy));
-  characters_.push_back({&mesh, fuzzy, pack_influences(mesh),
-                         find_rigid_check_blocks(mesh, fuzzy.vertex_check_begin, fuzzy.vertex_checks,
-                                                 fuzzy.check_rank)});
+  PackedInfluences influences = pack_influences(mesh);
+  std::vector<std::uint16_t> rigid =
+      find_rigid_check_blocks(mesh, influences, fuzzy.vertex_check_begin, fuzzy.vertex_checks, fuzzy.check_rank);
+  characters_.push_back({&mesh, fuzzy, std::move(influences), std::move(rigid)});
   return static_cast<std::uint32_t>(characters_.size() - 1);
 }
 

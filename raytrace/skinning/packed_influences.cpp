@@ -18,6 +18,7 @@ PackedInfluences pack_influences(const SkinnedMesh& mesh) {
     std::array<std::array<float, kMaxInfluences>, kInfluenceGroupLanes> weights{};
     std::array<std::array<std::uint16_t, kMaxInfluences>, kInfluenceGroupLanes> joints{};
     std::size_t slots = 0;
+    bool one_bone = lanes == kInfluenceGroupLanes;
     for (std::size_t lane = 0; lane < lanes; ++lane) {
       std::size_t used = 0;
       for (std::size_t k = 0; k < kMaxInfluences; ++k) {
@@ -28,7 +29,10 @@ PackedInfluences pack_influences(const SkinnedMesh& mesh) {
         ++used;
       }
       slots = std::max(slots, used);
+      one_bone = one_bone && used == 1 && weights[lane][0] == 1.0f && joints[lane][0] == joints[0][0] &&
+                 joints[lane][0] != kNoGroupBone;
     }
+    packed.group_bone.push_back(one_bone ? joints[0][0] : kNoGroupBone);
     for (std::size_t s = 0; s < slots; ++s) {
       for (std::size_t lane = 0; lane < kInfluenceGroupLanes; ++lane) {
         packed.weights.push_back(weights[lane][s]);

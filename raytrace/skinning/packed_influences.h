@@ -27,6 +27,7 @@
 namespace sinew::rt {
 
 inline constexpr std::size_t kInfluenceGroupLanes = 8;
+inline constexpr std::uint16_t kNoGroupBone = 0xFFFF;
 
 struct PackedInfluences {
   std::size_t vertex_count = 0;
@@ -36,6 +37,10 @@ struct PackedInfluences {
   // Per slot, kInfluenceGroupLanes entries: one per vertex of its group.
   std::vector<float> weights;
   std::vector<std::uint16_t> joints;
+  // Per group: the bone, when each of its eight vertices has one non-zero
+  // weight, exactly 1, on it (rigid vertices: the kernel broadcasts that
+  // bone, and rigid_checks.h skips their escape checks); else kNoGroupBone.
+  std::vector<std::uint16_t> group_bone;
 
   std::size_t group_count() const { return group_slot_begin.empty() ? 0 : group_slot_begin.size() - 1; }
 };

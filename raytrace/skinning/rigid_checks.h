@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "raytrace/fuzzy/fuzzy_character.h"
+#include "raytrace/skinning/packed_influences.h"
 #include "runtime/mesh/skinned_mesh.h"
 
 namespace sinew::rt {
@@ -27,13 +28,14 @@ inline constexpr std::size_t kRigidBlockVertices = 8;
 inline constexpr std::uint16_t kNotRigid = 0xFFFF;
 
 // Per block of kRigidBlockVertices vertices (the last, partial block
-// included): the bone all its checks are rigid in, when each of its
-// vertices has exactly one check, against that bone, rigid as above (one
-// non-zero weight, exactly 1, on that bone; ranked kSharedCheckBox when
-// `check_rank` is given; its rest position inside the check's box); else
-// kNotRigid. A partial block, a bone >= kNotRigid or arrays shorter than
-// the mesh make kNotRigid.
-std::vector<std::uint16_t> find_rigid_check_blocks(const SkinnedMesh& mesh,
+// included): the bone all its checks are rigid in, when the block's group
+// of `influences` (pack_influences(mesh)) is rigid on that bone
+// (PackedInfluences::group_bone: one non-zero weight, exactly 1, a vertex)
+// and each of its vertices has exactly one check, against that bone,
+// ranked kSharedCheckBox when `check_rank` is given, its rest position
+// inside the check's box; else kNotRigid. A partial block, a bone >=
+// kNotRigid or arrays shorter than the mesh make kNotRigid.
+std::vector<std::uint16_t> find_rigid_check_blocks(const SkinnedMesh& mesh, const PackedInfluences& influences,
                                                    std::span<const std::uint32_t> vertex_check_begin,
                                                    std::span<const VertexCheck> vertex_checks,
                                                    std::span<const std::uint32_t> check_rank);

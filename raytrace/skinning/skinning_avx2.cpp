@@ -90,9 +90,9 @@ void load_bone_row8(const float* const lane_bones[8], int r, __m256 cols[4]) {
 // Group g's slots are whole registers: one load of the slot's weights, and
 // its joints straight from the slot (no transpose).
 //
-// A group whose one slot is weight 1 on one bone for every lane (rigid
-// vertices: every rigid block of the escape check is one, 44% of the groups
-// at 855,552 triangles) takes that bone's entries broadcast, plus zero:
+// A group rigid on one bone (PackedInfluences::group_bone: every rigid
+// block of the escape check is one, 44% of the groups at 855,552
+// triangles) takes that bone's entries broadcast, plus zero:
 // fma(1, b, 0) to the bit (-0 + 0 is +0), without the row loads and
 // transposes.
 Matrix3x4x8 blend_bones(const SkinningArrays& a, std::size_t group) {
@@ -100,17 +100,10 @@ Matrix3x4x8 blend_bones(const SkinningArrays& a, std::size_t group) {
   for (__m256& e : out.m) e = _mm256_setzero_ps();
   const std::size_t first = a.group_slot_begin[group];
   const std::size_t last = a.group_slot_begin[group + 1];
-  if (last == first + 1) {
-    const std::uint16_t* joints = a.slot_joints + first * kAvx2Lanes;
-    const __m256 ones = _mm256_cmp_ps(_mm256_loadu_ps(a.slot_weights + first * kAvx2Lanes), _mm256_set1_ps(1.0f),
-                                      _CMP_EQ_OQ);
-    const __m128i same = _mm_cmpeq_epi16(_mm_loadu_si128(reinterpret_cast<const __m128i*>(joints)),
-                                         _mm_set1_epi16(static_cast<short>(joints[0])));
-    if (_mm256_movemask_ps(ones) == 0xFF && _mm_movemask_epi8(same) == 0xFFFF) {
-      const float* bone = a.bones + kFloatsPerBone * joints[0];
-      for (std::size_t e = 0; e < kFloatsPerBone; ++e) out.m[e] = _mm256_add_ps(_mm256_set1_ps(bone[e]), out.m[e]);
-      return out;
-    }
+  if (a.group_bone != nullptr && a.group_bone[group] != 0xFFFF) {
+    const float* bone = a.bones + kFloatsPerBone * a.group_bone[group];
+    for (std::size_t e = 0; e < kFloatsPerBone; ++e) out.m[e] = _mm256_add_ps(_mm256_set1_ps(bone[e]), out.m[e]);
+    return out;
   }
   for (std::size_t slot = first; slot < last; ++slot) {
     const __m256 w = _mm256_loadu_ps(a.slot_weights + slot * kAvx2Lanes);

@@ -24,6 +24,7 @@ struct SkinningArrays {
   const std::uint32_t* group_slot_begin = nullptr;
   const std::uint16_t* slot_joints = nullptr;
   const float* slot_weights = nullptr;
+  const std::uint16_t* group_bone = nullptr;  // per group, or 0xFFFF (PackedInfluences::group_bone)
   const float* bones = nullptr;
   float* positions = nullptr;
   float* normals = nullptr;             // null: no normals are written

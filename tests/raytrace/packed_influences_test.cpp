@@ -127,5 +127,31 @@ TEST(PackedInfluences, AGroupOfUnweightedVerticesHasNoSlots) {
   EXPECT_EQ(joint_at(p, 0, 0), 2);
 }
 
+// A group is rigid on a bone only when all eight vertices have one
+// non-zero weight, exactly 1, on that bone (in any slot).
+TEST(PackedInfluences, GroupBoneNamesGroupsRigidOnOneBone) {
+  SkinnedMesh mesh;
+  const auto seven = [&](std::uint16_t bone) {
+    for (int i = 0; i < 7; ++i) add_vertex(mesh, {{0, bone, 1.0f}});
+  };
+  seven(4);
+  add_vertex(mesh, {{3, 4, 1.0f}});  // 0: rigid on 4, the weight in slot 3
+  seven(4);
+  add_vertex(mesh, {{0, 5, 1.0f}});  // 1: another bone
+  seven(4);
+  add_vertex(mesh, {{0, 4, 0.5f}, {1, 4, 0.5f}});  // 2: two weights on the same bone
+  seven(4);
+  add_vertex(mesh, {{0, 4, std::nextafter(1.0f, 0.0f)}});  // 3: not exactly 1
+  seven(4);
+  add_vertex(mesh, {{0, 4, std::numeric_limits<float>::quiet_NaN()}});  // 4: NaN
+  seven(2);
+  add_vertex(mesh, {{0, 2, 1.0f}});  // 5: rigid on 2
+  for (int i = 0; i < 8; ++i) add_vertex(mesh, {{0, kNoGroupBone, 1.0f}});  // 6: the sentinel's bone
+  for (int i = 0; i < 5; ++i) add_vertex(mesh, {{0, 4, 1.0f}});             // 7: partial
+  const PackedInfluences packed = pack_influences(mesh);
+  EXPECT_EQ(packed.group_bone, (std::vector<std::uint16_t>{4, kNoGroupBone, kNoGroupBone, kNoGroupBone, kNoGroupBone,
+                                                           2, kNoGroupBone, kNoGroupBone}));
+}
+
 }  // namespace
 }  // namespace sinew::rt

@@ -98,32 +98,32 @@ TEST(RigidChecks, EachConditionDecidesItsBlock) {
   const std::vector<std::uint16_t> expected{3,         kNotRigid, kNotRigid, kNotRigid, kNotRigid,
                                             kNotRigid, kNotRigid, kNotRigid, kNotRigid, kNotRigid,
                                             3,         kNotRigid, kNotRigid, kNotRigid};
-  EXPECT_EQ(find_rigid_check_blocks(b.mesh, b.begin, b.checks, b.rank), expected);
+  EXPECT_EQ(find_rigid_check_blocks(b.mesh, pack_influences(b.mesh), b.begin, b.checks, b.rank), expected);
   // Without ranks (no clusters) block 8 is rigid too.
   std::vector<std::uint16_t> unranked = expected;
   unranked[8] = 3;
-  EXPECT_EQ(find_rigid_check_blocks(b.mesh, b.begin, b.checks, {}), unranked);
+  EXPECT_EQ(find_rigid_check_blocks(b.mesh, pack_influences(b.mesh), b.begin, b.checks, {}), unranked);
 }
 
 TEST(RigidChecks, ShortArraysMakeNoRigidBlock) {
   Builder b;
   b.add_seven_rigid(2);
   b.add(Vec3(1.0f), {{2, 1.0f}}, {2});
-  ASSERT_EQ(find_rigid_check_blocks(b.mesh, b.begin, b.checks, {}), std::vector<std::uint16_t>{2});
+  ASSERT_EQ(find_rigid_check_blocks(b.mesh, pack_influences(b.mesh), b.begin, b.checks, {}), std::vector<std::uint16_t>{2});
   // Check begins for fewer vertices than the mesh has.
   const std::vector<std::uint32_t> short_begin(b.begin.begin(), b.begin.end() - 1);
-  EXPECT_EQ(find_rigid_check_blocks(b.mesh, short_begin, b.checks, {}), std::vector<std::uint16_t>{kNotRigid});
+  EXPECT_EQ(find_rigid_check_blocks(b.mesh, pack_influences(b.mesh), short_begin, b.checks, {}), std::vector<std::uint16_t>{kNotRigid});
   // Fewer checks than the begins name.
   const std::vector<VertexCheck> short_checks(b.checks.begin(), b.checks.end() - 1);
-  EXPECT_EQ(find_rigid_check_blocks(b.mesh, b.begin, short_checks, {}), std::vector<std::uint16_t>{kNotRigid});
+  EXPECT_EQ(find_rigid_check_blocks(b.mesh, pack_influences(b.mesh), b.begin, short_checks, {}), std::vector<std::uint16_t>{kNotRigid});
   // Fewer ranks than checks.
   const std::vector<std::uint32_t> short_rank(b.checks.size() - 1, kSharedCheckBox);
-  EXPECT_EQ(find_rigid_check_blocks(b.mesh, b.begin, b.checks, short_rank), std::vector<std::uint16_t>{kNotRigid});
+  EXPECT_EQ(find_rigid_check_blocks(b.mesh, pack_influences(b.mesh), b.begin, b.checks, short_rank), std::vector<std::uint16_t>{kNotRigid});
   // Weights for fewer vertices than the mesh has.
   b.mesh.weights.pop_back();
-  EXPECT_EQ(find_rigid_check_blocks(b.mesh, b.begin, b.checks, {}), std::vector<std::uint16_t>{kNotRigid});
+  EXPECT_EQ(find_rigid_check_blocks(b.mesh, pack_influences(b.mesh), b.begin, b.checks, {}), std::vector<std::uint16_t>{kNotRigid});
   // No vertices.
-  EXPECT_TRUE(find_rigid_check_blocks(SkinnedMesh{}, std::vector<std::uint32_t>{0}, {}, {}).empty());
+  EXPECT_TRUE(find_rigid_check_blocks(SkinnedMesh{}, PackedInfluences{}, std::vector<std::uint32_t>{0}, {}, {}).empty());
 }
 
 }  // namespace

@@ -674,7 +674,7 @@ TEST(SkinningEscape, RigidBlocksAnswerAsTheirComputedChecks) {
       checks.push_back({b, box});
       begin.push_back(static_cast<std::uint32_t>(checks.size()));
     }
-    const std::vector<std::uint16_t> rigid = find_rigid_check_blocks(mesh, begin, checks, {});
+    const std::vector<std::uint16_t> rigid = find_rigid_check_blocks(mesh, pack_influences(mesh), begin, checks, {});
     const auto rigid_count = static_cast<std::size_t>(std::count_if(rigid.begin(), rigid.end(), [](std::uint16_t r) {
       return r != kNotRigid;
     }));
