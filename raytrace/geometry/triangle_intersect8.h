@@ -120,6 +120,44 @@ inline CommonOriginTriangle prepare_common_origin(const Vec3& origin, const Vec3
   return c;
 }
 
+// prepare_common_origin for eight triangles at once, corner k's coordinate
+// a of triangle i in p[k][a][i]: lane i of each array holds what
+// prepare_common_origin gives triangle i, bit for bit (the same operations
+// lane-wise; the build contracts no products into FMAs).
+struct CommonOriginLanes8 {
+  alignas(32) float e1[3][8], e2[3][8], tv[3][8], q[3][8], t_numerator[8];
+  CommonOriginTriangle at(int i) const {
+    CommonOriginTriangle c;
+    c.e1 = Vec3(e1[0][i], e1[1][i], e1[2][i]);
+    c.e2 = Vec3(e2[0][i], e2[1][i], e2[2][i]);
+    c.tv = Vec3(tv[0][i], tv[1][i], tv[2][i]);
+    c.q = Vec3(q[0][i], q[1][i], q[2][i]);
+    c.t_numerator = t_numerator[i];
+    return c;
+  }
+};
+
+inline void prepare_common_origin8(const Vec3& origin, const float (&p)[3][3][8], CommonOriginLanes8& out) {
+  const auto mul = [](__m256 a, __m256 b) { return _mm256_mul_ps(a, b); };
+  const auto add = [](__m256 a, __m256 b) { return _mm256_add_ps(a, b); };
+  const auto sub = [](__m256 a, __m256 b) { return _mm256_sub_ps(a, b); };
+  const float o[3] = {origin.x, origin.y, origin.z};
+  __m256 e1[3], e2[3], tv[3];
+  for (int a = 0; a < 3; ++a) {
+    const __m256 p0 = _mm256_load_ps(p[0][a]);
+    e1[a] = sub(_mm256_load_ps(p[1][a]), p0);
+    e2[a] = sub(_mm256_load_ps(p[2][a]), p0);
+    tv[a] = sub(_mm256_set1_ps(o[a]), p0);
+    _mm256_store_ps(out.e1[a], e1[a]);
+    _mm256_store_ps(out.e2[a], e2[a]);
+    _mm256_store_ps(out.tv[a], tv[a]);
+  }
+  const __m256 q[3] = {sub(mul(tv[1], e1[2]), mul(tv[2], e1[1])), sub(mul(tv[2], e1[0]), mul(tv[0], e1[2])),
+                       sub(mul(tv[0], e1[1]), mul(tv[1], e1[0]))};
+  for (int a = 0; a < 3; ++a) _mm256_store_ps(out.q[a], q[a]);
+  _mm256_store_ps(out.t_numerator, add(add(mul(e2[0], q[0]), mul(e2[1], q[1])), mul(e2[2], q[2])));
+}
+
 // intersect_triangle_fast8 for rays that all start at the origin `c` was
 // prepared with (r.o is not read): per lane the same values, bit for bit.
 inline std::uint32_t intersect_triangle_fast8_common_origin(const RayLanes8& r, std::uint32_t lanes,

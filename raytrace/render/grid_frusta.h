@@ -129,6 +129,52 @@ class GridFrusta {
     });
   }
 
+  // reached() for the triangles of `lanes` of `t` (bit i: triangle i),
+  // eight at a time, the same decisions per triangle: out[i] gets the
+  // groups of `groups` triangle i may reach, 0 for the other lanes. Only
+  // the columns and rows of `groups` are tested.
+  void reached8(const TriangleLanes8& t, std::uint32_t lanes, std::uint64_t groups, std::uint64_t (&out)[8]) const {
+    std::fill(std::begin(out), std::end(out), std::uint64_t{0});
+    if (!on_) {
+      for (std::uint32_t m = lanes; m != 0; m &= m - 1) out[std::countr_zero(m)] = groups;
+      return;
+    }
+    const detail::ApexTriangles8 x(t, apex_, apex_magnitude_);
+    const auto cut = [&](const Planes& p, int i) {
+      return (x.nearest(p.n[0][i], p.n[1][i], p.n[2][i]) > Float8(p.scale[i]) * x.margin).bits();
+    };
+    lanes &= ~(cut(outer_, 0) | cut(outer_, 1) | cut(outer_, 2) | cut(outer_, 3));
+    if (lanes == 0) return;
+    std::uint32_t columns = 0, rows = 0;
+    for (std::uint64_t m = groups; m != 0; m &= m - 1) {
+      const int g = std::countr_zero(m);
+      columns |= 1u << (g % columns_);
+      rows |= 1u << (g / columns_);
+    }
+    // Per triangle the columns and the rows it reaches.
+    std::uint32_t lane_columns[8] = {}, lane_rows[8] = {};
+    for (; columns != 0; columns &= columns - 1) {
+      const int c = std::countr_zero(columns);
+      for (std::uint32_t m = lanes & ~(cut(column_hi_, c) | cut(column_lo_, c)); m != 0; m &= m - 1) {
+        lane_columns[std::countr_zero(m)] |= 1u << c;
+      }
+    }
+    for (; rows != 0; rows &= rows - 1) {
+      const int r = std::countr_zero(rows);
+      for (std::uint32_t m = lanes & ~(cut(row_hi_, r) | cut(row_lo_, r)); m != 0; m &= m - 1) {
+        lane_rows[std::countr_zero(m)] |= 1u << r;
+      }
+    }
+    for (std::uint32_t m = lanes; m != 0; m &= m - 1) {
+      const int i = std::countr_zero(m);
+      std::uint64_t reach = 0;
+      for (std::uint32_t r = lane_rows[i]; r != 0; r &= r - 1) {
+        reach |= std::uint64_t{lane_columns[i]} << (columns_ * std::countr_zero(r));
+      }
+      out[i] = reach & groups;
+    }
+  }
+
   // The groups of `groups` whose column and row may reach `box` (its corner
   // nearest each plane, box_plane_nearest: at least every group a triangle
   // inside it reaches; an empty or non-finite box is reached by all).

@@ -54,6 +54,44 @@ inline Float8 box_plane_nearest(Float8 nx, Float8 ny, Float8 nz, const Vec3& lo,
   return (nearer(nx, lo.x, hi.x) + nearer(ny, lo.y, hi.y)) + nearer(nz, lo.z, hi.z);
 }
 
+// Up to eight triangles side by side, for culling a leaf's triangles eight
+// at a time (GroupFrusta::reached8, GridFrusta::reached8): coordinate a of
+// corner k of triangle i in p[k][a][i].
+struct TriangleLanes8 {
+  alignas(32) float p[3][3][8];
+  Vec3 corner(int k, int i) const { return Vec3(p[k][0][i], p[k][1][i], p[k][2][i]); }
+};
+
+namespace detail {
+
+// Eight triangles' corners relative to an apex, and each triangle's cull
+// margin: per lane the values reached() takes for one triangle (the same
+// differences, cull_margin of its corners' largest magnitude).
+struct ApexTriangles8 {
+  Vec3x8 x[3];
+  Float8 margin;
+
+  ApexTriangles8(const TriangleLanes8& t, const Vec3& apex, float apex_magnitude) {
+    Float8 corners(0.0f);
+    for (int k = 0; k < 3; ++k) {
+      const Float8 px = Float8::load(t.p[k][0]), py = Float8::load(t.p[k][1]), pz = Float8::load(t.p[k][2]);
+      x[k] = Vec3x8{px - Float8(apex.x), py - Float8(apex.y), pz - Float8(apex.z)};
+      corners = max(corners, max(max(abs(px), abs(py)), abs(pz)));
+    }
+    margin = Float8(0x1.0p-16f) * (corners + Float8(apex_magnitude));
+  }
+
+  // Per triangle, the least of n . x over its corners, each summed
+  // (n.x x + n.y y) + n.z z as the one-triangle culls sum it.
+  Float8 nearest(float nx, float ny, float nz) const {
+    const Float8 a(nx), b(ny), c(nz);
+    const auto side = [&](const Vec3x8& w) { return (a * w.x + b * w.y) + c * w.z; };
+    return min(min(side(x[0]), side(x[1])), side(x[2]));
+  }
+};
+
+}  // namespace detail
+
 template <int kMaxGroups>
 class GroupFrusta {
   static_assert(kMaxGroups % 8 == 0);
@@ -279,6 +317,43 @@ class GroupFrusta {
       return min(min(side(x0), side(x1)), side(x2));
     };
     return packet_then_groups(groups, corners, nearest, [&] { return slabs_uncut(groups, corners, x0, x1, x2); });
+  }
+
+  // reached() for the triangles of `lanes` of `t` (bit i: triangle i),
+  // eight at a time: out[i] gets the groups of `groups` whose own frustum
+  // triangle i may reach, decided per triangle and group as reached()
+  // decides it there, without the packet's frustum first (the caller's
+  // leaf box has already picked `groups`: its test would cost about one
+  // group's). out[i] is 0 for the other lanes. With slabs on, reached()
+  // per triangle.
+  void reached8(const TriangleLanes8& t, std::uint32_t lanes, std::uint64_t groups, std::uint64_t (&out)[8]) const {
+    std::fill(std::begin(out), std::end(out), std::uint64_t{0});
+    if (slabs_on_) {
+      for (std::uint32_t m = lanes; m != 0; m &= m - 1) {
+        const int i = std::countr_zero(m);
+        out[i] = reached(t.corner(0, i), t.corner(1, i), t.corner(2, i), groups);
+      }
+      return;
+    }
+    groups &= groups_ >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << groups_) - 1u;
+    const detail::ApexTriangles8 x(t, apex_, apex_magnitude_);
+    for (std::uint64_t m = groups; m != 0; m &= m - 1) {
+      const int g = std::countr_zero(m);
+      const std::size_t block = static_cast<std::size_t>(g / 8);
+      const int bit = g % 8;
+      const bool sides = (sides_[block] >> bit & 1u) != 0, far = (far_[block] >> bit & 1u) != 0;
+      std::uint32_t reach = lanes;
+      if (sides || far) {
+        Mask8 cut = Mask8::from_bits(0);
+        const auto d = [&](int i) { return x.nearest(n_[i][0][g], n_[i][1][g], n_[i][2][g]); };
+        if (sides) {
+          for (int i = 0; i < 4; ++i) cut = cut | (d(i) > Float8(scale_[i][g]) * x.margin);
+        }
+        if (far) cut = cut | (d(4) > Float8(scale_[4][g]) * x.margin + Float8(offset_[g]));
+        reach &= ~cut.bits();
+      }
+      for (; reach != 0; reach &= reach - 1) out[std::countr_zero(reach)] |= std::uint64_t{1} << g;
+    }
   }
 
   // Whether reached() tests triangles against the groups' slabs in the

@@ -380,11 +380,7 @@ class LargeQuery {
     frusta_.use_slabs(slabs_);
   }
 
-  // The groups of `groups` whose frustum (or grid slabs) may reach the
-  // triangle, or the box.
-  GroupMask frusta_reached(const Vec3& p0, const Vec3& p1, const Vec3& p2, GroupMask groups) const {
-    return grid_.on() ? grid_.reached(p0, p1, p2, groups) : frusta_.reached(p0, p1, p2, groups);
-  }
+  // The groups of `groups` whose frustum (or grid slabs) may reach the box.
   GroupMask frusta_box_reached(const Aabb& box, GroupMask groups) const {
     return grid_.on() ? grid_.box_reached(box, groups) : frusta_.box_reached(box, groups);
   }
@@ -549,41 +545,88 @@ class LargeQuery {
   }
 
   // A leaf's items for the groups reaching it. `corners(item)` gives the
-  // item's triangle (LeafTriangle). With group frusta each item is tested
-  // once per object visit, by the groups whose frustum it reaches (a tree
-  // that lists each item once, a BVH, `listed_once`, needs no mailbox for
-  // that); without, per item (mailboxed by its index) by the groups with
-  // lanes in the leaf left to test it. Returns true when every lane is
-  // answered (any hit).
+  // item's triangle (LeafTriangle). With group frusta see
+  // test_leaf_in_frusta; without, each item (mailboxed by its index) is
+  // tested by the groups with lanes in the leaf left to test it. Returns
+  // true when every lane is answered (any hit).
   template <class CornersFn>
   bool test_leaf(std::span<const std::uint32_t> items, GroupMask groups_here, CornersFn&& corners,
                  bool listed_once = false) {
-    if (frusta_on_) ensure_frusta(groups_here & alive_groups_);
+    if (frusta_on_) return test_leaf_in_frusta(items, groups_here, corners, listed_once);
     for (const std::uint32_t item : items) {
-      if (frusta_on_) {
-        if (!listed_once && !items_seen_.first_visit(item)) continue;
-        const LeafTriangle tri = corners(item);
-        // A shadow packet's leaf that one group alone reaches (most leaves
-        // on pixel-sized triangles, where the leaf's box picked its groups):
-        // the group's frustum or slab test would cost about what its lane
-        // test does.
-        const GroupMask here = groups_here & alive_groups_;
-        need_ = kAnyHit && std::has_single_bit(here) ? here : frusta_reached(*tri.p0, *tri.p1, *tri.p2, here);
-        if (need_ == 0) continue;
-        for_each_bit(need_, [&](int g) { visit_[g].leaf_lanes = visit_[g].lanes & live_[g]; });
-        test_groups(need_, *tri.p0, *tri.p1, *tri.p2, tri.triangle, tri.instance);
-      } else {
-        need_ = 0;
-        for_each_bit(groups_here & alive_groups_, [&](int g) {
-          visit_[g].leaf_lanes = mailbox_.untested(item, g, leaf_lanes_[g]) & live_[g];
-          if (visit_[g].leaf_lanes != 0) need_ |= GroupMask{1} << g;
-        });
-        if (need_ == 0) continue;
-        const LeafTriangle tri = corners(item);
-        test_groups(need_, *tri.p0, *tri.p1, *tri.p2, tri.triangle, tri.instance);
-      }
+      GroupMask need = 0;
+      for_each_bit(groups_here & alive_groups_, [&](int g) {
+        visit_[g].leaf_lanes = mailbox_.untested(item, g, leaf_lanes_[g]) & live_[g];
+        if (visit_[g].leaf_lanes != 0) need |= GroupMask{1} << g;
+      });
+      if (need == 0) continue;
+      const LeafTriangle tri = corners(item);
+      test_groups(need, *tri.p0, *tri.p1, *tri.p2, tri.triangle, tri.instance);
       // Done only when every group in the tree is (not just this leaf's).
       if (kAnyHit && (tree_groups_ & alive_groups_) == 0) return true;
+    }
+    return false;
+  }
+
+  // test_leaf with group frusta: each item is tested once per object visit
+  // (a tree that lists each item once, a BVH, `listed_once`, needs no
+  // mailbox for that), by the groups whose frustum it reaches. The items
+  // go eight at a time: their corners side by side, culled against each
+  // group of the leaf together (reached8) and, for the fast test, their
+  // origin terms prepared together (prepare_common_origin8), where one
+  // triangle at a time tested against every group of a block of eight
+  // whatever the leaf's groups.
+  template <class CornersFn>
+  bool test_leaf_in_frusta(std::span<const std::uint32_t> items, GroupMask groups_here, CornersFn& corners,
+                           bool listed_once) {
+    ensure_frusta(groups_here & alive_groups_);
+    std::size_t next = 0;
+    while (next < items.size()) {
+      const GroupMask here = groups_here & alive_groups_;
+      if (here == 0) return false;
+      int n = 0;
+      for (; next < items.size() && n < kLanes; ++next) {
+        const std::uint32_t item = items[next];
+        if (!listed_once && !items_seen_.first_visit(item)) continue;
+        const LeafTriangle tri = corners(item);
+        const Vec3* const p[3] = {tri.p0, tri.p1, tri.p2};
+        for (int k = 0; k < 3; ++k) {
+          batch_.p[k][0][n] = p[k]->x;
+          batch_.p[k][1][n] = p[k]->y;
+          batch_.p[k][2][n] = p[k]->z;
+        }
+        batch_triangle_[n] = tri.triangle;
+        batch_instance_[n] = tri.instance;
+        ++n;
+      }
+      if (n == 0) return false;
+      const std::uint32_t lanes = (1u << n) - 1u;
+      std::uint64_t reach[kLanes];
+      if (kAnyHit && std::has_single_bit(here)) {
+        // A shadow packet's leaf that one group alone reaches (most leaves
+        // on pixel-sized triangles, where the leaf's box picked its
+        // groups): the group's frustum test would cost about what its
+        // lane test does.
+        std::fill(std::begin(reach), std::end(reach), here);
+      } else if (grid_.on()) {
+        grid_.reached8(batch_, lanes, here, reach);
+      } else {
+        frusta_.reached8(batch_, lanes, here, reach);
+      }
+      if constexpr (kTest == TriangleTest::kFast) prepare_common_origin8(common_origin_at_, batch_.p, prepared_);
+      for (int i = 0; i < n; ++i) {
+        const GroupMask need = reach[i] & alive_groups_;
+        if (need == 0) continue;
+        for_each_bit(need, [&](int g) { visit_[g].leaf_lanes = visit_[g].lanes & live_[g]; });
+        if constexpr (kTest == TriangleTest::kFast) {
+          test_groups_prepared(need, prepared_.at(i), batch_triangle_[i], batch_instance_[i]);
+        } else {
+          test_groups(need, batch_.corner(0, i), batch_.corner(1, i), batch_.corner(2, i), batch_triangle_[i],
+                      batch_instance_[i]);
+        }
+        // Done only when every group in the tree is (not just this leaf's).
+        if (kAnyHit && (tree_groups_ & alive_groups_) == 0) return true;
+      }
     }
     return false;
   }
@@ -914,26 +957,31 @@ class LargeQuery {
                    std::uint32_t instance) {
     if constexpr (kTest == TriangleTest::kFast) {
       if (common_origin_) {
-        // The origin's terms once for every group; the zero-area check of
-        // the scalar test once per triangle, on the hit path.
-        const CommonOriginTriangle c = prepare_common_origin(common_origin_at_, p0, p1, p2);
-        int zero_area = -1;
-        for_each_bit(groups, [&](int g) {
-          const std::uint32_t lanes = visit_[g].leaf_lanes & live_[g];
-          if (lanes == 0) return;
-          counters_.triangle_tests += static_cast<std::uint64_t>(std::popcount(lanes));
-          Group& gr = group_[g];
-          alignas(32) float t[kLanes], u[kLanes], v[kLanes];
-          const RayLanes8 lanes8{gr.o, gr.d, gr.t_min, gr.t_limit};
-          const std::uint32_t hit = intersect_triangle_fast8_common_origin(lanes8, lanes, c, t, u, v);
-          if (hit == 0) return;
-          if (zero_area < 0) zero_area = detail::zero_area(c.e1, c.e2) ? 1 : 0;
-          if (zero_area == 0) record_lanes(g, hit, t, u, v, triangle, instance);
-        });
+        test_groups_prepared(groups, prepare_common_origin(common_origin_at_, p0, p1, p2), triangle, instance);
         return;
       }
     }
     for_each_bit(groups, [&](int g) { test(g, visit_[g].leaf_lanes, p0, p1, p2, triangle, instance); });
+  }
+
+  // test_groups with the fast test for rays from common_origin_at_, the
+  // triangle's origin terms prepared: once for every group; the zero-area
+  // check of the scalar test once per triangle, on the hit path.
+  void test_groups_prepared(GroupMask groups, const CommonOriginTriangle& c, std::uint32_t triangle,
+                            std::uint32_t instance) {
+    int zero_area = -1;
+    for_each_bit(groups, [&](int g) {
+      const std::uint32_t lanes = visit_[g].leaf_lanes & live_[g];
+      if (lanes == 0) return;
+      counters_.triangle_tests += static_cast<std::uint64_t>(std::popcount(lanes));
+      Group& gr = group_[g];
+      alignas(32) float t[kLanes], u[kLanes], v[kLanes];
+      const RayLanes8 lanes8{gr.o, gr.d, gr.t_min, gr.t_limit};
+      const std::uint32_t hit = intersect_triangle_fast8_common_origin(lanes8, lanes, c, t, u, v);
+      if (hit == 0) return;
+      if (zero_area < 0) zero_area = detail::zero_area(c.e1, c.e2) ? 1 : 0;
+      if (zero_area == 0) record_lanes(g, hit, t, u, v, triangle, instance);
+    });
   }
 
   // Tests one world-space triangle for the live lanes of `lanes` of group g.
@@ -1015,7 +1063,12 @@ class LargeQuery {
   std::array<VisitGroup, kMaxPacketGroups> visit_;
   std::array<std::uint32_t, kMaxPacketGroups> leaf_lanes_{};  // per group: the lanes reaching the current leaf
   GroupMask tree_groups_ = 0;  // the groups walking the current tree
-  GroupMask need_ = 0;  // test_leaf: the groups with lanes left to test the current item
+  // test_leaf_in_frusta: up to eight of a leaf's triangles, their ids and
+  // instances, and their origin terms.
+  TriangleLanes8 batch_;
+  std::array<std::uint32_t, kLanes> batch_triangle_{};
+  std::array<std::uint32_t, kLanes> batch_instance_{};
+  CommonOriginLanes8 prepared_;
   std::array<std::array<WatertightRay, kLanes>, kTest == TriangleTest::kWatertight ? kMaxPacketGroups : 1>
       watertight_;
   std::array<std::uint32_t, kMaxPacketGroups> live_{};

@@ -179,5 +179,75 @@ TEST(GridFrusta, GridsThatDoNotFitOrLanesBehindCullNothing) {
   EXPECT_EQ(grid.box_reached(Aabb{q0, q1 + Vec3(0.0f, 1.0f, 0.0f)}, 0x3u), 0x3u);
 }
 
+// reached8 (a leaf's triangles eight at a time, render/large_packet.cpp)
+// decides each triangle and group as reached() does, for random batches of
+// one to eight triangles about the region's rays, random lanes of the
+// batch and random groups, near the origin and far from it; and reaches
+// every group of the lanes given when the grid is off.
+TEST(GridFrusta, ReachedEightAtATimeDecidesAsOneAtATime) {
+  std::mt19937 g(29);
+  int compared = 0, culled = 0, some_groups = 0;
+  for (const float offset : {0.0f, 70.0f, 3000.0f}) {
+    for (int view = 0; view < 30; ++view) {
+      const Vec3 eye = offset * random_vec(g) + random_vec(g);
+      const Vec3 target = eye + random_vec(g) + Vec3(0.0f, 0.0f, 0.01f);
+      const float fov = 5.0f + 100.0f * unit(g);
+      const int size = 64 + static_cast<int>(g() % 1500);
+      const auto made = rt::PinholeCamera::create({eye, target, Vec3(0, 1, 0), fov}, size, size);
+      if (!made.ok()) continue;
+      const rt::PinholeCamera& camera = made.value();
+      const int columns = 1 + static_cast<int>(g() % 8), rows = 1 + static_cast<int>(g() % 8);
+      const Region r = make_region(camera, static_cast<int>(g() % 32), static_cast<int>(g() % 32), columns, rows,
+                                   view % 3 == 0, g);
+      rt::GridFrusta grid;
+      if (!build(grid, camera, r)) continue;
+      const int groups = columns * rows;
+      const float pixel = 2.0f * std::tan(0.5f * fov * 3.14159265f / 180.0f) / static_cast<float>(size);
+      for (int batch = 0; batch < 60; ++batch) {
+        rt::TriangleLanes8 t;
+        for (int i = 0; i < 8; ++i) {
+          const int group = static_cast<int>(g() % static_cast<unsigned>(groups));
+          const int lane = static_cast<int>(g() % 8);
+          const Vec3 d(r.q(group)[0][lane], r.q(group)[1][lane], r.q(group)[2][lane]);
+          const float depth = 0.05f + 40.0f * unit(g);
+          const float width = 8.0f * pixel * depth;
+          const Vec3 at = eye + depth * d + 2.0f * width * unit(g) * random_vec(g);
+          for (int k = 0; k < 3; ++k) {
+            const Vec3 p = at + width * unit(g) * random_vec(g);
+            t.p[k][0][i] = p.x;
+            t.p[k][1][i] = p.y;
+            t.p[k][2][i] = p.z;
+          }
+        }
+        const int n = 1 + static_cast<int>(g() % 8);
+        const std::uint32_t lanes = ((1u << n) - 1u) & (batch % 3 == 0 ? g() | 1u : ~0u);
+        const std::uint64_t all = groups == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << groups) - 1u;
+        const std::uint64_t want_groups = batch % 2 == 0 ? all : all & (std::uint64_t{g()} << 32 | g());
+        std::uint64_t out[8];
+        grid.reached8(t, lanes, want_groups, out);
+        for (int i = 0; i < 8; ++i) {
+          const std::uint64_t want =
+              (lanes >> i & 1u) ? grid.reached(t.corner(0, i), t.corner(1, i), t.corner(2, i), want_groups) : 0u;
+          ASSERT_EQ(out[i], want) << "triangle " << i << " of batch " << batch << " view " << view << " offset "
+                                  << offset;
+          if (!(lanes >> i & 1u)) continue;
+          ++compared;
+          if (want == 0) ++culled;
+          if (want != 0 && want != want_groups) ++some_groups;
+        }
+      }
+    }
+  }
+  EXPECT_GT(compared, 5000);
+  EXPECT_GT(culled, compared / 10) << culled << " of " << compared;
+  EXPECT_GT(some_groups, compared / 10) << some_groups << " of " << compared;
+  // Off: every group given, for the lanes given only.
+  rt::GridFrusta off;
+  rt::TriangleLanes8 t{};
+  std::uint64_t out[8];
+  off.reached8(t, 0x5u, 0x30u, out);
+  for (int i = 0; i < 8; ++i) EXPECT_EQ(out[i], i == 0 || i == 2 ? 0x30u : 0u) << i;
+}
+
 }  // namespace
 }  // namespace sinew

@@ -196,6 +196,78 @@ TEST(GroupFrusta, EveryHitTriangleIsReachedBySegmentsFromTheApex) {
   EXPECT_GT(tally.boxes_culled, tally.tried / 5) << tally.boxes_culled << " of " << tally.tried;
 }
 
+// A 32x16-pixel packet from `apex` (offset from the origin by up to
+// `offset`) about a random centre, `pixel` apart: rays, or segments to
+// t = 1 of lengths 1 to 41; with `partial`, random lanes of each group.
+struct Packet {
+  Vec3 apex{0.0f};
+  float pixel = 0.0f;
+  float q[64][3][8];
+  alignas(32) float reach[64][8];
+  std::uint32_t lanes[64];
+  std::array<Ray, 512> rays;
+};
+
+void make_packet(float offset, bool segments, bool partial, std::mt19937& g, Packet& p) {
+  p.apex = offset * random_vec(g) + random_vec(g);
+  const Vec3 c = glm::normalize(random_vec(g) + Vec3(0.0f, 0.0f, 1e-3f));
+  const Vec3 u = glm::normalize(glm::cross(c, std::fabs(c.z) < 0.9f ? Vec3(0, 0, 1) : Vec3(1, 0, 0)));
+  const Vec3 v = glm::cross(c, u);
+  p.pixel = 0.0005f * (1.0f + 6.0f * unit(g));
+  for (int group = 0; group < 64; ++group) {
+    p.lanes[group] = partial ? (g() & 0xFFu) | 1u : 0xFFu;
+    for (int lane = 0; lane < 8; ++lane) {
+      const float x = static_cast<float>(4 * (group % 8) + lane % 4) - 15.5f;
+      const float y = static_cast<float>(2 * (group / 8) + lane / 4) - 7.5f;
+      const float length = segments ? 1.0f + 40.0f * unit(g) : 1.0f + unit(g);
+      const Vec3 d = length * (c + p.pixel * (x * u + y * v));
+      p.q[group][0][lane] = d.x;
+      p.q[group][1][lane] = d.y;
+      p.q[group][2][lane] = d.z;
+      p.reach[group][lane] = segments ? 1.0f : kInf;
+      Ray& r = p.rays[static_cast<std::size_t>(8 * group + lane)];
+      r.origin = p.apex;
+      r.direction = d;
+      r.t_min = 0.0f;
+      r.t_max = p.reach[group][lane];
+    }
+  }
+}
+
+// The packet's frusta: each group's own (unless `slabs`), then, with
+// `bound`, the packet's bound and the groups' slabs in its basis.
+void build_frusta(const Packet& p, bool segments, bool slabs, bool bound, rt::GroupFrusta<64>& frusta) {
+  frusta.reset(p.apex, 64);
+  frusta.use_slabs(slabs);
+  const auto directions = [&](int group) -> const float (&)[3][8] { return p.q[group]; };
+  const auto lanes_of = [&](int group) { return p.lanes[group]; };
+  const auto reach_of = [&](int group, float* out) { std::copy(p.reach[group], p.reach[group] + 8, out); };
+  const std::uint64_t all = ~std::uint64_t{0};
+  if (segments) {
+    if (!slabs) frusta.set_groups<true>(all, 1.0f, directions, lanes_of, reach_of);
+    if (bound) frusta.set_bound<true>(all, 1.0f, directions, lanes_of, reach_of);
+  } else {
+    if (!slabs) frusta.set_groups<false>(all, 1.0f, directions, lanes_of, reach_of);
+    if (bound) frusta.set_bound<false>(all, 1.0f, directions, lanes_of, reach_of);
+  }
+}
+
+// A triangle about a random lane's ray, or beside the packet by up to its
+// width, at a random size.
+std::array<Vec3, 3> triangle_near(const Packet& p, bool segments, std::mt19937& g) {
+  const int k = static_cast<int>(g() % 512);
+  const Ray& r = p.rays[static_cast<std::size_t>(k)];
+  const float t = segments ? 1.3f * unit(g) : 0.5f + 30.0f * unit(g);
+  const Vec3 at = r.origin + t * r.direction;
+  const float width = 16.0f * p.pixel * glm::length(r.direction) * (segments ? 1.0f : t);
+  const float size = width * (0.005f + 0.3f * unit(g) * unit(g));
+  const Vec3 shift = 1.5f * width * unit(g) * random_vec(g);
+  const Vec3 p0 = at + shift + size * random_vec(g);
+  const Vec3 p1 = at + shift + size * random_vec(g);
+  const Vec3 p2 = at + shift + size * random_vec(g);
+  return {p0, p1, p2};
+}
+
 // A 32x16-pixel packet (64 groups of 4x2 pixels, the most a packet holds) with its own frustum
 // (set_bound) tested before the groups': a triangle some lane hits is still
 // reached by that lane's group, from an apex near and far from the origin,
@@ -213,60 +285,17 @@ TEST(GroupFrusta, ThePacketFrustumNeverCullsATriangleALaneHits) {
   for (const bool segments : {false, true}) {
     for (const float offset : {0.0f, 60.0f, 4000.0f}) {
       for (int packet = 0; packet < 20; ++packet) {
-        const Vec3 apex = offset * random_vec(g) + random_vec(g);
-        const Vec3 c = glm::normalize(random_vec(g) + Vec3(0.0f, 0.0f, 1e-3f));
-        const Vec3 u = glm::normalize(glm::cross(c, std::fabs(c.z) < 0.9f ? Vec3(0, 0, 1) : Vec3(1, 0, 0)));
-        const Vec3 v = glm::cross(c, u);
-        const float pixel = 0.0005f * (1.0f + 6.0f * unit(g));
-        float q[64][3][8];
-        alignas(32) float reach[64][8];
-        std::uint32_t lanes[64];
-        std::array<Ray, 512> rays;
-        for (int group = 0; group < 64; ++group) {
-          lanes[group] = packet % 4 == 0 ? (g() & 0xFFu) | 1u : 0xFFu;
-          for (int lane = 0; lane < 8; ++lane) {
-            const float x = static_cast<float>(4 * (group % 8) + lane % 4) - 15.5f;
-            const float y = static_cast<float>(2 * (group / 8) + lane / 4) - 7.5f;
-            const float length = segments ? 1.0f + 40.0f * unit(g) : 1.0f + unit(g);
-            const Vec3 d = length * (c + pixel * (x * u + y * v));
-            for (int a = 0; a < 3; ++a) q[group][a][lane] = d[a];
-            reach[group][lane] = segments ? 1.0f : kInf;
-            Ray& r = rays[static_cast<std::size_t>(8 * group + lane)];
-            r.origin = apex;
-            r.direction = d;
-            r.t_min = 0.0f;
-            r.t_max = reach[group][lane];
-          }
-        }
+        Packet pk;
+        make_packet(offset, segments, packet % 4 == 0, g, pk);
+        const Vec3& apex = pk.apex;
         rt::GroupFrusta<64> frusta;
-        frusta.reset(apex, 64);
-        frusta.use_slabs(slabs);
-        const auto directions = [&](int group) -> const float (&)[3][8] { return q[group]; };
-        const auto lanes_of = [&](int group) { return lanes[group]; };
-        const auto reach_of = [&](int group, float* out) { std::copy(reach[group], reach[group] + 8, out); };
         // With slabs the groups' own frusta are not built: the slabs alone cull.
-        if (segments) {
-          if (!slabs) frusta.set_groups<true>(~std::uint64_t{0}, 1.0f, directions, lanes_of, reach_of);
-          frusta.set_bound<true>(~std::uint64_t{0}, 1.0f, directions, lanes_of, reach_of);
-        } else {
-          if (!slabs) frusta.set_groups<false>(~std::uint64_t{0}, 1.0f, directions, lanes_of, reach_of);
-          frusta.set_bound<false>(~std::uint64_t{0}, 1.0f, directions, lanes_of, reach_of);
-        }
+        build_frusta(pk, segments, slabs, true, frusta);
         if (slabs) {
           ASSERT_EQ(frusta.slab_groups(), ~std::uint64_t{0});
         }
         for (int trial = 0; trial < 300; ++trial) {
-          // About a lane's ray, or beside the packet by up to its width.
-          const int k = static_cast<int>(g() % 512);
-          const Ray& r = rays[static_cast<std::size_t>(k)];
-          const float t = segments ? 1.3f * unit(g) : 0.5f + 30.0f * unit(g);
-          const Vec3 at = r.origin + t * r.direction;
-          const float width = 16.0f * pixel * glm::length(r.direction) * (segments ? 1.0f : t);
-          const float size = width * (0.005f + 0.3f * unit(g) * unit(g));
-          const Vec3 shift = 1.5f * width * unit(g) * random_vec(g);
-          const Vec3 p0 = at + shift + size * random_vec(g);
-          const Vec3 p1 = at + shift + size * random_vec(g);
-          const Vec3 p2 = at + shift + size * random_vec(g);
+          const auto [p0, p1, p2] = triangle_near(pk, segments, g);
           const std::uint64_t reached = frusta.reached(p0, p1, p2, ~std::uint64_t{0});
           ++tried;
           if (reached == 0) ++culled;
@@ -278,7 +307,8 @@ TEST(GroupFrusta, ThePacketFrustumNeverCullsATriangleALaneHits) {
           if (box_groups == 0) ++boxes_culled;
           if (box_groups != 0 && std::popcount(box_groups) < 32) ++boxes_some_groups;
           for (int lane = 0; lane < 512; ++lane) {
-            if (!(lanes[lane / 8] >> (lane % 8) & 1u) || !hits(rays[static_cast<std::size_t>(lane)], p0, p1, p2)) {
+            if (!(pk.lanes[lane / 8] >> (lane % 8) & 1u) ||
+                !hits(pk.rays[static_cast<std::size_t>(lane)], p0, p1, p2)) {
               continue;
             }
             ++hit;
@@ -297,6 +327,61 @@ TEST(GroupFrusta, ThePacketFrustumNeverCullsATriangleALaneHits) {
   EXPECT_GT(boxes_culled, tried / 5) << boxes_culled << " of " << tried;
   EXPECT_GT(boxes_some_groups, tried / 10) << boxes_some_groups << " of " << tried;
   }
+}
+
+// reached8 (a leaf's triangles eight at a time, render/large_packet.cpp)
+// decides each triangle and group as reached() does with the groups' own
+// frusta alone (the packet's bound is not its to test), and as reached()
+// itself with slabs; for random batches of one to eight triangles, random
+// lanes of the batch and random groups, near the origin and far from it.
+TEST(GroupFrusta, ReachedEightAtATimeDecidesAsOneAtATime) {
+  std::mt19937 g(23);
+  int compared = 0, culled = 0, some_groups = 0;
+  for (const bool slabs : {false, true}) {
+    for (const bool segments : {false, true}) {
+      for (const float offset : {0.0f, 60.0f, 4000.0f}) {
+        for (int packet = 0; packet < 8; ++packet) {
+          Packet pk;
+          make_packet(offset, segments, packet % 4 == 0, g, pk);
+          rt::GroupFrusta<64> frusta, own;
+          build_frusta(pk, segments, slabs, true, frusta);
+          build_frusta(pk, segments, slabs, false, own);
+          const rt::GroupFrusta<64>& expected = slabs ? frusta : own;
+          for (int batch = 0; batch < 60; ++batch) {
+            rt::TriangleLanes8 t;
+            const int n = 1 + static_cast<int>(g() % 8);
+            for (int i = 0; i < 8; ++i) {
+              // Lanes past n hold stale triangles, as a leaf's last batch does.
+              const std::array<Vec3, 3> tri = triangle_near(pk, segments, g);
+              for (int k = 0; k < 3; ++k) {
+                t.p[k][0][i] = tri[static_cast<std::size_t>(k)].x;
+                t.p[k][1][i] = tri[static_cast<std::size_t>(k)].y;
+                t.p[k][2][i] = tri[static_cast<std::size_t>(k)].z;
+              }
+            }
+            const std::uint32_t lanes = ((1u << n) - 1u) & (batch % 3 == 0 ? g() | 1u : ~0u);
+            const std::uint64_t groups = batch % 2 == 0 ? ~std::uint64_t{0} : (std::uint64_t{g()} << 32 | g());
+            std::uint64_t out[8];
+            frusta.reached8(t, lanes, groups, out);
+            for (int i = 0; i < 8; ++i) {
+              const std::uint64_t want =
+                  (lanes >> i & 1u) ? expected.reached(t.corner(0, i), t.corner(1, i), t.corner(2, i), groups) : 0u;
+              ASSERT_EQ(out[i], want) << "triangle " << i << " of batch " << batch << " packet " << packet
+                                      << " offset " << offset << (segments ? " segments" : " rays")
+                                      << (slabs ? " slabs" : " own frusta");
+              if (!(lanes >> i & 1u)) continue;
+              ++compared;
+              if (want == 0) ++culled;
+              if (want != 0 && (want & groups) != groups) ++some_groups;
+            }
+          }
+        }
+      }
+    }
+  }
+  // The comparison has teeth: triangles culled outright and reaching some groups.
+  EXPECT_GT(culled, compared / 10) << culled << " of " << compared;
+  EXPECT_GT(some_groups, compared / 10) << some_groups << " of " << compared;
 }
 
 TEST(GroupFrusta, TrianglesBeyondTheRaysEndsAreCulledByTheFarPlane) {

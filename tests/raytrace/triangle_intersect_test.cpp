@@ -1,9 +1,14 @@
 #include "raytrace/geometry/triangle_intersect.h"
 
+#if defined(__AVX2__)
+#include "raytrace/geometry/triangle_intersect8.h"
+#endif
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -547,6 +552,51 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> shared_edges(const Mesh& me
   }
   return shared;
 }
+
+#if defined(__AVX2__)
+// prepare_common_origin8 (a leaf's triangles eight at a time,
+// render/large_packet.cpp) gives each lane what prepare_common_origin gives
+// its triangle, bit for bit: small, huge, far, degenerate and non-finite
+// corners, origins near and far.
+TEST(TriangleIntersectEdgeCases, CommonOriginTermsEightAtATimeMatchOneAtATime) {
+  Random rng(41);
+  const auto bits = [](float x) { return std::bit_cast<std::uint32_t>(x); };
+  const auto same = [&](const Vec3& a, const Vec3& b) {
+    return bits(a.x) == bits(b.x) && bits(a.y) == bits(b.y) && bits(a.z) == bits(b.z);
+  };
+  const float specials[] = {0.0f, -0.0f, kInf, -kInf, kNaN, 3e38f, 1e-40f};
+  int compared = 0;
+  for (int batch = 0; batch < 400; ++batch) {
+    const float scale = std::pow(10.0f, rng.range(-4.0f, 5.0f));
+    const Vec3 origin = scale * rng.box(-2.0f, 2.0f);
+    alignas(32) float p[3][3][8];
+    Vec3 corners[8][3];
+    for (int i = 0; i < 8; ++i) {
+      const Vec3 centre = scale * rng.box(-1.0f, 1.0f);
+      for (int k = 0; k < 3; ++k) {
+        Vec3 c = centre + 0.01f * scale * rng.box(-1.0f, 1.0f);
+        if (k == 2 && i == 3) c = corners[i][0];  // a degenerate triangle
+        if (batch % 5 == 0 && rng.below(6) == 0) c[static_cast<int>(rng.below(3))] = specials[rng.below(7)];
+        corners[i][k] = c;
+        p[k][0][i] = c.x;
+        p[k][1][i] = c.y;
+        p[k][2][i] = c.z;
+      }
+    }
+    CommonOriginLanes8 lanes;
+    prepare_common_origin8(origin, p, lanes);
+    for (int i = 0; i < 8; ++i) {
+      const CommonOriginTriangle want = prepare_common_origin(origin, corners[i][0], corners[i][1], corners[i][2]);
+      const CommonOriginTriangle got = lanes.at(i);
+      ASSERT_TRUE(same(got.e1, want.e1) && same(got.e2, want.e2) && same(got.tv, want.tv) && same(got.q, want.q) &&
+                  bits(got.t_numerator) == bits(want.t_numerator))
+          << "batch " << batch << " lane " << i;
+      ++compared;
+    }
+  }
+  EXPECT_EQ(compared, 3200);
+}
+#endif
 
 TEST(TriangleIntersectWatertight, NoLeaksThroughAJitteredGrid) {
   Random rng(2024);
