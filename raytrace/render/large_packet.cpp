@@ -576,9 +576,11 @@ class LargeQuery {
   // origin terms prepared together (prepare_common_origin8), where one
   // triangle at a time tested against every group of a block of eight
   // whatever the leaf's groups.
+  // `lanes_clipped`: leaf_lanes_ holds each group's lanes that reach the
+  // leaf (clip_to_leaf_box); otherwise every lane of a group is tested.
   template <class CornersFn>
   bool test_leaf_in_frusta(std::span<const std::uint32_t> items, GroupMask groups_here, CornersFn& corners,
-                           bool listed_once) {
+                           bool listed_once, bool lanes_clipped = false) {
     ensure_frusta(groups_here & alive_groups_);
     std::size_t next = 0;
     while (next < items.size()) {
@@ -617,7 +619,9 @@ class LargeQuery {
       for (int i = 0; i < n; ++i) {
         const GroupMask need = reach[i] & alive_groups_;
         if (need == 0) continue;
-        for_each_bit(need, [&](int g) { visit_[g].leaf_lanes = visit_[g].lanes & live_[g]; });
+        for_each_bit(need, [&](int g) {
+          visit_[g].leaf_lanes = visit_[g].lanes & live_[g] & (lanes_clipped ? leaf_lanes_[g] : 0xFFu);
+        });
         if constexpr (kTest == TriangleTest::kFast) {
           test_groups_prepared(need, prepared_.at(i), batch_triangle_[i], batch_instance_[i]);
         } else {
@@ -706,8 +710,9 @@ class LargeQuery {
         // a leaf no frustum reaches costs one box test, not one per triangle.
         ensure_frusta(groups_here & alive_groups_);
         const Aabb box = frame.leaf_boxes.get(bone, node, [&] { return triangles_box(triangles, corners); });
-        groups_here = frusta_box_reached(box, groups_here & alive_groups_);
+        groups_here = clip_to_leaf_box(box, frusta_box_reached(box, groups_here & alive_groups_));
         if (groups_here == 0) return false;
+        return test_leaf_in_frusta(triangles, groups_here, corners, character.fuzzy.has_bvhs(), true);
       }
       return test_leaf(triangles, groups_here, corners, character.fuzzy.has_bvhs());
     };
@@ -716,6 +721,29 @@ class LargeQuery {
     } else {
       walk_tree(character.fuzzy.tree_view(tree), entry, leaf);
     }
+  }
+
+  // The lanes of each group of `groups` whose world ray, over its passage
+  // through the object and short of its best hit, meets `box` (a bone-tree
+  // leaf's current triangles, raytrace/scene/leaf_boxes.h) grown by the
+  // single ray's slack for a world box (world_eps), kept in leaf_lanes_;
+  // returns the groups left with lanes. A group's frustum reaching the box
+  // says one of its rays may; this says which: a leaf near the ends of
+  // thin shadow groups, or behind a closest hit, keeps few of their lanes.
+  GroupMask clip_to_leaf_box(const Aabb& box, GroupMask groups) {
+    GroupMask kept = 0;
+    const float box_magnitude = max_abs(box);
+    for_each_bit(groups, [&](int g) {
+      const Group& gr = group_[g];
+      const VisitGroup& vg = visit_[g];
+      Float8 t0 = Float8::load(vg.t0);
+      Float8 t1 = min(Float8::load(vg.t1), Float8::load(gr.t_limit));
+      const Vec3x8 inv{Float8::load(gr.inv[0]), Float8::load(gr.inv[1]), Float8::load(gr.inv[2])};
+      leaf_lanes_[g] = clip_lanes(box, world_eps(gr, box_magnitude, t1), gr.origin(), gr.direction(), inv,
+                                  vg.lanes & live_[g], t0, t1);
+      if (leaf_lanes_[g] != 0) kept |= GroupMask{1} << g;
+    });
+    return kept;
   }
 
   // Entering a tree: the groups' lanes clipped to its root box, their rays
