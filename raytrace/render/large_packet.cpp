@@ -193,6 +193,7 @@ class LargeQuery {
     grid_basis_[1] = rays.grid_right;
     grid_basis_[2] = rays.grid_up;
     group_frusta_ = rays.group_frusta;
+    clip_leaf_lanes_ = rays.clip_leaf_lanes;
     groups_ = std::clamp(rays.groups, 0, kMaxPacketGroups);
     alive_groups_ = 0;
     limits_lowered_ = 0;
@@ -710,9 +711,10 @@ class LargeQuery {
         // a leaf no frustum reaches costs one box test, not one per triangle.
         ensure_frusta(groups_here & alive_groups_);
         const Aabb box = frame.leaf_boxes.get(bone, node, [&] { return triangles_box(triangles, corners); });
-        groups_here = clip_to_leaf_box(box, frusta_box_reached(box, groups_here & alive_groups_));
+        groups_here = frusta_box_reached(box, groups_here & alive_groups_);
+        if (clip_leaf_lanes_) groups_here = clip_to_leaf_box(box, groups_here);
         if (groups_here == 0) return false;
-        return test_leaf_in_frusta(triangles, groups_here, corners, character.fuzzy.has_bvhs(), true);
+        return test_leaf_in_frusta(triangles, groups_here, corners, character.fuzzy.has_bvhs(), clip_leaf_lanes_);
       }
       return test_leaf(triangles, groups_here, corners, character.fuzzy.has_bvhs());
     };
@@ -1116,6 +1118,7 @@ class LargeQuery {
   bool frusta_on_ = false;         // grid_ (when on) or frusta_ pick each leaf triangle's groups
   bool slabs_ = false;             // frusta_ tests the groups' slabs in the packet's basis
   bool group_frusta_ = false;      // LargePacketRays::group_frusta
+  bool clip_leaf_lanes_ = false;   // LargePacketRays::clip_leaf_lanes
   GroupMask frusta_built_ = 0;  // the groups whose frustum frusta_ holds
   TraversalCounters counters_;
 };

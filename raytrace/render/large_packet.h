@@ -58,6 +58,12 @@ struct LargePacketRays {
   // and dearer per triangle. It pays on pixel-sized triangles, where a
   // leaf's box leaves it a group or two (docs/RAYTRACE.md, "Leaf boxes").
   bool group_frusta = false;
+  // Rays from one apex among pixel-sized triangles: at a bone tree's leaf
+  // each group's lanes are clipped to the box of the leaf's current
+  // triangles and only those test them. On coarse meshes the clip keeps
+  // nearly every lane and costs more than it saves (docs/RAYTRACE.md, "Leaf
+  // triangles eight at a time, lanes clipped to the leaf box").
+  bool clip_leaf_lanes = false;
 };
 
 // The nearest hits of every active lane, written to 8 * groups entries of

@@ -190,8 +190,8 @@ namespace {
 
 // One tile, stage by stage (render/tile_stages.h), timing each phase.
 void render_tile(const Scene& scene, const PinholeCamera& camera, const RenderSettings& settings,
-                 std::span<const Light> lights, bool fine, const OutputPlanes& out, const Tile& tile,
-                 TileRecord& record) {
+                 std::span<const Light> lights, bool characters_fine, bool fine, const OutputPlanes& out,
+                 const Tile& tile, TileRecord& record) {
   TileScratch& s = tile_scratch();
   int region_x = 1, region_y = 1;
   packet_region_blocks(settings.packet_rays, region_x, region_y);
@@ -199,6 +199,7 @@ void render_tile(const Scene& scene, const PinholeCamera& camera, const RenderSe
   s.split_fine_shadows = settings.split_fine_shadow_packets;
   s.split_static_shadows = fine;
   s.shadow_group_frusta = fine;
+  s.clip_leaf_lanes = characters_fine;
   const auto t0 = Clock::now();
   generate_camera_rays(camera, s);
   trace_primary(scene, camera, settings.triangle_test, settings.packet_rays, s, record.primary);
@@ -256,9 +257,11 @@ Expected<RenderStats> Renderer::render(const Scene& scene, const PinholeCamera& 
   std::vector<TileRecord> records(static_cast<std::size_t>(tiles_x) * static_cast<std::size_t>(tiles_y));
 
   const auto start = Clock::now();
-  const bool fine = settings.shadows && settings.split_fine_shadow_packets && characters_look_fine(scene, camera);
+  const bool characters_fine = characters_look_fine(scene, camera);
+  const bool fine = settings.shadows && settings.split_fine_shadow_packets && characters_fine;
   jobs.parallel_for_tiles(buffers.width, buffers.height, tile, [&](const Tile& t) {
-    render_tile(scene, camera, settings, lights, fine, out, t, records[static_cast<std::size_t>(t.index)]);
+    render_tile(scene, camera, settings, lights, characters_fine, fine, out, t,
+                records[static_cast<std::size_t>(t.index)]);
   });
   const double wall_ms = ms_since(start);
 

@@ -100,6 +100,11 @@ struct TileScratch {
   // says): shadow packets cull with their groups' own frusta
   // (LargePacketRays::group_frusta).
   bool shadow_group_frusta = false;
+  // Set per frame where some character's triangles come out about a pixel
+  // across (characters_look_fine, whatever the shadow settings): camera and
+  // shadow packets clip their lanes to each leaf's current box
+  // (LargePacketRays::clip_leaf_lanes).
+  bool clip_leaf_lanes = false;
   // The tile's outputs until shade_and_write stores them (render/output_staging.h).
   OutputStaging staging;
 

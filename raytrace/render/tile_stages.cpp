@@ -431,6 +431,7 @@ void trace_primary_large(const Scene& scene, const PinholeCamera& camera, Triang
     rays.grid_forward = camera.forward();
     rays.grid_right = camera.right();
     rays.grid_up = camera.up();
+    rays.clip_leaf_lanes = s.clip_leaf_lanes;
     TraversalCounters work;
     intersect_large_packet(scene, rays, test, objects,
                            PacketHits{&s.t[k0], &s.u[k0], &s.v[k0], &s.triangle[k0], &s.instance[k0]}, &work);
@@ -473,6 +474,7 @@ std::uint64_t trace_shadow_large(const Scene& scene, TriangleTest test, const st
     rays.t_max = &s.s_tmax[i0];
     rays.active = active.data();
     rays.group_frusta = s.shadow_group_frusta;
+    rays.clip_leaf_lanes = s.clip_leaf_lanes;
     TraversalCounters work;
     occluded_large_packet(scene, rays, test, objects, blocked.data(), &work);
     add_work(counters, work);

@@ -513,7 +513,8 @@ struct PacketArrays {
 // Random large packets (1 to 64 groups) around the characters: shared
 // origins with coherent directions, scattered origins with mixed direction
 // signs, origins inside bone boxes, partial lane masks and finite t ranges,
-// invalid lanes; given every object or only the tile's cull. Each lane's
+// invalid lanes; given every object or only the tile's cull; lanes clipped to
+// each bone leaf's box or not (LargePacketRays::clip_leaf_lanes). Each lane's
 // nearest hit and occlusion are the single ray's (the fallback instance
 // goes through the 8-ray path, the ground through the small-static tests).
 TEST(LargePackets, FindTheSingleRayHits) {
@@ -559,6 +560,8 @@ TEST(LargePackets, FindTheSingleRayHits) {
       }
     }
     for (auto& bits : active) bits = static_cast<std::uint8_t>(p % 7 == 0 ? (g() & 0xFFu) : 0xFFu);
+    // Lanes clipped to each bone leaf's box (pixel-sized triangles' packets) or not.
+    arrays.rays.clip_leaf_lanes = (p / 2) % 2 == 1;
     const rt::LargePacketRays& rays = arrays.view();
     // The tile's cull, as the renderer does, or every object.
     std::vector<std::uint32_t> tile;
@@ -636,8 +639,10 @@ TEST(LargePackets, ShadowRaysToAPointLightMatchSingleRays) {
       std::vector<std::uint32_t> every(objects.size());
       for (std::uint32_t i = 0; i < every.size(); ++i) every[i] = i;
       for (const TriangleTest test : kTests) {
-        // The groups' slabs, or their own frusta (LargePacketRays::group_frusta).
+        // The groups' slabs, or their own frusta (LargePacketRays::group_frusta),
+        // with and without lanes clipped to each bone leaf's box.
         rays.group_frusta = p % 2 == 1;
+        rays.clip_leaf_lanes = (p / 2) % 2 == 1;
         std::vector<std::uint8_t> blocked(static_cast<std::size_t>(groups));
         rt::occluded_large_packet(s, rays, test, every, blocked.data(), nullptr);
         for (std::size_t k = 0; k < n; ++k) {
