@@ -574,9 +574,9 @@ class LargeQuery {
   // mailbox for that), by the groups whose frustum it reaches. The items
   // go eight at a time: their corners side by side, culled against each
   // group of the leaf together (reached8) and, for the fast test, their
-  // origin terms prepared together (prepare_common_origin8), where one
-  // triangle at a time tested against every group of a block of eight
-  // whatever the leaf's groups.
+  // origin terms prepared together (prepare_common_origin8); one triangle
+  // at a time was tested against every group of a block of eight, whatever
+  // the leaf's groups.
   // `lanes_clipped`: leaf_lanes_ holds each group's lanes that reach the
   // leaf (clip_to_leaf_box); otherwise every lane of a group is tested.
   template <class CornersFn>
