@@ -25,7 +25,7 @@ namespace sinew::rt {
 
 // The vertices of a block: the AVX2 skinning and check width.
 inline constexpr std::size_t kRigidBlockVertices = 8;
-inline constexpr std::uint16_t kNotRigid = 0xFFFF;
+inline constexpr std::uint16_t kNotRigid = kNoGroupBone;
 
 // Per block of kRigidBlockVertices vertices (the last, partial block
 // included): the bone all its checks are rigid in, when the block's group

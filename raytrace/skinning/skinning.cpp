@@ -363,6 +363,7 @@ detail::SkinningArrays flat_arrays(const SkinnedMesh& mesh, const PackedInfluenc
   a.group_slot_begin = influences.group_slot_begin.data();
   a.slot_joints = influences.joints.data();
   a.slot_weights = influences.weights.data();
+  static_assert(kNoGroupBone == 0xFFFF, "the kernels see group_bone as raw 16-bit values (skinning_kernels.h)");
   a.group_bone = influences.group_bone.size() >= influences.group_count() ? influences.group_bone.data() : nullptr;
   a.bones = reinterpret_cast<const float*>(bones.data());
   a.positions = reinterpret_cast<float*>(targets.positions.data());
