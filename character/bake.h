@@ -14,7 +14,7 @@
 #include "animation/joint_limits.h"
 #include "animation/pose_space.h"
 #include "character/model.h"
-#include "raytrace/fuzzy/fuzzy_bake.h"
+#include "raytrace/bake/fuzzy_bake.h"
 #include "runtime/core/expected.h"
 #include "runtime/math/affine.h"
 

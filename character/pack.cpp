@@ -5,7 +5,7 @@
 #include <cstring>
 #include <utility>
 
-#include "raytrace/fuzzy/fuzzy_bake.h"
+#include "raytrace/bake/fuzzy_bake.h"
 #include "runtime/mesh/mesh_checks.h"
 #include "runtime/pack/pack_writer.h"
 #include "runtime/pack/section_codec.h"

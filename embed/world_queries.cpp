@@ -1,5 +1,5 @@
 // sinew::api::World's ray queries: single rays through rt::intersect and
-// rt::occluded (render/traversal.h) on the scene's frame state, prepared
+// rt::occluded (traverse/traversal.h) on the scene's frame state, prepared
 // again first when an instance changed since the last pass or query.
 #include <cmath>
 #include <string>
@@ -7,7 +7,7 @@
 #include "embed/api_errors.h"
 #include "embed/convert.h"
 #include "embed/world_impl.h"
-#include "raytrace/render/traversal.h"
+#include "raytrace/traverse/traversal.h"
 
 namespace sinew::api {
 namespace {

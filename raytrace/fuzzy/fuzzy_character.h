@@ -17,8 +17,8 @@
 #include <span>
 #include <vector>
 
-#include "raytrace/bvh/box_bvh.h"
-#include "raytrace/kdtree/kd_tree.h"
+#include "raytrace/accel/box_bvh.h"
+#include "raytrace/accel/kd_tree.h"
 #include "runtime/core/status.h"
 #include "runtime/math/aabb.h"
 
@@ -29,8 +29,8 @@ struct SkinnedMesh;
 namespace sinew::rt {
 
 // The structure over a bone's fuzzy boxes (FuzzyBakeOptions::bone_trees):
-// the paper's kd-tree, or a BVH listing each triangle once (raytrace/bvh/
-// box_bvh.h, docs/RAYTRACE.md "Bone trees: kd-tree or BVH"). One kind for
+// the paper's kd-tree, or a BVH listing each triangle once (accel/box_bvh.h,
+// docs/RAYTRACE.md "Bone trees: kd-tree or BVH"). One kind for
 // every tree of a character.
 enum class BoneTreeKind : std::uint8_t { kKdTree = 0, kBvh = 1 };
 

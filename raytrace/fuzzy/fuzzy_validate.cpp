@@ -83,7 +83,7 @@ Status validate_tree(const KdTreeView& tree, std::uint32_t item_limit, const std
 }
 
 // Whether a kd-tree walk reaching the cells that `box` overlaps finds
-// `item` in every leaf it must. As the builder (kdtree/kd_builder.cpp) does,
+// `item` in every leaf it must. As the builder (accel/kd_builder.cpp) does,
 // the box is clipped to each child's side of a split, and goes below a
 // split when it starts below it, above when it ends above it (a box flat on
 // the split goes to one side). Leaf items are sorted (checked before).

@@ -5,8 +5,9 @@
 // bit-identical to the scalar test's: packets and single rays agree.
 #pragma once
 
-#if defined(__AVX2__)
-#include <immintrin.h>
+#include "runtime/math/simd.h"
+
+#if SINEW_AVX2
 
 #include <cstdint>
 
@@ -206,4 +207,4 @@ inline std::uint32_t intersect_triangle_fast8_common_origin(const RayLanes8& r, 
 
 }  // namespace sinew::rt
 
-#endif  // __AVX2__
+#endif  // SINEW_AVX2

@@ -8,31 +8,16 @@
 #include <limits>
 #include <string>
 
-#include "raytrace/render/output_planes.h"
+#include "raytrace/render/output/output_planes.h"
+#include "raytrace/render/stages/tile_stages.h"
 #include "raytrace/render/tile_scratch.h"
-#include "raytrace/render/tile_stages.h"
-#include "raytrace/render/traversal_shared.h"
+#include "raytrace/traverse/traversal_shared.h"
 #include "runtime/jobs/job_system.h"
 #include "runtime/timing/phase_timers.h"
 #include "runtime/timing/stopwatch.h"
 
 namespace sinew::rt {
 namespace {
-
-// pbrt's gamma(n): a bound on n successive float roundings.
-constexpr float gamma(int n) {
-  constexpr float u = std::numeric_limits<float>::epsilon() * 0.5f;
-  return (static_cast<float>(n) * u) / (1.0f - static_cast<float>(n) * u);
-}
-
-// The next float towards +inf (up) or -inf; infinities and NaN unchanged.
-float next_float(float x, bool up) {
-  if (!std::isfinite(x)) return x;
-  if (x == 0.0f) return up ? std::numeric_limits<float>::denorm_min() : -std::numeric_limits<float>::denorm_min();
-  std::uint32_t bits = std::bit_cast<std::uint32_t>(x);
-  bits = (x > 0.0f) == up ? bits + 1 : bits - 1;
-  return std::bit_cast<float>(bits);
-}
 
 // Sums per-tile counters in tile order so the totals are deterministic.
 void add(TraversalCounters& into, const TraversalCounters& from) {
@@ -43,78 +28,6 @@ void add(TraversalCounters& into, const TraversalCounters& from) {
 }
 
 }  // namespace
-
-SurfacePoint surface_at(const Scene& scene, const Hit& hit, const Vec3& default_albedo) {
-  SurfacePoint s;
-  const Scene::ObjectSlot slot = scene.object_slots()[hit.instance_id];
-  const float w = 1.0f - hit.u - hit.v;
-  Vec3 p[3];
-  Vec3 shading(0.0f);
-  bool have_normals = false;
-  if (slot.kind == Scene::ObjectKind::kCharacter) {
-    const InstanceFrame& frame = scene.instances()[slot.index];
-    const SkinnedMesh& mesh = *scene.characters()[frame.character].mesh;
-    const auto& v = mesh.triangles[hit.triangle_id];
-    for (int i = 0; i < 3; ++i) p[i] = frame.positions[v[static_cast<std::size_t>(i)]];
-    if (!frame.normals.empty()) {
-      shading = w * frame.normals[v[0]] + hit.u * frame.normals[v[1]] + hit.v * frame.normals[v[2]];
-      have_normals = true;
-    }
-    s.albedo = default_albedo;
-    if (hit.triangle_id < mesh.triangle_material.size()) {
-      const std::uint32_t m = mesh.triangle_material[hit.triangle_id];
-      if (m < mesh.material_colors.size()) s.albedo = mesh.material_colors[m];
-    }
-  } else {
-    const StaticMeshDesc& mesh = scene.static_meshes()[slot.index].desc;
-    const auto& v = mesh.triangles[hit.triangle_id];
-    for (int i = 0; i < 3; ++i) p[i] = mesh.positions[v[static_cast<std::size_t>(i)]];
-    s.albedo = default_albedo;
-    const std::uint32_t m = mesh.triangle_material.empty() ? 0 : mesh.triangle_material[hit.triangle_id];
-    if (m < mesh.material_colors.size()) s.albedo = mesh.material_colors[m];
-  }
-  s.position = w * p[0] + hit.u * p[1] + hit.v * p[2];
-  // Bounds the rounding of `position` and, more to the point, of a triangle
-  // test started from it: Moller-Trumbore forms origin - p0 in every axis,
-  // so its error is relative to the largest vertex coordinate in any axis.
-  // A per-axis bound is 0 across a floor at exactly y = 0, and a shadow ray
-  // started one float above it hit the floor itself at t = -0.
-  const float magnitude = std::max({detail::max_abs(p[0]), detail::max_abs(p[1]), detail::max_abs(p[2])});
-  s.error = Vec3(gamma(7) * magnitude);
-  const Vec3 n = glm::cross(p[1] - p[0], p[2] - p[0]);
-  const float length = glm::length(n);
-  s.geometric_normal = length > 0.0f && std::isfinite(length) ? n / length : Vec3(0.0f, 0.0f, 1.0f);
-  const float shading_length = have_normals ? glm::length(shading) : 0.0f;
-  s.shading_normal = shading_length > 0.0f && std::isfinite(shading_length) ? shading / shading_length
-                                                                             : s.geometric_normal;
-  return s;
-}
-
-Vec3 offset_origin(const SurfacePoint& surface, const Vec3& toward) {
-  const Vec3& n = surface.geometric_normal;
-  const float distance = glm::dot(glm::abs(n), surface.error);
-  Vec3 offset = distance * n;
-  if (glm::dot(n, toward) < 0.0f) offset = -offset;
-  Vec3 origin = surface.position + offset;
-  // The addition itself rounds: step one more float away from the surface.
-  for (int a = 0; a < 3; ++a) {
-    if (offset[a] > 0.0f) origin[a] = next_float(origin[a], true);
-    if (offset[a] < 0.0f) origin[a] = next_float(origin[a], false);
-  }
-  return origin;
-}
-
-Ray shadow_ray_from_light(const SurfacePoint& surface, const Vec3& toward, const Vec3& light) {
-  SurfacePoint widened = surface;
-  const float reach = detail::max_abs(light) + 2.0f * detail::max_abs(light - surface.position);
-  widened.error = surface.error + Vec3(gamma(32) * reach);
-  Ray ray;
-  ray.origin = light;
-  ray.direction = offset_origin(widened, toward) - light;
-  ray.t_min = 0.0f;
-  ray.t_max = 1.0f;
-  return ray;
-}
 
 namespace {
 
@@ -155,54 +68,17 @@ Expected<OutputPlanes> output_planes(const FrameBuffers& buffers) {
 
 }  // namespace
 
-bool characters_look_fine(const Scene& scene, const PinholeCamera& camera) {
-  // Pixels per unit of image-plane slope, along the image's x and y.
-  const float w = static_cast<float>(camera.width()), h = static_cast<float>(camera.height());
-  const float across = w / (camera.right_offset(w) - camera.right_offset(0.0f));
-  const float down = h / (camera.up_offset(0.0f) - camera.up_offset(h));
-  for (const InstanceFrame& frame : scene.instances()) {
-    Aabb box = Aabb::empty();
-    for (const Aabb& b : frame.bone_world_boxes) box.extend(b);
-    if (!(box.lower.x <= box.upper.x)) continue;
-    float x_lo = std::numeric_limits<float>::infinity(), x_hi = -x_lo, y_lo = x_lo, y_hi = -x_lo;
-    bool in_front = true;
-    for (int corner = 0; corner < 8 && in_front; ++corner) {
-      const Vec3 p((corner & 1) ? box.upper.x : box.lower.x, (corner & 2) ? box.upper.y : box.lower.y,
-                   (corner & 4) ? box.upper.z : box.lower.z);
-      const Vec3 q = p - camera.eye();
-      const float z = glm::dot(q, camera.forward());
-      in_front = z > 0.0f;
-      const float x = glm::dot(q, camera.right()) / z, y = glm::dot(q, camera.up()) / z;
-      x_lo = std::min(x_lo, x);
-      x_hi = std::max(x_hi, x);
-      y_lo = std::min(y_lo, y);
-      y_hi = std::max(y_hi, y);
-    }
-    const std::size_t triangles = scene.characters()[frame.character].mesh->triangles.size();
-    if (!in_front || triangles == 0) continue;
-    const double pixels = static_cast<double>((x_hi - x_lo) * across) * static_cast<double>((y_hi - y_lo) * down);
-    if (pixels <= kFineBoxPixelsPerTriangle * static_cast<double>(triangles)) return true;
-  }
-  return false;
-}
-
 namespace {
 
-// One tile, stage by stage (render/tile_stages.h), timing each phase.
+// One tile, stage by stage (render/stages/tile_stages.h), timing each phase.
 void render_tile(const Scene& scene, const PinholeCamera& camera, const RenderSettings& settings,
-                 std::span<const Light> lights, bool characters_fine, bool fine, const OutputPlanes& out,
-                 const Tile& tile, TileRecord& record) {
+                 std::span<const Light> lights, const TracePlan& plan, const OutputPlanes& out, const Tile& tile,
+                 TileRecord& record) {
   TileScratch& s = tile_scratch();
-  int region_x = 1, region_y = 1;
-  packet_region_blocks(settings.packet_rays, region_x, region_y);
-  s.prepare(tile, region_x, region_y);
-  s.split_fine_shadows = settings.split_fine_shadow_packets;
-  s.split_static_shadows = fine;
-  s.shadow_group_frusta = fine;
-  s.clip_leaf_lanes = characters_fine;
+  s.prepare(tile, plan);
   const auto t0 = Clock::now();
   generate_camera_rays(camera, s);
-  trace_primary(scene, camera, settings.triangle_test, settings.packet_rays, s, record.primary);
+  trace_primary(scene, camera, settings.triangle_test, s, record.primary);
   const auto t1 = Clock::now();
   for (std::size_t b = 0; b < s.lanes / kBlockLanes; ++b) {
     record.hits += static_cast<std::uint64_t>(std::popcount(static_cast<unsigned>(s.block_hits[b])));
@@ -216,8 +92,7 @@ void render_tile(const Scene& scene, const PinholeCamera& camera, const RenderSe
     for (std::size_t l = 0; l < lights.size(); ++l) {
       aim_shadow_rays(lights[l], static_cast<int>(l), s);
       record.shadowed +=
-          trace_shadow_rays(scene, settings.triangle_test, settings.packet_rays, static_cast<int>(l), s,
-                            record.shadow);
+          trace_shadow_rays(scene, settings.triangle_test, static_cast<int>(l), s, record.shadow);
     }
     shadow_ns = nanoseconds(shadow_start, Clock::now());
   }
@@ -239,7 +114,7 @@ Expected<RenderStats> Renderer::render(const Scene& scene, const PinholeCamera& 
                             "differs from the camera's image size");
   }
   if (!valid_packet_rays(settings.packet_rays)) {
-    return invalid_argument("settings.packet_rays", std::to_string(settings.packet_rays), "must be 1, 8, 64 or 256");
+    return invalid_argument("settings.packet_rays", std::to_string(settings.packet_rays), "must be 1, 8, 64, 256 or 512");
   }
   if (settings.tile_size < 1) {
     return invalid_argument("settings.tile_size", std::to_string(settings.tile_size), "must be at least 1");
@@ -257,11 +132,9 @@ Expected<RenderStats> Renderer::render(const Scene& scene, const PinholeCamera& 
   std::vector<TileRecord> records(static_cast<std::size_t>(tiles_x) * static_cast<std::size_t>(tiles_y));
 
   const auto start = Clock::now();
-  const bool characters_fine = characters_look_fine(scene, camera);
-  const bool fine = settings.shadows && settings.split_fine_shadow_packets && characters_fine;
+  const TracePlan plan = make_trace_plan(scene, camera, settings);
   jobs.parallel_for_tiles(buffers.width, buffers.height, tile, [&](const Tile& t) {
-    render_tile(scene, camera, settings, lights, characters_fine, fine, out, t,
-                records[static_cast<std::size_t>(t.index)]);
+    render_tile(scene, camera, settings, lights, plan, out, t, records[static_cast<std::size_t>(t.index)]);
   });
   const double wall_ms = ms_since(start);
 

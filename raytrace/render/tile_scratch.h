@@ -2,10 +2,10 @@
 // tiles and frames. The tile's pixels are laid out in blocks of 4x2 (eight
 // lanes: one ray group, one Float8): pixel k = 8 * block + lane, lane =
 // 4 * (y % 2) + x % 4. Blocks are grouped into regions (the large packets
-// of render/large_packet.h: 8x8, 16x16 or 32x16 pixels, or one block each),
+// of traverse/large_packet.h: 8x8, 16x16 or 32x16 pixels, or one block each),
 // regions row-major over the tile and blocks row-major within a region, so
 // a region's blocks, rays and hits are consecutive. Every stage
-// (render/tile_stages.h) walks the blocks, so the rays, hits and surfaces of
+// (render/stages/tile_stages.h) walks the blocks, so the rays, hits and surfaces of
 // a block stay in cache from ray generation through the shadow rays to the
 // shading. Shared by the renderer and by tracers that stand in for it (the
 // Embree peer of the benchmarks), which run the same stages.
@@ -15,7 +15,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "raytrace/render/output_staging.h"
+#include "raytrace/render/output/output_staging.h"
+#include "raytrace/render/trace_plan.h"
 #include "runtime/jobs/job_system.h"
 #include "runtime/math/aabb.h"
 #include "runtime/math/ray.h"
@@ -45,19 +46,19 @@ struct TileScratch {
   // Nearest hits (triangle kInvalidId on a miss).
   std::vector<float> t, u, v;
   std::vector<std::uint32_t> triangle, instance;
-  // Surfaces at the hits, world space (render/renderer.h SurfacePoint).
+  // Surfaces at the hits, world space (render/surface.h SurfacePoint).
   std::vector<float> px, py, pz;     // position
   std::vector<float> gx, gy, gz;     // unit geometric normal
   std::vector<float> nx, ny, nz;     // unit shading normal facing the camera
   std::vector<float> ar, ag, ab;     // albedo
   std::vector<float> error;          // rounding bound of the position, every axis
   std::vector<std::uint8_t> lit;     // bit l: light l reaches the hit
-  // A colour-only frame's shading (render/tile_stages.h shade_and_write):
+  // A colour-only frame's shading (render/stages/tile_stages.h shade_and_write):
   // the linear colour of each hit, and its RGBA8 pixel, encoded sixteen
-  // lanes at a time (render/srgb_encode.h).
+  // lanes at a time (render/output/srgb_encode.h).
   std::vector<float> lr, lg, lb;
   std::vector<std::uint32_t> rgba8;
-  // This light's shadow rays as placed, lane by lane (render/tile_stages.h
+  // This light's shadow rays as placed, lane by lane (render/stages/tile_stages.h
   // place_shadow_rays): per block the lanes with a ray, and per lane the
   // ray's direction (a point light's, from shadow_origin) or its origin (a
   // directional light's, along shadow_direction).
@@ -66,7 +67,7 @@ struct TileScratch {
   std::vector<float> shadow_lane_x, shadow_lane_y, shadow_lane_z;
   std::vector<float> shadow_push_x, shadow_push_y, shadow_push_z;
   Vec3 shadow_direction{0.0f};
-  // Aimed but not placed yet (render/tile_stages.h aim_shadow_rays): the
+  // Aimed but not placed yet (render/stages/tile_stages.h aim_shadow_rays): the
   // lanes are chosen, shadow_lane_* hold the pushed-off points and
   // shadow_push_* the pushes, which placing turns into the rays.
   bool shadows_aimed_only = false;
@@ -75,44 +76,31 @@ struct TileScratch {
   // nothing.
   Aabb shadow_ends;
   bool shadows_compacted = true;  // shadow_* below hold the placed rays
-  // This light's shadow rays, compacted in block order (render/tile_stages.h
+  // This light's shadow rays, compacted in block order (render/stages/tile_stages.h
   // compact_shadow_rays).
   std::size_t shadow_count = 0;
   std::vector<std::uint32_t> shadow_pixel;  // the lane index k each ray belongs to
   std::vector<float> so_x, so_y, so_z, sd_x, sd_y, sd_z, s_tmax;
   // Whether every shadow ray starts at shadow_origin with t in [0, 1) (a
-  // point light's: render/renderer.h shadow_ray_from_light).
+  // point light's: render/surface.h shadow_ray_from_light).
   bool shadows_from_point = false;
   Vec3 shadow_origin{0.0f};
   // Shadow run r: rays [shadow_region_begin[r], shadow_region_begin[r + 1])
   // come from one region's pixels, those on characters or those on static
-  // meshes (runs without a ray have no entry). With split_fine_shadows
-  // (RenderSettings::split_fine_shadow_packets), a region whose character
-  // hits lie on pixel-sized triangles gives its character rays one run per
-  // 8x8 pixels.
+  // meshes (runs without a ray have no entry), split finer where the plan
+  // says so (TracePlan::split_fine_shadows, split_static_shadows).
   std::vector<std::uint32_t> shadow_region_begin;
-  bool split_fine_shadows = true;
-  // With split_fine_shadows: the static meshes' shadow rays too go in
-  // 8x8-pixel runs, set per frame where some character's triangles come out
-  // about a pixel across (render/renderer.h characters_look_fine).
-  bool split_static_shadows = false;
-  // Set per frame with split_static_shadows (whatever split_fine_shadows
-  // says): shadow packets cull with their groups' own frusta
-  // (LargePacketRays::group_frusta).
-  bool shadow_group_frusta = false;
-  // Set per frame where some character's triangles come out about a pixel
-  // across (characters_look_fine, whatever the shadow settings): camera and
-  // shadow packets clip their lanes to each leaf's current box
-  // (LargePacketRays::clip_leaf_lanes).
-  bool clip_leaf_lanes = false;
-  // The tile's outputs until shade_and_write stores them (render/output_staging.h).
+  // How this frame traces (render/trace_plan.h); set by prepare.
+  TracePlan plan;
+  // The tile's outputs until shade_and_write stores them (render/output/output_staging.h).
   OutputStaging staging;
 
-  // Lays out `area`'s pixels in regions of region_blocks_x by
-  // region_blocks_y blocks (clipped at the tile's edges) and sizes every
-  // array (padded to whole groups, plus one group of slack for the shadow
-  // rays' unaligned groups, and the sRGB encoding's pairs of blocks).
-  void prepare(const Tile& area, int region_blocks_x = 1, int region_blocks_y = 1);
+  // Keeps `frame_plan` and lays out `area`'s pixels in its regions of
+  // region_blocks_x by region_blocks_y blocks (clipped at the tile's edges);
+  // sizes every array (padded to whole groups, plus one group of slack for
+  // the shadow rays' unaligned groups, and the sRGB encoding's pairs of
+  // blocks).
+  void prepare(const Tile& area, const TracePlan& frame_plan = {});
 
   std::size_t blocks() const { return lanes / kBlockLanes; }
   std::size_t regions() const { return region_begin.empty() ? 0 : region_begin.size() - 1; }

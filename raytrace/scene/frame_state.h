@@ -6,8 +6,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "raytrace/accel/kd_tree.h"
 #include "raytrace/fuzzy/fuzzy_character.h"
-#include "raytrace/kdtree/kd_tree.h"
 #include "raytrace/scene/leaf_boxes.h"
 #include "raytrace/skinning/skinning.h"
 #include "runtime/core/status.h"

@@ -6,7 +6,7 @@
 // set each instance's bone matrices and call prepare_frame(), which skins,
 // checks escapes, computes bone world boxes, builds the fallback for escaped
 // triangles and rebuilds the top level. After that the scene is read-only and
-// can be traced from many threads (render/traversal.h).
+// can be traced from many threads (traverse/traversal.h).
 #pragma once
 
 #include <cstdint>
@@ -14,10 +14,10 @@
 #include <span>
 #include <vector>
 
+#include "raytrace/accel/kd_tree.h"
+#include "raytrace/accel/top_level.h"
 #include "raytrace/fuzzy/fuzzy_character.h"
-#include "raytrace/kdtree/kd_tree.h"
 #include "raytrace/scene/frame_state.h"
-#include "raytrace/scene/top_level.h"
 #include "raytrace/skinning/skinning.h"
 #include "runtime/core/expected.h"
 #include "runtime/math/affine.h"

@@ -13,8 +13,10 @@
 //   them, and an escape flag is written only where targets.escaped has room
 //   (the check is still counted). A check whose bone has no bone_from_world
 //   or tolerance entry counts as escaped, the safe answer for the renderer.
-// - The escape check runs in scalar code on the chunk's fresh positions,
-//   right after they were written, while they are still in cache.
+// - The escape check runs on the chunk's fresh positions, right after they
+//   were written, while they are still in cache: rigid blocks by
+//   construction, the others eight vertices at a time (AVX2) or four lanes
+//   per check.
 #include "raytrace/skinning/skinning.h"
 
 #include <algorithm>

@@ -11,17 +11,15 @@
 #include <cmath>
 #include <cstdint>
 
-#if defined(__AVX2__)
-#include <immintrin.h>
-#define SINEW_FLOAT8_AVX2 1
-#else
+#include "runtime/math/simd.h"
+
+#if !SINEW_AVX2
 #include <algorithm>
-#define SINEW_FLOAT8_AVX2 0
 #endif
 
 namespace sinew {
 
-#if SINEW_FLOAT8_AVX2
+#if SINEW_AVX2
 
 struct Mask8 {
   __m256 m;

@@ -1,6 +1,6 @@
 // Storage that starts on a 64-byte cache line: frame buffers handed to the
 // renderer, whose rows it stores a whole line at a time when they start on
-// one (raytrace/render/output_staging.h).
+// one (raytrace/render/output/output_staging.h).
 #pragma once
 
 #include <cstddef>

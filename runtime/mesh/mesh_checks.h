@@ -1,6 +1,6 @@
 // One validation of mesh data for every path a mesh comes in by: a pack's
 // MESH section (character/pack.cpp), the fuzzy bake's input
-// (raytrace/fuzzy/fuzzy_bake.cpp), a fuzzy view handed to
+// (raytrace/bake/fuzzy_bake.cpp), a fuzzy view handed to
 // Scene::add_character (raytrace/fuzzy/fuzzy_validate.cpp) and a static
 // mesh (Scene::add_static_mesh). Every index is checked before anything
 // reads through it and every float before it reaches a box or a ray, so a

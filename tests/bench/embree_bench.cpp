@@ -781,7 +781,7 @@ int run_embree_bench(const std::vector<std::string>& args, const std::string& co
               "  rtcCommitScene (rebuild or refit); exact: merge + SAH kd build + top level. trace = primary +\n"
               "  shadow rays; total = skinning (shared) + build + trace + shade; medians over the frames.\n"
               "  sinew/this < 1: Sinew is faster. Sinew traces %s culled cell by cell\n"
-              "  (render/large_packet.h) after a tile cull of the top level (render/tile_stages.h). Embree is\n"
+              "  (traverse/large_packet.h) after a tile cull of the top level (render/stages/tile_stages.h). Embree is\n"
               "  shown at every width run: 1 = rtcIntersect1/rtcOccluded1,\n"
               "  4/8/16 = rtcIntersectN/rtcOccludedN packets with RTC_INTERSECT_CONTEXT_FLAG_COHERENT; the best\n"
               "  Embree row (lowest median total) is marked, and Sinew/best compares Sinew with it.\n",

@@ -12,8 +12,8 @@
 #include <string>
 #include <vector>
 
+#include "raytrace/render/stages/tile_stages.h"
 #include "raytrace/render/tile_scratch.h"
-#include "raytrace/render/tile_stages.h"
 #include "runtime/jobs/job_system.h"
 
 namespace sinew::bench {

@@ -2,7 +2,7 @@
 // Embree scene over the skinned triangles a prepared rt::Scene already holds
 // (Sinew's own skinning, so skinning is identical for every contender), and
 // a tile-parallel renderer over Sinew's JobSystem that runs the renderer's
-// own tile stages (render/tile_stages.h: camera rays, surfaces, shadow-ray
+// own tile stages (render/stages/tile_stages.h: camera rays, surfaces, shadow-ray
 // origins, shading) with Embree doing the two trace stages. Only the
 // acceleration structure and the traversal differ.
 //

@@ -17,7 +17,7 @@
 #include "animation/joint_limits.h"
 #include "animation/pose_space.h"
 #include "content/mannequin/mannequin.h"
-#include "raytrace/render/traversal.h"
+#include "raytrace/traverse/traversal.h"
 #include "tests/extremes/extremes_support.h"
 
 namespace sinew::extremes {

@@ -17,7 +17,7 @@
 #include "character/pack.h"
 #include "content/mannequin/mannequin.h"
 #include "editor/cli/pack_commands.h"
-#include "raytrace/fuzzy/fuzzy_bake.h"
+#include "raytrace/bake/fuzzy_bake.h"
 #include "runtime/jobs/job_system.h"
 #include "runtime/pack/checksum.h"
 #include "runtime/pack/pack_reader.h"

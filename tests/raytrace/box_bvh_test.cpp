@@ -13,8 +13,8 @@
 #include <set>
 #include <vector>
 
-#include "raytrace/bvh/box_bvh.h"
-#include "raytrace/kdtree/kd_tree.h"
+#include "raytrace/accel/box_bvh.h"
+#include "raytrace/accel/kd_tree.h"
 
 namespace sinew::rt {
 namespace {

@@ -1,4 +1,4 @@
-// Tests of the fuzzy bake (raytrace/fuzzy/fuzzy_bake.h) against independent
+// Tests of the fuzzy bake (raytrace/bake/fuzzy_bake.h) against independent
 // references: every sampled vertex is re-skinned and re-transformed in double
 // precision, and each triangle's bone choice is re-derived by brute force
 // over its candidate bones.
@@ -6,7 +6,7 @@
 // Float slack: the bake skins and inverts in float, the references in double.
 // Positions here are O(1..20), so the difference is a few float ulps of the
 // magnitudes involved; kSlack (relative to max(1, |value|)) is ~100x that.
-#include "raytrace/fuzzy/fuzzy_bake.h"
+#include "raytrace/bake/fuzzy_bake.h"
 
 #include <gtest/gtest.h>
 
@@ -24,7 +24,7 @@
 
 #include "raytrace/fuzzy/pose_clusters.h"
 #include "raytrace/scene/scene.h"
-#include "raytrace/render/traversal.h"
+#include "raytrace/traverse/traversal.h"
 #include "runtime/jobs/job_system.h"
 #include "tests/support/brute_force.h"
 

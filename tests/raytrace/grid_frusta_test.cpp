@@ -1,4 +1,4 @@
-// Grid frusta (render/grid_frusta.h) of camera packets never cull a group
+// Grid frusta (cull/grid_frusta.h) of camera packets never cull a group
 // whose ray hits a triangle or enters a box, by either triangle test, for
 // random cameras, image sizes and regions (1 to 8 columns, 1 to 8 rows of
 // 4x2-pixel blocks, partial lane masks), near the origin and thousands of
@@ -14,8 +14,8 @@
 #include <vector>
 
 #include "raytrace/camera/camera.h"
+#include "raytrace/cull/grid_frusta.h"
 #include "raytrace/geometry/triangle_intersect.h"
-#include "raytrace/render/grid_frusta.h"
 #include "runtime/math/aabb.h"
 #include "runtime/math/float8.h"
 #include "runtime/math/ray.h"
@@ -41,7 +41,7 @@ bool enters(const Ray& ray, const Aabb& box) {
 }
 
 // A region of `columns` x `rows` blocks at pixel (x0, y0): each group's
-// directions as generate_camera_rays computes them (render/tile_stages.h).
+// directions as generate_camera_rays computes them (render/stages/tile_stages.h).
 struct Region {
   int columns = 0, rows = 0;
   std::vector<std::array<std::array<float, 8>, 3>> d;  // [group][axis][lane]
@@ -179,7 +179,7 @@ TEST(GridFrusta, GridsThatDoNotFitOrLanesBehindCullNothing) {
   EXPECT_EQ(grid.box_reached(Aabb{q0, q1 + Vec3(0.0f, 1.0f, 0.0f)}, 0x3u), 0x3u);
 }
 
-// reached8 (a leaf's triangles eight at a time, render/large_packet.cpp)
+// reached8 (a leaf's triangles eight at a time, traverse/large_packet.cpp)
 // decides each triangle and group as reached() does, for random batches of
 // one to eight triangles about the region's rays, random lanes of the
 // batch and random groups, near the origin and far from it; and reaches

@@ -1,4 +1,4 @@
-// Group frusta (render/group_frusta.h) never cull a triangle that a ray of
+// Group frusta (cull/group_frusta.h) never cull a triangle that a ray of
 // the group hits, by either triangle test, for rays from an apex and for
 // rays ending near one, at small and large coordinates; and they do cull
 // most triangles beside a narrow group.
@@ -12,8 +12,8 @@
 #include <limits>
 #include <random>
 
+#include "raytrace/cull/group_frusta.h"
 #include "raytrace/geometry/triangle_intersect.h"
-#include "raytrace/render/group_frusta.h"
 #include "runtime/math/aabb.h"
 #include "runtime/math/ray.h"
 #include "tests/support/slab_test.h"
@@ -329,7 +329,7 @@ TEST(GroupFrusta, ThePacketFrustumNeverCullsATriangleALaneHits) {
   }
 }
 
-// reached8 (a leaf's triangles eight at a time, render/large_packet.cpp)
+// reached8 (a leaf's triangles eight at a time, traverse/large_packet.cpp)
 // decides each triangle and group as reached() does with the groups' own
 // frusta alone (the packet's bound is not its to test), and as reached()
 // itself with slabs; for random batches of one to eight triangles, random

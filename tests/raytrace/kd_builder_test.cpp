@@ -13,7 +13,7 @@
 #include <set>
 #include <vector>
 
-#include "raytrace/kdtree/kd_tree.h"
+#include "raytrace/accel/kd_tree.h"
 
 namespace sinew::rt {
 namespace {

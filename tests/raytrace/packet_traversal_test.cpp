@@ -1,4 +1,4 @@
-// Packet traversal (render/packet_traversal.h): every lane of an 8-ray
+// Packet traversal (traverse/packet_traversal.h): every lane of an 8-ray
 // packet gets exactly the single-ray answer (same triangle, instance and t,
 // u, v bits; same occlusion), for coherent camera packets, incoherent random
 // packets with partial masks and finite t_max, shadow packets, and with the
@@ -22,10 +22,11 @@
 #include "character/bake.h"
 #include "content/mannequin/mannequin.h"
 #include "raytrace/camera/camera.h"
-#include "raytrace/render/packet_traversal.h"
-#include "raytrace/render/traversal.h"
 #include "raytrace/scene/scene.h"
+#include "raytrace/traverse/packet_traversal.h"
+#include "raytrace/traverse/traversal.h"
 #include "runtime/jobs/job_system.h"
+#include "runtime/math/simd.h"
 #include "tests/support/brute_force.h"
 #include "tests/support/idle_mannequin.h"
 
@@ -300,7 +301,7 @@ INSTANTIATE_TEST_SUITE_P(Poses, PacketTraversal,
 // Lanes that share cells share node fetches: a coherent camera packet walks
 // fewer nodes than its eight rays do one by one.
 TEST(PacketTraversalCounters, CoherentPacketsShareNodeVisits) {
-#if !(defined(__AVX2__) && defined(__FMA__))
+#if !SINEW_AVX2
   GTEST_SKIP() << "built without AVX2: packets are traced lane by lane";
 #endif
   const auto s = make_scene(false);

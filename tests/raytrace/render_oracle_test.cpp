@@ -22,8 +22,8 @@
 #include "editor/mesh/subdivide.h"
 #include "raytrace/camera/camera.h"
 #include "raytrace/render/renderer.h"
-#include "raytrace/render/traversal.h"
 #include "raytrace/scene/scene.h"
+#include "raytrace/traverse/traversal.h"
 #include "runtime/jobs/job_system.h"
 #include "tests/support/brute_force.h"
 #if SINEW_HAVE_CAL3D
@@ -158,7 +158,7 @@ struct Mismatch {
 };
 
 // Every pixel's single-ray hit and the renderer's (culled packets of
-// `packet_rays` rays, render/tile_stages.h) against brute force.
+// `packet_rays` rays, render/stages/tile_stages.h) against brute force.
 void compare_primary(const rt::Scene& scene, std::span<const SoupTriangle> soup, const rt::CameraDesc& desc,
                      int size, TriangleTest test, JobSystem& jobs, Mismatch& m, int packet_rays) {
   auto camera = rt::PinholeCamera::create(desc, size, size);

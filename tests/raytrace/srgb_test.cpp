@@ -1,7 +1,7 @@
-// The sRGB encoding (render/srgb.h) against IEC 61966-2-1's curve in
+// The sRGB encoding (render/output/srgb.h) against IEC 61966-2-1's curve in
 // double: every 97th float of [0, 1] gets the correctly rounded byte, or one
 // step off only where the exact value lies within 0.001 of a half step; the
-// toe, the clamps and NaN. The many-pixel encoder (render/srgb_encode.h)
+// toe, the clamps and NaN. The many-pixel encoder (render/output/srgb_encode.h)
 // gives those bytes on each of its paths.
 #include <gtest/gtest.h>
 
@@ -12,8 +12,8 @@
 #include <string>
 #include <vector>
 
-#include "raytrace/render/srgb.h"
-#include "raytrace/render/srgb_encode.h"
+#include "raytrace/render/output/srgb.h"
+#include "raytrace/render/output/srgb_encode.h"
 
 namespace sinew {
 namespace {

@@ -20,17 +20,17 @@
 #include <string>
 #include <vector>
 
+#include "raytrace/accel/top_level.h"
 #include "raytrace/camera/camera.h"
-#include "raytrace/render/large_packet.h"
-#include "raytrace/render/packet_traversal.h"
-#include "raytrace/render/ray_bound.h"
+#include "raytrace/cull/ray_bound.h"
 #include "raytrace/render/renderer.h"
-#include "raytrace/render/static_tiles.h"
-#include "raytrace/render/tile_stages.h"
-#include "raytrace/render/traversal.h"
-#include "raytrace/render/traversal_shared.h"
+#include "raytrace/render/stages/tile_stages.h"
 #include "raytrace/scene/scene.h"
-#include "raytrace/scene/top_level.h"
+#include "raytrace/traverse/large_packet.h"
+#include "raytrace/traverse/packet_traversal.h"
+#include "raytrace/traverse/static_tiles.h"
+#include "raytrace/traverse/traversal.h"
+#include "raytrace/traverse/traversal_shared.h"
 #include "runtime/jobs/job_system.h"
 #include "runtime/math/float8.h"
 #include "runtime/memory/line_aligned.h"
@@ -1023,12 +1023,10 @@ TEST(StaticTiles, FloorCellsFindTheSingleRayHits) {
   rt::TileScratch w;
   const auto wide = camera_tile(Vec3(0.0f, 20.0f, 20.0f), Vec3(0.0f), 60.0f, 16, 16, w);
   EXPECT_FALSE(rt::gather_static_tile(sc, TriangleTest::kFast, camera_bound(wide, w), 0.0f, objects, tile));
-  int region_x = 1, region_y = 1;
-  rt::packet_region_blocks(256, region_x, region_y);
-  w.prepare(Tile{0, 0, 16, 16, 0}, region_x, region_y);
+  w.prepare(Tile{0, 0, 16, 16, 0}, rt::plan_for_packet_rays(256));
   rt::generate_camera_rays(wide, w);
   rt::TraversalCounters walked;
-  rt::trace_primary(sc, wide, TriangleTest::kFast, 256, w, walked);
+  rt::trace_primary(sc, wide, TriangleTest::kFast, w, walked);
   EXPECT_GT(walked.node_visits, 0u);
   const std::vector<std::size_t> wide_hits = expect_single_ray_hits(sc, wide, w);
   EXPECT_GT(wide_hits[0], 100u);
@@ -1042,7 +1040,10 @@ TEST(TileStages, CameraDirectionsAreTheCameraRays) {
   // then region by region).
   for (const auto& [region_x, region_y] : {std::pair{1, 1}, std::pair{4, 8}, std::pair{8, 8}}) {
     rt::TileScratch s;
-    s.prepare(Tile{5, 3, 18, 14, 0}, region_x, region_y);  // 13x11: partial blocks at both edges
+    rt::TracePlan plan;
+    plan.region_blocks_x = region_x;
+    plan.region_blocks_y = region_y;
+    s.prepare(Tile{5, 3, 18, 14, 0}, plan);  // 13x11: partial blocks at both edges
     rt::generate_camera_rays(camera, s);
     std::size_t pixels = 0;
     for (std::size_t k = 0; k < s.lanes; ++k) {
@@ -1070,10 +1071,13 @@ TEST(TileStages, SurfacesAndShadowOriginsAreTheScalarOnes) {
     for (int ty = 0; ty < 64; ty += 16) {
       for (int tx = 0; tx < 64; tx += 16) {
         rt::TileScratch s;
-        s.prepare(Tile{tx, ty, tx + 16, ty + 16, 0}, region_x, 2 * region_x);
+        rt::TracePlan plan;  // 8-ray packets over either layout
+        plan.region_blocks_x = region_x;
+        plan.region_blocks_y = 2 * region_x;
+        s.prepare(Tile{tx, ty, tx + 16, ty + 16, 0}, plan);
         rt::generate_camera_rays(camera, s);
         rt::TraversalCounters counters;
-        rt::trace_primary(sc, camera, TriangleTest::kFast, 8, s, counters);
+        rt::trace_primary(sc, camera, TriangleTest::kFast, s, counters);
         std::fill(s.lit.begin(), s.lit.end(), std::uint8_t{1});
         rt::reconstruct_surfaces(sc, Vec3(0.7f), s);
         rt::make_shadow_rays(light, 0, s);
@@ -1186,7 +1190,7 @@ TEST(TileStages, SurfacesAndShadowOriginsAreTheScalarOnes) {
 // Blocks whose lanes hit several triangles: the same triangle index on
 // both characters and on the ground, lanes that miss between them, in every
 // order. Each block's corners are loaded once per distinct (instance,
-// triangle) and blended into its lanes (render/tile_stages.cpp
+// triangle) and blended into its lanes (render/stages/tile_stages.cpp
 // gather_lanes); every lane must still be surface_at's, bit for bit.
 TEST(TileStages, SurfacesOfBlocksOnSeveralTrianglesAreTheScalarOnes) {
   const rt::Scene& sc = scene();
@@ -1354,9 +1358,10 @@ template <class OnCharacter, class TriangleOf>
 rt::TileScratch compacted_region(bool split, bool split_statics, OnCharacter&& on_character,
                                  TriangleOf&& triangle_of) {
   rt::TileScratch s;
-  s.prepare(Tile{0, 0, 16, 16, 0}, 4, 8);
-  s.split_fine_shadows = split;
-  s.split_static_shadows = split_statics;
+  rt::TracePlan plan = rt::plan_for_packet_rays(256);
+  plan.split_fine_shadows = split;
+  plan.split_static_shadows = split_statics;
+  s.prepare(Tile{0, 0, 16, 16, 0}, plan);
   for (std::size_t b = 0; b < s.blocks(); ++b) {
     s.block_hits[b] = 0xFF;
     s.block_on_character[b] = on_character(b * 8) ? 0xFF : 0x00;
@@ -1432,7 +1437,7 @@ rt::TileScratch half_ground_region(bool split, bool split_statics) {
 
 // The character's rays run first, then the ground's; the ground's go in
 // 8x8-pixel runs only where the frame's characters look fine
-// (TileScratch::split_static_shadows) and splitting is on at all.
+// (TracePlan::split_static_shadows) and splitting is on at all.
 TEST(TileStages, StaticShadowRaysRunAsEightByEightPacketsWhereCharactersLookFine) {
   EXPECT_EQ(half_ground_region(true, true).shadow_region_begin, (std::vector<std::uint32_t>{0, 64, 128, 192, 256}));
   EXPECT_EQ(half_ground_region(true, false).shadow_region_begin, (std::vector<std::uint32_t>{0, 64, 128, 256}));
@@ -1629,7 +1634,7 @@ struct HostFrame {
 };
 
 // Rows that start on a line are staged and stored by streaming whole lines
-// (render/output_staging.h); the others are written in place. Both must
+// (render/output/output_staging.h); the others are written in place. Both must
 // give every output the same bytes, and neither may touch the padding
 // between rows, whatever the tile and image edges do to the lines.
 TEST(Renderer, StagedAndInPlaceOutputsHoldTheSameBytes) {
@@ -1680,7 +1685,7 @@ TEST(Renderer, StagedAndInPlaceOutputsHoldTheSameBytes) {
 }
 
 // Colour alone (a game's frame) takes its own path through the shading
-// (shade_rgba8_only, render/tile_stages.cpp); its bytes must be those of a
+// (shade_rgba8_only, render/stages/tile_stages.cpp); its bytes must be those of a
 // render that asks for every output, staged or in place, with partial
 // blocks at the image's edges and lights of both kinds.
 TEST(Renderer, ColourAloneHoldsTheBytesOfARenderOfEveryOutput) {

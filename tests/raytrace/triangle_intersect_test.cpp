@@ -1,6 +1,7 @@
 #include "raytrace/geometry/triangle_intersect.h"
 
-#if defined(__AVX2__)
+#include "runtime/math/simd.h"
+#if SINEW_AVX2
 #include "raytrace/geometry/triangle_intersect8.h"
 #endif
 
@@ -553,9 +554,9 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> shared_edges(const Mesh& me
   return shared;
 }
 
-#if defined(__AVX2__)
+#if SINEW_AVX2
 // prepare_common_origin8 (a leaf's triangles eight at a time,
-// render/large_packet.cpp) gives each lane what prepare_common_origin gives
+// traverse/large_packet.cpp) gives each lane what prepare_common_origin gives
 // its triangle, bit for bit: small, huge, far, degenerate and non-finite
 // corners, origins near and far.
 TEST(TriangleIntersectEdgeCases, CommonOriginTermsEightAtATimeMatchOneAtATime) {

@@ -1,0 +1,665 @@
+// Frusta of a large packet's groups (traverse/large_packet.h): for rays that
+// leave one apex (a camera's primary rays, a point light's shadow rays),
+// each group of eight gets four planes through the apex that hold all of
+// its rays, and rays of finite reach (shadow rays) a far plane. A triangle
+// whose three corners all lie beyond one of a group's planes is missed by
+// every ray of that group, so a leaf's triangle is tested only by the
+// groups whose frustum it reaches: one test of a triangle against eight
+// frusta costs about what one eight-lane triangle test costs, and most
+// groups of a 64-ray packet miss most of the triangles its cells hold (the
+// fuzzy boxes are loose, the triangles are not).
+//
+// Numerical safety (docs/RAYTRACE.md, "Group frusta"). The planes are grown
+// away from the rays by 2^-16 of their slopes, far above the rounding of
+// their construction (tens of float epsilons), so every ray lies inside
+// each plane. A triangle is culled only when its corners lie beyond a plane
+// by 2^-16 of the coordinate magnitudes involved: that margin is hundreds
+// of times the rounding of the corner tests, and it covers where either
+// triangle test can report a hit off the triangle. The watertight test's
+// edge signs are exact; the fast test's rounding moves its hit point off
+// the triangle by a few float epsilons of the origin's distance across the
+// ray (at grazing angles the error grows along the ray, which no side
+// plane sees). A larger margin keeps every answer but tests triangles
+// further beyond a group's rays: at 2^-12 a shadow group on a fine mesh
+// tested its neighbours' triangles a pixel away.
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+#include "runtime/math/aabb.h"
+#include "runtime/math/float8.h"
+#include "runtime/math/types.h"
+
+namespace sinew::rt {
+
+// The frusta's one relative margin, 2^-16 (the header comment above derives
+// it). Shared by the group frusta, the camera grid (grid_frusta.h) and the
+// tile cone (traverse/static_tiles.h), in three roles: a side plane is grown
+// away from its rays by kFrustumMargin of their slope (grown_slope), a far
+// plane pushed out by kFrustumMargin of its reach (far_offset), and a shape
+// is culled only beyond kFrustumMargin of the coordinate magnitudes
+// involved (cull_margin).
+inline constexpr float kFrustumMargin = 0x1.0p-16f;
+
+// The growth of a bounding slope s away from the rays it bounds.
+inline float grown_slope(float s) { return kFrustumMargin * (1.0f + std::fabs(s)); }
+inline Float8 grown_slope(Float8 s) { return Float8(kFrustumMargin) * (Float8(1.0f) + abs(s)); }
+
+// A far plane's offset from the largest reach of its rays along its normal.
+inline float far_offset(float reach) { return reach * (1.0f + kFrustumMargin); }
+inline Float8 far_offset(Float8 reach) { return reach * Float8(1.0f + kFrustumMargin); }
+
+// How far beyond a plane a shape must lie to be culled, per unit of the
+// plane's L1 norm: kFrustumMargin of the coordinate magnitudes involved (its
+// corners' largest and the apex's).
+inline Float8 cull_margin(float corners, float apex_magnitude) {
+  return Float8(kFrustumMargin * (corners + apex_magnitude));
+}
+
+// The least of n . x over the box [lo, hi] (relative to an apex) for eight
+// planes n: per axis the nearer corner's product. Rounding is monotone, so
+// it never exceeds (n.x x + n.y y) + n.z z, the sum the triangle culls of
+// GroupFrusta and GridFrusta take at a corner, at any point of the box: a
+// box reaches every group a triangle inside it reaches.
+inline Float8 box_plane_nearest(Float8 nx, Float8 ny, Float8 nz, const Vec3& lo, const Vec3& hi) {
+  const auto nearer = [](Float8 n, float l, float h) { return min(n * Float8(l), n * Float8(h)); };
+  return (nearer(nx, lo.x, hi.x) + nearer(ny, lo.y, hi.y)) + nearer(nz, lo.z, hi.z);
+}
+
+// Up to eight triangles side by side, for culling a leaf's triangles eight
+// at a time (GroupFrusta::reached8, GridFrusta::reached8): coordinate a of
+// corner k of triangle i in p[k][a][i].
+struct TriangleLanes8 {
+  alignas(32) float p[3][3][8];
+  Vec3 corner(int k, int i) const { return Vec3(p[k][0][i], p[k][1][i], p[k][2][i]); }
+};
+
+namespace detail {
+
+// Eight triangles' corners relative to an apex, and each triangle's cull
+// margin: per lane the values reached() takes for one triangle (the same
+// differences, cull_margin of its corners' largest magnitude).
+struct ApexTriangles8 {
+  Vec3x8 x[3];
+  Float8 margin;
+
+  ApexTriangles8(const TriangleLanes8& t, const Vec3& apex, float apex_magnitude) {
+    Float8 corners(0.0f);
+    for (int k = 0; k < 3; ++k) {
+      const Float8 px = Float8::load(t.p[k][0]), py = Float8::load(t.p[k][1]), pz = Float8::load(t.p[k][2]);
+      x[k] = Vec3x8{px - Float8(apex.x), py - Float8(apex.y), pz - Float8(apex.z)};
+      corners = max(corners, max(max(abs(px), abs(py)), abs(pz)));
+    }
+    margin = Float8(kFrustumMargin) * (corners + Float8(apex_magnitude));
+  }
+
+  // Per triangle, the least of n . x over its corners, each summed
+  // (n.x x + n.y y) + n.z z as the one-triangle culls sum it.
+  Float8 nearest(float nx, float ny, float nz) const {
+    const Float8 a(nx), b(ny), c(nz);
+    const auto side = [&](const Vec3x8& w) { return (a * w.x + b * w.y) + c * w.z; };
+    return min(min(side(x[0]), side(x[1])), side(x[2]));
+  }
+};
+
+}  // namespace detail
+
+template <int kMaxGroups>
+class GroupFrusta {
+  static_assert(kMaxGroups % 8 == 0);
+
+ public:
+  // A packet of `groups` groups whose rays' points are apex + s q, s >= 0;
+  // every group starts with no frustum (it reaches every triangle).
+  void reset(const Vec3& apex, int groups) {
+    apex_ = apex;
+    apex_magnitude_ = std::max({std::fabs(apex.x), std::fabs(apex.y), std::fabs(apex.z)});
+    groups_ = std::clamp(groups, 0, kMaxGroups);
+    // The planes themselves are left as they are: reached() reads only
+    // those of groups marked built.
+    sides_.fill(0);
+    far_.fill(0);
+    bound_groups_ = 0;
+    slab_groups_ = 0;
+  }
+
+  // Group g's frustum around the directions q of `lanes` (structure of
+  // arrays, eight lanes; other lanes are not read). A group whose rays
+  // spread over more than about 75 degrees from their mean keeps none.
+  // With `reach` (per lane, the largest s of its points apex + s q) the
+  // frustum also gets a far plane: a triangle beyond every lane's end point
+  // (a shadow ray's shadowed point) cannot block it.
+  void set_group(int g, const float (&q)[3][8], std::uint32_t lanes, const float* reach = nullptr) {
+    if (lanes == 0 || g < 0 || g >= groups_) return;
+    const Mask8 use = Mask8::from_bits(lanes);
+    const Float8 zero(0.0f);
+    const Vec3x8 d{select(use, Float8::load(q[0]), zero), select(use, Float8::load(q[1]), zero),
+                   select(use, Float8::load(q[2]), zero)};
+    // Any centre in front of every lane will do: the planes come from the
+    // slopes around it, whatever it is. The sum of the directions is one.
+    const Vec3 c = normalized({sum(d.x), sum(d.y), sum(d.z)});
+    if (!(c.x == c.x)) return;
+    // u along a row of the group: from its first lane to the one three on
+    // (a camera block's lanes are two rows of four pixels), or to its last.
+    // Any u bounds the rays; one along the pixel rows bounds a block's
+    // rectangle of rays, where a diagonal one (lane 0 to lane 7) bounded a
+    // rectangle turned by 18 degrees, 1.7 times the area.
+    const int first = std::countr_zero(lanes);
+    const int last = first + 3 < 8 && (lanes >> (first + 3) & 1u) ? first + 3 : 31 - std::countl_zero(lanes);
+    Vec3 u, v;
+    if (!row_basis(c, Vec3(q[0][last] - q[0][first], q[1][last] - q[1][first], q[2][last] - q[2][first]), u, v)) return;
+    Float8 a, b, dc;
+    if (!slopes(d, use, c, u, v, a, b, dc)) return;
+    const float big = std::numeric_limits<float>::max();
+    const float a_lo = reduce_min(select(use, a, Float8(big))), a_hi = reduce_max(select(use, a, Float8(-big)));
+    const float b_lo = reduce_min(select(use, b, Float8(big))), b_hi = reduce_max(select(use, b, Float8(-big)));
+    // Outside: n . (p - apex) > 0. Each plane holds the rays with slopes on
+    // its side: a <= a_hi means (u - a_hi c) . q <= 0.
+    set_plane(0, g, u - (a_hi + grown_slope(a_hi)) * c);
+    set_plane(1, g, (a_lo - grown_slope(a_lo)) * c - u);
+    set_plane(2, g, v - (b_hi + grown_slope(b_hi)) * c);
+    set_plane(3, g, (b_lo - grown_slope(b_lo)) * c - v);
+    sides_[g / 8] = static_cast<std::uint8_t>(sides_[g / 8] | 1u << (g % 8));
+    if (reach != nullptr) {
+      // c . (p - apex) <= s (c . q) on every lane's points.
+      const Float8 far = select(use, Float8::load(reach) * dc, Float8(0.0f));
+      const float offset = far_offset(reduce_max(far));
+      if (std::isfinite(offset)) {
+        set_plane(4, g, c);
+        offset_[g] = offset;
+        far_[g / 8] = static_cast<std::uint8_t>(far_[g / 8] | 1u << (g % 8));
+      }
+    }
+  }
+
+  // set_group for every group of `groups`, with group g's directions
+  // sign * q(g) (a float[3][8]), its lanes lanes(g) and, with kFar, its
+  // per-lane reach written by reach(g, out). Groups with all eight lanes in
+  // use are built eight at a time, one group per SIMD lane (set_group's
+  // construction transposed: a packet's frusta cost about what one did);
+  // the others one by one.
+  template <bool kFar, class Q, class Lanes, class Reach>
+  void set_groups(std::uint64_t groups, float sign, Q&& q, Lanes&& lanes, Reach&& reach) {
+    for (int base = 0; base < groups_; base += 8) {
+      std::uint32_t full = 0;
+      for (std::uint32_t m = static_cast<std::uint32_t>(groups >> base) & 0xFFu; m != 0; m &= m - 1) {
+        const int g = base + std::countr_zero(m);
+        const std::uint32_t l = lanes(g);
+        if (l == 0xFFu) {
+          full |= 1u << (g - base);
+          continue;
+        }
+        alignas(32) float d[3][8], r[8] = {};
+        for (int a = 0; a < 3; ++a) (Float8(sign) * Float8::load(q(g)[a])).store(d[a]);
+        if constexpr (kFar) reach(g, r);
+        set_group(g, d, l, kFar ? r : nullptr);
+      }
+      if (full != 0) set_block<kFar>(base, full, sign, q, reach);
+    }
+  }
+
+  // One frustum around every ray of `groups` (set_groups' arguments), the
+  // same construction as set_group's over all their lanes: reached() tests
+  // a triangle against it first, and most triangles a packet's cells hold
+  // lie outside it (seven in ten on Cally), so they cost one plane test
+  // instead of one per block of eight groups. Rays spread over more than
+  // about 75 degrees leave the packet without one.
+  template <bool kFar, class Q, class Lanes, class Reach>
+  void set_bound(std::uint64_t groups, float sign, Q&& q, Lanes&& lanes, Reach&& reach) {
+    bound_groups_ = 0;
+    groups &= groups_ >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << groups_) - 1u;
+    if (groups == 0) return;
+    const Float8 zero(0.0f);
+    const auto directions = [&](int g, std::uint32_t use_bits) {
+      const Mask8 use = Mask8::from_bits(use_bits);
+      const float (&d)[3][8] = q(g);
+      return Vec3x8{select(use, Float8(sign) * Float8::load(d[0]), zero),
+                    select(use, Float8(sign) * Float8::load(d[1]), zero),
+                    select(use, Float8(sign) * Float8::load(d[2]), zero)};
+    };
+    Vec3x8 sum{zero, zero, zero};
+    int first = -1;
+    for (std::uint64_t m = groups; m != 0; m &= m - 1) {
+      const int g = std::countr_zero(m);
+      const std::uint32_t l = lanes(g);
+      if (l == 0) continue;
+      if (first < 0) first = g;
+      sum = sum + directions(g, l);
+    }
+    if (first < 0) return;
+    const Vec3 c = normalized({reduce_add(sum.x), reduce_add(sum.y), reduce_add(sum.z)});
+    if (!(c.x == c.x)) return;
+    // u along a pixel row of the first group, as set_group's.
+    const std::uint32_t first_lanes = lanes(first);
+    const int i0 = std::countr_zero(first_lanes);
+    const int i1 = i0 + 3 < 8 && (first_lanes >> (i0 + 3) & 1u) ? i0 + 3 : 31 - std::countl_zero(first_lanes);
+    const float (&f)[3][8] = q(first);
+    Vec3 u, v;
+    if (!row_basis(c, sign * Vec3(f[0][i1] - f[0][i0], f[1][i1] - f[1][i0], f[2][i1] - f[2][i0]), u, v)) return;
+    const float big = std::numeric_limits<float>::max();
+    Float8 a_lo(big), a_hi(-big), b_lo(big), b_hi(-big), far(0.0f);
+    // Each group's own slab in this basis too (slab_groups_, reached()).
+    slab_groups_ = 0;
+    const float u1 = l1(u), v1 = l1(v), c1 = l1(c);
+    for (std::uint64_t m = groups; m != 0; m &= m - 1) {
+      const int g = std::countr_zero(m);
+      const std::uint32_t l = lanes(g);
+      // A group without lanes has no rays: an empty slab cuts everything.
+      slab_[0][g] = big;
+      slab_[1][g] = -big;
+      slab_[2][g] = big;
+      slab_[3][g] = -big;
+      slab_far_[g] = kFar ? -big : big;
+      if (l == 0) continue;
+      const Mask8 use = Mask8::from_bits(l);
+      Float8 a, b, dc;
+      if (!slopes(directions(g, l), use, c, u, v, a, b, dc)) return;
+      const Float8 ga_lo = select(use, a, Float8(big)), ga_hi = select(use, a, Float8(-big));
+      const Float8 gb_lo = select(use, b, Float8(big)), gb_hi = select(use, b, Float8(-big));
+      a_lo = min(a_lo, ga_lo);
+      a_hi = max(a_hi, ga_hi);
+      b_lo = min(b_lo, gb_lo);
+      b_hi = max(b_hi, gb_hi);
+      const float ranges[4] = {reduce_min(ga_lo), reduce_max(ga_hi), reduce_min(gb_lo), reduce_max(gb_hi)};
+      for (int i = 0; i < 4; ++i) {
+        const float grown = i % 2 == 0 ? ranges[i] - grown_slope(ranges[i]) : ranges[i] + grown_slope(ranges[i]);
+        slab_[i][g] = grown;
+        // |n|_1 of the side's plane (u or v minus grown times c), as set_plane.
+        slab_scale_[i][g] = 1.001f * ((i < 2 ? u1 : v1) + std::fabs(grown) * c1);
+      }
+      if constexpr (kFar) {
+        alignas(32) float r[8] = {};
+        reach(g, r);
+        const Float8 group_far = select(use, Float8::load(r) * dc, zero);
+        far = max(far, group_far);
+        const float offset = far_offset(reduce_max(group_far));
+        slab_far_[g] = std::isfinite(offset) ? offset : big;
+      }
+    }
+    slab_basis_[0] = c;
+    slab_basis_[1] = u;
+    slab_basis_[2] = v;
+    slab_far_scale_ = 1.001f * c1;
+    slab_groups_ = groups;
+    const float alo = reduce_min(a_lo), ahi = reduce_max(a_hi), blo = reduce_min(b_lo), bhi = reduce_max(b_hi);
+    const Vec3 planes[4] = {u - (ahi + grown_slope(ahi)) * c, (alo - grown_slope(alo)) * c - u, v - (bhi + grown_slope(bhi)) * c,
+                            (blo - grown_slope(blo)) * c - v};
+    // Lane i: plane i (the unused lanes' zero normals never cut).
+    for (int a = 0; a < 3; ++a) std::fill(std::begin(bound_n_[a]), std::end(bound_n_[a]), 0.0f);
+    std::fill(std::begin(bound_scale_), std::end(bound_scale_), 0.0f);
+    std::fill(std::begin(bound_offset_), std::end(bound_offset_), 0.0f);
+    const auto set = [&](int i, const Vec3& n, float offset) {
+      bound_n_[0][i] = n.x;
+      bound_n_[1][i] = n.y;
+      bound_n_[2][i] = n.z;
+      bound_scale_[i] = 1.001f * (std::fabs(n.x) + std::fabs(n.y) + std::fabs(n.z));
+      bound_offset_[i] = offset;
+    };
+    for (int i = 0; i < 4; ++i) set(i, planes[i], 0.0f);
+    if constexpr (kFar) {
+      const float offset = far_offset(reduce_max(far));
+      if (std::isfinite(offset)) set(4, c, offset);
+    }
+    bound_groups_ = groups;
+  }
+
+  // The groups of `groups` whose frustum may reach `box` (an object's box,
+  // before its lanes are clipped to it; a leaf's current triangles'). A box
+  // lies wholly beyond a plane when its corner nearest the plane does; the
+  // same margin as reached() covers the rounding of that corner's distance,
+  // and box_plane_nearest() takes it as reached() takes a point, so a box reaches
+  // every group a triangle inside it reaches. A box that is empty or not
+  // finite is reached by every group (its distances are NaN or -inf).
+  std::uint64_t box_reached(const Aabb& box, std::uint64_t groups) const {
+    const Vec3 lo = box.lower - apex_, hi = box.upper - apex_;
+    const float corners = std::max(magnitude(box.lower), magnitude(box.upper));
+    return packet_then_groups(
+        groups, corners, [&](Float8 nx, Float8 ny, Float8 nz) { return box_plane_nearest(nx, ny, nz, lo, hi); },
+        [&] { return slabs_box_uncut(groups, corners, lo, hi); });
+  }
+
+  // The groups of `groups` whose frustum the triangle may reach.
+  std::uint64_t reached(const Vec3& p0, const Vec3& p1, const Vec3& p2, std::uint64_t groups) const {
+    const Vec3 x0 = p0 - apex_, x1 = p1 - apex_, x2 = p2 - apex_;
+    const float corners = std::max({magnitude(p0), magnitude(p1), magnitude(p2)});
+    const auto nearest = [&](Float8 nx, Float8 ny, Float8 nz) {
+      const auto side = [&](const Vec3& x) { return (nx * Float8(x.x) + ny * Float8(x.y)) + nz * Float8(x.z); };
+      return min(min(side(x0), side(x1)), side(x2));
+    };
+    return packet_then_groups(groups, corners, nearest, [&] { return slabs_uncut(groups, corners, x0, x1, x2); });
+  }
+
+  // reached() for the triangles of `lanes` of `t` (bit i: triangle i),
+  // eight at a time: out[i] gets the groups of `groups` whose own frustum
+  // triangle i may reach, decided per triangle and group as reached()
+  // decides it there, without the packet's frustum first (the caller's
+  // leaf box has already picked `groups`: its test would cost about one
+  // group's). out[i] is 0 for the other lanes. With slabs on, reached()
+  // per triangle.
+  void reached8(const TriangleLanes8& t, std::uint32_t lanes, std::uint64_t groups, std::uint64_t (&out)[8]) const {
+    std::fill(std::begin(out), std::end(out), std::uint64_t{0});
+    if (slabs_on_) {
+      for (std::uint32_t m = lanes; m != 0; m &= m - 1) {
+        const int i = std::countr_zero(m);
+        out[i] = reached(t.corner(0, i), t.corner(1, i), t.corner(2, i), groups);
+      }
+      return;
+    }
+    groups &= groups_ >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << groups_) - 1u;
+    const detail::ApexTriangles8 x(t, apex_, apex_magnitude_);
+    for (std::uint64_t m = groups; m != 0; m &= m - 1) {
+      const int g = std::countr_zero(m);
+      const std::size_t block = static_cast<std::size_t>(g / 8);
+      const int bit = g % 8;
+      const bool sides = (sides_[block] >> bit & 1u) != 0, far = (far_[block] >> bit & 1u) != 0;
+      std::uint32_t reach = lanes;
+      if (sides || far) {
+        Mask8 cut = Mask8::from_bits(0);
+        const auto d = [&](int i) { return x.nearest(n_[i][0][g], n_[i][1][g], n_[i][2][g]); };
+        if (sides) {
+          for (int i = 0; i < 4; ++i) cut = cut | (d(i) > Float8(scale_[i][g]) * x.margin);
+        }
+        if (far) cut = cut | (d(4) > Float8(scale_[4][g]) * x.margin + Float8(offset_[g]));
+        reach &= ~cut.bits();
+      }
+      for (; reach != 0; reach &= reach - 1) out[std::countr_zero(reach)] |= std::uint64_t{1} << g;
+    }
+  }
+
+  // Whether reached() tests triangles against the groups' slabs in the
+  // packet's basis (set_bound) rather than their own frusta.
+  void use_slabs(bool on) { slabs_on_ = on; }
+  // The groups set_bound gave slabs.
+  std::uint64_t slab_groups() const { return slab_groups_; }
+
+ private:
+  // A shape (nearest: its least signed distance to eight planes) against
+  // the packet's frustum first, its planes side by side with uncut()'s test
+  // and margin, then the groups' slabs (slabs()) or their own frusta.
+  template <class Nearest, class Slabs>
+  std::uint64_t packet_then_groups(std::uint64_t groups, float corners, Nearest&& nearest, Slabs&& slabs) const {
+    if (groups != 0 && (groups & ~bound_groups_) == 0) {
+      const Float8 d = nearest(Float8::load(bound_n_[0]), Float8::load(bound_n_[1]), Float8::load(bound_n_[2]));
+      const Float8 limit =
+          Float8::load(bound_scale_) * cull_margin(corners, apex_magnitude_) + Float8::load(bound_offset_);
+      if ((d > limit).bits() != 0) return 0;
+      if (slabs_on_ && (groups & ~slab_groups_) == 0) return slabs();
+    }
+    return uncut(groups, corners, nearest);
+  }
+
+  // The groups of `groups` whose slab in the packet's basis (c, u, v) no
+  // side cuts off: a side plane u - s c has distance u.x - s (c.x) from a
+  // point x (relative to the apex), so the three corners' coordinates in
+  // the basis are taken once per triangle and each block of eight groups
+  // costs a product and a difference per corner and side, where its own
+  // frusta cost a dot product (traverse/large_packet.h, shadow packets).
+  std::uint64_t slabs_uncut(std::uint64_t groups, float corners, const Vec3& x0, const Vec3& x1,
+                            const Vec3& x2) const {
+    const Vec3& c = slab_basis_[0];
+    const Vec3& u = slab_basis_[1];
+    const Vec3& v = slab_basis_[2];
+    const Float8 z0(dot3(c, x0)), z1(dot3(c, x1)), z2(dot3(c, x2));
+    const Float8 a0(dot3(u, x0)), a1(dot3(u, x1)), a2(dot3(u, x2));
+    const Float8 b0(dot3(v, x0)), b1(dot3(v, x1)), b2(dot3(v, x2));
+    const Float8 z_min = min(min(z0, z1), z2);
+    return slabs_uncut_by(groups, corners, z_min, [&](Float8 a_lo, Float8 a_hi, Float8 b_lo, Float8 b_hi) {
+      // Beyond the high side: every corner's u.x - a_hi (c.x) past the margin.
+      return SlabDistances{min(min(a0 - a_hi * z0, a1 - a_hi * z1), a2 - a_hi * z2),
+                           min(min(a_lo * z0 - a0, a_lo * z1 - a1), a_lo * z2 - a2),
+                           min(min(b0 - b_hi * z0, b1 - b_hi * z1), b2 - b_hi * z2),
+                           min(min(b_lo * z0 - b0, b_lo * z1 - b1), b_lo * z2 - b2)};
+    });
+  }
+  // slabs_uncut for the box [lo, hi] (relative to the apex): each side's
+  // u.x - s (c.x) is at least u.x's least over the box minus s times c.x's
+  // greatest (least, for s < 0) over it, each the sum dot3 takes at a point
+  // with the nearer corner's products, so the box's bound never exceeds a
+  // point's (rounding is monotone). Looser than the box's own nearest
+  // corner by about |s| times its depth, which is small beside a pixel for
+  // the boxes this sees (a leaf's, an object's).
+  std::uint64_t slabs_box_uncut(std::uint64_t groups, float corners, const Vec3& lo, const Vec3& hi) const {
+    const Vec3& c = slab_basis_[0];
+    const Vec3& u = slab_basis_[1];
+    const Vec3& v = slab_basis_[2];
+    const auto least = [&](const Vec3& w) {
+      return (std::min(w.x * lo.x, w.x * hi.x) + std::min(w.y * lo.y, w.y * hi.y)) + std::min(w.z * lo.z, w.z * hi.z);
+    };
+    const auto most = [&](const Vec3& w) {
+      return (std::max(w.x * lo.x, w.x * hi.x) + std::max(w.y * lo.y, w.y * hi.y)) + std::max(w.z * lo.z, w.z * hi.z);
+    };
+    const Float8 a_least(least(u)), a_most(most(u)), b_least(least(v)), b_most(most(v));
+    const Float8 z_least(least(c)), z_most(most(c));
+    const Float8 zero(0.0f);
+    // s (c.x) at its greatest: c.x's greatest for s >= 0, its least below.
+    const auto s_z_most = [&](Float8 s) { return s * select(s >= zero, z_most, z_least); };
+    const auto s_z_least = [&](Float8 s) { return s * select(s >= zero, z_least, z_most); };
+    return slabs_uncut_by(groups, corners, z_least, [&](Float8 a_lo, Float8 a_hi, Float8 b_lo, Float8 b_hi) {
+      return SlabDistances{a_least - s_z_most(a_hi), s_z_least(a_lo) - a_most, b_least - s_z_most(b_hi),
+                           s_z_least(b_lo) - b_most};
+    });
+  }
+  // A shape's least distances past eight groups' slab sides: u high, u
+  // low, v high, v low.
+  struct SlabDistances {
+    Float8 a_hi, a_lo, b_hi, b_lo;
+  };
+  // The groups of `groups`, eight at a time, that no side of their slab
+  // cuts off: distances(a_lo, a_hi, b_lo, b_hi) gives the shape's distances
+  // past the sides of eight groups' slopes, z_min its least depth along c
+  // (for the far plane); each must exceed the margin to cut.
+  template <class Distances>
+  std::uint64_t slabs_uncut_by(std::uint64_t groups, float corners, Float8 z_min, Distances&& distances) const {
+    const Float8 margin = cull_margin(corners, apex_magnitude_);
+    std::uint64_t out = 0;
+    for (int base = 0; base < groups_; base += 8) {
+      const std::uint64_t part = (groups >> base) & 0xFFu;
+      if (part == 0) continue;
+      const SlabDistances d = distances(Float8::load(&slab_[0][base]), Float8::load(&slab_[1][base]),
+                                        Float8::load(&slab_[2][base]), Float8::load(&slab_[3][base]));
+      const Mask8 cut = (d.a_hi > Float8::load(&slab_scale_[1][base]) * margin) |
+                        (d.a_lo > Float8::load(&slab_scale_[0][base]) * margin) |
+                        (d.b_hi > Float8::load(&slab_scale_[3][base]) * margin) |
+                        (d.b_lo > Float8::load(&slab_scale_[2][base]) * margin) |
+                        (z_min > Float8::load(&slab_far_[base]) + Float8(slab_far_scale_) * margin);
+      out |= (part & ~static_cast<std::uint64_t>(cut.bits())) << base;
+    }
+    return out;
+  }
+  // A dot product summed as (x + y) + z, the order slabs_box_uncut bounds.
+  static float dot3(const Vec3& a, const Vec3& b) { return (a.x * b.x + a.y * b.y) + a.z * b.z; }
+  static float l1(const Vec3& w) { return std::fabs(w.x) + std::fabs(w.y) + std::fabs(w.z); }
+
+  // The groups of `groups` that no plane of theirs cuts off, eight at a
+  // time: nearest(nx, ny, nz) is the shape's least signed distance
+  // n . (p - apex) to each group's plane n, and a plane cuts the shape off
+  // when that exceeds the margin for coordinates up to `corners` (for the
+  // far plane, beyond its offset). Groups without a frustum are never cut.
+  template <class Nearest>
+  std::uint64_t uncut(std::uint64_t groups, float corners, Nearest&& nearest) const {
+    const Float8 margin = cull_margin(corners, apex_magnitude_);
+    std::uint64_t out = 0;
+    for (int base = 0; base < groups_; base += 8) {
+      const std::uint64_t part = (groups >> base) & 0xFFu;
+      if (part == 0) continue;
+      const std::uint32_t block = static_cast<std::uint32_t>(base / 8);
+      const std::uint32_t sides = sides_[block], far = far_[block];
+      if ((part & (sides | far)) == 0) {
+        out |= part << base;  // no group here has a frustum
+        continue;
+      }
+      Mask8 culled_by_sides = Mask8::from_bits(0), culled_by_far = Mask8::from_bits(0);
+      for (int i = 0; i < (far != 0 ? 5 : 4); ++i) {
+        const Float8 d = nearest(Float8::load(&n_[i][0][base]), Float8::load(&n_[i][1][base]),
+                                 Float8::load(&n_[i][2][base]));
+        const Float8 limit = Float8::load(&scale_[i][base]) * margin;
+        if (i == 4) {
+          culled_by_far = d > limit + Float8::load(&offset_[base]);
+        } else {
+          culled_by_sides = culled_by_sides | (d > limit);
+        }
+      }
+      const std::uint64_t culled = (culled_by_sides.bits() & sides) | (culled_by_far.bits() & far);
+      out |= (part & ~culled) << base;
+    }
+    return out;
+  }
+
+  // Groups base + k for the bits k of `full` (all eight lanes in use),
+  // lane k of every vector below holding group base + k.
+  template <bool kFar, class Q, class Reach>
+  void set_block(int base, std::uint32_t full, float sign, Q& q, Reach& reach) {
+    alignas(32) float t[3][8][8];  // [axis][ray][group]
+    alignas(32) float r[8][8] = {};  // [ray][group]
+    for (int k = 0; k < 8; ++k) {
+      const bool used = (full >> k & 1u) != 0;
+      for (int a = 0; a < 3; ++a) {
+        for (int j = 0; j < 8; ++j) t[a][j][k] = used ? sign * q(base + k)[a][j] : (a == 2 ? 1.0f : 0.0f);
+      }
+      if constexpr (kFar) {
+        if (used) {
+          alignas(32) float rk[8];
+          reach(base + k, rk);
+          for (int j = 0; j < 8; ++j) r[j][k] = rk[j];
+        }
+      }
+    }
+    const Float8 zero(0.0f), one(1.0f);
+    Vec3x8 d[8];
+    for (int j = 0; j < 8; ++j) d[j] = Vec3x8{Float8::load(t[0][j]), Float8::load(t[1][j]), Float8::load(t[2][j])};
+    const auto unit = [&](const Vec3x8& w, Mask8& ok) {
+      const Float8 length = sqrt(dot(w, w));
+      ok = (length > zero) & is_finite(length);
+      return (one / select(ok, length, one)) * w;
+    };
+    Vec3x8 sum = d[0];
+    for (int j = 1; j < 8; ++j) sum = sum + d[j];
+    Mask8 c_ok, u_ok, alt_ok;
+    const Vec3x8 c = unit(sum, c_ok);
+    Vec3x8 across = d[3] - d[0];  // along a row, as set_group
+    across = across - dot(across, c) * c;
+    const Vec3x8 u_across = unit(across, u_ok);
+    const Vec3x8 alt = select(abs(c.x) < Float8(0.5f), Vec3x8{zero, zero - c.z, c.y}, Vec3x8{zero - c.z, zero, c.x});
+    const Vec3x8 u = select(u_ok, u_across, unit(alt, alt_ok));
+    const Vec3x8 v = cross(c, u);
+    Mask8 ok = c_ok & (u_ok | alt_ok) & Mask8::from_bits(full);
+    Float8 dc[8];
+    for (int j = 0; j < 8; ++j) {
+      dc[j] = dot(d[j], c);
+      const Float8 dd = dot(d[j], d[j]);
+      ok = ok & (dc[j] > zero) & (dc[j] * dc[j] > Float8(0.0625f) * dd) & is_finite(dd);
+    }
+    if (ok.bits() == 0) return;
+    const float big = std::numeric_limits<float>::max();
+    Float8 a_lo(big), a_hi(-big), b_lo(big), b_hi(-big), far(0.0f);
+    for (int j = 0; j < 8; ++j) {
+      const Float8 inv_dc = one / select(ok, dc[j], one);
+      const Float8 a = dot(d[j], u) * inv_dc, b = dot(d[j], v) * inv_dc;
+      a_lo = min(a_lo, a);
+      a_hi = max(a_hi, a);
+      b_lo = min(b_lo, b);
+      b_hi = max(b_hi, b);
+      if constexpr (kFar) far = max(far, Float8::load(r[j]) * dc[j]);
+    }
+    store_planes(0, base, u - (a_hi + grown_slope(a_hi)) * c, ok);
+    store_planes(1, base, (a_lo - grown_slope(a_lo)) * c - u, ok);
+    store_planes(2, base, v - (b_hi + grown_slope(b_hi)) * c, ok);
+    store_planes(3, base, (b_lo - grown_slope(b_lo)) * c - v, ok);
+    sides_[static_cast<std::size_t>(base / 8)] |= static_cast<std::uint8_t>(ok.bits());
+    if constexpr (kFar) {
+      const Float8 offset = far_offset(far);
+      const Mask8 far_ok = ok & is_finite(offset);
+      if (far_ok.bits() != 0) {
+        store_planes(4, base, c, far_ok);
+        select(far_ok, offset, Float8::load(&offset_[base])).store(&offset_[base]);
+        far_[static_cast<std::size_t>(base / 8)] |= static_cast<std::uint8_t>(far_ok.bits());
+      }
+    }
+  }
+  // set_plane for the groups base + k of the lanes k of `m`.
+  void store_planes(int i, int base, const Vec3x8& n, Mask8 m) {
+    const Float8* const axis[3] = {&n.x, &n.y, &n.z};
+    for (int a = 0; a < 3; ++a) select(m, *axis[a], Float8::load(&n_[i][a][base])).store(&n_[i][a][base]);
+    const Float8 scale = Float8(1.001f) * ((abs(n.x) + abs(n.y)) + abs(n.z));
+    select(m, scale, Float8::load(&scale_[i][base])).store(&scale_[i][base]);
+  }
+
+  static float magnitude(const Vec3& p) { return std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)}); }
+  // Near unit length is enough: the planes hold the rays for any centre
+  // and any u (set_group), so one reciprocal serves the three axes.
+  static Vec3 normalized(const Vec3& w) {
+    const float length = std::sqrt(glm::dot(w, w));
+    return length > 0.0f && std::isfinite(length) ? w * (1.0f / length)
+                                                  : Vec3(std::numeric_limits<float>::quiet_NaN());
+  }
+  static float sum(Float8 a) { return reduce_add(a); }
+  // The frame a frustum's slopes are measured in around the unit centre
+  // c: u along `across` (a pixel row) made perpendicular to c, or any
+  // perpendicular where that is degenerate, and v = c x u.
+  static bool row_basis(const Vec3& c, Vec3 across, Vec3& u, Vec3& v) {
+    across = across - glm::dot(across, c) * c;
+    u = normalized(across);
+    if (!(u.x == u.x)) u = normalized(std::fabs(c.x) < 0.5f ? Vec3(0.0f, -c.z, c.y) : Vec3(-c.z, 0.0f, c.x));
+    if (!(u.x == u.x)) return false;
+    v = glm::cross(c, u);
+    return true;
+  }
+  // Each lane's slopes a = d.u / d.c and b = d.v / d.c (and d.c) over the
+  // lanes of `use`; false unless every such lane lies well in front of the
+  // centre (within about 75 degrees of it: slopes stay finite and small;
+  // non-finite lanes fail too).
+  static bool slopes(const Vec3x8& d, Mask8 use, const Vec3& c, const Vec3& u, const Vec3& v, Float8& a, Float8& b,
+                     Float8& dc) {
+    const auto along = [&](const Vec3& w) { return d.x * Float8(w.x) + d.y * Float8(w.y) + d.z * Float8(w.z); };
+    dc = along(c);
+    const Float8 zero(0.0f);
+    const Mask8 in_front = (dc > zero) & (dc * dc > Float8(0.0625f) * dot(d, d)) & is_finite(dot(d, d));
+    if ((in_front | !use).bits() != 0xFFu) return false;
+    const Float8 inv_dc = Float8(1.0f) / select(use, dc, Float8(1.0f));
+    a = along(u) * inv_dc;
+    b = along(v) * inv_dc;
+    return true;
+  }
+  void set_plane(int i, int g, const Vec3& n) {
+    n_[i][0][g] = n.x;
+    n_[i][1][g] = n.y;
+    n_[i][2][g] = n.z;
+    // |n|_1 bounds n . e for |e| <= margin per coordinate; slightly more
+    // for the rounding of the products.
+    scale_[i][g] = 1.001f * (std::fabs(n.x) + std::fabs(n.y) + std::fabs(n.z));
+  }
+
+  Vec3 apex_{0.0f};
+  float apex_magnitude_ = 0.0f;
+  int groups_ = 0;
+  // Per plane (four sides, then the far plane), axis and group; read only
+  // for the groups whose bit is set in sides_ (the four sides) or far_ (the
+  // far plane), per block of eight groups.
+  alignas(32) std::array<std::array<std::array<float, kMaxGroups>, 3>, 5> n_{};
+  std::array<std::uint8_t, kMaxGroups / 8> sides_{}, far_{};
+  alignas(32) std::array<std::array<float, kMaxGroups>, 5> scale_{};
+  alignas(32) std::array<float, kMaxGroups> offset_{};  // the far plane's, per group
+  // The packet's frustum (set_bound): lane i of each array is plane i (four
+  // sides, then the far plane), for the groups of bound_groups_.
+  alignas(32) float bound_n_[3][8] = {};
+  alignas(32) float bound_scale_[8] = {};
+  alignas(32) float bound_offset_[8] = {};
+  std::uint64_t bound_groups_ = 0;
+  // Per group its slab in the packet's basis (set_bound): slopes along u
+  // (lo, hi) and v (lo, hi) grown as the planes', each side's |n|_1, and the
+  // far offset along c (max float: none).
+  bool slabs_on_ = false;
+  std::uint64_t slab_groups_ = 0;
+  Vec3 slab_basis_[3] = {Vec3(0.0f), Vec3(0.0f), Vec3(0.0f)};  // c, u, v
+  alignas(32) std::array<std::array<float, kMaxGroups>, 4> slab_{};
+  alignas(32) std::array<std::array<float, kMaxGroups>, 4> slab_scale_{};
+  alignas(32) std::array<float, kMaxGroups> slab_far_{};
+  float slab_far_scale_ = 0.0f;
+};
+
+}  // namespace sinew::rt

@@ -1,0 +1,256 @@
+// IntervalBound: interval arithmetic over a set of rays, the one box test
+// a large packet (traverse/large_packet.h) pays per kd-tree cell.
+//
+// The set is kept as ranges: per axis the range of the origins and of the
+// directions, and the range of the ray parameter. A ray of the set inside a
+// box at parameter t satisfies, on every axis whose direction sign is the
+// same for the whole set, entry_a <= t <= exit_a for the box's slab, and
+// the products of (plane - origin range) x (reciprocal range) bound entry_a
+// from below and exit_a from above over every ray of the set. A box no ray
+// of the set can reach gets +inf; otherwise entry() is a lower bound on the
+// parameter at which the first ray enters it (the front-to-back key).
+//
+// Numerical safety: every product is widened by a relative 2^-20 (far above
+// its 2^-24 rounding), reciprocal bounds likewise, and callers grow boxes by
+// grow_for(): their own slack plus, per axis, 2^-20 of the larger of the
+// box's and the origins' magnitudes on that axis, for the rounding of
+// (plane - origin). A set holding
+// a non-finite ray bounds nothing: every box may be entered.
+#pragma once
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+#include <immintrin.h>
+
+#include "runtime/math/aabb.h"
+#include "runtime/math/float8.h"
+
+namespace sinew::rt {
+
+// Ranges of a set of rays: origin and direction per axis, parameter.
+struct RayRanges {
+  float o_lo[3] = {0, 0, 0}, o_hi[3] = {0, 0, 0};
+  float d_lo[3] = {0, 0, 0}, d_hi[3] = {0, 0, 0};
+  float t_lo = 0.0f, t_hi = 0.0f;
+  bool finite = true;
+
+  // The largest |origin| coordinate.
+  float origin_magnitude() const {
+    float m = 0.0f;
+    for (int a = 0; a < 3; ++a) m = std::max({m, std::fabs(o_lo[a]), std::fabs(o_hi[a])});
+    return m;
+  }
+};
+
+// The ranges of many groups of eight rays, kept lane by lane and reduced
+// once: adding a group costs a dozen min/max, not a dozen reductions.
+class RangeAccumulator {
+ public:
+  RangeAccumulator() {
+    constexpr float kInf = std::numeric_limits<float>::infinity();
+    for (int a = 0; a < 3; ++a) {
+      o_lo_[a] = d_lo_[a] = Float8(kInf);
+      o_hi_[a] = d_hi_[a] = Float8(-kInf);
+    }
+    t_lo_ = Float8(kInf);
+    t_hi_ = Float8(-kInf);
+  }
+  // Rays o + t d, t in [t0, t1], of the lanes in `mask` (t1 may be +inf).
+  void add(const Vec3x8& o, const Vec3x8& d, Float8 t0, Float8 t1, std::uint32_t mask) {
+    if (mask == 0) return;
+    constexpr float kInf = std::numeric_limits<float>::infinity();
+    const Mask8 use = Mask8::from_bits(mask);
+    const Float8 plus(kInf), minus(-kInf);
+    const Float8* const oc[3] = {&o.x, &o.y, &o.z};
+    const Float8* const dc[3] = {&d.x, &d.y, &d.z};
+    Mask8 finite = is_finite(t0);
+    for (int a = 0; a < 3; ++a) {
+      o_lo_[a] = min(o_lo_[a], select(use, *oc[a], plus));
+      o_hi_[a] = max(o_hi_[a], select(use, *oc[a], minus));
+      d_lo_[a] = min(d_lo_[a], select(use, *dc[a], plus));
+      d_hi_[a] = max(d_hi_[a], select(use, *dc[a], minus));
+      finite = finite & is_finite(*oc[a]) & is_finite(*dc[a]);
+    }
+    t_lo_ = min(t_lo_, select(use, t0, plus));
+    t_hi_ = max(t_hi_, select(use, t1, minus));
+    finite_ = finite_ && (finite.bits() & mask) == mask;
+    any_ = true;
+  }
+  bool empty() const { return !any_; }
+  RayRanges ranges() const {
+    RayRanges r;
+    for (int a = 0; a < 3; ++a) {
+      r.o_lo[a] = reduce_min(o_lo_[a]);
+      r.o_hi[a] = reduce_max(o_hi_[a]);
+      r.d_lo[a] = reduce_min(d_lo_[a]);
+      r.d_hi[a] = reduce_max(d_hi_[a]);
+    }
+    r.t_lo = reduce_min(t_lo_);
+    r.t_hi = reduce_max(t_hi_);
+    r.finite = finite_;
+    return r;
+  }
+
+ private:
+  Float8 o_lo_[3], o_hi_[3], d_lo_[3], d_hi_[3];
+  Float8 t_lo_, t_hi_;
+  bool finite_ = true;
+  bool any_ = false;
+};
+
+class IntervalBound {
+ public:
+  static constexpr float kRelativeMargin = 0x1.0p-20f;
+
+  IntervalBound() = default;
+  explicit IntervalBound(const RayRanges& r) {
+    // Directions smaller than this on an axis give no reciprocal bound
+    // there (1/d may overflow): such an axis simply does not cull.
+    constexpr float kTinyDirection = 1e-30f;
+    unbounded_ = !r.finite;
+    t_lo_ = r.t_lo;
+    t_hi_ = r.t_hi;
+    const float ones = std::bit_cast<float>(0xFFFFFFFFu);
+    alignas(16) float olo[4], ohi[4], rlo[4], rhi[4], pos[4], neg[4], nr[4], nf[4];
+    for (int a = 0; a < 4; ++a) {
+      const bool axis = a < 3;
+      olo[a] = axis ? r.o_lo[a] : 0.0f;
+      ohi[a] = axis ? r.o_hi[a] : 0.0f;
+      const bool positive = axis && r.d_lo[a] >= kTinyDirection;
+      const bool negative = axis && r.d_hi[a] <= -kTinyDirection;
+      pos[a] = positive ? ones : 0.0f;
+      neg[a] = negative ? ones : 0.0f;
+      nr[a] = axis && r.d_hi[a] <= 0.0f ? ones : 0.0f;
+      nf[a] = axis && r.d_lo[a] >= 0.0f ? ones : 0.0f;
+      // 1/d decreases on each sign, so [1/d_hi, 1/d_lo], widened.
+      float lo = positive || negative ? 1.0f / r.d_hi[a] : 0.0f;
+      float hi = positive || negative ? 1.0f / r.d_lo[a] : 0.0f;
+      rlo[a] = lo - std::fabs(lo) * kRelativeMargin;
+      rhi[a] = hi + std::fabs(hi) * kRelativeMargin;
+    }
+    for (int a = 0; a < 3; ++a) {
+      axis_[a].o_lo = olo[a];
+      axis_[a].o_hi = ohi[a];
+      axis_[a].r_lo = rlo[a];
+      axis_[a].r_hi = rhi[a];
+      axis_[a].sign = pos[a] != 0.0f ? 1 : neg[a] != 0.0f ? -1 : 0;
+    }
+    o_lo_ = _mm_load_ps(olo);
+    o_hi_ = _mm_load_ps(ohi);
+    r_lo_ = _mm_load_ps(rlo);
+    r_hi_ = _mm_load_ps(rhi);
+    positive_ = _mm_load_ps(pos);
+    negative_ = _mm_load_ps(neg);
+    not_rising_ = _mm_load_ps(nr);
+    not_falling_ = _mm_load_ps(nf);
+  }
+
+  // How much to grow boxes by, per axis.
+  struct Growth {
+    __m128 v;         // x, y, z, 0
+    float axis[3];
+  };
+
+  // The growth for boxes inside `enclosing` that absorbs this bound's own
+  // rounding, on top of the caller's `slack`: the rounding of
+  // (plane - origin) on an axis is relative to that axis's coordinates
+  // alone, so a flat ground is not grown at the scale of its width.
+  Growth grow_for(const Aabb& enclosing, float slack) const {
+    Growth g;
+    alignas(16) float v[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+    for (int a = 0; a < 3; ++a) {
+      const float box = std::max(std::fabs(enclosing.lower[a]), std::fabs(enclosing.upper[a]));
+      const float origin = std::max(std::fabs(axis_[a].o_lo), std::fabs(axis_[a].o_hi));
+      // NaN coordinates make the growth NaN, and so every box test pass.
+      const float m = box != box || origin != origin ? box + origin : std::max(box, origin);
+      v[a] = g.axis[a] = slack + kRelativeMargin * m;
+    }
+    g.v = _mm_load_ps(v);
+    return g;
+  }
+
+  float t_lo() const { return t_lo_; }
+  float t_hi() const { return t_hi_; }
+
+  // A lower bound on the parameter, within [t_lo, t_hi], at which some ray
+  // enters `box` grown by `grow` on every side; +inf when no ray does.
+  float entry(const Aabb& box, const Growth& grow, float t_hi) const {
+    constexpr float kInf = std::numeric_limits<float>::infinity();
+    if (unbounded_) return -kInf;
+    const __m128 g = grow.v;
+    const __m128 lo = _mm_sub_ps(_mm_setr_ps(box.lower.x, box.lower.y, box.lower.z, 0.0f), g);
+    const __m128 hi = _mm_add_ps(_mm_setr_ps(box.upper.x, box.upper.y, box.upper.z, 0.0f), g);
+    // Every origin on one side of a slab, no direction turning towards it.
+    const __m128 below = _mm_and_ps(_mm_cmplt_ps(o_hi_, lo), not_rising_);
+    const __m128 above = _mm_and_ps(_mm_cmpgt_ps(o_lo_, hi), not_falling_);
+    if (_mm_movemask_ps(_mm_or_ps(below, above)) != 0) return kInf;
+    const __m128 sign = _mm_set1_ps(-0.0f);
+    const __m128 rel = _mm_set1_ps(kRelativeMargin);
+    // Rising rays enter through the lower plane, falling ones through the
+    // upper; the extremes of the four products of each plane's offset
+    // range and the reciprocal range, widened.
+    const auto lower_bound = [&](__m128 plane) {
+      const __m128 a0 = _mm_sub_ps(plane, o_hi_), a1 = _mm_sub_ps(plane, o_lo_);
+      const __m128 mn = _mm_min_ps(_mm_min_ps(_mm_mul_ps(a0, r_lo_), _mm_mul_ps(a0, r_hi_)),
+                                   _mm_min_ps(_mm_mul_ps(a1, r_lo_), _mm_mul_ps(a1, r_hi_)));
+      return _mm_sub_ps(mn, _mm_mul_ps(_mm_andnot_ps(sign, mn), rel));
+    };
+    const auto upper_bound = [&](__m128 plane) {
+      const __m128 a0 = _mm_sub_ps(plane, o_hi_), a1 = _mm_sub_ps(plane, o_lo_);
+      const __m128 mx = _mm_max_ps(_mm_max_ps(_mm_mul_ps(a0, r_lo_), _mm_mul_ps(a0, r_hi_)),
+                                   _mm_max_ps(_mm_mul_ps(a1, r_lo_), _mm_mul_ps(a1, r_hi_)));
+      return _mm_add_ps(mx, _mm_mul_ps(_mm_andnot_ps(sign, mx), rel));
+    };
+    // Per axis the plane a ray enters by and the one it leaves by.
+    const __m128 enter_plane = _mm_blendv_ps(hi, lo, positive_);
+    const __m128 leave_plane = _mm_blendv_ps(lo, hi, positive_);
+    const __m128 bounded = _mm_or_ps(positive_, negative_);
+    const __m128 enter = _mm_blendv_ps(_mm_set1_ps(-kInf), lower_bound(enter_plane), bounded);
+    const __m128 leave = _mm_blendv_ps(_mm_set1_ps(kInf), upper_bound(leave_plane), bounded);
+    __m128 e = _mm_max_ps(enter, _mm_movehl_ps(enter, enter));
+    e = _mm_max_ss(e, _mm_movehdup_ps(e));
+    __m128 l = _mm_min_ps(leave, _mm_movehl_ps(leave, leave));
+    l = _mm_min_ss(l, _mm_movehdup_ps(l));
+    const float t_enter = std::max(t_lo_, _mm_cvtss_f32(e));
+    const float t_leave = std::min(t_hi, _mm_cvtss_f32(l));
+    return t_enter <= t_leave ? t_enter : kInf;
+  }
+  float entry(const Aabb& box, const Growth& grow) const { return entry(box, grow, t_hi_); }
+
+  // The direction sign of every ray of the set on axis a: +1, -1, or 0
+  // (mixed, zero or too small to bound).
+  int sign(int a) const { return axis_[a].sign; }
+
+  // For an axis of fixed sign: bounds on the parameter at which the rays
+  // cross the plane x_a = plane, over every ray of the set (the plane
+  // offset by the caller's growth).
+  float crossing_lo(int a, float plane) const {
+    const Axis& x = axis_[a];
+    const float a0 = plane - x.o_hi, a1 = plane - x.o_lo;
+    const float mn = std::min(std::min(a0 * x.r_lo, a0 * x.r_hi), std::min(a1 * x.r_lo, a1 * x.r_hi));
+    return mn - std::fabs(mn) * kRelativeMargin;
+  }
+  float crossing_hi(int a, float plane) const {
+    const Axis& x = axis_[a];
+    const float a0 = plane - x.o_hi, a1 = plane - x.o_lo;
+    const float mx = std::max(std::max(a0 * x.r_lo, a0 * x.r_hi), std::max(a1 * x.r_lo, a1 * x.r_hi));
+    return mx + std::fabs(mx) * kRelativeMargin;
+  }
+
+ private:
+  __m128 o_lo_{}, o_hi_{}, r_lo_{}, r_hi_{};
+  __m128 positive_{}, negative_{}, not_rising_{}, not_falling_{};
+  struct Axis {
+    float o_lo = 0.0f, o_hi = 0.0f, r_lo = 0.0f, r_hi = 0.0f;
+    int sign = 0;
+  };
+  Axis axis_[3];
+  float t_lo_ = 0.0f, t_hi_ = 0.0f;
+  bool unbounded_ = false;
+};
+
+}  // namespace sinew::rt

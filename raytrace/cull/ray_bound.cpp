@@ -1,0 +1,372 @@
+#include "raytrace/cull/ray_bound.h"
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cmath>
+#include <limits>
+
+#include "raytrace/traverse/traversal_shared.h"
+#include "runtime/math/float8.h"
+
+#include <immintrin.h>
+
+namespace sinew::rt {
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+// Directions smaller than this on an axis give no reciprocal bound there
+// (1/d may overflow); such an axis simply does not cull.
+constexpr float kTinyDirection = 1e-30f;
+// Widening of every interval product and box coordinate: far above the
+// 2^-24 relative rounding of each operation.
+constexpr float kRelativeMargin = 0x1.0p-20f;
+
+}  // namespace
+
+namespace {
+
+// Lanes not in `lanes` repeat an active lane's values, so they widen nothing.
+Float8 pick(const float* p, Mask8 use, int first) { return select(use, Float8::load(p), Float8(p[first])); }
+
+void fold_in(bool empty, float* lo, float* hi, Float8 x) {
+  if (empty) {
+    x.store(lo);
+    x.store(hi);
+  } else {
+    min(Float8::load(lo), x).store(lo);
+    max(Float8::load(hi), x).store(hi);
+  }
+}
+
+}  // namespace
+
+bool RayBound::add_directions(const float* const d[3], std::uint32_t lanes) {
+  const Mask8 use = Mask8::from_bits(lanes);
+  const int first = std::countr_zero(lanes);
+  Mask8 finite = Mask8::from_bits(0xFFu);
+  for (int a = 0; a < 3; ++a) {
+    const Float8 da = pick(d[a], use, first);
+    finite = finite & is_finite(da);
+    fold_in(empty_, lanes_.d_min[a], lanes_.d_max[a], da);
+  }
+  empty_ = false;
+  folded_ = false;
+  return finite.bits() == 0xFFu;
+}
+
+void RayBound::add_lanes(const float* const o[3], const float* const d[3], const float* t_min, const float* t_max,
+                         std::uint32_t lanes) {
+  lanes &= 0xFFu;
+  if (lanes == 0) return;
+  const Mask8 use = Mask8::from_bits(lanes);
+  const int first = std::countr_zero(lanes);
+  const Float8 t0p = pick(t_min, use, first), t1p = pick(t_max, use, first);
+  Mask8 finite = is_finite(t0p) & (t0p < t1p);
+  for (int a = 0; a < 3; ++a) {
+    const Float8 oa = pick(o[a], use, first);
+    finite = finite & is_finite(oa);
+    fold_in(lane_origins_empty_, lanes_.o_min[a], lanes_.o_max[a], oa);
+  }
+  if (lane_origins_empty_) {
+    t0p.store(lanes_.t_min);
+    t1p.store(lanes_.t_max);
+  } else {
+    min(Float8::load(lanes_.t_min), t0p).store(lanes_.t_min);
+    max(Float8::load(lanes_.t_max), t1p).store(lanes_.t_max);
+  }
+  lane_origins_empty_ = false;
+  if (!add_directions(d, lanes) || finite.bits() != 0xFFu) unbounded_ = true;
+}
+
+bool RayBound::add_shared(const Vec3& origin, float t_min, float t_max) {
+  bool finite = std::isfinite(t_min) && t_min < t_max;
+  for (int a = 0; a < 3; ++a) {
+    finite = finite && std::isfinite(origin[a]);
+    shared_o_lo_[a] = shared_empty_ ? origin[a] : std::min(shared_o_lo_[a], origin[a]);
+    shared_o_hi_[a] = shared_empty_ ? origin[a] : std::max(shared_o_hi_[a], origin[a]);
+  }
+  shared_t_lo_ = shared_empty_ ? t_min : std::min(shared_t_lo_, t_min);
+  shared_t_hi_ = shared_empty_ ? t_max : std::max(shared_t_hi_, t_max);
+  shared_empty_ = false;
+  return finite;
+}
+
+template <class LanesOf>
+void RayBound::add_shared_groups(const Vec3& origin, const float* const d[3], float t_min, float t_max,
+                                 std::size_t groups, LanesOf&& lanes_of) {
+  // The running extremes stay in registers; lanes never in use keep +-inf,
+  // which no fold picks.
+  const Float8 plus(kInf), minus(-kInf);
+  Float8 lo[3] = {plus, plus, plus}, hi[3] = {minus, minus, minus};
+  Mask8 finite = Mask8::from_bits(0xFFu);
+  std::uint32_t any = 0;
+  for (std::size_t k = 0; k < groups; ++k) {
+    const std::uint32_t lanes = lanes_of(k) & 0xFFu;
+    if (lanes == 0) continue;
+    any |= lanes;
+    const Mask8 use = Mask8::from_bits(lanes);
+    for (int a = 0; a < 3; ++a) {
+      const Float8 x = Float8::load(d[a] + 8 * k);
+      finite = finite & (is_finite(x) | !use);
+      lo[a] = min(lo[a], select(use, x, plus));
+      hi[a] = max(hi[a], select(use, x, minus));
+    }
+  }
+  if (any == 0) return;
+  for (int a = 0; a < 3; ++a) {
+    if (empty_) {
+      lo[a].store(lanes_.d_min[a]);
+      hi[a].store(lanes_.d_max[a]);
+    } else {
+      min(Float8::load(lanes_.d_min[a]), lo[a]).store(lanes_.d_min[a]);
+      max(Float8::load(lanes_.d_max[a]), hi[a]).store(lanes_.d_max[a]);
+    }
+  }
+  empty_ = false;
+  folded_ = false;
+  if (!add_shared(origin, t_min, t_max) || finite.bits() != 0xFFu) unbounded_ = true;
+}
+
+void RayBound::add_lanes(const Vec3& origin, const float* const d[3], float t_min, float t_max,
+                         std::uint32_t lanes) {
+  add_shared_groups(origin, d, t_min, t_max, 1, [&](std::size_t) { return lanes; });
+}
+
+void RayBound::add_groups(const Vec3& origin, const float* const d[3], float t_min, float t_max,
+                          std::span<const std::uint8_t> lanes) {
+  add_shared_groups(origin, d, t_min, t_max, lanes.size(), [&](std::size_t k) { return std::uint32_t{lanes[k]}; });
+}
+
+void RayBound::add_run(const Vec3& origin, const float* const d[3], float t_min, float t_max, std::size_t rays) {
+  add_shared_groups(origin, d, t_min, t_max, (rays + 7) / 8, [&](std::size_t k) {
+    const std::size_t left = rays - 8 * k;
+    return left >= 8 ? 0xFFu : (1u << left) - 1u;
+  });
+}
+
+void RayBound::fold() const {
+  if (folded_ || empty_) return;
+  o_mag_ = d_mag_ = 0.0f;
+  const float big = std::numeric_limits<float>::max();
+  for (int a = 0; a < 3; ++a) {
+    o_lo_[a] = shared_empty_ ? big : shared_o_lo_[a];
+    o_hi_[a] = shared_empty_ ? -big : shared_o_hi_[a];
+    if (!lane_origins_empty_) {
+      o_lo_[a] = std::min(o_lo_[a], reduce_min(Float8::load(lanes_.o_min[a])));
+      o_hi_[a] = std::max(o_hi_[a], reduce_max(Float8::load(lanes_.o_max[a])));
+    }
+    d_lo_[a] = reduce_min(Float8::load(lanes_.d_min[a]));
+    d_hi_[a] = reduce_max(Float8::load(lanes_.d_max[a]));
+    o_mag_ = std::max({o_mag_, std::fabs(o_lo_[a]), std::fabs(o_hi_[a])});
+    d_mag_ = std::max({d_mag_, std::fabs(d_lo_[a]), std::fabs(d_hi_[a])});
+  }
+  t_lo_ = shared_empty_ ? kInf : shared_t_lo_;
+  t_hi_ = shared_empty_ ? -kInf : shared_t_hi_;
+  if (!lane_origins_empty_) {
+    t_lo_ = std::min(t_lo_, reduce_min(Float8::load(lanes_.t_min)));
+    t_hi_ = std::max(t_hi_, reduce_max(Float8::load(lanes_.t_max)));
+  }
+  folded_ = true;
+}
+
+float RayBound::world_slack_bound(float scene_magnitude) const {
+  fold();
+  return traversal_slack_bound(o_mag_, d_mag_, t_hi_, scene_magnitude);
+}
+
+RayBound::Test RayBound::test() const {
+  fold();
+  Test t;
+  t.unbounded = unbounded_;
+  t.t_lo = t_lo_;
+  t.t_hi = t_hi_;
+  const float ones = std::bit_cast<float>(0xFFFFFFFFu);
+  for (int a = 0; a < 4; ++a) {
+    const bool axis = a < 3;
+    t.o_lo[a] = axis ? o_lo_[a] : 0.0f;
+    t.o_hi[a] = axis ? o_hi_[a] : 0.0f;
+    const bool positive = axis && d_lo_[a] >= kTinyDirection;
+    const bool negative = axis && d_hi_[a] <= -kTinyDirection;
+    t.positive[a] = positive ? ones : 0.0f;
+    t.negative[a] = negative ? ones : 0.0f;
+    t.not_rising[a] = axis && d_hi_[a] <= 0.0f ? ones : 0.0f;
+    t.not_falling[a] = axis && d_lo_[a] >= 0.0f ? ones : 0.0f;
+    // 1/d decreases on each sign, so [1/d_hi, 1/d_lo], widened.
+    float r_lo = positive || negative ? 1.0f / d_hi_[a] : 0.0f;
+    float r_hi = positive || negative ? 1.0f / d_lo_[a] : 0.0f;
+    r_lo -= std::fabs(r_lo) * kRelativeMargin;
+    r_hi += std::fabs(r_hi) * kRelativeMargin;
+    t.r_lo[a] = r_lo;
+    t.r_hi[a] = r_hi;
+  }
+  return t;
+}
+
+bool RayBound::Test::may_enter(const Aabb& box, float grow) const {
+  if (unbounded) return true;
+  const __m128 sign = _mm_set1_ps(-0.0f);
+  const __m128 lower = _mm_setr_ps(box.lower.x, box.lower.y, box.lower.z, 0.0f);
+  const __m128 upper = _mm_setr_ps(box.upper.x, box.upper.y, box.upper.z, 0.0f);
+  if (_mm_movemask_ps(_mm_cmpunord_ps(lower, upper)) != 0) return true;  // a NaN box: never culled
+  const __m128 olo = _mm_loadu_ps(o_lo), ohi = _mm_loadu_ps(o_hi);
+  // The rounding of (plane - origin) on an axis is relative to that axis's
+  // coordinates alone: a flat ground's height is not rounded at the scale
+  // of its width.
+  const __m128 mag = _mm_max_ps(_mm_max_ps(_mm_andnot_ps(sign, lower), _mm_andnot_ps(sign, upper)),
+                                _mm_max_ps(_mm_andnot_ps(sign, olo), _mm_andnot_ps(sign, ohi)));
+  const __m128 margin = _mm_add_ps(_mm_set1_ps(grow), _mm_mul_ps(_mm_set1_ps(kRelativeMargin), mag));
+  const __m128 lo = _mm_sub_ps(lower, margin);
+  const __m128 hi = _mm_add_ps(upper, margin);
+  // Every origin on one side of a slab, no direction turning towards it.
+  const __m128 below = _mm_and_ps(_mm_cmplt_ps(ohi, lo), _mm_loadu_ps(not_rising));
+  const __m128 above = _mm_and_ps(_mm_cmpgt_ps(olo, hi), _mm_loadu_ps(not_falling));
+  if (_mm_movemask_ps(_mm_or_ps(below, above)) != 0) return false;
+  const __m128 rlo = _mm_loadu_ps(r_lo), rhi = _mm_loadu_ps(r_hi);
+  // Each plane's parameter range over the set: the extremes of the four
+  // products of (plane - origin range) x (reciprocal range), widened.
+  const auto products = [&](__m128 plane, __m128& min_out, __m128& max_out) {
+    const __m128 a0 = _mm_sub_ps(plane, ohi), a1 = _mm_sub_ps(plane, olo);
+    const __m128 p0 = _mm_mul_ps(a0, rlo), p1 = _mm_mul_ps(a0, rhi);
+    const __m128 p2 = _mm_mul_ps(a1, rlo), p3 = _mm_mul_ps(a1, rhi);
+    const __m128 mn = _mm_min_ps(_mm_min_ps(p0, p1), _mm_min_ps(p2, p3));
+    const __m128 mx = _mm_max_ps(_mm_max_ps(p0, p1), _mm_max_ps(p2, p3));
+    const __m128 rel = _mm_set1_ps(kRelativeMargin);
+    min_out = _mm_sub_ps(mn, _mm_mul_ps(_mm_andnot_ps(sign, mn), rel));
+    max_out = _mm_add_ps(mx, _mm_mul_ps(_mm_andnot_ps(sign, mx), rel));
+  };
+  __m128 lo_min, lo_max, hi_min, hi_max;
+  products(lo, lo_min, lo_max);
+  products(hi, hi_min, hi_max);
+  // Rising rays enter through the lower plane and leave through the upper;
+  // falling ones the other way; other axes bound nothing.
+  const __m128 pos = _mm_loadu_ps(positive), neg = _mm_loadu_ps(negative);
+  const __m128 minus_inf = _mm_set1_ps(-kInf), plus_inf = _mm_set1_ps(kInf);
+  const __m128 enter = _mm_blendv_ps(_mm_blendv_ps(minus_inf, hi_min, neg), lo_min, pos);
+  const __m128 leave = _mm_blendv_ps(_mm_blendv_ps(plus_inf, lo_max, neg), hi_max, pos);
+  __m128 e = _mm_max_ps(enter, _mm_movehl_ps(enter, enter));
+  e = _mm_max_ss(e, _mm_movehdup_ps(e));
+  __m128 l = _mm_min_ps(leave, _mm_movehl_ps(leave, leave));
+  l = _mm_min_ss(l, _mm_movehdup_ps(l));
+  const float t_enter = std::max(t_lo, _mm_cvtss_f32(e));
+  const float t_leave = std::min(t_hi, _mm_cvtss_f32(l));
+  return !(t_enter > t_leave);
+}
+
+void cull_objects(const Scene& scene, const RayBound& bound, std::vector<std::uint32_t>& out, float extra_grow) {
+  const TopLevel& top = scene.top_level();
+  const KdTreeView tree = top.view();
+  if (tree.empty() || bound.empty()) return;
+  const std::span<const TopLevelObject> objects = top.objects();
+  const RayBound::Test test = bound.test();
+  // One grow for every box and cell: the largest slack of any box in the
+  // scene. A point within an object's slack of the object lies within that
+  // much of a cell that lists the object.
+  const float grow = bound.world_slack_bound(detail::max_abs(tree.bounds)) + extra_grow;
+  const std::span<const ObjectRun> runs = top.runs();
+  if (runs.size() <= kFlatCullObjects) {
+    // A few dozen runs (characters, grounds): one box test each, and one
+    // per member of the runs a ray may enter, costs less than walking the
+    // tree's cells to them (Cally walk, 2 threads: primary 4.5 -> 4.4 ms,
+    // shadow 3.8 -> 3.6 ms testing every object; most tiles miss the
+    // character's box, which skips its bones at once). A run's box holds
+    // its members' and its margin is no smaller (the margin grows with the
+    // coordinates), so a member a ray may enter never sits in a run it
+    // cannot. In index order, as the walk's sorted output.
+    for (const ObjectRun& run : runs) {
+      if (run.count > 1 && !test.may_enter(run.box, grow)) continue;
+      for (std::uint32_t object = run.first; object < run.first + run.count; ++object) {
+        if (test.may_enter(objects[object].box, grow)) out.push_back(object);
+      }
+    }
+    return;
+  }
+  // Walk the top-level tree over the cells the set may enter; each object
+  // is tested once (objects straddle splits and sit in several leaves).
+  thread_local std::vector<std::uint32_t> stamp;
+  thread_local std::uint32_t stamp_value = 0;
+  if (stamp.size() < objects.size()) stamp.assign(objects.size(), 0);
+  if (++stamp_value == 0) {
+    std::fill(stamp.begin(), stamp.end(), 0);
+    stamp_value = 1;
+  }
+  const std::size_t first_out = out.size();
+  for_each_reached_leaf(tree, test, grow, [&](std::uint32_t first, std::uint32_t count) {
+    for (std::uint32_t i = 0; i < count; ++i) {
+      const std::uint32_t object = tree.items[first + i];
+      if (stamp[object] == stamp_value) continue;
+      stamp[object] = stamp_value;
+      if (test.may_enter(objects[object].box, grow)) out.push_back(object);
+    }
+    return true;
+  });
+  std::sort(out.begin() + static_cast<std::ptrdiff_t>(first_out), out.end());
+}
+
+void cull_objects_for_packet(const Scene& scene, const float* const o[3], const float* const d[3],
+                             const float* t_min, const float* t_max, std::uint32_t lanes,
+                             const std::vector<std::uint32_t>& among, std::vector<std::uint32_t>& out) {
+  lanes &= 0xFFu;
+  if (lanes == 0 || among.empty()) return;
+  const std::span<const TopLevelObject> objects = scene.top_level().objects();
+  const float scene_magnitude = detail::max_abs(scene.top_level().bounds());
+  // The traversal's slack for these lanes, bounded as RayBound does (one
+  // value for all lanes and boxes).
+  Float8 o_mag(0.0f), d_mag(0.0f);
+  Vec3x8 origin, direction, inverse;
+  Float8* const oc[3] = {&origin.x, &origin.y, &origin.z};
+  Float8* const dc[3] = {&direction.x, &direction.y, &direction.z};
+  Float8* const ic[3] = {&inverse.x, &inverse.y, &inverse.z};
+  for (int a = 0; a < 3; ++a) {
+    *oc[a] = Float8::load(o[a]);
+    *dc[a] = Float8::load(d[a]);
+    *ic[a] = Float8(1.0f) / *dc[a];
+    o_mag = max(o_mag, abs(*oc[a]));
+    d_mag = max(d_mag, abs(*dc[a]));
+  }
+  const Float8 t0 = Float8::load(t_min), t1 = Float8::load(t_max);
+  const Mask8 use = Mask8::from_bits(lanes);
+  const float om = reduce_max(select(use, o_mag, Float8(0.0f)));
+  const float dm = reduce_max(select(use, d_mag, Float8(0.0f)));
+  const float tm = reduce_max(select(use, t1, Float8(0.0f)));
+  float reach = 1.01f * (om + scene_magnitude);
+  if (std::isfinite(tm)) reach = std::max(reach, tm * dm * 1.01f);
+  const float grow = kFrameRelativeSlack * 1.01f * (om + reach + scene_magnitude);
+  // Entered objects with the earliest entry of any lane, sorted by it.
+  struct Entered {
+    float entry;
+    std::uint32_t object;
+  };
+  thread_local std::vector<Entered> entered;
+  entered.clear();
+  for (const std::uint32_t object : among) {
+    const Aabb& box = objects[object].box;
+    // The lane clip of traverse/traversal_shared.h (clip_to_box), per lane,
+    // against the box grown by `grow` (>= every lane's own slack).
+    Float8 near_t = t0, far_t = t1;
+    Mask8 outside = Mask8::from_bits(0);
+    for (int a = 0; a < 3; ++a) {
+      const Float8 lo = Float8(box.lower[a] - grow);
+      const Float8 hi = Float8(box.upper[a] + grow);
+      const Mask8 parallel = *dc[a] == Float8(0.0f);
+      outside = outside | (parallel & !((*oc[a] >= lo) & (*oc[a] <= hi)));
+      const Float8 n = (lo - *oc[a]) * *ic[a];
+      const Float8 f = (hi - *oc[a]) * *ic[a];
+      near_t = select(parallel, near_t, max(min(n, f), near_t));
+      far_t = select(parallel, far_t, min(max(n, f), far_t));
+    }
+    // NaN in near/far (0 * inf cannot happen off parallel lanes) keeps the lane.
+    const std::uint32_t open = (!(near_t > far_t)).bits() & ~outside.bits() & lanes;
+    if (open != 0) {
+      // NaN entries (kept lanes) sort first.
+      const float entry = reduce_min(select(Mask8::from_bits(open), near_t, Float8(kInf)));
+      entered.push_back({entry == entry ? entry : -kInf, object});
+    }
+  }
+  std::sort(entered.begin(), entered.end(), [](const Entered& a, const Entered& b) {
+    return a.entry < b.entry || (a.entry == b.entry && a.object < b.object);
+  });
+  for (const Entered& e : entered) out.push_back(e.object);
+}
+
+}  // namespace sinew::rt

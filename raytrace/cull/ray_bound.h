@@ -1,0 +1,181 @@
+// RayBound: a conservative bound on a whole set of rays (a tile's primary
+// rays, a packet's shadow rays), and the culling it pays for: which of the
+// scene's top-level objects any ray of the set may enter.
+//
+// The bound is interval arithmetic over the set: per axis the range of the
+// origins, the range of the directions (and so of their reciprocals, where
+// the sign is the same for every ray), and the range of [t_min, t_max]. A
+// ray of the set inside a box at parameter t satisfies, on every axis whose
+// direction sign is fixed, entry_a <= t <= exit_a for the box's slab; the
+// interval products below bound entry_a from below and exit_a from above
+// over every origin and reciprocal in the ranges. When
+// max(t_lo, max_a entry_a) > min(t_hi, min_a exit_a), no ray of the set
+// reaches the box. One test costs a dozen multiplies whatever the set's size,
+// which is what makes tiles that see only the ground or the sky cheap.
+//
+// Numerical safety: the traversal's own box clips (traverse/traversal.h) grow
+// each box by a slack eps that depends on the ray (its origin, its reach and
+// the box's magnitude). cull_objects() grows every box by an upper bound on
+// that slack over the whole set plus a relative margin for its own rounding,
+// and widens each interval product by a relative 2^-20, so it never rejects a
+// box that a single ray's clip would accept: culling changes no result.
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "raytrace/accel/kd_tree.h"
+#include "raytrace/scene/scene.h"
+#include "runtime/math/aabb.h"
+#include "runtime/math/types.h"
+
+namespace sinew::rt {
+
+// An upper bound on the slack the traversal grows a world-space box by
+// (kFrameRelativeSlack * (|o| + t_end |d| + |box|), traverse/traversal.h)
+// over rays whose origin and direction coordinates are at most o_mag and
+// d_mag in magnitude and whose t_max is at most t_hi, for boxes inside a
+// scene of magnitude scene_magnitude. The reach t_end |d| is at most
+// t_hi d_mag when t_hi is finite (t_end never passes t_max); otherwise it is
+// a finite hit's, inside the scene, so at most o_mag + scene_magnitude.
+// Shadow rays (t_hi = 1) reach only their own length, not the scene's.
+inline float traversal_slack_bound(float o_mag, float d_mag, float t_hi, float scene_magnitude) {
+  const float reach = std::isfinite(t_hi) ? 1.01f * t_hi * d_mag : 1.01f * (o_mag + scene_magnitude);
+  return kFrameRelativeSlack * 1.01f * (o_mag + reach + scene_magnitude);
+}
+
+class RayBound {
+ public:
+  // Adds the rays of `lanes` (bit i: lane i) of an eight-lane SoA packet.
+  // Accumulates lane by lane; the eight lanes are folded into one range
+  // only when the bound is used.
+  void add_lanes(const float* const o[3], const float* const d[3], const float* t_min, const float* t_max,
+                 std::uint32_t lanes);
+  // Adds eight rays from one shared origin with one [t_min, t_max]: only
+  // the directions are folded lane by lane (a tile's camera rays, a point
+  // light's shadow rays).
+  void add_lanes(const Vec3& origin, const float* const d[3], float t_min, float t_max, std::uint32_t lanes);
+  // The same for consecutive groups of eight at d[axis][8 k + lane]: group
+  // k's lanes lanes[k] (a tile's camera rays, block by block), or every ray
+  // of a run of `rays` (a point light's shadow rays). The same bound as
+  // adding each group on its own, at a fraction of the cost.
+  void add_groups(const Vec3& origin, const float* const d[3], float t_min, float t_max,
+                  std::span<const std::uint8_t> lanes);
+  void add_run(const Vec3& origin, const float* const d[3], float t_min, float t_max, std::size_t rays);
+
+  bool empty() const { return empty_; }
+
+  // An upper bound, over every ray of the set, on the slack the traversal
+  // grows a world-space box by when it clips a ray against it, for boxes
+  // inside a scene of magnitude `scene_magnitude` (traverse/traversal.h).
+  float world_slack_bound(float scene_magnitude) const;
+
+  // The bound in the form the box test wants, computed once per set.
+  class Test {
+   public:
+    // Whether some ray of the set may pass through `box` grown by `grow`
+    // on every side within its [t_min, t_max]. False only when none can.
+    bool may_enter(const Aabb& box, float grow) const;
+
+   private:
+    friend class RayBound;
+    float o_lo[4], o_hi[4];  // origin range per axis (x, y, z, unused)
+    float r_lo[4], r_hi[4];  // reciprocal direction range where the sign is fixed
+    float positive[4], negative[4];         // all-ones where every direction is > 0 (< 0)
+    float not_rising[4], not_falling[4];    // all-ones where no direction is > 0 (< 0)
+    float t_lo = 0.0f, t_hi = 0.0f;
+    bool unbounded = false;  // a non-finite ray: every box may be entered
+  };
+  Test test() const;
+
+ private:
+  // Folds the directions of `lanes` (not 0) of rays with their own origins
+  // in; false when one is not finite.
+  bool add_directions(const float* const d[3], std::uint32_t lanes);
+  // Folds in one shared origin and parameter range; false when not finite.
+  bool add_shared(const Vec3& origin, float t_min, float t_max);
+  // add_groups for `groups` groups, group k's lanes lanes_of(k).
+  template <class LanesOf>
+  void add_shared_groups(const Vec3& origin, const float* const d[3], float t_min, float t_max, std::size_t groups,
+                         LanesOf&& lanes_of);
+  void fold() const;
+
+  // Per lane, the running minimum and maximum of each quantity: the
+  // directions of every ray added, the origins and parameters of the rays
+  // added with their own (lane_origins_empty_ says whether any were).
+  struct Lanes {
+    float o_min[3][8], o_max[3][8], d_min[3][8], d_max[3][8];
+    float t_min[8], t_max[8];
+  };
+  Lanes lanes_{};
+  // The shared origins and parameter ranges of the rays added with one.
+  float shared_o_lo_[3] = {0, 0, 0}, shared_o_hi_[3] = {0, 0, 0};
+  float shared_t_lo_ = 0.0f, shared_t_hi_ = 0.0f;
+  bool empty_ = true;               // no ray at all (so no direction)
+  bool lane_origins_empty_ = true;  // no ray with its own origin
+  bool shared_empty_ = true;        // no ray with a shared origin
+  bool unbounded_ = false;  // a non-finite ray was added
+  // Folded (by fold(), on first use).
+  mutable bool folded_ = false;
+  mutable float o_lo_[3] = {0, 0, 0}, o_hi_[3] = {0, 0, 0};
+  mutable float d_lo_[3] = {0, 0, 0}, d_hi_[3] = {0, 0, 0};
+  mutable float t_lo_ = 0.0f, t_hi_ = 0.0f;
+  mutable float o_mag_ = 0.0f, d_mag_ = 0.0f;
+};
+
+// Calls leaf(first_item, item_count) for every leaf of `tree` whose cell,
+// grown by `grow`, some ray of `test`'s set may enter (empty leaves too),
+// until it returns false.
+template <class LeafFn>
+void for_each_reached_leaf(const KdTreeView& tree, const RayBound::Test& test, float grow, LeafFn&& leaf) {
+  if (tree.empty() || !test.may_enter(tree.bounds, grow)) return;
+  struct Entry {
+    std::uint32_t node;
+    Aabb cell;
+  };
+  std::array<Entry, kMaxTraversalDepth + 2> stack;
+  std::size_t top = 0;
+  stack[top++] = {0, tree.bounds};
+  while (top > 0) {
+    const Entry e = stack[--top];
+    const KdNode node = tree.nodes[e.node];
+    if (node.is_leaf()) {
+      if (!leaf(node.first_item(), node.item_count())) return;
+      continue;
+    }
+    const int a = node.axis();
+    Entry below{e.node + 1, e.cell};
+    Entry above{node.above_child(), e.cell};
+    below.cell.upper[a] = std::min(below.cell.upper[a], node.split());
+    above.cell.lower[a] = std::max(above.cell.lower[a], node.split());
+    if (test.may_enter(below.cell, grow)) stack[top++] = below;
+    if (test.may_enter(above.cell, grow)) stack[top++] = above;
+  }
+}
+
+// Scenes with at most this many runs of top-level objects (characters,
+// static meshes: accel/top_level.h ObjectRun) are culled by testing each
+// run's box, then the boxes of the runs entered; larger ones by walking the
+// top-level tree.
+inline constexpr std::size_t kFlatCullObjects = 64;
+
+// The top-level objects (indices into scene.top_level().objects(), in
+// ascending order) that some ray of `bound` may enter, every box grown by
+// extra_grow beyond the bound's own slack bound. Appends to `out`.
+void cull_objects(const Scene& scene, const RayBound& bound, std::vector<std::uint32_t>& out,
+                  float extra_grow = 0.0f);
+
+// Of `among` (object indices), those that some lane of `lanes` of an
+// eight-ray SoA packet may enter, by each lane's own slab test against the
+// box grown by a bound on the traversal's slack (exact per lane, so tighter
+// than a bound on the packet). Appends them to `out` front to back: by the
+// earliest entry of any lane, then by index.
+void cull_objects_for_packet(const Scene& scene, const float* const o[3], const float* const d[3],
+                             const float* t_min, const float* t_max, std::uint32_t lanes,
+                             const std::vector<std::uint32_t>& among, std::vector<std::uint32_t>& out);
+
+}  // namespace sinew::rt

@@ -1,0 +1,99 @@
+// What one render is asked for: the lights, the settings that trade speed
+// for accuracy or choose the ray layout, the host's output buffers, and the
+// statistics it returns (render/renderer.h).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+
+#include "raytrace/geometry/triangle_intersect.h"
+#include "raytrace/traverse/traversal.h"
+#include "runtime/math/types.h"
+
+namespace sinew::rt {
+
+struct Light {
+  enum class Kind : std::uint8_t { kPoint, kDirectional };
+  Kind kind = Kind::kPoint;
+  Vec3 position{4.0f, 8.0f, 6.0f};   // kPoint
+  Vec3 direction{0.4f, 1.0f, 0.6f};  // kDirectional: towards the light (any length)
+  Vec3 color{1.0f};                  // linear RGB radiance scale (no distance falloff)
+};
+
+// Lights one render shades with, each with its own shadow ray.
+inline constexpr std::size_t kMaxLights = 8;
+
+struct RenderSettings {
+  TriangleTest triangle_test = TriangleTest::kFast;
+  bool shadows = true;
+  Light light;
+  // When non-empty, these lights (1 to kMaxLights; kept by the caller for
+  // the render's duration) replace `light`.
+  std::span<const Light> lights;
+  Vec3 ambient{0.18f};
+  Vec3 background{0.32f, 0.36f, 0.42f};
+  Vec3 default_albedo{0.7f};  // meshes without material colors
+  int tile_size = 32;
+  // Rays traced together: 1 (single rays), 8 (4x2-pixel packets,
+  // traverse/packet_traversal.h), 64, 256 or 512 (8x8-, 16x16- or
+  // 32x16-pixel packets culled cell by cell, traverse/large_packet.h). Shadow rays are packed
+  // from the same pixels. The hits agree (large packets may pick another
+  // triangle only at an exact tie in t); other values are refused.
+  int packet_rays = 256;
+  // With packets larger than 8x8 pixels: a packet region whose hits on
+  // characters lie on triangles about a pixel across or smaller (two in
+  // three neighbouring pixels on different triangles) traces their shadow
+  // rays as 8x8-pixel packets, and where some character's triangles look
+  // that fine from the camera (characters_look_fine) so do the static
+  // meshes' shadow rays. Same results either way: it pays on finely
+  // subdivided characters and changes nothing on coarse ones, where no
+  // region splits (docs/RAYTRACE.md, "Shadow packets on fine meshes").
+  bool split_fine_shadow_packets = true;
+};
+
+// Host-owned outputs; an empty span means "not requested" and is neither
+// computed nor written. Each non-empty span holds width * height entries
+// (colour: 4 bytes per pixel, sRGB-encoded RGBA8), row-major, y = 0 on top,
+// unless a row pitch is given for it.
+struct FrameBuffers {
+  int width = 0;
+  int height = 0;
+  std::span<std::uint8_t> color_rgba8;
+  std::span<float> color_rgba32f;  // linear RGBA
+  std::span<float> depth;          // distance along the unit primary ray; +inf on a miss
+  std::span<Vec3> normal;          // unit shading normal facing the camera; 0 on a miss
+  std::span<std::uint32_t> triangle_id;  // kInvalidId on a miss
+  std::span<std::uint32_t> instance_id;  // kInvalidId on a miss
+
+  // Bytes from the start of one row to the next, per output (a host's
+  // texture or staging buffer with padded rows); 0: rows packed. A pitch
+  // holds at least a row and is a multiple of the element's alignment (4
+  // bytes for every output but color_rgba8). With a pitch, the span reaches
+  // at least to the end of the last row's last pixel; the padding between
+  // rows is never written. Rows on 64-byte lines (span start and pitch
+  // multiples of 64) are stored fastest (render/output/output_staging.h).
+  struct RowPitches {
+    std::size_t color_rgba8 = 0;
+    std::size_t color_rgba32f = 0;
+    std::size_t depth = 0;
+    std::size_t normal = 0;
+    std::size_t triangle_id = 0;
+    std::size_t instance_id = 0;
+  };
+  RowPitches row_pitch;
+};
+
+struct RenderStats {
+  std::uint64_t primary_rays = 0;
+  std::uint64_t primary_hits = 0;
+  std::uint64_t shadow_rays = 0;
+  std::uint64_t shadowed = 0;
+  TraversalCounters primary;
+  TraversalCounters shadow;
+  double trace_primary_ms = 0.0;
+  double trace_shadow_ms = 0.0;
+  double shade_ms = 0.0;
+};
+
+}  // namespace sinew::rt

@@ -1,0 +1,75 @@
+// Pieces the tile stages (render/stages/tile_stages.h) share: lane loads and
+// stores over the tile's arrays, the rounding bound, a missed lane, and the
+// per-thread culling lists of a tile and of an eight-ray packet. Private to
+// render/stages.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "raytrace/cull/ray_bound.h"
+#include "raytrace/render/tile_scratch.h"
+#include "raytrace/traverse/packet_traversal.h"
+#include "raytrace/traverse/traversal.h"
+#include "runtime/math/float8.h"
+
+namespace sinew::rt::stages {
+
+inline constexpr float kInf = std::numeric_limits<float>::infinity();
+
+// pbrt's gamma(n): a bound on n successive float roundings.
+inline constexpr float gamma(int n) {
+  constexpr float u = std::numeric_limits<float>::epsilon() * 0.5f;
+  return (static_cast<float>(n) * u) / (1.0f - static_cast<float>(n) * u);
+}
+
+inline Vec3x8 load3(const std::vector<float>& x, const std::vector<float>& y, const std::vector<float>& z, std::size_t k) {
+  return {Float8::load(&x[k]), Float8::load(&y[k]), Float8::load(&z[k])};
+}
+inline void store3(const Vec3x8& v, std::vector<float>& x, std::vector<float>& y, std::vector<float>& z, std::size_t k) {
+  v.x.store(&x[k]);
+  v.y.store(&y[k]);
+  v.z.store(&z[k]);
+}
+
+// Per-thread lists of the objects a tile's and a packet's rays may enter.
+struct CullLists {
+  std::vector<std::uint32_t> tile;
+  std::vector<std::uint32_t> packet;
+};
+inline CullLists& cull_lists() {
+  thread_local CullLists lists;
+  return lists;
+}
+
+// Of the tile's objects, those `packet` may enter, into lists.packet. With
+// one object for the whole tile the packet's own cull could only drop it,
+// which the object's box clip does as cheaply.
+inline void cull_for_packet(const Scene& scene, const RayPacket& packet, CullLists& lists) {
+  lists.packet.clear();
+  if (lists.tile.size() == 1) {
+    lists.packet.push_back(lists.tile[0]);
+    return;
+  }
+  const float* const o[3] = {packet.ox, packet.oy, packet.oz};
+  const float* const d[3] = {packet.dx, packet.dy, packet.dz};
+  cull_objects_for_packet(scene, o, d, packet.t_min, packet.t_max, packet.active, lists.tile, lists.packet);
+}
+
+// A packet query's work added to the tile's (rays are counted by the caller).
+inline void add_work(TraversalCounters& into, const TraversalCounters& from) {
+  into.node_visits += from.node_visits;
+  into.object_visits += from.object_visits;
+  into.triangle_tests += from.triangle_tests;
+}
+
+inline void set_miss(TileScratch& s, std::size_t k) {
+  s.t[k] = kInf;
+  s.u[k] = 0.0f;
+  s.v[k] = 0.0f;
+  s.triangle[k] = kInvalidId;
+  s.instance[k] = kInvalidId;
+}
+
+}  // namespace sinew::rt::stages

@@ -1,0 +1,94 @@
+// The stages of one tile's frame, each over the tile's 4x2-pixel blocks in
+// structure-of-arrays form (render/tile_scratch.h), eight lanes at a time:
+//
+//   generate_camera_rays -> trace_primary -> reconstruct_surfaces
+//   -> per light: aim_shadow_rays -> trace_shadow_rays
+//   -> shade_and_write
+//
+// Renderer::render runs them per tile; the Embree peer of the benchmarks
+// runs the same stages with its own two trace stages, so camera rays,
+// surfaces, shadow-ray origins and shading are the same code for both.
+#pragma once
+
+#include <cstdint>
+#include <span>
+
+#include "raytrace/camera/camera.h"
+#include "raytrace/render/output/output_planes.h"
+#include "raytrace/render/render_settings.h"
+#include "raytrace/render/surface.h"
+#include "raytrace/render/tile_scratch.h"
+#include "raytrace/scene/scene.h"
+#include "raytrace/traverse/static_tiles.h"
+
+namespace sinew::rt {
+
+// Unit primary directions of every lane (lanes outside the image too, so
+// the arithmetic stays finite); bit-identical to PinholeCamera::ray.
+void generate_camera_rays(const PinholeCamera& camera, TileScratch& s);
+
+// The cone (traverse/static_tiles.h) holding every camera ray of `tile`'s
+// pixels: the rays through its corner pixels span the others (a pinhole
+// camera's direction is affine in the pixel before it is normalised, which
+// does not move a ray). And the one holding every shadow ray
+// aim_shadow_rays bounded from a point light (to the corners of
+// s.shadow_ends); without a point light none (nothing is culled).
+TileCone camera_tile_cone(const PinholeCamera& camera, const Tile& tile);
+TileCone shadow_tile_cone(const TileScratch& s);
+
+// Nearest hits of the tile's pixels, with the tile's primary rays culled
+// against the top level as one bound and each packet's again
+// (cull/ray_bound.h), s.plan.packet_rays at a time: 1 is one single-ray
+// query per pixel, no culling; 64, 256 and 512 take one packet per region.
+// Fills t, u, v, triangle, instance and block_hits.
+void trace_primary(const Scene& scene, const PinholeCamera& camera, TriangleTest test, TileScratch& s,
+                   TraversalCounters& counters);
+
+// The surfaces at the hits (positions, camera-facing geometric and
+// shading normals, albedo, rounding bound), as surface_at computes them,
+// and which hits are on characters (s.block_on_character).
+void reconstruct_surfaces(const Scene& scene, const Vec3& default_albedo, TileScratch& s);
+
+// Light `l`'s shadow rays for the hits whose surface faces it, placed lane
+// by lane (s.shadow_lanes, s.shadow_lane_*); hits facing away lose bit l of
+// s.lit here. A point light's rays are shadow_ray_from_light's (from the
+// light, t_max 1); a directional light's leave offset_origin along the
+// light (t_max inf).
+void place_shadow_rays(const Light& light, int l, TileScratch& s);
+
+// The renderer's way to the same rays, in two steps. aim_shadow_rays picks
+// the lanes (and clears bit l of s.lit for hits facing away) and bounds
+// where every ray ends (s.shadow_ends) without computing the rays;
+// offset_shadow_rays then places them as place_shadow_rays does.
+// trace_shadow_rays places aimed rays itself, and only when the bound of
+// every ray the box allows reaches some object: a tile in the open pays for
+// no ray.
+void aim_shadow_rays(const Light& light, int l, TileScratch& s);
+void offset_shadow_rays(TileScratch& s);
+
+// The placed rays compacted into s.shadow_* in runs (s.shadow_region_begin):
+// per region, the rays of its hits on characters, then those on static
+// meshes, each in block order. Does nothing when they already are.
+void compact_shadow_rays(TileScratch& s);
+
+// place_shadow_rays, then compact_shadow_rays (tracers that take every ray,
+// as the Embree peer of the benchmarks does).
+void make_shadow_rays(const Light& light, int l, TileScratch& s);
+
+// Traces the placed (or aimed) shadow rays one by one, as packets of eight,
+// or as one large packet per region (s.plan); blocked rays clear bit l of
+// s.lit. Returns how many were blocked. Packets are culled like the primary
+// rays, first the tile's rays as one bound (from their ends' box when they
+// are only aimed, then from the placed rays): when that reaches no object,
+// nothing is placed, compacted or traced. Single rays (packet_rays 1) are
+// all traced.
+std::uint64_t trace_shadow_rays(const Scene& scene, TriangleTest test, int l, TileScratch& s,
+                                TraversalCounters& counters);
+
+// Diffuse shading (ambient + each unblocked light's N.L) and the requested
+// outputs of the tile's pixels, through s.staging: line-aligned planes get
+// whole lines by streaming stores, the others are written in place.
+void shade_and_write(const RenderSettings& settings, std::span<const Light> lights, const OutputPlanes& out,
+                     TileScratch& s);
+
+}  // namespace sinew::rt

@@ -1,0 +1,1222 @@
+#include "raytrace/traverse/large_packet.h"
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "raytrace/cull/grid_frusta.h"
+#include "raytrace/cull/group_frusta.h"
+#include "raytrace/cull/interval_bound.h"
+#include "raytrace/cull/ray_bound.h"
+#include "raytrace/geometry/triangle_intersect8.h"
+#include "raytrace/traverse/traversal_shared.h"
+#include "runtime/math/float8.h"
+
+#include "runtime/math/simd.h"
+
+namespace sinew::rt {
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+constexpr int kLanes = 8;
+
+}  // namespace
+
+#if SINEW_AVX2
+namespace {
+
+using detail::max_abs;
+
+template <class Mask, class Fn>
+void for_each_bit(Mask mask, Fn&& fn) {
+  while (mask != 0) {
+    const int i = std::countr_zero(mask);
+    mask &= mask - 1;
+    fn(i);
+  }
+}
+
+// One group's rays in world space (invalid or inactive lanes hold the
+// default Ray, so eight-wide arithmetic stays finite).
+struct alignas(32) Group {
+  float o[3][kLanes];
+  float d[3][kLanes];
+  float inv[3][kLanes];
+  float t_min[kLanes];
+  float t_limit[kLanes];  // closest hit: the best t so far (exclusive); any-hit: t_max
+  float o_mag[kLanes];    // max |origin| coordinate
+  float d_mag[kLanes];    // max |direction| coordinate
+  Vec3x8 origin() const { return {Float8::load(o[0]), Float8::load(o[1]), Float8::load(o[2])}; }
+  Vec3x8 direction() const { return {Float8::load(d[0]), Float8::load(d[1]), Float8::load(d[2])}; }
+};
+
+// A group's part in one object visit: the lanes that entered the object,
+// their interval, and (in a bone's tree) the group's bound and slack.
+struct alignas(32) VisitGroup {
+  float t0[kLanes];
+  float t1[kLanes];
+  // In a bone's tree: the lanes' rays in the bone frame and their slack,
+  // for the exact lane clip against a leaf's cell.
+  float o[3][kLanes], d[3][kLanes], inv[3][kLanes];
+  float lane_eps[kLanes];
+  std::uint32_t lanes = 0;       // the lanes that entered the object
+  std::uint32_t leaf_lanes = 0;  // of those, the ones whose ray reaches the current leaf (or object)
+  Vec3x8 origin() const { return {Float8::load(o[0]), Float8::load(o[1]), Float8::load(o[2])}; }
+  Vec3x8 direction() const { return {Float8::load(d[0]), Float8::load(d[1]), Float8::load(d[2])}; }
+  Vec3x8 inverse() const { return {Float8::load(inv[0]), Float8::load(inv[1]), Float8::load(inv[2])}; }
+};
+
+// Per object visit, which lanes of each group have tested a triangle: a
+// triangle whose fuzzy box straddles splits is listed in several leaves.
+// Direct-mapped on (triangle, group); a lane that tests a triangle twice
+// (after an eviction) gets the same answer, which cannot beat its best t
+// strictly.
+class LaneMailbox {
+ public:
+  void reset() { keys_.fill(kInvalidId); }
+  // Of `lanes` of group g, those that have not tested `id` yet (marking them).
+  std::uint32_t untested(std::uint32_t id, int g, std::uint32_t lanes) {
+    const std::uint32_t key = id * kMaxPacketGroups + static_cast<std::uint32_t>(g);
+    const std::size_t slot = (id * 7u + static_cast<std::uint32_t>(g)) & (keys_.size() - 1);
+    if (keys_[slot] != key) {
+      keys_[slot] = key;
+      lanes_[slot] = static_cast<std::uint8_t>(lanes);
+      return lanes;
+    }
+    const std::uint32_t fresh = lanes & ~std::uint32_t{lanes_[slot]};
+    lanes_[slot] = static_cast<std::uint8_t>(lanes_[slot] | lanes);
+    return fresh;
+  }
+
+ private:
+  std::array<std::uint32_t, 256> keys_{};
+  std::array<std::uint8_t, 256> lanes_{};
+};
+
+// Per object visit, the items already tested by every group whose frustum
+// they reach (with group frusta a triangle's test does not depend on the
+// leaf it is listed in). Direct-mapped; an evicted item is tested again,
+// with the same answers.
+// A key holds the visit's epoch above the id, so reset() is a count, not a
+// 2 KiB fill per object visit; the slots are cleared only when the epoch
+// wraps (every 2^32 visits: key 0 never matches a key formed after it).
+class ItemMailbox {
+ public:
+  void reset() {
+    if (++epoch_ == 0) {
+      keys_.fill(0);
+      epoch_ = 1;
+    }
+  }
+  // True the first time `id` is seen since reset (or since its eviction).
+  bool first_visit(std::uint32_t id) {
+    const std::uint64_t key = std::uint64_t{epoch_} << 32 | id;
+    std::uint64_t& slot = keys_[id & (keys_.size() - 1)];
+    if (slot == key) return false;
+    slot = key;
+    return true;
+  }
+
+ private:
+  std::array<std::uint64_t, 512> keys_{};
+  std::uint32_t epoch_ = 0;
+};
+
+// The single-ray traversal's slack for a world-space box of magnitude
+// `box_magnitude` reached up to t_end (traverse/traversal.cpp world_eps),
+// per lane.
+Float8 world_eps(const Group& g, float box_magnitude, Float8 t_end) {
+  const Mask8 finite_end = abs(t_end) <= Float8(std::numeric_limits<float>::max());
+  const Float8 reach = select(finite_end, t_end * Float8::load(g.d_mag), Float8(0.0f));
+  return Float8(kFrameRelativeSlack) * ((Float8::load(g.o_mag) + reach) + Float8(box_magnitude));
+}
+
+// clip_to_box (traverse/traversal_shared.h) for eight lanes of rays o + t d
+// with reciprocals inv: [t0, t1] clipped to `box` grown by each lane's eps;
+// returns the lanes of `mask` left with t0 <= t1.
+std::uint32_t clip_lanes(const Aabb& box, Float8 eps, const Vec3x8& o, const Vec3x8& d, const Vec3x8& inv,
+                         std::uint32_t mask, Float8& t0, Float8& t1) {
+  const Float8* const oc[3] = {&o.x, &o.y, &o.z};
+  const Float8* const dc[3] = {&d.x, &d.y, &d.z};
+  const Float8* const ic[3] = {&inv.x, &inv.y, &inv.z};
+  std::uint32_t outside = 0;
+  for (int a = 0; a < 3; ++a) {
+    const Float8 lo = Float8(box.lower[a]) - eps;
+    const Float8 hi = Float8(box.upper[a]) + eps;
+    const Mask8 parallel = *dc[a] == Float8(0.0f);
+    outside |= (parallel & !((*oc[a] >= lo) & (*oc[a] <= hi))).bits();
+    const Float8 n = (lo - *oc[a]) * *ic[a];
+    const Float8 f = (hi - *oc[a]) * *ic[a];
+    const Mask8 swap = n > f;
+    t0 = select(parallel, t0, max(select(swap, f, n), t0));
+    t1 = select(parallel, t1, min(select(swap, n, f), t1));
+  }
+  return (t0 <= t1).bits() & ~outside & mask;
+}
+
+// A kd-tree cell waiting on the stack, with the parameter range that
+// holds every ray's passage through it.
+// Plain arrays: glm's operator[] is a switch on the index.
+struct Cell {
+  float lo[3], hi[3];
+  std::uint32_t node;
+  float t0, t1;
+  Aabb box() const { return {Vec3(lo[0], lo[1], lo[2]), Vec3(hi[0], hi[1], hi[2])}; }
+};
+
+// A leaf item's triangle in world space.
+struct LeafTriangle {
+  const Vec3* p0;
+  const Vec3* p1;
+  const Vec3* p2;
+  std::uint32_t triangle;
+  std::uint32_t instance;
+};
+
+template <TriangleTest kTest, bool kAnyHit>
+class LargeQuery {
+ public:
+  // The query's state is tens of kilobytes: one object per thread is
+  // reused, start() resetting what one packet reads.
+  void start(const Scene& scene, const LargePacketRays& rays, PacketHits out) {
+    scene_p_ = &scene;
+    out_ = out;
+    grid_columns_ = rays.grid_columns;
+    grid_basis_[0] = rays.grid_forward;
+    grid_basis_[1] = rays.grid_right;
+    grid_basis_[2] = rays.grid_up;
+    group_frusta_ = rays.group_frusta;
+    clip_leaf_lanes_ = rays.clip_leaf_lanes;
+    groups_ = std::clamp(rays.groups, 0, kMaxPacketGroups);
+    alive_groups_ = 0;
+    limits_lowered_ = 0;
+    common_origin_ = false;
+    frusta_on_ = false;
+    counters_ = {};
+    const Ray none{};
+    for (int g = 0; g < groups_; ++g) {
+      const std::size_t k0 = static_cast<std::size_t>(g) * kLanes;
+      Group& gr = group_[g];
+      // valid_ray() per lane: finite origin and direction, a non-zero
+      // direction, t_min < t_max (false for NaN).
+      const Float8 t_min = Float8::load(rays.t_min + k0), t_max = Float8::load(rays.t_max + k0);
+      Mask8 valid = t_min < t_max;
+      Mask8 nonzero = Mask8::from_bits(0);
+      Float8 o[3], d[3];
+      for (int a = 0; a < 3; ++a) {
+        o[a] = Float8::load(rays.o[a] + k0);
+        d[a] = Float8::load(rays.d[a] + k0);
+        valid = valid & is_finite(o[a]) & is_finite(d[a]);
+        nonzero = nonzero | !(d[a] == Float8(0.0f));
+      }
+      live_[g] = (valid & nonzero).bits() & rays.active[g];
+      valid_[g] = live_[g];
+      blocked_[g] = 0;
+      const Mask8 use = Mask8::from_bits(live_[g]);
+      Float8 o_mag(0.0f), d_mag(0.0f);
+      for (int a = 0; a < 3; ++a) {
+        o[a] = select(use, o[a], Float8(none.origin[a]));
+        d[a] = select(use, d[a], Float8(none.direction[a]));
+        o[a].store(gr.o[a]);
+        d[a].store(gr.d[a]);
+        o_mag = max(o_mag, abs(o[a]));
+        d_mag = max(d_mag, abs(d[a]));
+      }
+      o_mag.store(gr.o_mag);
+      d_mag.store(gr.d_mag);
+      select(use, t_min, Float8(none.t_min)).store(gr.t_min);
+      select(use, t_max, Float8(none.t_max)).store(gr.t_limit);
+      if (live_[g] != 0) {
+        if (alive_groups_ == 0) {
+          const int lane = std::countr_zero(live_[g]);
+          common_origin_at_ = Vec3(gr.o[0][lane], gr.o[1][lane], gr.o[2][lane]);
+          common_origin_ = true;
+        }
+        const Mask8 same = (o[0] == Float8(common_origin_at_.x)) & (o[1] == Float8(common_origin_at_.y)) &
+                           (o[2] == Float8(common_origin_at_.z));
+        common_origin_ = common_origin_ && (same.bits() & live_[g]) == live_[g];
+        alive_groups_ |= GroupMask{1} << g;
+      }
+      if constexpr (kTest == TriangleTest::kWatertight) {
+        for_each_bit(live_[g], [&](int lane) { watertight_[g][lane] = prepare_watertight(world_ray(g, lane)); });
+      }
+      if constexpr (!kAnyHit) {
+        Float8(kInf).store(out_.t + k0);
+        Float8(0.0f).store(out_.u + k0);
+        Float8(0.0f).store(out_.v + k0);
+        std::fill_n(out_.triangle + k0, kLanes, kInvalidId);
+        std::fill_n(out_.instance + k0, kLanes, kInvalidId);
+      }
+    }
+  }
+
+  void run(std::span<const std::uint32_t> objects) {
+    if (alive_groups_ == 0 || objects.empty()) return;
+    const std::span<const TopLevelObject> all = scene_ref().top_level().objects();
+    // The packet's bound in world space and a bound on the slack of every
+    // single-ray box clip (traversal_slack_bound, cull/ray_bound.h).
+    RangeAccumulator acc;
+    Float8 o_mag8(0.0f), d_mag8(0.0f), t_hi8(0.0f);
+    for_each_bit(alive_groups_, [&](int g) {
+      const Group& gr = group_[g];
+      const Mask8 use = Mask8::from_bits(live_[g]);
+      const Float8 t_max = Float8::load(gr.t_limit);
+      acc.add(gr.origin(), gr.direction(), Float8::load(gr.t_min), t_max, live_[g]);
+      o_mag8 = max(o_mag8, select(use, Float8::load(gr.o_mag), Float8(0.0f)));
+      d_mag8 = max(d_mag8, select(use, Float8::load(gr.d_mag), Float8(0.0f)));
+      t_hi8 = max(t_hi8, select(use, t_max, Float8(0.0f)));
+    });
+    const RayRanges ranges = acc.ranges();
+    const float o_mag = reduce_max(o_mag8), d_mag = reduce_max(d_mag8), t_hi = reduce_max(t_hi8);
+    const IntervalBound bound(ranges);
+    const float scene_magnitude = max_abs(scene_ref().top_level().bounds());
+    const float slack = traversal_slack_bound(o_mag, d_mag, t_hi, scene_magnitude);
+    const IntervalBound::Growth grow = bound.grow_for(scene_ref().top_level().bounds(), slack);
+    visit_slack_ = slack;
+    struct Candidate {
+      float entry;
+      std::uint32_t object;
+    };
+    std::array<Candidate, 256> stack_candidates;
+    std::vector<Candidate> heap_candidates;
+    std::size_t count = 0;
+    const auto add = [&](Candidate c) {
+      if (count < stack_candidates.size()) {
+        stack_candidates[count++] = c;
+        return;
+      }
+      if (heap_candidates.empty()) heap_candidates.assign(stack_candidates.begin(), stack_candidates.end());
+      heap_candidates.push_back(c);
+      ++count;
+    };
+    for (const std::uint32_t object : objects) {
+      const float e = bound.entry(all[object].box, grow);
+      if (e != kInf) add({e != e ? -kInf : e, object});
+    }
+    Candidate* const begin = heap_candidates.empty() ? stack_candidates.data() : heap_candidates.data();
+    // Closest hit: front to back, so an object entered after every lane's
+    // best hit is skipped. Any hit from one origin (shadow rays from a
+    // point light): from the light, so a lane blocked on the way retires
+    // before it walks the tree it ends in, which costs most.
+    if (!kAnyHit || common_origin_) {
+      std::sort(begin, begin + count, [](const Candidate& a, const Candidate& b) {
+        return a.entry < b.entry || (a.entry == b.entry && a.object < b.object);
+      });
+    }
+    const bool small_statics_only =
+        kTest == TriangleTest::kFast && count > 0 &&
+        std::all_of(begin, begin + count,
+                    [&](const Candidate& c) { return detail::is_small_static(scene_ref(), all[c.object]); });
+    if (small_statics_only) {
+      // A ground quad and the like: every triangle against every group, in
+      // order, without box clips (as the 8-ray packets' short cut; the
+      // nearest hit is the same).
+      for (std::size_t i = 0; i < count && alive_groups_ != 0; ++i) {
+        const Scene::StaticMesh& mesh = scene_ref().static_meshes()[all[begin[i].object].index];
+        for_each_bit(alive_groups_, [&](int g) {
+          visit_[g].leaf_lanes = live_[g];
+          counters_.object_visits += static_cast<std::uint64_t>(std::popcount(live_[g]));
+        });
+        visit_small_static(mesh, alive_groups_);
+      }
+      return;
+    }
+    // The reciprocals for the box clips (correctly rounded, like the single ray's).
+    for_each_bit(alive_groups_, [&](int g) {
+      Group& gr = group_[g];
+      for (int a = 0; a < 3; ++a) (Float8(1.0f) / Float8::load(gr.d[a])).store(gr.inv[a]);
+    });
+    prepare_frusta();
+    for (std::size_t i = 0; i < count; ++i) {
+      if (alive_groups_ == 0) return;
+      if constexpr (!kAnyHit) {
+        if (begin[i].entry > packet_limit(alive_groups_, nullptr)) return;
+      }
+      visit(all[begin[i].object]);
+    }
+  }
+
+  std::uint32_t valid_lanes(int g) const { return valid_[g]; }
+  std::uint8_t blocked(int g) const { return static_cast<std::uint8_t>(blocked_[g]); }
+  const TraversalCounters& counters() const { return counters_; }
+
+ private:
+  // Group frusta (cull/group_frusta.h) for rays from one origin, t >= 0:
+  // camera rays and shadow rays from a point light, whose frusta also get a
+  // far plane at their ends; other packets go without (frusta_on_ stays
+  // false). Each group's own frustum is built when a leaf first needs it
+  // (ensure_frusta).
+  void prepare_frusta() {
+    frusta_on_ = false;
+    frusta_built_ = 0;
+    grid_.reset();
+    if (!common_origin_) return;
+    bool forward = true;
+    for_each_bit(alive_groups_, [&](int g) {
+      forward = forward && (select(Mask8::from_bits(live_[g]), Float8::load(group_[g].t_min), Float8(0.0f)) >=
+                            Float8(0.0f)).bits() == 0xFFu;
+    });
+    if (!forward) return;
+    frusta_on_ = true;
+    // A camera's packet: its grid's slabs stand in for the groups' frusta.
+    const auto directions = [&](int g) -> const float (&)[3][kLanes] { return group_[g].d; };
+    const auto lanes = [&](int g) { return live_[g]; };
+    if (grid_columns_ > 0 && grid_.build(common_origin_at_, grid_basis_[0], grid_basis_[1], grid_basis_[2], groups_,
+                                         grid_columns_, directions, lanes)) {
+      return;
+    }
+    frusta_.reset(common_origin_at_, groups_);
+    // Shadow packets: the groups' slabs in the packet's basis
+    // (GroupFrusta::use_slabs), cheaper per triangle than their own frusta
+    // and built with the packet's bound (docs/RAYTRACE.md, "Shadow slabs"),
+    // unless the packet asks for the groups' own (LargePacketRays::group_frusta).
+    slabs_ = kAnyHit && !group_frusta_;
+    frusta_.use_slabs(slabs_);
+  }
+
+  // The groups of `groups` whose frustum (or grid slabs) may reach the box.
+  GroupMask frusta_box_reached(const Aabb& box, GroupMask groups) const {
+    return grid_.on() ? grid_.box_reached(box, groups) : frusta_.box_reached(box, groups);
+  }
+
+  // The frusta of `groups` and of every other live group not built yet:
+  // built together, eight at a time, they cost about what one did.
+  void ensure_frusta(GroupMask groups) {
+    if (grid_.on() || (groups & ~frusta_built_) == 0) return;
+    const GroupMask unbuilt = alive_groups_ & ~frusta_built_;
+    const auto directions = [&](int g) -> const float (&)[3][kLanes] { return group_[g].d; };
+    const auto lanes = [&](int g) { return live_[g]; };
+    // The packet's own frustum over every group built so far.
+    const GroupMask built = frusta_built_ | unbuilt;
+    if constexpr (!kAnyHit) {
+      frusta_.template set_groups<false>(unbuilt, 1.0f, directions, lanes, [](int, float*) {});
+      frusta_.template set_bound<false>(built, 1.0f, directions, lanes, [](int, float*) {});
+    } else {
+      // A lane's points end at t_max (an infinite one: no far plane).
+      const auto reach = [&](int g, float* out) { std::copy_n(group_[g].t_limit, kLanes, out); };
+      frusta_.template set_bound<true>(built, 1.0f, directions, lanes, reach);
+      // The groups' own frusta only where the packet's slabs are off.
+      if (!slabs_ || (built & ~frusta_.slab_groups()) != 0) {
+        frusta_.template set_groups<true>(unbuilt, 1.0f, directions, lanes, reach);
+      }
+    }
+    frusta_built_ = built;
+  }
+
+  // The largest t any lane of `groups` still looks for: its best hit (or
+  // t_max), capped by its exit from the current object when `visit` holds it.
+  float packet_limit(GroupMask groups, const VisitGroup* visit) const {
+    float limit = -kInf;
+    for_each_bit(groups, [&](int g) { limit = std::max(limit, group_limit(g, visit)); });
+    return limit;
+  }
+  float group_limit(int g, const VisitGroup* visit) const {
+    const std::uint32_t lanes = visit ? visit[g].lanes & live_[g] : live_[g];
+    if (lanes == 0) return -kInf;
+    Float8 t = Float8::load(group_[g].t_limit);
+    if (visit) t = min(t, Float8::load(visit[g].t1));
+    return reduce_max(select(Mask8::from_bits(lanes), t, Float8(-kInf)));
+  }
+
+  Ray world_ray(int g, int lane) const {
+    const Group& gr = group_[g];
+    Ray r;
+    r.origin = Vec3(gr.o[0][lane], gr.o[1][lane], gr.o[2][lane]);
+    r.direction = Vec3(gr.d[0][lane], gr.d[1][lane], gr.d[2][lane]);
+    r.t_min = gr.t_min[lane];
+    r.t_max = gr.t_limit[lane];
+    return r;
+  }
+
+  // Enters one object: each group's lanes clipped to its box as the single
+  // ray clips them (traverse/traversal.cpp visit).
+  void visit(const TopLevelObject& object) {
+    GroupMask groups = 0;
+    const float box_magnitude = max_abs(object.box);
+    // With group frusta, only the groups whose frustum reaches the box
+    // grown by every lane's slack clip their lanes to it: most groups of a
+    // packet miss most of the objects its bound reaches (a shadow packet's
+    // groups enter about one object in three). The others enter nothing.
+    GroupMask clipped = alive_groups_;
+    if (frusta_on_) {
+      ensure_frusta(alive_groups_);
+      const Vec3 s(visit_slack_);
+      clipped = frusta_box_reached({object.box.lower - s, object.box.upper + s}, alive_groups_);
+      for_each_bit(alive_groups_ & ~clipped, [&](int g) { visit_[g].lanes = visit_[g].leaf_lanes = 0; });
+    }
+    if (kTest == TriangleTest::kFast && detail::is_small_static(scene_ref(), object)) {
+      // A ground quad and the like: its triangles are tested directly, and
+      // a lane's clip to their box would only repeat what the triangle
+      // tests decide (run()'s short cut for packets of such meshes).
+      for_each_bit(clipped, [&](int g) {
+        visit_[g].lanes = visit_[g].leaf_lanes = live_[g];
+        if (live_[g] != 0) groups |= GroupMask{1} << g;
+        counters_.object_visits += static_cast<std::uint64_t>(std::popcount(live_[g]));
+      });
+      if (groups != 0) visit_small_static(scene_ref().static_meshes()[object.index], groups);
+      return;
+    }
+    for_each_bit(clipped, [&](int g) {
+      const Group& gr = group_[g];
+      VisitGroup& vg = visit_[g];
+      Float8 t0 = Float8::load(gr.t_min), t1 = Float8::load(gr.t_limit);
+      const Float8 eps = world_eps(gr, box_magnitude, t1);
+      const Vec3x8 inv{Float8::load(gr.inv[0]), Float8::load(gr.inv[1]), Float8::load(gr.inv[2])};
+      vg.lanes = clip_lanes(object.box, eps, gr.origin(), gr.direction(), inv, live_[g], t0, t1);
+      vg.leaf_lanes = vg.lanes;
+      t0.store(vg.t0);
+      t1.store(vg.t1);
+      if (vg.lanes != 0) {
+        groups |= GroupMask{1} << g;
+        counters_.object_visits += static_cast<std::uint64_t>(std::popcount(vg.lanes));
+      }
+    });
+    if (groups == 0) return;
+    if (frusta_on_) {
+      items_seen_.reset();
+    } else {
+      mailbox_.reset();
+    }
+    switch (object.kind) {
+      case TopLevelObject::Kind::kBone: {
+        visit_bone(scene_ref().instances()[object.index], object.bone, groups);
+        return;
+      }
+      case TopLevelObject::Kind::kStatic: {
+        const Scene::StaticMesh& mesh = scene_ref().static_meshes()[object.index];
+        if (mesh.desc.triangles.size() <= detail::kBruteForceStaticTriangles) {
+          visit_small_static(mesh, groups);
+          return;
+        }
+        const auto leaf = [&](std::uint32_t, std::span<const std::uint32_t> triangles, GroupMask groups_here) {
+          return test_leaf(triangles, groups_here, [&](std::uint32_t t) {
+            const auto& v = mesh.desc.triangles[t];
+            return LeafTriangle{&mesh.desc.positions[v[0]], &mesh.desc.positions[v[1]], &mesh.desc.positions[v[2]],
+                                t, mesh.instance_id};
+          });
+        };
+        visit_world_tree(mesh.tree.view(), groups, leaf);
+        return;
+      }
+      case TopLevelObject::Kind::kFallback: {
+        const InstanceFrame& frame = scene_ref().instances()[object.index];
+        const SkinnedMesh& mesh = *scene_ref().characters()[frame.character].mesh;
+        const auto leaf = [&](std::uint32_t, std::span<const std::uint32_t> items, GroupMask groups_here) {
+          return test_leaf(items, groups_here, [&](std::uint32_t item) {
+            const std::uint32_t t = frame.escaped_triangles[item];
+            const auto& v = mesh.triangles[t];
+            return LeafTriangle{&frame.positions[v[0]], &frame.positions[v[1]], &frame.positions[v[2]], t,
+                                frame.instance_id};
+          });
+        };
+        visit_world_tree(frame.fallback.view(), groups, leaf);
+        return;
+      }
+    }
+  }
+
+  void visit_small_static(const Scene::StaticMesh& mesh, GroupMask groups) {
+    for (std::uint32_t t = 0; t < mesh.desc.triangles.size() && groups != 0; ++t) {
+      const auto& v = mesh.desc.triangles[t];
+      const Vec3& p0 = mesh.desc.positions[v[0]];
+      const Vec3& p1 = mesh.desc.positions[v[1]];
+      const Vec3& p2 = mesh.desc.positions[v[2]];
+      test_groups(groups, p0, p1, p2, t, mesh.instance_id);
+      groups &= alive_groups_;
+    }
+  }
+
+  // The box of the triangles of `items` (corners(item): a LeafTriangle).
+  template <class CornersFn>
+  static Aabb triangles_box(std::span<const std::uint32_t> items, CornersFn& corners) {
+    Vec3 lo(kInf), hi(-kInf);
+    for (const std::uint32_t item : items) {
+      const LeafTriangle tri = corners(item);
+      lo = min(lo, min(*tri.p0, min(*tri.p1, *tri.p2)));
+      hi = max(hi, max(*tri.p0, max(*tri.p1, *tri.p2)));
+    }
+    return {lo, hi};
+  }
+
+  // A leaf's items for the groups reaching it. `corners(item)` gives the
+  // item's triangle (LeafTriangle). With group frusta see
+  // test_leaf_in_frusta; without, each item (mailboxed by its index) is
+  // tested by the groups with lanes in the leaf left to test it. Returns
+  // true when every lane is answered (any hit).
+  template <class CornersFn>
+  bool test_leaf(std::span<const std::uint32_t> items, GroupMask groups_here, CornersFn&& corners,
+                 bool listed_once = false) {
+    if (frusta_on_) return test_leaf_in_frusta(items, groups_here, corners, listed_once);
+    for (const std::uint32_t item : items) {
+      GroupMask need = 0;
+      for_each_bit(groups_here & alive_groups_, [&](int g) {
+        visit_[g].leaf_lanes = mailbox_.untested(item, g, leaf_lanes_[g]) & live_[g];
+        if (visit_[g].leaf_lanes != 0) need |= GroupMask{1} << g;
+      });
+      if (need == 0) continue;
+      const LeafTriangle tri = corners(item);
+      test_groups(need, *tri.p0, *tri.p1, *tri.p2, tri.triangle, tri.instance);
+      // Done only when every group in the tree is (not just this leaf's).
+      if (kAnyHit && (tree_groups_ & alive_groups_) == 0) return true;
+    }
+    return false;
+  }
+
+  // test_leaf with group frusta: each item is tested once per object visit
+  // (a tree that lists each item once, a BVH, `listed_once`, needs no
+  // mailbox for that), by the groups whose frustum it reaches. The items
+  // go eight at a time: their corners side by side, culled against each
+  // group of the leaf together (reached8) and, for the fast test, their
+  // origin terms prepared together (prepare_common_origin8); one triangle
+  // at a time was tested against every group of a block of eight, whatever
+  // the leaf's groups.
+  // `lanes_clipped`: leaf_lanes_ holds each group's lanes that reach the
+  // leaf (clip_to_leaf_box); otherwise every lane of a group is tested.
+  template <class CornersFn>
+  bool test_leaf_in_frusta(std::span<const std::uint32_t> items, GroupMask groups_here, CornersFn& corners,
+                           bool listed_once, bool lanes_clipped = false) {
+    ensure_frusta(groups_here & alive_groups_);
+    std::size_t next = 0;
+    while (next < items.size()) {
+      const GroupMask here = groups_here & alive_groups_;
+      if (here == 0) return false;
+      int n = 0;
+      for (; next < items.size() && n < kLanes; ++next) {
+        const std::uint32_t item = items[next];
+        if (!listed_once && !items_seen_.first_visit(item)) continue;
+        const LeafTriangle tri = corners(item);
+        const Vec3* const p[3] = {tri.p0, tri.p1, tri.p2};
+        for (int k = 0; k < 3; ++k) {
+          batch_.p[k][0][n] = p[k]->x;
+          batch_.p[k][1][n] = p[k]->y;
+          batch_.p[k][2][n] = p[k]->z;
+        }
+        batch_triangle_[n] = tri.triangle;
+        batch_instance_[n] = tri.instance;
+        ++n;
+      }
+      if (n == 0) return false;
+      const std::uint32_t lanes = (1u << n) - 1u;
+      std::uint64_t reach[kLanes];
+      if (kAnyHit && std::has_single_bit(here)) {
+        // A shadow packet's leaf that one group alone reaches (most leaves
+        // on pixel-sized triangles, where the leaf's box picked its
+        // groups): the group's frustum test would cost about what its
+        // lane test does.
+        std::fill(std::begin(reach), std::end(reach), here);
+      } else if (grid_.on()) {
+        grid_.reached8(batch_, lanes, here, reach);
+      } else {
+        frusta_.reached8(batch_, lanes, here, reach);
+      }
+      if constexpr (kTest == TriangleTest::kFast) prepare_common_origin8(common_origin_at_, batch_.p, prepared_);
+      for (int i = 0; i < n; ++i) {
+        const GroupMask need = reach[i] & alive_groups_;
+        if (need == 0) continue;
+        for_each_bit(need, [&](int g) {
+          visit_[g].leaf_lanes = visit_[g].lanes & live_[g] & (lanes_clipped ? leaf_lanes_[g] : 0xFFu);
+        });
+        if constexpr (kTest == TriangleTest::kFast) {
+          test_groups_prepared(need, prepared_.at(i), batch_triangle_[i], batch_instance_[i]);
+        } else {
+          test_groups(need, batch_.corner(0, i), batch_.corner(1, i), batch_.corner(2, i), batch_triangle_[i],
+                      batch_instance_[i]);
+        }
+        // Done only when every group in the tree is (not just this leaf's).
+        if (kAnyHit && (tree_groups_ & alive_groups_) == 0) return true;
+      }
+    }
+    return false;
+  }
+
+  // A world-space tree below the top level (a static mesh's, the escape
+  // fallback's): the world rays with the single ray's slack for the tree.
+  template <class LeafFn>
+  void visit_world_tree(const KdTreeView& tree, GroupMask groups, LeafFn& leaf) {
+    if (tree.empty()) return;
+    const float box_magnitude = max_abs(tree.bounds);
+    TreeEntry entry;
+    for_each_bit(groups, [&](int g) {
+      const Group& gr = group_[g];
+      const Float8 eps = world_eps(gr, box_magnitude, Float8::load(visit_[g].t1));
+      if (frusta_on_) {
+        // The lanes were just clipped to the object's box, which is the
+        // tree's (a static mesh's, the fallback's): a second clip would
+        // only narrow their passage by the difference in slack.
+        enter_tree_unclipped(entry, g, gr.origin(), gr.direction(), eps);
+        return;
+      }
+      const Vec3x8 inv{Float8::load(gr.inv[0]), Float8::load(gr.inv[1]), Float8::load(gr.inv[2])};
+      enter_tree(entry, tree.bounds, g, gr.origin(), gr.direction(), inv, eps);
+    });
+    walk_tree(tree, entry, leaf);
+  }
+
+  void visit_bone(const InstanceFrame& frame, std::uint32_t bone, GroupMask groups) {
+    const Scene::Character& character = scene_ref().characters()[frame.character];
+    const BoneTree& tree = frame.bone_tree(character.fuzzy, bone);
+    if (tree.node_count == 0) return;
+    const Affine3& to_bone = frame.bone_from_world[bone];
+    const InstanceFrame::BoneCarry& carry = frame.bone_carry[bone];
+    // Each group's rays in the bone frame (Affine3::transform_point /
+    // transform_vector term by term, as the single ray), with each lane's
+    // slack there.
+    TreeEntry entry;
+    for_each_bit(groups, [&](int g) {
+      const Group& gr = group_[g];
+      const Vec3x8 wo = gr.origin(), wd = gr.direction();
+      const Mask8 use = Mask8::from_bits(visit_[g].lanes);
+      Vec3x8 o, d;
+      Float8* const oc[3] = {&o.x, &o.y, &o.z};
+      Float8* const dc[3] = {&d.x, &d.y, &d.z};
+      Float8 o_mag(0.0f), d_mag(0.0f);
+      for (int a = 0; a < 3; ++a) {
+        const Vec4& row = to_bone.rows[a];
+        const Float8 rx(row.x), ry(row.y), rz(row.z);
+        *oc[a] = select(use, ((rx * wo.x + ry * wo.y) + rz * wo.z) + Float8(row.w), Float8(0.0f));
+        *dc[a] = select(use, (rx * wd.x + ry * wd.y) + rz * wd.z, Float8(1.0f));
+        o_mag = max(o_mag, abs(*oc[a]));
+        d_mag = max(d_mag, abs(*dc[a]));
+      }
+      // 2 tolerance + slack * (((carried + |o|) + t1 |d|) + |bounds|), with
+      // carried = linear_norm * |world origin| + translation magnitude.
+      const Float8 carried =
+          Float8(carry.linear_norm) * Float8::load(gr.o_mag) + Float8(carry.translation_magnitude);
+      const Float8 eps = Float8(2.0f * frame.tolerance[bone]) +
+                         Float8(kFrameRelativeSlack) *
+                             (((carried + o_mag) + Float8::load(visit_[g].t1) * d_mag) + Float8(carry.bounds_magnitude));
+      if (frusta_on_) {
+        enter_tree_unclipped(entry, g, o, d, eps);
+        return;
+      }
+      const Vec3x8 inv{Float8(1.0f) / d.x, Float8(1.0f) / d.y, Float8(1.0f) / d.z};
+      enter_tree(entry, tree.bounds, g, o, d, inv, eps);
+    });
+    const SkinnedMesh& mesh = *character.mesh;
+    const auto corners = [&](std::uint32_t t) {
+      const auto& v = mesh.triangles[t];
+      return LeafTriangle{&frame.positions[v[0]], &frame.positions[v[1]], &frame.positions[v[2]], t,
+                          frame.instance_id};
+    };
+    const auto leaf = [&](std::uint32_t node, std::span<const std::uint32_t> triangles, GroupMask groups_here) {
+      if (frusta_on_) {
+        // The leaf's triangles as they are this frame (raytrace/scene/leaf_boxes.h):
+        // a leaf no frustum reaches costs one box test, not one per triangle.
+        ensure_frusta(groups_here & alive_groups_);
+        const Aabb box = frame.leaf_boxes.get(bone, node, [&] { return triangles_box(triangles, corners); });
+        groups_here = frusta_box_reached(box, groups_here & alive_groups_);
+        if (clip_leaf_lanes_) groups_here = clip_to_leaf_box(box, groups_here);
+        if (groups_here == 0) return false;
+        return test_leaf_in_frusta(triangles, groups_here, corners, character.fuzzy.has_bvhs(), clip_leaf_lanes_);
+      }
+      return test_leaf(triangles, groups_here, corners, character.fuzzy.has_bvhs());
+    };
+    if (character.fuzzy.has_bvhs()) {
+      walk_bvh(character.fuzzy.bvh_view(tree), entry, leaf);
+    } else {
+      walk_tree(character.fuzzy.tree_view(tree), entry, leaf);
+    }
+  }
+
+  // The lanes of each group of `groups` whose world ray, over its passage
+  // through the object and short of its best hit, meets `box` (a bone-tree
+  // leaf's current triangles, raytrace/scene/leaf_boxes.h) grown by the
+  // single ray's slack for a world box (world_eps), kept in leaf_lanes_;
+  // returns the groups left with lanes. A group's frustum reaching the box
+  // says one of its rays may; this says which: a leaf near the ends of
+  // thin shadow groups, or behind a closest hit, keeps few of their lanes.
+  GroupMask clip_to_leaf_box(const Aabb& box, GroupMask groups) {
+    GroupMask kept = 0;
+    const float box_magnitude = max_abs(box);
+    for_each_bit(groups, [&](int g) {
+      const Group& gr = group_[g];
+      const VisitGroup& vg = visit_[g];
+      Float8 t0 = Float8::load(vg.t0);
+      Float8 t1 = min(Float8::load(vg.t1), Float8::load(gr.t_limit));
+      const Vec3x8 inv{Float8::load(gr.inv[0]), Float8::load(gr.inv[1]), Float8::load(gr.inv[2])};
+      leaf_lanes_[g] = clip_lanes(box, world_eps(gr, box_magnitude, t1), gr.origin(), gr.direction(), inv,
+                                  vg.lanes & live_[g], t0, t1);
+      if (leaf_lanes_[g] != 0) kept |= GroupMask{1} << g;
+    });
+    return kept;
+  }
+
+  // Entering a tree: the groups' lanes clipped to its root box, their rays
+  // in the tree's frame kept for the leaf clips, and the packet's bound.
+  struct TreeEntry {
+    RangeAccumulator ranges;
+    float eps = 0.0f;  // the largest lane slack
+    GroupMask groups = 0;
+  };
+
+  // Group g's rays o + t d in the tree's frame (reciprocals inv, lane
+  // slack eps).
+  void enter_tree(TreeEntry& entry, const Aabb& bounds, int g, const Vec3x8& o, const Vec3x8& d,
+                  const Vec3x8& inv, Float8 eps) {
+    VisitGroup& vg = visit_[g];
+    Float8 t0 = Float8::load(vg.t0), t1 = Float8::load(vg.t1);
+    vg.lanes = clip_lanes(bounds, eps, o, d, inv, vg.lanes, t0, t1);
+    if (vg.lanes == 0) return;
+    t0.store(vg.t0);
+    t1.store(vg.t1);
+    const Float8* const oc[3] = {&o.x, &o.y, &o.z};
+    const Float8* const dc[3] = {&d.x, &d.y, &d.z};
+    const Float8* const ic[3] = {&inv.x, &inv.y, &inv.z};
+    for (int a = 0; a < 3; ++a) {
+      oc[a]->store(vg.o[a]);
+      dc[a]->store(vg.d[a]);
+      ic[a]->store(vg.inv[a]);
+    }
+    eps.store(vg.lane_eps);
+    enter_tree_unclipped(entry, g, o, d, eps);
+  }
+
+  // With group frusta no leaf clips a group's lanes (the triangles pick
+  // their groups), so the rays need not be clipped to the root box or kept
+  // in the tree's frame: they join the packet's bound over their passage
+  // through the object, and the walk tests the root box itself.
+  void enter_tree_unclipped(TreeEntry& entry, int g, const Vec3x8& o, const Vec3x8& d, Float8 eps) {
+    const VisitGroup& vg = visit_[g];
+    if (vg.lanes == 0) return;
+    const Float8 t0 = Float8::load(vg.t0), t1 = Float8::load(vg.t1);
+    entry.ranges.add(o, d, t0, t1, vg.lanes);
+    entry.eps = std::max(entry.eps, reduce_max(select(Mask8::from_bits(vg.lanes), eps, Float8(0.0f))));
+    entry.groups |= GroupMask{1} << g;
+  }
+
+  template <class LeafFn>
+  void walk_tree(const KdTreeView& tree, const TreeEntry& entry, LeafFn& leaf) {
+    if (entry.groups == 0) return;
+    const IntervalBound bound(entry.ranges.ranges());
+    tree_groups_ = entry.groups;
+    traverse(tree, bound, bound.grow_for(tree.bounds, entry.eps), entry.groups, leaf);
+  }
+
+  // Front to back over the cells the packet's bound reaches, each with a
+  // parameter range [t0, t1] that holds every ray's passage through it: on
+  // a split axis where every ray has one sign, the child ranges are cut at
+  // the bounds on where the rays cross the (thick) split plane, one
+  // product pair per node; elsewhere each child box is tested whole. At a
+  // leaf, the groups whose own bound reaches its cell test its triangles.
+  // `leaf` returns true to stop (every lane answered).
+  template <class LeafFn>
+  void traverse(const KdTreeView& tree, const IntervalBound& bound, const IntervalBound::Growth& grow, GroupMask groups,
+                LeafFn& leaf) {
+    PacketLimit limit(*this, groups, bound);
+    std::array<Cell, kMaxTraversalDepth + 2> stack;
+    std::size_t top = 0;
+    Cell cur{{tree.bounds.lower.x, tree.bounds.lower.y, tree.bounds.lower.z},
+             {tree.bounds.upper.x, tree.bounds.upper.y, tree.bounds.upper.z},
+             0,
+             bound.entry(tree.bounds, grow, limit()),
+             bound.t_hi()};
+    if (cur.t0 == kInf) return;
+    for (;;) {
+      cur.t1 = std::min(cur.t1, limit());
+      if (cur.t0 <= cur.t1) {
+        ++counters_.node_visits;
+        const KdNode node = tree.nodes[cur.node];
+        if (!node.is_leaf()) {
+          const int a = node.axis();
+          const float split = node.split();
+          Cell below = cur, above = cur;
+          below.node = cur.node + 1;
+          above.node = node.above_child();
+          below.hi[a] = std::min(below.hi[a], split);
+          above.lo[a] = std::max(above.lo[a], split);
+          const int sign = bound.sign(a);
+          bool below_first = true;
+          if (sign > 0) {
+            // Rising rays: below until they cross split + grow, above from split - grow.
+            below.t1 = std::min(cur.t1, bound.crossing_hi(a, split + grow.axis[a]));
+            above.t0 = std::max(cur.t0, bound.crossing_lo(a, split - grow.axis[a]));
+          } else if (sign < 0) {
+            above.t1 = std::min(cur.t1, bound.crossing_hi(a, split - grow.axis[a]));
+            below.t0 = std::max(cur.t0, bound.crossing_lo(a, split + grow.axis[a]));
+            below_first = false;
+          } else {
+            const float eb = bound.entry(below.box(), grow, cur.t1);
+            const float ea = bound.entry(above.box(), grow, cur.t1);
+            below.t0 = std::max(cur.t0, eb);
+            above.t0 = std::max(cur.t0, ea);
+            if (eb == kInf) below.t0 = kInf;
+            if (ea == kInf) above.t0 = kInf;
+            below_first = !(above.t0 < below.t0);
+          }
+          const Cell& near = below_first ? below : above;
+          const Cell& far = below_first ? above : below;
+          const bool near_open = near.t0 <= near.t1;
+          if (far.t0 <= far.t1) {
+            if (near_open) {
+              stack[top++] = far;
+            } else {
+              cur = far;
+              continue;
+            }
+          }
+          if (near_open) {
+            cur = near;
+            continue;
+          }
+        } else if (node.item_count() > 0) {
+          if (visit_leaf(cur.box(), cur.node, tree.items.subspan(node.first_item(), node.item_count()), groups,
+                         leaf)) {
+            return;
+          }
+        }
+      }
+      if (top == 0) return;
+      cur = stack[--top];
+    }
+  }
+
+  // The packet's limit for pruning a walk's nodes: for any-hit rays the
+  // bound's far end; for closest-hit rays the largest of its groups'
+  // (group_limit), and a group's changes only when one of its lanes records
+  // a hit, so only those groups are looked at again (a closest-hit
+  // packet's groups stay alive throughout).
+  class PacketLimit {
+   public:
+    PacketLimit(LargeQuery& q, GroupMask groups, const IntervalBound& bound) : q_(q), groups_(groups), bound_(bound) {
+      if constexpr (!kAnyHit) {
+        limits_.fill(-kInf);
+        for_each_bit(groups_ & q_.alive_groups_, [&](int g) { limits_[g] = q_.group_limit(g, q_.visit_.data()); });
+        cached_ = packet_max();
+        q_.limits_lowered_ = 0;
+      }
+    }
+    float operator()() {
+      if constexpr (kAnyHit) {
+        return bound_.t_hi();
+      } else {
+        if (q_.limits_lowered_ != 0) {
+          for_each_bit(q_.limits_lowered_ & groups_ & q_.alive_groups_,
+                       [&](int g) { limits_[g] = q_.group_limit(g, q_.visit_.data()); });
+          q_.limits_lowered_ = 0;
+          cached_ = packet_max();
+        }
+        return cached_;
+      }
+    }
+
+   private:
+    float packet_max() const {
+      Float8 m(-kInf);
+      const int blocks = (q_.groups_ + kLanes - 1) / kLanes;
+      for (int i = 0; i < blocks; ++i) m = max(m, Float8::load(&limits_[static_cast<std::size_t>(i * kLanes)]));
+      return reduce_max(m);
+    }
+    LargeQuery& q_;
+    GroupMask groups_;
+    const IntervalBound& bound_;
+    alignas(32) std::array<float, kMaxPacketGroups> limits_;
+    float cached_ = kInf;
+  };
+
+  // A leaf (a kd-tree cell, or a BVH leaf's box: every item's fuzzy box
+  // inside it) reached by the packet: without group frusta each group's
+  // lanes are clipped to `cell` exactly, as their single rays would be
+  // (grown by each lane's own slack); with them each triangle picks its
+  // groups itself, more tightly than the cell would. Returns true to stop.
+  template <class LeafFn>
+  bool visit_leaf(const Aabb& cell, std::uint32_t node, std::span<const std::uint32_t> items, GroupMask groups,
+                  LeafFn& leaf) {
+    GroupMask reaching = 0;
+    if (frusta_on_) reaching = groups & alive_groups_;
+    for_each_bit(frusta_on_ ? GroupMask{0} : groups & alive_groups_, [&](int g) {
+      const VisitGroup& vg = visit_[g];
+      Float8 t0 = Float8::load(vg.t0), t1 = Float8::load(vg.t1);
+      if constexpr (!kAnyHit) t1 = min(t1, Float8::load(group_[g].t_limit));
+      leaf_lanes_[g] = clip_lanes(cell, Float8::load(vg.lane_eps), vg.origin(), vg.direction(), vg.inverse(),
+                                  vg.lanes & live_[g], t0, t1);
+      if (leaf_lanes_[g] != 0) reaching |= GroupMask{1} << g;
+    });
+    return reaching != 0 && leaf(node, items, reaching);
+  }
+
+  // Front to back over the BVH nodes the packet's bound reaches (each
+  // node's box grown as the kd walk grows its cells), the child the bound
+  // enters first first; at a leaf, as the kd walk's.
+  template <class LeafFn>
+  void walk_bvh(const BvhView& tree, const TreeEntry& entry, LeafFn& leaf) {
+    if (entry.groups == 0) return;
+    const IntervalBound bound(entry.ranges.ranges());
+    tree_groups_ = entry.groups;
+    const IntervalBound::Growth grow = bound.grow_for(tree.bounds, entry.eps);
+    const GroupMask groups = entry.groups;
+    PacketLimit limit(*this, groups, bound);
+    struct Pending {
+      std::uint32_t node;
+      float t;
+    };
+    std::array<Pending, kMaxTraversalDepth + 2> stack;
+    std::size_t top = 0;
+    const float t_root = bound.entry(tree.nodes[0].box, grow, limit());
+    if (t_root == kInf) return;
+    stack[top++] = {0, t_root};
+    while (top > 0) {
+      const Pending e = stack[--top];
+      if (e.t > limit()) continue;
+      ++counters_.node_visits;
+      const BvhNode& node = tree.nodes[e.node];
+      if (node.is_leaf()) {
+        if (visit_leaf(node.box, e.node, tree.items.subspan(node.first, node.count), groups, leaf)) return;
+        continue;
+      }
+      const float t_limit = limit();
+      const float ta = bound.entry(tree.nodes[node.first].box, grow, t_limit);
+      const float tb = bound.entry(tree.nodes[node.first + 1].box, grow, t_limit);
+      const bool a_first = ta <= tb;
+      const Pending near{a_first ? node.first : node.first + 1, a_first ? ta : tb};
+      const Pending far{a_first ? node.first + 1 : node.first, a_first ? tb : ta};
+      if (far.t <= t_limit) stack[top++] = far;
+      if (near.t <= t_limit) stack[top++] = near;
+    }
+  }
+
+  // Tests one world-space triangle for the live lanes of each group of
+  // `groups` that reach it (visit_[g].leaf_lanes).
+  void test_groups(GroupMask groups, const Vec3& p0, const Vec3& p1, const Vec3& p2, std::uint32_t triangle,
+                   std::uint32_t instance) {
+    if constexpr (kTest == TriangleTest::kFast) {
+      if (common_origin_) {
+        test_groups_prepared(groups, prepare_common_origin(common_origin_at_, p0, p1, p2), triangle, instance);
+        return;
+      }
+    }
+    for_each_bit(groups, [&](int g) { test(g, visit_[g].leaf_lanes, p0, p1, p2, triangle, instance); });
+  }
+
+  // test_groups with the fast test for rays from common_origin_at_, the
+  // triangle's origin terms prepared: once for every group; the zero-area
+  // check of the scalar test once per triangle, on the hit path.
+  void test_groups_prepared(GroupMask groups, const CommonOriginTriangle& c, std::uint32_t triangle,
+                            std::uint32_t instance) {
+    int zero_area = -1;
+    for_each_bit(groups, [&](int g) {
+      const std::uint32_t lanes = visit_[g].leaf_lanes & live_[g];
+      if (lanes == 0) return;
+      counters_.triangle_tests += static_cast<std::uint64_t>(std::popcount(lanes));
+      Group& gr = group_[g];
+      alignas(32) float t[kLanes], u[kLanes], v[kLanes];
+      const RayLanes8 lanes8{gr.o, gr.d, gr.t_min, gr.t_limit};
+      const std::uint32_t hit = intersect_triangle_fast8_common_origin(lanes8, lanes, c, t, u, v);
+      if (hit == 0) return;
+      if (zero_area < 0) zero_area = detail::zero_area(c.e1, c.e2) ? 1 : 0;
+      if (zero_area == 0) record_lanes(g, hit, t, u, v, triangle, instance);
+    });
+  }
+
+  // Tests one world-space triangle for the live lanes of `lanes` of group g.
+  void test(int g, std::uint32_t lanes, const Vec3& p0, const Vec3& p1, const Vec3& p2, std::uint32_t triangle,
+            std::uint32_t instance) {
+    lanes &= live_[g];
+    if (lanes == 0) return;
+    counters_.triangle_tests += static_cast<std::uint64_t>(std::popcount(lanes));
+    Group& gr = group_[g];
+    if constexpr (kTest == TriangleTest::kWatertight) {
+      for_each_bit(lanes, [&](int lane) {
+        TriangleHit h;
+        if (intersect_triangle_watertight(watertight_[g][lane], world_ray(g, lane), gr.t_limit[lane], p0, p1, p2,
+                                          h)) {
+          if constexpr (kAnyHit) {
+            retire(g, lane);
+          } else {
+            record(g, lane, h.t, h.u, h.v, triangle, instance);
+          }
+        }
+      });
+    } else {
+      alignas(32) float t[kLanes], u[kLanes], v[kLanes];
+      const RayLanes8 lanes8{gr.o, gr.d, gr.t_min, gr.t_limit};
+      const std::uint32_t hit = intersect_triangle_fast8(lanes8, lanes, p0, p1, p2, t, u, v);
+      // The scalar test's last check, once per triangle.
+      if (hit == 0 || detail::zero_area(p1 - p0, p2 - p0)) return;
+      if constexpr (kAnyHit) {
+        for_each_bit(hit, [&](int lane) { retire(g, lane); });
+      } else {
+        record_lanes(g, hit, t, u, v, triangle, instance);
+      }
+    }
+  }
+
+  // The hits of `lanes` of group g, eight lanes at once.
+  void record_lanes(int g, std::uint32_t lanes, const float* t, const float* u, const float* v,
+                    std::uint32_t triangle, std::uint32_t instance) {
+    if constexpr (kAnyHit) {
+      for_each_bit(lanes, [&](int lane) { retire(g, lane); });
+    } else {
+      const std::size_t k0 = static_cast<std::size_t>(g) * kLanes;
+      const Mask8 m = Mask8::from_bits(lanes);
+      const Float8 tt = Float8::load(t);
+      select(m, tt, Float8::load(group_[g].t_limit)).store(group_[g].t_limit);
+      select(m, tt, Float8::load(out_.t + k0)).store(out_.t + k0);
+      select(m, Float8::load(u), Float8::load(out_.u + k0)).store(out_.u + k0);
+      select(m, Float8::load(v), Float8::load(out_.v + k0)).store(out_.v + k0);
+      for_each_bit(lanes, [&](int lane) {
+        out_.triangle[k0 + static_cast<std::size_t>(lane)] = triangle;
+        out_.instance[k0 + static_cast<std::size_t>(lane)] = instance;
+      });
+      limits_lowered_ |= GroupMask{1} << g;
+    }
+  }
+
+  void record(int g, int lane, float t, float u, float v, std::uint32_t triangle, std::uint32_t instance) {
+    group_[g].t_limit[lane] = t;
+    limits_lowered_ |= GroupMask{1} << g;
+    const std::size_t k = static_cast<std::size_t>(g) * kLanes + static_cast<std::size_t>(lane);
+    out_.t[k] = t;
+    out_.u[k] = u;
+    out_.v[k] = v;
+    out_.triangle[k] = triangle;
+    out_.instance[k] = instance;
+  }
+
+  void retire(int g, int lane) {
+    blocked_[g] |= 1u << lane;
+    live_[g] &= ~(1u << lane);
+    if (live_[g] == 0) alive_groups_ &= ~(GroupMask{1} << g);
+  }
+
+  const Scene* scene_p_ = nullptr;
+  const Scene& scene_ref() const { return *scene_p_; }
+  PacketHits out_{};
+  int groups_ = 0;
+  std::array<Group, kMaxPacketGroups> group_;
+  std::array<VisitGroup, kMaxPacketGroups> visit_;
+  std::array<std::uint32_t, kMaxPacketGroups> leaf_lanes_{};  // per group: the lanes reaching the current leaf
+  GroupMask tree_groups_ = 0;  // the groups walking the current tree
+  // test_leaf_in_frusta: up to eight of a leaf's triangles, their ids and
+  // instances, and their origin terms.
+  TriangleLanes8 batch_;
+  std::array<std::uint32_t, kLanes> batch_triangle_{};
+  std::array<std::uint32_t, kLanes> batch_instance_{};
+  CommonOriginLanes8 prepared_;
+  std::array<std::array<WatertightRay, kLanes>, kTest == TriangleTest::kWatertight ? kMaxPacketGroups : 1>
+      watertight_;
+  std::array<std::uint32_t, kMaxPacketGroups> live_{};
+  std::array<std::uint32_t, kMaxPacketGroups> valid_{};
+  std::array<std::uint32_t, kMaxPacketGroups> blocked_{};
+  GroupMask alive_groups_ = 0;
+  GroupMask limits_lowered_ = 0;  // the groups that recorded a hit since traverse() last looked
+  bool common_origin_ = false;  // every live lane starts at common_origin_at_
+  Vec3 common_origin_at_{0.0f};
+  LaneMailbox mailbox_;
+  ItemMailbox items_seen_;
+  GroupFrusta<kMaxPacketGroups> frusta_;
+  GridFrusta grid_;                 // on: a camera packet's slabs, used instead of frusta_
+  int grid_columns_ = 0;            // LargePacketRays::grid_columns
+  std::array<Vec3, 3> grid_basis_{};  // forward, right, up
+  float visit_slack_ = 0.0f;       // run(): a bound on every lane's slack in an object's box clip
+  bool frusta_on_ = false;         // grid_ (when on) or frusta_ pick each leaf triangle's groups
+  bool slabs_ = false;             // frusta_ tests the groups' slabs in the packet's basis
+  bool group_frusta_ = false;      // LargePacketRays::group_frusta
+  bool clip_leaf_lanes_ = false;   // LargePacketRays::clip_leaf_lanes
+  GroupMask frusta_built_ = 0;  // the groups whose frustum frusta_ holds
+  TraversalCounters counters_;
+};
+
+template <TriangleTest kTest, bool kAnyHit>
+void run_query(const Scene& scene, const LargePacketRays& rays, std::span<const std::uint32_t> objects, PacketHits out,
+               std::uint8_t* blocked, TraversalCounters* counters) {
+  thread_local LargeQuery<kTest, kAnyHit> query;
+  query.start(scene, rays, out);
+  query.run(objects);
+  std::uint64_t rays_valid = 0;
+  for (int g = 0; g < std::clamp(rays.groups, 0, kMaxPacketGroups); ++g) {
+    rays_valid += static_cast<std::uint64_t>(std::popcount(query.valid_lanes(g)));
+    if (blocked) blocked[g] = query.blocked(g);
+  }
+  if (counters) {
+    counters->rays += rays_valid;
+    counters->node_visits += query.counters().node_visits;
+    counters->object_visits += query.counters().object_visits;
+    counters->triangle_tests += query.counters().triangle_tests;
+  }
+}
+
+}  // namespace
+
+void intersect_large_packet(const Scene& scene, const LargePacketRays& rays, TriangleTest test,
+                            std::span<const std::uint32_t> objects, PacketHits out, TraversalCounters* counters) {
+  if (test == TriangleTest::kWatertight) {
+    run_query<TriangleTest::kWatertight, false>(scene, rays, objects, out, nullptr, counters);
+  } else {
+    run_query<TriangleTest::kFast, false>(scene, rays, objects, out, nullptr, counters);
+  }
+}
+
+void occluded_large_packet(const Scene& scene, const LargePacketRays& rays, TriangleTest test,
+                           std::span<const std::uint32_t> objects, std::uint8_t* blocked,
+                           TraversalCounters* counters) {
+  const PacketHits none{nullptr, nullptr, nullptr, nullptr, nullptr};
+  if (test == TriangleTest::kWatertight) {
+    run_query<TriangleTest::kWatertight, true>(scene, rays, objects, none, blocked, counters);
+  } else {
+    run_query<TriangleTest::kFast, true>(scene, rays, objects, none, blocked, counters);
+  }
+}
+
+#else
+
+namespace {
+// Eight rays (arrays of eight lanes) as an 8-ray packet, lanes of `lanes` active.
+RayPacket packet_of(const float* const o[3], const float* const d[3], const float* t_min, const float* t_max,
+                    std::uint32_t lanes) {
+  RayPacket p;
+  for (int i = 0; i < kLanes; ++i) {
+    p.ox[i] = o[0][i];
+    p.oy[i] = o[1][i];
+    p.oz[i] = o[2][i];
+    p.dx[i] = d[0][i];
+    p.dy[i] = d[1][i];
+    p.dz[i] = d[2][i];
+    p.t_min[i] = t_min[i];
+    p.t_max[i] = t_max[i];
+  }
+  p.active = static_cast<std::uint8_t>(lanes);
+  return p;
+}
+
+RayPacket group_of(const LargePacketRays& rays, int g) {
+  const std::size_t k0 = static_cast<std::size_t>(g) * kLanes;
+  const float* const o[3] = {rays.o[0] + k0, rays.o[1] + k0, rays.o[2] + k0};
+  const float* const d[3] = {rays.d[0] + k0, rays.d[1] + k0, rays.d[2] + k0};
+  return packet_of(o, d, rays.t_min + k0, rays.t_max + k0, rays.active[g]);
+}
+}  // namespace
+
+// Without AVX2 each group is an 8-ray packet (which is itself the single-ray
+// query per lane there).
+void intersect_large_packet(const Scene& scene, const LargePacketRays& rays, TriangleTest test,
+                            std::span<const std::uint32_t> /*objects: culling only saves time*/, PacketHits out,
+                            TraversalCounters* counters) {
+  for (int g = 0; g < std::clamp(rays.groups, 0, kMaxPacketGroups); ++g) {
+    const std::size_t k0 = static_cast<std::size_t>(g) * kLanes;
+    Hit hits[kPacketSize];
+    intersect_packet(scene, group_of(rays, g), test, hits, counters);
+    for (int lane = 0; lane < kLanes; ++lane) {
+      const std::size_t k = k0 + static_cast<std::size_t>(lane);
+      out.t[k] = hits[lane].t;
+      out.u[k] = hits[lane].u;
+      out.v[k] = hits[lane].v;
+      out.triangle[k] = hits[lane].triangle_id;
+      out.instance[k] = hits[lane].instance_id;
+    }
+  }
+}
+
+void occluded_large_packet(const Scene& scene, const LargePacketRays& rays, TriangleTest test,
+                           std::span<const std::uint32_t> /*objects*/, std::uint8_t* blocked,
+                           TraversalCounters* counters) {
+  for (int g = 0; g < std::clamp(rays.groups, 0, kMaxPacketGroups); ++g) {
+    blocked[g] = occluded_packet(scene, group_of(rays, g), test, counters);
+  }
+}
+
+#endif  // SINEW_AVX2
+
+}  // namespace sinew::rt

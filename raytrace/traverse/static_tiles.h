@@ -1,0 +1,109 @@
+// Tiles whose rays can reach only a few triangles of static meshes: a
+// ground, a checkered floor, walls. Most of a frame's pixels are such
+// pixels, and their shadow rays too. The tile's triangles are gathered once
+// from the tile's bound (small meshes whole, larger ones from the cells of
+// their kd-tree the bound reaches), and every ray of the tile is tested
+// against them directly, eight lanes at a time: no packet bound, no tree
+// walk per packet, no box clip, and a triangle's per-origin terms once per
+// tile for the camera's rays.
+//
+// Culling is conservative as in cull/ray_bound.h: a triangle is left out
+// only when no ray of the tile can enter its box grown by the traversal's
+// slack bound, so each lane's nearest hit is the single ray's; between two
+// triangles hit at exactly the same t the one gathered first wins (meshes in
+// list order, each mesh's triangles in ascending order, as the single ray
+// meets them in a leaf).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "raytrace/cull/group_frusta.h"
+#include "raytrace/cull/ray_bound.h"
+#include "raytrace/geometry/triangle_intersect.h"
+#include "raytrace/render/tile_scratch.h"
+#include "raytrace/scene/scene.h"
+#include "raytrace/traverse/traversal.h"
+
+namespace sinew::rt {
+
+// At most this many triangles per tile take the direct tests: each costs
+// every ray of the tile a share of an eight-lane test, against a tree walk
+// per packet without it; 24 holds a box and the floor quads around it
+// (docs/RAYTRACE.md, "Static tiles").
+inline constexpr std::size_t kMaxStaticTileTriangles = 24;
+
+struct StaticTriangle {
+  Vec3 p0, p1, p2;
+  std::uint32_t triangle;
+  std::uint32_t instance;
+  bool zero_area;  // never hit (the scalar test's last check, once per triangle)
+  bool first;      // the first of its mesh: the rays enter a new object
+};
+
+// The triangles of one tile (per thread, reused).
+struct StaticTile {
+  std::vector<StaticTriangle> triangles;
+  std::uint64_t meshes = 0;  // the static meshes they came from
+};
+
+// The cone from one apex (a camera's eye, a point light) spanned by the
+// directions of a tile's extreme rays (its corner pixels', or those to the
+// corners of the box its shadow rays end in), which holds every ray of the
+// tile. A triangle it misses is never tested by the tile's rays: either all
+// three corners lie beyond one of the cone's four planes
+// (cull/group_frusta.h), or every corner ray lies beyond one of the
+// triangle's edge planes through the apex. Both with a margin relative to
+// the coordinate magnitudes (corners and apex) at the triangle, beyond which
+// neither triangle test reports a hit off the triangle: the frusta's
+// kFrustumMargin (2^-16) for the cone's planes, kConeEdgeMargin (2^-11, far
+// wider) for the edge planes. The first drops floor triangles beside a tile,
+// the second the half of a ground quad across its diagonal from the tile.
+// The edge-plane cull's margin per unit of the coordinate magnitudes: wider
+// than the frusta's, it still drops the far half of a ground quad.
+inline constexpr double kConeEdgeMargin = 0x1.0p-11;
+
+class TileCone {
+ public:
+  // No cone: every triangle may be hit.
+  TileCone() = default;
+  // From `count` (at most 8) directions; without a usable frustum (rays
+  // spread over about 75 degrees) nothing is culled.
+  TileCone(const Vec3& apex, const Vec3* directions, int count);
+  bool misses(const Vec3& p0, const Vec3& p1, const Vec3& p2) const;
+
+ private:
+  bool on_ = false;
+  Vec3 apex_{0.0f};
+  std::array<Vec3, 8> directions_{};  // unit
+  int count_ = 0;
+  GroupFrusta<8> frustum_;
+};
+
+// Gathers into `tile` the triangles that some ray of `bound` may reach
+// among `objects` (indices into scene.top_level().objects()), every box
+// grown by `extra_grow` beyond the bound's slack bound as cull_objects
+// grows it. Returns whether the direct tests apply: the fast triangle test,
+// a non-empty list of static meshes only, and at most
+// kMaxStaticTileTriangles triangles reached.
+//
+// Triangles `cone` misses are left out too, and do not count towards the
+// limit (a tile on a ground quad keeps the half it sees).
+bool gather_static_tile(const Scene& scene, TriangleTest test, const RayBound& bound, float extra_grow,
+                        std::span<const std::uint32_t> objects, StaticTile& tile, const TileCone& cone = {});
+
+// The nearest hits of the tile's camera rays (from `eye` along s.dir_*)
+// among the gathered triangles: fills t, u, v, triangle, instance and
+// block_hits as trace_primary does (render/stages/tile_stages.h). Counts object
+// visits and triangle tests, not rays.
+void intersect_static_tile(const StaticTile& tile, const Vec3& eye, TileScratch& s, TraversalCounters& counters);
+
+// Occlusion of the tile's shadow rays for light l (s.so_*, s.sd_*, t in
+// [0, s.s_tmax)) by the gathered triangles: a blocked ray clears bit l of
+// its pixel's s.lit, as trace_shadow_rays does. Returns how many were
+// blocked. Counts object visits and triangle tests, not rays.
+std::uint64_t occluded_static_tile(const StaticTile& tile, int l, TileScratch& s, TraversalCounters& counters);
+
+}  // namespace sinew::rt
