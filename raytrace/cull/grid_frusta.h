@@ -86,22 +86,19 @@ class GridFrusta {
     // column or row) keep zero normals, which never cut.
     for (Planes* p : {&column_hi_, &column_lo_, &row_hi_, &row_lo_, &outer_}) *p = Planes{};
     float a_min = big, a_max = -big, b_min = big, b_max = -big;
-    for (int i = 0; i < columns; ++i) {
-      const float lo = reduce_min(a_lo[i]), hi = reduce_max(a_hi[i]);
-      if (lo > hi) continue;
-      column_hi_.set(i, u - (hi + grown_slope(hi)) * c);
-      column_lo_.set(i, (lo - grown_slope(lo)) * c - u);
-      a_min = std::min(a_min, lo);
-      a_max = std::max(a_max, hi);
-    }
-    for (int i = 0; i < rows; ++i) {
-      const float lo = reduce_min(b_lo[i]), hi = reduce_max(b_hi[i]);
-      if (lo > hi) continue;
-      row_hi_.set(i, v - (hi + grown_slope(hi)) * c);
-      row_lo_.set(i, (lo - grown_slope(lo)) * c - v);
-      b_min = std::min(b_min, lo);
-      b_max = std::max(b_max, hi);
-    }
+    // Column (row) i's pair of planes holds its lanes' slopes along `side`
+    // (u for columns, v for rows), and the slopes' overall range grows.
+    const auto set_pair = [&](Planes& upper, Planes& lower, int i, Float8 lo8, Float8 hi8, const Vec3& side,
+                              float& least, float& most) {
+      const float lo = reduce_min(lo8), hi = reduce_max(hi8);
+      if (lo > hi) return;
+      upper.set(i, side - (hi + grown_slope(hi)) * c);
+      lower.set(i, (lo - grown_slope(lo)) * c - side);
+      least = std::min(least, lo);
+      most = std::max(most, hi);
+    };
+    for (int i = 0; i < columns; ++i) set_pair(column_hi_, column_lo_, i, a_lo[i], a_hi[i], u, a_min, a_max);
+    for (int i = 0; i < rows; ++i) set_pair(row_hi_, row_lo_, i, b_lo[i], b_hi[i], v, b_min, b_max);
     // The whole packet's four sides, the same planes at its extreme slopes
     // (none without a lane).
     if (a_min <= a_max && b_min <= b_max) {

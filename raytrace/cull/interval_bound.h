@@ -31,6 +31,20 @@
 
 namespace sinew::rt {
 
+// A ray set's passage through a box from its per-axis slab entries and exits
+// (lane 3 unused: -inf and +inf): [max(t_lo, latest entry), min(t_hi,
+// earliest exit)], empty when enter > leave.
+struct SlabPassage {
+  float enter, leave;
+};
+inline SlabPassage slab_passage(__m128 enter, __m128 leave, float t_lo, float t_hi) {
+  __m128 e = _mm_max_ps(enter, _mm_movehl_ps(enter, enter));
+  e = _mm_max_ss(e, _mm_movehdup_ps(e));
+  __m128 l = _mm_min_ps(leave, _mm_movehl_ps(leave, leave));
+  l = _mm_min_ss(l, _mm_movehdup_ps(l));
+  return {std::max(t_lo, _mm_cvtss_f32(e)), std::min(t_hi, _mm_cvtss_f32(l))};
+}
+
 // Ranges of a set of rays: origin and direction per axis, parameter.
 struct RayRanges {
   float o_lo[3] = {0, 0, 0}, o_hi[3] = {0, 0, 0};
@@ -211,13 +225,8 @@ class IntervalBound {
     const __m128 bounded = _mm_or_ps(positive_, negative_);
     const __m128 enter = _mm_blendv_ps(_mm_set1_ps(-kInf), lower_bound(enter_plane), bounded);
     const __m128 leave = _mm_blendv_ps(_mm_set1_ps(kInf), upper_bound(leave_plane), bounded);
-    __m128 e = _mm_max_ps(enter, _mm_movehl_ps(enter, enter));
-    e = _mm_max_ss(e, _mm_movehdup_ps(e));
-    __m128 l = _mm_min_ps(leave, _mm_movehl_ps(leave, leave));
-    l = _mm_min_ss(l, _mm_movehdup_ps(l));
-    const float t_enter = std::max(t_lo_, _mm_cvtss_f32(e));
-    const float t_leave = std::min(t_hi, _mm_cvtss_f32(l));
-    return t_enter <= t_leave ? t_enter : kInf;
+    const SlabPassage p = slab_passage(enter, leave, t_lo_, t_hi);
+    return p.enter <= p.leave ? p.enter : kInf;
   }
   float entry(const Aabb& box, const Growth& grow) const { return entry(box, grow, t_hi_); }
 

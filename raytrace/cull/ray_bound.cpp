@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 
+#include "raytrace/cull/interval_bound.h"
 #include "raytrace/traverse/traversal_shared.h"
 #include "runtime/math/float8.h"
 
@@ -244,13 +245,8 @@ bool RayBound::Test::may_enter(const Aabb& box, float grow) const {
   const __m128 minus_inf = _mm_set1_ps(-kInf), plus_inf = _mm_set1_ps(kInf);
   const __m128 enter = _mm_blendv_ps(_mm_blendv_ps(minus_inf, hi_min, neg), lo_min, pos);
   const __m128 leave = _mm_blendv_ps(_mm_blendv_ps(plus_inf, lo_max, neg), hi_max, pos);
-  __m128 e = _mm_max_ps(enter, _mm_movehl_ps(enter, enter));
-  e = _mm_max_ss(e, _mm_movehdup_ps(e));
-  __m128 l = _mm_min_ps(leave, _mm_movehl_ps(leave, leave));
-  l = _mm_min_ss(l, _mm_movehdup_ps(l));
-  const float t_enter = std::max(t_lo, _mm_cvtss_f32(e));
-  const float t_leave = std::min(t_hi, _mm_cvtss_f32(l));
-  return !(t_enter > t_leave);
+  const SlabPassage p = slab_passage(enter, leave, t_lo, t_hi);
+  return !(p.enter > p.leave);
 }
 
 void cull_objects(const Scene& scene, const RayBound& bound, std::vector<std::uint32_t>& out, float extra_grow) {
@@ -301,72 +297,6 @@ void cull_objects(const Scene& scene, const RayBound& bound, std::vector<std::ui
     return true;
   });
   std::sort(out.begin() + static_cast<std::ptrdiff_t>(first_out), out.end());
-}
-
-void cull_objects_for_packet(const Scene& scene, const float* const o[3], const float* const d[3],
-                             const float* t_min, const float* t_max, std::uint32_t lanes,
-                             const std::vector<std::uint32_t>& among, std::vector<std::uint32_t>& out) {
-  lanes &= 0xFFu;
-  if (lanes == 0 || among.empty()) return;
-  const std::span<const TopLevelObject> objects = scene.top_level().objects();
-  const float scene_magnitude = detail::max_abs(scene.top_level().bounds());
-  // The traversal's slack for these lanes, bounded as RayBound does (one
-  // value for all lanes and boxes).
-  Float8 o_mag(0.0f), d_mag(0.0f);
-  Vec3x8 origin, direction, inverse;
-  Float8* const oc[3] = {&origin.x, &origin.y, &origin.z};
-  Float8* const dc[3] = {&direction.x, &direction.y, &direction.z};
-  Float8* const ic[3] = {&inverse.x, &inverse.y, &inverse.z};
-  for (int a = 0; a < 3; ++a) {
-    *oc[a] = Float8::load(o[a]);
-    *dc[a] = Float8::load(d[a]);
-    *ic[a] = Float8(1.0f) / *dc[a];
-    o_mag = max(o_mag, abs(*oc[a]));
-    d_mag = max(d_mag, abs(*dc[a]));
-  }
-  const Float8 t0 = Float8::load(t_min), t1 = Float8::load(t_max);
-  const Mask8 use = Mask8::from_bits(lanes);
-  const float om = reduce_max(select(use, o_mag, Float8(0.0f)));
-  const float dm = reduce_max(select(use, d_mag, Float8(0.0f)));
-  const float tm = reduce_max(select(use, t1, Float8(0.0f)));
-  float reach = 1.01f * (om + scene_magnitude);
-  if (std::isfinite(tm)) reach = std::max(reach, tm * dm * 1.01f);
-  const float grow = kFrameRelativeSlack * 1.01f * (om + reach + scene_magnitude);
-  // Entered objects with the earliest entry of any lane, sorted by it.
-  struct Entered {
-    float entry;
-    std::uint32_t object;
-  };
-  thread_local std::vector<Entered> entered;
-  entered.clear();
-  for (const std::uint32_t object : among) {
-    const Aabb& box = objects[object].box;
-    // The lane clip of traverse/traversal_shared.h (clip_to_box), per lane,
-    // against the box grown by `grow` (>= every lane's own slack).
-    Float8 near_t = t0, far_t = t1;
-    Mask8 outside = Mask8::from_bits(0);
-    for (int a = 0; a < 3; ++a) {
-      const Float8 lo = Float8(box.lower[a] - grow);
-      const Float8 hi = Float8(box.upper[a] + grow);
-      const Mask8 parallel = *dc[a] == Float8(0.0f);
-      outside = outside | (parallel & !((*oc[a] >= lo) & (*oc[a] <= hi)));
-      const Float8 n = (lo - *oc[a]) * *ic[a];
-      const Float8 f = (hi - *oc[a]) * *ic[a];
-      near_t = select(parallel, near_t, max(min(n, f), near_t));
-      far_t = select(parallel, far_t, min(max(n, f), far_t));
-    }
-    // NaN in near/far (0 * inf cannot happen off parallel lanes) keeps the lane.
-    const std::uint32_t open = (!(near_t > far_t)).bits() & ~outside.bits() & lanes;
-    if (open != 0) {
-      // NaN entries (kept lanes) sort first.
-      const float entry = reduce_min(select(Mask8::from_bits(open), near_t, Float8(kInf)));
-      entered.push_back({entry == entry ? entry : -kInf, object});
-    }
-  }
-  std::sort(entered.begin(), entered.end(), [](const Entered& a, const Entered& b) {
-    return a.entry < b.entry || (a.entry == b.entry && a.object < b.object);
-  });
-  for (const Entered& e : entered) out.push_back(e.object);
 }
 
 }  // namespace sinew::rt

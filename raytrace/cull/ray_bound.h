@@ -169,13 +169,4 @@ inline constexpr std::size_t kFlatCullObjects = 64;
 void cull_objects(const Scene& scene, const RayBound& bound, std::vector<std::uint32_t>& out,
                   float extra_grow = 0.0f);
 
-// Of `among` (object indices), those that some lane of `lanes` of an
-// eight-ray SoA packet may enter, by each lane's own slab test against the
-// box grown by a bound on the traversal's slack (exact per lane, so tighter
-// than a bound on the packet). Appends them to `out` front to back: by the
-// earliest entry of any lane, then by index.
-void cull_objects_for_packet(const Scene& scene, const float* const o[3], const float* const d[3],
-                             const float* t_min, const float* t_max, std::uint32_t lanes,
-                             const std::vector<std::uint32_t>& among, std::vector<std::uint32_t>& out);
-
 }  // namespace sinew::rt

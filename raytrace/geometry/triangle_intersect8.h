@@ -1,22 +1,20 @@
 // The fast (Moller-Trumbore) triangle test for eight rays against one
-// triangle at once, AVX2. Per lane it evaluates exactly the expressions of
-// intersect_triangle_fast (triangle_intersect.h) in the same order, and the
-// build disables FMA contraction, so every lane's hit, t, u and v are
-// bit-identical to the scalar test's: packets and single rays agree.
+// triangle at once, over Float8 (runtime/math/float8.h). Per lane it
+// evaluates exactly the expressions of intersect_triangle_fast
+// (triangle_intersect.h) in the same order, and the build disables FMA
+// contraction, so every lane's hit, t, u and v are bit-identical to the
+// scalar test's: packets and single rays agree.
 #pragma once
-
-#include "runtime/math/simd.h"
-
-#if SINEW_AVX2
 
 #include <cstdint>
 
 #include "raytrace/geometry/triangle_intersect.h"
+#include "runtime/math/float8.h"
 
 namespace sinew::rt {
 
-// The rays, structure of arrays, 32-byte aligned: origin o[axis][lane],
-// direction d[axis][lane], and per lane t_min and the exclusive t_max.
+// The rays, structure of arrays: origin o[axis][lane], direction
+// d[axis][lane], and per lane t_min and the exclusive t_max.
 struct RayLanes8 {
   const float (*o)[8];
   const float (*d)[8];
@@ -27,18 +25,25 @@ struct RayLanes8 {
 namespace detail {
 // The last checks of both eight-lane tests (t_min <= t < t_max, finite t):
 // the hit lanes of `lanes`, their t, u, v stored when there are any.
-inline std::uint32_t accept_hits8(const RayLanes8& r, std::uint32_t lanes, __m256 ok, __m256 t, __m256 u, __m256 v,
+inline std::uint32_t accept_hits8(const RayLanes8& r, std::uint32_t lanes, Mask8 ok, Float8 t, Float8 u, Float8 v,
                                   float* t_out, float* u_out, float* v_out) {
-  ok = _mm256_and_ps(ok, _mm256_cmp_ps(t, _mm256_load_ps(r.t_min), _CMP_GE_OQ));
-  ok = _mm256_and_ps(ok, _mm256_cmp_ps(t, _mm256_load_ps(r.t_max), _CMP_LT_OQ));
-  ok = _mm256_and_ps(ok, _mm256_cmp_ps(t, _mm256_set1_ps(kFloatMax), _CMP_LE_OQ));
-  const std::uint32_t hit = static_cast<std::uint32_t>(_mm256_movemask_ps(ok)) & lanes;
+  ok = ok & (t >= Float8::load(r.t_min)) & (t < Float8::load(r.t_max)) & (t <= Float8(kFloatMax));
+  const std::uint32_t hit = ok.bits() & lanes;
   if (hit != 0) {
-    _mm256_storeu_ps(t_out, t);
-    _mm256_storeu_ps(u_out, u);
-    _mm256_storeu_ps(v_out, v);
+    t.store(t_out);
+    u.store(u_out);
+    v.store(v_out);
   }
   return hit;
+}
+
+// The scalar test's determinant checks, lane-wise: finite_nonzero(det)
+// (0 < |det| <= FLT_MAX, NaN excluded) and |det| > kFastDetTolerance *
+// det_bound.
+inline Mask8 usable_det8(Float8 det, Float8 det_bound) {
+  const Float8 abs_det = abs(det);
+  return (abs_det > Float8(0.0f)) & (abs_det <= Float8(kFloatMax)) &
+         (abs_det > Float8(kFastDetTolerance) * det_bound);
 }
 }  // namespace detail
 
@@ -51,51 +56,36 @@ inline std::uint32_t intersect_triangle_fast8(const RayLanes8& r, std::uint32_t 
                                               float* v_out) {
   const Vec3 e1s = p1 - p0;
   const Vec3 e2s = p2 - p0;
-  const __m256 e1x = _mm256_set1_ps(e1s.x), e1y = _mm256_set1_ps(e1s.y), e1z = _mm256_set1_ps(e1s.z);
-  const __m256 e2x = _mm256_set1_ps(e2s.x), e2y = _mm256_set1_ps(e2s.y), e2z = _mm256_set1_ps(e2s.z);
-  const __m256 dx = _mm256_load_ps(r.d[0]), dy = _mm256_load_ps(r.d[1]), dz = _mm256_load_ps(r.d[2]);
-  const auto mul = [](__m256 a, __m256 b) { return _mm256_mul_ps(a, b); };
-  const auto add = [](__m256 a, __m256 b) { return _mm256_add_ps(a, b); };
-  const auto sub = [](__m256 a, __m256 b) { return _mm256_sub_ps(a, b); };
+  const Float8 e1x(e1s.x), e1y(e1s.y), e1z(e1s.z);
+  const Float8 e2x(e2s.x), e2y(e2s.y), e2z(e2s.z);
+  const Float8 dx = Float8::load(r.d[0]), dy = Float8::load(r.d[1]), dz = Float8::load(r.d[2]);
 
-  const __m256 px = sub(mul(dy, e2z), mul(dz, e2y));
-  const __m256 py = sub(mul(dz, e2x), mul(dx, e2z));
-  const __m256 pz = sub(mul(dx, e2y), mul(dy, e2x));
-  const __m256 det = add(add(mul(e1x, px), mul(e1y, py)), mul(e1z, pz));
-  // finite_nonzero(det): 0 < |det| <= FLT_MAX, NaN excluded.
-  const __m256 abs_det = _mm256_andnot_ps(_mm256_set1_ps(-0.0f), det);
-  __m256 ok = _mm256_and_ps(_mm256_cmp_ps(abs_det, _mm256_setzero_ps(), _CMP_GT_OQ),
-                            _mm256_cmp_ps(abs_det, _mm256_set1_ps(detail::kFloatMax), _CMP_LE_OQ));
-  // |det| > kFastDetTolerance * det_bound, as the scalar test computes it.
-  const __m256 sign = _mm256_set1_ps(-0.0f);
-  const auto abs = [&sign](__m256 a) { return _mm256_andnot_ps(sign, a); };
-  const __m256 det_bound =
-      add(add(mul(abs(e1x), add(abs(mul(dy, e2z)), abs(mul(dz, e2y)))),
-              mul(abs(e1y), add(abs(mul(dz, e2x)), abs(mul(dx, e2z))))),
-          mul(abs(e1z), add(abs(mul(dx, e2y)), abs(mul(dy, e2x)))));
-  ok = _mm256_and_ps(ok, _mm256_cmp_ps(abs_det, mul(_mm256_set1_ps(detail::kFastDetTolerance), det_bound),
-                                       _CMP_GT_OQ));
-  if (_mm256_testz_ps(ok, ok) != 0) return 0;
-  const __m256 inv_det = _mm256_div_ps(_mm256_set1_ps(1.0f), det);
+  const Float8 px = dy * e2z - dz * e2y;
+  const Float8 py = dz * e2x - dx * e2z;
+  const Float8 pz = dx * e2y - dy * e2x;
+  const Float8 det = (e1x * px + e1y * py) + e1z * pz;
+  const Float8 det_bound = (abs(e1x) * (abs(dy * e2z) + abs(dz * e2y)) + abs(e1y) * (abs(dz * e2x) + abs(dx * e2z))) +
+                           abs(e1z) * (abs(dx * e2y) + abs(dy * e2x));
+  Mask8 ok = detail::usable_det8(det, det_bound);
+  if (!ok.any()) return 0;
+  const Float8 inv_det = Float8(1.0f) / det;
 
-  const __m256 tx = sub(_mm256_load_ps(r.o[0]), _mm256_set1_ps(p0.x));
-  const __m256 ty = sub(_mm256_load_ps(r.o[1]), _mm256_set1_ps(p0.y));
-  const __m256 tz = sub(_mm256_load_ps(r.o[2]), _mm256_set1_ps(p0.z));
-  const __m256 u = mul(add(add(mul(tx, px), mul(ty, py)), mul(tz, pz)), inv_det);
-  const __m256 zero = _mm256_setzero_ps();
-  const __m256 one = _mm256_set1_ps(1.0f);
-  ok = _mm256_and_ps(ok, _mm256_and_ps(_mm256_cmp_ps(u, zero, _CMP_GE_OQ), _mm256_cmp_ps(u, one, _CMP_LE_OQ)));
-  if (_mm256_testz_ps(ok, ok) != 0) return 0;
+  const Float8 tx = Float8::load(r.o[0]) - Float8(p0.x);
+  const Float8 ty = Float8::load(r.o[1]) - Float8(p0.y);
+  const Float8 tz = Float8::load(r.o[2]) - Float8(p0.z);
+  const Float8 u = ((tx * px + ty * py) + tz * pz) * inv_det;
+  const Float8 zero(0.0f), one(1.0f);
+  ok = ok & (u >= zero) & (u <= one);
+  if (!ok.any()) return 0;
 
-  const __m256 qx = sub(mul(ty, e1z), mul(tz, e1y));
-  const __m256 qy = sub(mul(tz, e1x), mul(tx, e1z));
-  const __m256 qz = sub(mul(tx, e1y), mul(ty, e1x));
-  const __m256 v = mul(add(add(mul(dx, qx), mul(dy, qy)), mul(dz, qz)), inv_det);
-  ok = _mm256_and_ps(ok, _mm256_and_ps(_mm256_cmp_ps(v, zero, _CMP_GE_OQ),
-                                       _mm256_cmp_ps(add(u, v), one, _CMP_LE_OQ)));
-  if (_mm256_testz_ps(ok, ok) != 0) return 0;
+  const Float8 qx = ty * e1z - tz * e1y;
+  const Float8 qy = tz * e1x - tx * e1z;
+  const Float8 qz = tx * e1y - ty * e1x;
+  const Float8 v = ((dx * qx + dy * qy) + dz * qz) * inv_det;
+  ok = ok & (v >= zero) & (u + v <= one);
+  if (!ok.any()) return 0;
 
-  const __m256 t = mul(add(add(mul(e2x, qx), mul(e2y, qy)), mul(e2z, qz)), inv_det);
+  const Float8 t = ((e2x * qx + e2y * qy) + e2z * qz) * inv_det;
   return detail::accept_hits8(r, lanes, ok, t, u, v, t_out, u_out, v_out);
 }
 
@@ -139,24 +129,20 @@ struct CommonOriginLanes8 {
 };
 
 inline void prepare_common_origin8(const Vec3& origin, const float (&p)[3][3][8], CommonOriginLanes8& out) {
-  const auto mul = [](__m256 a, __m256 b) { return _mm256_mul_ps(a, b); };
-  const auto add = [](__m256 a, __m256 b) { return _mm256_add_ps(a, b); };
-  const auto sub = [](__m256 a, __m256 b) { return _mm256_sub_ps(a, b); };
   const float o[3] = {origin.x, origin.y, origin.z};
-  __m256 e1[3], e2[3], tv[3];
+  Float8 e1[3], e2[3], tv[3];
   for (int a = 0; a < 3; ++a) {
-    const __m256 p0 = _mm256_load_ps(p[0][a]);
-    e1[a] = sub(_mm256_load_ps(p[1][a]), p0);
-    e2[a] = sub(_mm256_load_ps(p[2][a]), p0);
-    tv[a] = sub(_mm256_set1_ps(o[a]), p0);
-    _mm256_store_ps(out.e1[a], e1[a]);
-    _mm256_store_ps(out.e2[a], e2[a]);
-    _mm256_store_ps(out.tv[a], tv[a]);
+    const Float8 p0 = Float8::load(p[0][a]);
+    e1[a] = Float8::load(p[1][a]) - p0;
+    e2[a] = Float8::load(p[2][a]) - p0;
+    tv[a] = Float8(o[a]) - p0;
+    e1[a].store(out.e1[a]);
+    e2[a].store(out.e2[a]);
+    tv[a].store(out.tv[a]);
   }
-  const __m256 q[3] = {sub(mul(tv[1], e1[2]), mul(tv[2], e1[1])), sub(mul(tv[2], e1[0]), mul(tv[0], e1[2])),
-                       sub(mul(tv[0], e1[1]), mul(tv[1], e1[0]))};
-  for (int a = 0; a < 3; ++a) _mm256_store_ps(out.q[a], q[a]);
-  _mm256_store_ps(out.t_numerator, add(add(mul(e2[0], q[0]), mul(e2[1], q[1])), mul(e2[2], q[2])));
+  const Float8 q[3] = {tv[1] * e1[2] - tv[2] * e1[1], tv[2] * e1[0] - tv[0] * e1[2], tv[0] * e1[1] - tv[1] * e1[0]};
+  for (int a = 0; a < 3; ++a) q[a].store(out.q[a]);
+  ((e2[0] * q[0] + e2[1] * q[1]) + e2[2] * q[2]).store(out.t_numerator);
 }
 
 // intersect_triangle_fast8 for rays that all start at the origin `c` was
@@ -164,47 +150,28 @@ inline void prepare_common_origin8(const Vec3& origin, const float (&p)[3][3][8]
 inline std::uint32_t intersect_triangle_fast8_common_origin(const RayLanes8& r, std::uint32_t lanes,
                                                             const CommonOriginTriangle& c, float* t_out,
                                                             float* u_out, float* v_out) {
-  const __m256 e1x = _mm256_set1_ps(c.e1.x), e1y = _mm256_set1_ps(c.e1.y), e1z = _mm256_set1_ps(c.e1.z);
-  const __m256 e2x = _mm256_set1_ps(c.e2.x), e2y = _mm256_set1_ps(c.e2.y), e2z = _mm256_set1_ps(c.e2.z);
-  const __m256 dx = _mm256_load_ps(r.d[0]), dy = _mm256_load_ps(r.d[1]), dz = _mm256_load_ps(r.d[2]);
-  const auto mul = [](__m256 a, __m256 b) { return _mm256_mul_ps(a, b); };
-  const auto add = [](__m256 a, __m256 b) { return _mm256_add_ps(a, b); };
-  const auto sub = [](__m256 a, __m256 b) { return _mm256_sub_ps(a, b); };
-  const __m256 sign = _mm256_set1_ps(-0.0f);
-  const auto abs = [&sign](__m256 a) { return _mm256_andnot_ps(sign, a); };
+  const Float8 e1x(c.e1.x), e1y(c.e1.y), e1z(c.e1.z);
+  const Float8 e2x(c.e2.x), e2y(c.e2.y), e2z(c.e2.z);
+  const Float8 dx = Float8::load(r.d[0]), dy = Float8::load(r.d[1]), dz = Float8::load(r.d[2]);
 
-  const __m256 dy_e2z = mul(dy, e2z), dz_e2y = mul(dz, e2y);
-  const __m256 dz_e2x = mul(dz, e2x), dx_e2z = mul(dx, e2z);
-  const __m256 dx_e2y = mul(dx, e2y), dy_e2x = mul(dy, e2x);
-  const __m256 px = sub(dy_e2z, dz_e2y);
-  const __m256 py = sub(dz_e2x, dx_e2z);
-  const __m256 pz = sub(dx_e2y, dy_e2x);
-  const __m256 det = add(add(mul(e1x, px), mul(e1y, py)), mul(e1z, pz));
-  const __m256 abs_det = abs(det);
-  __m256 ok = _mm256_and_ps(_mm256_cmp_ps(abs_det, _mm256_setzero_ps(), _CMP_GT_OQ),
-                            _mm256_cmp_ps(abs_det, _mm256_set1_ps(detail::kFloatMax), _CMP_LE_OQ));
-  const __m256 det_bound = add(add(mul(abs(e1x), add(abs(dy_e2z), abs(dz_e2y))),
-                                   mul(abs(e1y), add(abs(dz_e2x), abs(dx_e2z)))),
-                               mul(abs(e1z), add(abs(dx_e2y), abs(dy_e2x))));
-  ok = _mm256_and_ps(ok, _mm256_cmp_ps(abs_det, mul(_mm256_set1_ps(detail::kFastDetTolerance), det_bound),
-                                       _CMP_GT_OQ));
-  if (_mm256_testz_ps(ok, ok) != 0) return 0;
-  const __m256 inv_det = _mm256_div_ps(_mm256_set1_ps(1.0f), det);
-  const __m256 u = mul(add(add(mul(_mm256_set1_ps(c.tv.x), px), mul(_mm256_set1_ps(c.tv.y), py)),
-                           mul(_mm256_set1_ps(c.tv.z), pz)),
-                       inv_det);
-  const __m256 v = mul(add(add(mul(dx, _mm256_set1_ps(c.q.x)), mul(dy, _mm256_set1_ps(c.q.y))),
-                           mul(dz, _mm256_set1_ps(c.q.z))),
-                       inv_det);
-  const __m256 t = mul(_mm256_set1_ps(c.t_numerator), inv_det);
-  const __m256 zero = _mm256_setzero_ps();
-  const __m256 one = _mm256_set1_ps(1.0f);
-  ok = _mm256_and_ps(ok, _mm256_and_ps(_mm256_cmp_ps(u, zero, _CMP_GE_OQ), _mm256_cmp_ps(u, one, _CMP_LE_OQ)));
-  ok = _mm256_and_ps(ok, _mm256_and_ps(_mm256_cmp_ps(v, zero, _CMP_GE_OQ),
-                                       _mm256_cmp_ps(add(u, v), one, _CMP_LE_OQ)));
+  const Float8 dy_e2z = dy * e2z, dz_e2y = dz * e2y;
+  const Float8 dz_e2x = dz * e2x, dx_e2z = dx * e2z;
+  const Float8 dx_e2y = dx * e2y, dy_e2x = dy * e2x;
+  const Float8 px = dy_e2z - dz_e2y;
+  const Float8 py = dz_e2x - dx_e2z;
+  const Float8 pz = dx_e2y - dy_e2x;
+  const Float8 det = (e1x * px + e1y * py) + e1z * pz;
+  const Float8 det_bound = (abs(e1x) * (abs(dy_e2z) + abs(dz_e2y)) + abs(e1y) * (abs(dz_e2x) + abs(dx_e2z))) +
+                           abs(e1z) * (abs(dx_e2y) + abs(dy_e2x));
+  Mask8 ok = detail::usable_det8(det, det_bound);
+  if (!ok.any()) return 0;
+  const Float8 inv_det = Float8(1.0f) / det;
+  const Float8 u = ((Float8(c.tv.x) * px + Float8(c.tv.y) * py) + Float8(c.tv.z) * pz) * inv_det;
+  const Float8 v = ((dx * Float8(c.q.x) + dy * Float8(c.q.y)) + dz * Float8(c.q.z)) * inv_det;
+  const Float8 t = Float8(c.t_numerator) * inv_det;
+  const Float8 zero(0.0f), one(1.0f);
+  ok = ok & (u >= zero) & (u <= one) & (v >= zero) & (u + v <= one);
   return detail::accept_hits8(r, lanes, ok, t, u, v, t_out, u_out, v_out);
 }
 
 }  // namespace sinew::rt
-
-#endif  // SINEW_AVX2

@@ -19,18 +19,6 @@
 namespace sinew::rt {
 namespace {
 
-// Sums per-tile counters in tile order so the totals are deterministic.
-void add(TraversalCounters& into, const TraversalCounters& from) {
-  into.rays += from.rays;
-  into.node_visits += from.node_visits;
-  into.object_visits += from.object_visits;
-  into.triangle_tests += from.triangle_tests;
-}
-
-}  // namespace
-
-namespace {
-
 using Clock = std::chrono::steady_clock;
 
 double nanoseconds(Clock::time_point from, Clock::time_point to) {
@@ -142,8 +130,8 @@ Expected<RenderStats> Renderer::render(const Scene& scene, const PinholeCamera& 
   RenderStats stats;
   double primary_ns = 0.0, shadow_ns = 0.0, shade_ns = 0.0;
   for (const TileRecord& r : records) {
-    add(stats.primary, r.primary);
-    add(stats.shadow, r.shadow);
+    stats.primary += r.primary;
+    stats.shadow += r.shadow;
     stats.primary_hits += r.hits;
     stats.shadowed += r.shadowed;
     primary_ns += r.primary_ns;

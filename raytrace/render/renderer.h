@@ -12,21 +12,14 @@
 // the scene, so images are identical for any thread count.
 #pragma once
 
-#include <cstdint>
-#include <span>
-#include <vector>
-
 #include "raytrace/camera/camera.h"
 #include "raytrace/render/render_settings.h"
 #include "raytrace/render/surface.h"
 #include "raytrace/render/trace_plan.h"
 #include "raytrace/scene/scene.h"
 #include "runtime/core/expected.h"
-
-namespace sinew {
-class JobSystem;
-class PhaseTimers;
-}  // namespace sinew
+#include "runtime/jobs/job_system.h"
+#include "runtime/timing/phase_timers.h"
 
 namespace sinew::rt {
 

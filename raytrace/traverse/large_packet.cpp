@@ -12,10 +12,12 @@
 #include "raytrace/cull/interval_bound.h"
 #include "raytrace/cull/ray_bound.h"
 #include "raytrace/geometry/triangle_intersect8.h"
+#include "raytrace/traverse/leaf_triangles.h"
+#include "raytrace/traverse/mailbox.h"
+#include "raytrace/traverse/ray_frames.h"
 #include "raytrace/traverse/traversal_shared.h"
 #include "runtime/math/float8.h"
 
-#include "runtime/math/simd.h"
 
 namespace sinew::rt {
 namespace {
@@ -25,7 +27,6 @@ constexpr int kLanes = 8;
 
 }  // namespace
 
-#if SINEW_AVX2
 namespace {
 
 using detail::max_abs;
@@ -69,92 +70,16 @@ struct alignas(32) VisitGroup {
   Vec3x8 inverse() const { return {Float8::load(inv[0]), Float8::load(inv[1]), Float8::load(inv[2])}; }
 };
 
-// Per object visit, which lanes of each group have tested a triangle: a
-// triangle whose fuzzy box straddles splits is listed in several leaves.
-// Direct-mapped on (triangle, group); a lane that tests a triangle twice
-// (after an eviction) gets the same answer, which cannot beat its best t
-// strictly.
-class LaneMailbox {
- public:
-  void reset() { keys_.fill(kInvalidId); }
-  // Of `lanes` of group g, those that have not tested `id` yet (marking them).
-  std::uint32_t untested(std::uint32_t id, int g, std::uint32_t lanes) {
-    const std::uint32_t key = id * kMaxPacketGroups + static_cast<std::uint32_t>(g);
-    const std::size_t slot = (id * 7u + static_cast<std::uint32_t>(g)) & (keys_.size() - 1);
-    if (keys_[slot] != key) {
-      keys_[slot] = key;
-      lanes_[slot] = static_cast<std::uint8_t>(lanes);
-      return lanes;
-    }
-    const std::uint32_t fresh = lanes & ~std::uint32_t{lanes_[slot]};
-    lanes_[slot] = static_cast<std::uint8_t>(lanes_[slot] | lanes);
-    return fresh;
-  }
-
- private:
-  std::array<std::uint32_t, 256> keys_{};
-  std::array<std::uint8_t, 256> lanes_{};
-};
-
-// Per object visit, the items already tested by every group whose frustum
-// they reach (with group frusta a triangle's test does not depend on the
-// leaf it is listed in). Direct-mapped; an evicted item is tested again,
-// with the same answers.
-// A key holds the visit's epoch above the id, so reset() is a count, not a
-// 2 KiB fill per object visit; the slots are cleared only when the epoch
-// wraps (every 2^32 visits: key 0 never matches a key formed after it).
-class ItemMailbox {
- public:
-  void reset() {
-    if (++epoch_ == 0) {
-      keys_.fill(0);
-      epoch_ = 1;
-    }
-  }
-  // True the first time `id` is seen since reset (or since its eviction).
-  bool first_visit(std::uint32_t id) {
-    const std::uint64_t key = std::uint64_t{epoch_} << 32 | id;
-    std::uint64_t& slot = keys_[id & (keys_.size() - 1)];
-    if (slot == key) return false;
-    slot = key;
-    return true;
-  }
-
- private:
-  std::array<std::uint64_t, 512> keys_{};
-  std::uint32_t epoch_ = 0;
-};
-
-// The single-ray traversal's slack for a world-space box of magnitude
-// `box_magnitude` reached up to t_end (traverse/traversal.cpp world_eps),
-// per lane.
+// A group's world slack for a box of magnitude `box_magnitude` reached up
+// to t_end (traverse/ray_frames.h world_slack).
 Float8 world_eps(const Group& g, float box_magnitude, Float8 t_end) {
-  const Mask8 finite_end = abs(t_end) <= Float8(std::numeric_limits<float>::max());
-  const Float8 reach = select(finite_end, t_end * Float8::load(g.d_mag), Float8(0.0f));
-  return Float8(kFrameRelativeSlack) * ((Float8::load(g.o_mag) + reach) + Float8(box_magnitude));
+  return per_lane::world_slack<Float8>(Float8::load(g.o_mag), Float8::load(g.d_mag), box_magnitude, t_end);
 }
 
-// clip_to_box (traverse/traversal_shared.h) for eight lanes of rays o + t d
-// with reciprocals inv: [t0, t1] clipped to `box` grown by each lane's eps;
-// returns the lanes of `mask` left with t0 <= t1.
+// The shared box clip (traverse/ray_frames.h) for the lanes of `mask`.
 std::uint32_t clip_lanes(const Aabb& box, Float8 eps, const Vec3x8& o, const Vec3x8& d, const Vec3x8& inv,
                          std::uint32_t mask, Float8& t0, Float8& t1) {
-  const Float8* const oc[3] = {&o.x, &o.y, &o.z};
-  const Float8* const dc[3] = {&d.x, &d.y, &d.z};
-  const Float8* const ic[3] = {&inv.x, &inv.y, &inv.z};
-  std::uint32_t outside = 0;
-  for (int a = 0; a < 3; ++a) {
-    const Float8 lo = Float8(box.lower[a]) - eps;
-    const Float8 hi = Float8(box.upper[a]) + eps;
-    const Mask8 parallel = *dc[a] == Float8(0.0f);
-    outside |= (parallel & !((*oc[a] >= lo) & (*oc[a] <= hi))).bits();
-    const Float8 n = (lo - *oc[a]) * *ic[a];
-    const Float8 f = (hi - *oc[a]) * *ic[a];
-    const Mask8 swap = n > f;
-    t0 = select(parallel, t0, max(select(swap, f, n), t0));
-    t1 = select(parallel, t1, min(select(swap, n, f), t1));
-  }
-  return (t0 <= t1).bits() & ~outside & mask;
+  return per_lane::clip_to_box<Float8>(box, eps, o, d, inv, t0, t1).bits() & mask;
 }
 
 // A kd-tree cell waiting on the stack, with the parameter range that
@@ -165,15 +90,6 @@ struct Cell {
   std::uint32_t node;
   float t0, t1;
   Aabb box() const { return {Vec3(lo[0], lo[1], lo[2]), Vec3(hi[0], hi[1], hi[2])}; }
-};
-
-// A leaf item's triangle in world space.
-struct LeafTriangle {
-  const Vec3* p0;
-  const Vec3* p1;
-  const Vec3* p2;
-  std::uint32_t triangle;
-  std::uint32_t instance;
 };
 
 template <TriangleTest kTest, bool kAnyHit>
@@ -491,26 +407,18 @@ class LargeQuery {
           visit_small_static(mesh, groups);
           return;
         }
-        const auto leaf = [&](std::uint32_t, std::span<const std::uint32_t> triangles, GroupMask groups_here) {
-          return test_leaf(triangles, groups_here, [&](std::uint32_t t) {
-            const auto& v = mesh.desc.triangles[t];
-            return LeafTriangle{&mesh.desc.positions[v[0]], &mesh.desc.positions[v[1]], &mesh.desc.positions[v[2]],
-                                t, mesh.instance_id};
-          });
+        const StaticTriangles triangles{mesh};
+        const auto leaf = [&](std::uint32_t, std::span<const std::uint32_t> items, GroupMask groups_here) {
+          return test_leaf(items, groups_here, triangles);
         };
         visit_world_tree(mesh.tree.view(), groups, leaf);
         return;
       }
       case TopLevelObject::Kind::kFallback: {
         const InstanceFrame& frame = scene_ref().instances()[object.index];
-        const SkinnedMesh& mesh = *scene_ref().characters()[frame.character].mesh;
+        const EscapedTriangles triangles{*scene_ref().characters()[frame.character].mesh, frame};
         const auto leaf = [&](std::uint32_t, std::span<const std::uint32_t> items, GroupMask groups_here) {
-          return test_leaf(items, groups_here, [&](std::uint32_t item) {
-            const std::uint32_t t = frame.escaped_triangles[item];
-            const auto& v = mesh.triangles[t];
-            return LeafTriangle{&frame.positions[v[0]], &frame.positions[v[1]], &frame.positions[v[2]], t,
-                                frame.instance_id};
-          });
+          return test_leaf(items, groups_here, triangles);
         };
         visit_world_tree(frame.fallback.view(), groups, leaf);
         return;
@@ -530,8 +438,8 @@ class LargeQuery {
   }
 
   // The box of the triangles of `items` (corners(item): a LeafTriangle).
-  template <class CornersFn>
-  static Aabb triangles_box(std::span<const std::uint32_t> items, CornersFn& corners) {
+  template <class TriangleSource>
+  static Aabb triangles_box(std::span<const std::uint32_t> items, const TriangleSource& corners) {
     Vec3 lo(kInf), hi(-kInf);
     for (const std::uint32_t item : items) {
       const LeafTriangle tri = corners(item);
@@ -546,8 +454,8 @@ class LargeQuery {
   // test_leaf_in_frusta; without, each item (mailboxed by its index) is
   // tested by the groups with lanes in the leaf left to test it. Returns
   // true when every lane is answered (any hit).
-  template <class CornersFn>
-  bool test_leaf(std::span<const std::uint32_t> items, GroupMask groups_here, CornersFn&& corners,
+  template <class TriangleSource>
+  bool test_leaf(std::span<const std::uint32_t> items, GroupMask groups_here, const TriangleSource& corners,
                  bool listed_once = false) {
     if (frusta_on_) return test_leaf_in_frusta(items, groups_here, corners, listed_once);
     for (const std::uint32_t item : items) {
@@ -575,8 +483,8 @@ class LargeQuery {
   // the leaf's groups.
   // `lanes_clipped`: leaf_lanes_ holds each group's lanes that reach the
   // leaf (clip_to_leaf_box); otherwise every lane of a group is tested.
-  template <class CornersFn>
-  bool test_leaf_in_frusta(std::span<const std::uint32_t> items, GroupMask groups_here, CornersFn& corners,
+  template <class TriangleSource>
+  bool test_leaf_in_frusta(std::span<const std::uint32_t> items, GroupMask groups_here, const TriangleSource& corners,
                            bool listed_once, bool lanes_clipped = false) {
     ensure_frusta(groups_here & alive_groups_);
     std::size_t next = 0;
@@ -659,48 +567,24 @@ class LargeQuery {
     const Scene::Character& character = scene_ref().characters()[frame.character];
     const BoneTree& tree = frame.bone_tree(character.fuzzy, bone);
     if (tree.node_count == 0) return;
-    const Affine3& to_bone = frame.bone_from_world[bone];
-    const InstanceFrame::BoneCarry& carry = frame.bone_carry[bone];
-    // Each group's rays in the bone frame (Affine3::transform_point /
-    // transform_vector term by term, as the single ray), with each lane's
-    // slack there.
+    // Each group's rays in the bone frame, with each lane's slack there
+    // (traverse/ray_frames.h, as the single ray).
     TreeEntry entry;
     for_each_bit(groups, [&](int g) {
       const Group& gr = group_[g];
-      const Vec3x8 wo = gr.origin(), wd = gr.direction();
-      const Mask8 use = Mask8::from_bits(visit_[g].lanes);
-      Vec3x8 o, d;
-      Float8* const oc[3] = {&o.x, &o.y, &o.z};
-      Float8* const dc[3] = {&d.x, &d.y, &d.z};
-      Float8 o_mag(0.0f), d_mag(0.0f);
-      for (int a = 0; a < 3; ++a) {
-        const Vec4& row = to_bone.rows[a];
-        const Float8 rx(row.x), ry(row.y), rz(row.z);
-        *oc[a] = select(use, ((rx * wo.x + ry * wo.y) + rz * wo.z) + Float8(row.w), Float8(0.0f));
-        *dc[a] = select(use, (rx * wd.x + ry * wd.y) + rz * wd.z, Float8(1.0f));
-        o_mag = max(o_mag, abs(*oc[a]));
-        d_mag = max(d_mag, abs(*dc[a]));
-      }
-      // 2 tolerance + slack * (((carried + |o|) + t1 |d|) + |bounds|), with
-      // carried = linear_norm * |world origin| + translation magnitude.
-      const Float8 carried =
-          Float8(carry.linear_norm) * Float8::load(gr.o_mag) + Float8(carry.translation_magnitude);
-      const Float8 eps = Float8(2.0f * frame.tolerance[bone]) +
-                         Float8(kFrameRelativeSlack) *
-                             (((carried + o_mag) + Float8::load(visit_[g].t1) * d_mag) + Float8(carry.bounds_magnitude));
+      const per_lane::FrameRay<Float8> r =
+          per_lane::to_bone_frame<Float8>(frame, bone, gr.origin(), gr.direction(), Float8::load(gr.o_mag),
+                                       Float8::load(visit_[g].t1), Mask8::from_bits(visit_[g].lanes));
+      const Vec3x8& o = r.o;
+      const Vec3x8& d = r.d;
+      const Float8 eps = r.eps;
       if (frusta_on_) {
         enter_tree_unclipped(entry, g, o, d, eps);
         return;
       }
-      const Vec3x8 inv{Float8(1.0f) / d.x, Float8(1.0f) / d.y, Float8(1.0f) / d.z};
-      enter_tree(entry, tree.bounds, g, o, d, inv, eps);
+      enter_tree(entry, tree.bounds, g, o, d, per_lane::reciprocal<Float8>(d), eps);
     });
-    const SkinnedMesh& mesh = *character.mesh;
-    const auto corners = [&](std::uint32_t t) {
-      const auto& v = mesh.triangles[t];
-      return LeafTriangle{&frame.positions[v[0]], &frame.positions[v[1]], &frame.positions[v[2]], t,
-                          frame.instance_id};
-    };
+    const SkinnedTriangles corners{*character.mesh, frame};
     const auto leaf = [&](std::uint32_t node, std::span<const std::uint32_t> triangles, GroupMask groups_here) {
       if (frusta_on_) {
         // The leaf's triangles as they are this frame (raytrace/scene/leaf_boxes.h):
@@ -1104,8 +988,8 @@ class LargeQuery {
   GroupMask limits_lowered_ = 0;  // the groups that recorded a hit since traverse() last looked
   bool common_origin_ = false;  // every live lane starts at common_origin_at_
   Vec3 common_origin_at_{0.0f};
-  LaneMailbox mailbox_;
-  ItemMailbox items_seen_;
+  LaneMailbox<kMaxPacketGroups> mailbox_;
+  ItemMailbox<512> items_seen_;
   GroupFrusta<kMaxPacketGroups> frusta_;
   GridFrusta grid_;                 // on: a camera packet's slabs, used instead of frusta_
   int grid_columns_ = 0;            // LargePacketRays::grid_columns
@@ -1130,12 +1014,7 @@ void run_query(const Scene& scene, const LargePacketRays& rays, std::span<const 
     rays_valid += static_cast<std::uint64_t>(std::popcount(query.valid_lanes(g)));
     if (blocked) blocked[g] = query.blocked(g);
   }
-  if (counters) {
-    counters->rays += rays_valid;
-    counters->node_visits += query.counters().node_visits;
-    counters->object_visits += query.counters().object_visits;
-    counters->triangle_tests += query.counters().triangle_tests;
-  }
+  if (counters) *counters += query.counters().for_rays(rays_valid);
 }
 
 }  // namespace
@@ -1159,64 +1038,5 @@ void occluded_large_packet(const Scene& scene, const LargePacketRays& rays, Tria
     run_query<TriangleTest::kFast, true>(scene, rays, objects, none, blocked, counters);
   }
 }
-
-#else
-
-namespace {
-// Eight rays (arrays of eight lanes) as an 8-ray packet, lanes of `lanes` active.
-RayPacket packet_of(const float* const o[3], const float* const d[3], const float* t_min, const float* t_max,
-                    std::uint32_t lanes) {
-  RayPacket p;
-  for (int i = 0; i < kLanes; ++i) {
-    p.ox[i] = o[0][i];
-    p.oy[i] = o[1][i];
-    p.oz[i] = o[2][i];
-    p.dx[i] = d[0][i];
-    p.dy[i] = d[1][i];
-    p.dz[i] = d[2][i];
-    p.t_min[i] = t_min[i];
-    p.t_max[i] = t_max[i];
-  }
-  p.active = static_cast<std::uint8_t>(lanes);
-  return p;
-}
-
-RayPacket group_of(const LargePacketRays& rays, int g) {
-  const std::size_t k0 = static_cast<std::size_t>(g) * kLanes;
-  const float* const o[3] = {rays.o[0] + k0, rays.o[1] + k0, rays.o[2] + k0};
-  const float* const d[3] = {rays.d[0] + k0, rays.d[1] + k0, rays.d[2] + k0};
-  return packet_of(o, d, rays.t_min + k0, rays.t_max + k0, rays.active[g]);
-}
-}  // namespace
-
-// Without AVX2 each group is an 8-ray packet (which is itself the single-ray
-// query per lane there).
-void intersect_large_packet(const Scene& scene, const LargePacketRays& rays, TriangleTest test,
-                            std::span<const std::uint32_t> /*objects: culling only saves time*/, PacketHits out,
-                            TraversalCounters* counters) {
-  for (int g = 0; g < std::clamp(rays.groups, 0, kMaxPacketGroups); ++g) {
-    const std::size_t k0 = static_cast<std::size_t>(g) * kLanes;
-    Hit hits[kPacketSize];
-    intersect_packet(scene, group_of(rays, g), test, hits, counters);
-    for (int lane = 0; lane < kLanes; ++lane) {
-      const std::size_t k = k0 + static_cast<std::size_t>(lane);
-      out.t[k] = hits[lane].t;
-      out.u[k] = hits[lane].u;
-      out.v[k] = hits[lane].v;
-      out.triangle[k] = hits[lane].triangle_id;
-      out.instance[k] = hits[lane].instance_id;
-    }
-  }
-}
-
-void occluded_large_packet(const Scene& scene, const LargePacketRays& rays, TriangleTest test,
-                           std::span<const std::uint32_t> /*objects*/, std::uint8_t* blocked,
-                           TraversalCounters* counters) {
-  for (int g = 0; g < std::clamp(rays.groups, 0, kMaxPacketGroups); ++g) {
-    blocked[g] = occluded_packet(scene, group_of(rays, g), test, counters);
-  }
-}
-
-#endif  // SINEW_AVX2
 
 }  // namespace sinew::rt

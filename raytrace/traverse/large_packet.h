@@ -1,8 +1,8 @@
-// Large packets: up to 64 groups of eight rays (a tile's 8x8-, 16x16- or
-// 32x16-pixel region) traced together through the top level and every kd-tree. Where
-// the 8-ray packets of traverse/packet_traversal.h make each lane repeat the
-// single ray's walk, a large packet walks a tree once for all its rays,
-// culling whole cells with a conservative interval bound on the rays
+// Packets: one to 64 groups of eight rays (a tile's 4x2-pixel block, or its
+// 8x8-, 16x16- or 32x16-pixel region) traced together through every tree:
+// the one packet core, which 8-ray packets (traverse/packet_traversal.h)
+// run as one group. A packet walks a tree once for all its rays, culling
+// whole cells with a conservative interval bound on the rays
 // (cull/interval_bound.h): a cell costs one box test whatever the number
 // of rays, and a leaf's triangles are tested only by the groups whose own
 // bound reaches its cell, or, for rays from one apex (a camera, a point

@@ -8,13 +8,10 @@
 
 #include <glm/geometric.hpp>
 
-#include "raytrace/traverse/traversal_shared.h"
-
-#include "runtime/math/simd.h"
-#if SINEW_AVX2
 #include "raytrace/geometry/triangle_intersect8.h"
+#include "raytrace/traverse/ray_frames.h"
+#include "raytrace/traverse/traversal_shared.h"
 #include "runtime/math/float8.h"
-#endif
 
 namespace sinew::rt {
 namespace {
@@ -156,8 +153,6 @@ bool gather_static_tile(const Scene& scene, TriangleTest test, const RayBound& b
 
 namespace {
 
-#if SINEW_AVX2
-
 // One group's rays, aligned for the eight-lane tests.
 struct alignas(32) GroupRays {
   float o[3][kBlockLanes];
@@ -167,16 +162,11 @@ struct alignas(32) GroupRays {
   RayLanes8 lanes() const { return {o, d, t_min, t_limit}; }
 };
 
-// valid_ray (traverse/traversal_shared.h) per lane.
+// The rays the queries accept (traverse/ray_frames.h valid_rays).
 std::uint32_t valid_lanes(const GroupRays& r) {
-  Mask8 valid = Float8::load(r.t_min) < Float8::load(r.t_limit);
-  Mask8 nonzero = Mask8::from_bits(0);
-  for (int a = 0; a < 3; ++a) {
-    const Float8 d = Float8::load(r.d[a]);
-    valid = valid & is_finite(Float8::load(r.o[a])) & is_finite(d);
-    nonzero = nonzero | !(d == Float8(0.0f));
-  }
-  return (valid & nonzero).bits();
+  const Vec3x8 o{Float8::load(r.o[0]), Float8::load(r.o[1]), Float8::load(r.o[2])};
+  const Vec3x8 d{Float8::load(r.d[0]), Float8::load(r.d[1]), Float8::load(r.d[2])};
+  return per_lane::valid_rays<Float8>(o, d, Float8::load(r.t_min), Float8::load(r.t_limit)).bits();
 }
 
 // The camera rays of one tile from `eye`: the triangles with their origin
@@ -310,71 +300,6 @@ class ShadowBlocks {
   const std::vector<CommonOriginTriangle>* prepared_ = nullptr;
 };
 
-#else  // lane by lane with the scalar test, which the eight-lane tests equal bit for bit
-
-class CameraBlocks {
- public:
-  CameraBlocks(const std::vector<StaticTriangle>& triangles, const Vec3& eye) : triangles_(triangles), eye_(eye) {}
-
-  std::uint32_t trace(TileScratch& s, std::size_t b, std::uint64_t objects, TraversalCounters& counters) {
-    std::uint32_t hits = 0;
-    for (int lane = 0; lane < kBlockLanes; ++lane) {
-      const std::size_t k = b * kBlockLanes + static_cast<std::size_t>(lane);
-      s.t[k] = kInf;
-      s.u[k] = s.v[k] = 0.0f;
-      s.triangle[k] = s.instance[k] = kInvalidId;
-      Ray ray;
-      ray.origin = eye_;
-      ray.direction = Vec3(s.dir_x[k], s.dir_y[k], s.dir_z[k]);
-      if (!(s.block_pixels[b] >> lane & 1u) || !detail::valid_ray(ray)) continue;
-      counters.object_visits += objects;
-      counters.triangle_tests += triangles_.size();
-      for (const StaticTriangle& tri : triangles_) {
-        TriangleHit h;
-        if (!intersect_triangle_fast(ray, s.t[k], tri.p0, tri.p1, tri.p2, h)) continue;
-        s.t[k] = h.t;
-        s.u[k] = h.u;
-        s.v[k] = h.v;
-        s.triangle[k] = tri.triangle;
-        s.instance[k] = tri.instance;
-        hits |= 1u << lane;
-      }
-    }
-    return hits;
-  }
-
- private:
-  const std::vector<StaticTriangle>& triangles_;
-  Vec3 eye_;
-};
-
-class ShadowBlocks {
- public:
-  ShadowBlocks(const std::vector<StaticTriangle>& triangles, const TileScratch& /*s*/) : triangles_(triangles) {}
-
-  std::uint32_t blocked(const TileScratch& s, std::size_t i, std::size_t n, TraversalCounters& counters) const {
-    std::uint32_t blocked = 0;
-    for (std::size_t lane = 0; lane < n; ++lane) {
-      const Ray ray = s.shadow_ray(i + lane);
-      if (!detail::valid_ray(ray)) continue;
-      for (const StaticTriangle& tri : triangles_) {
-        if (tri.first) ++counters.object_visits;
-        ++counters.triangle_tests;
-        TriangleHit h;
-        if (intersect_triangle_fast(ray, ray.t_max, tri.p0, tri.p1, tri.p2, h)) {
-          blocked |= 1u << lane;
-          break;
-        }
-      }
-    }
-    return blocked;
-  }
-
- private:
-  const std::vector<StaticTriangle>& triangles_;
-};
-
-#endif  // SINEW_AVX2
 
 }  // namespace
 

@@ -1,5 +1,8 @@
 #include "raytrace/traverse/traversal.h"
 
+#include "raytrace/traverse/leaf_triangles.h"
+#include "raytrace/traverse/mailbox.h"
+#include "raytrace/traverse/ray_frames.h"
 #include "raytrace/traverse/traversal_shared.h"
 
 #include <algorithm>
@@ -11,17 +14,15 @@
 namespace sinew::rt {
 namespace {
 
-using detail::clip_to_box;
-using detail::finite;
-using detail::Mailbox;
 using detail::max_abs;
 using detail::valid_ray;
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
-
-
-
+// The shared box clip (traverse/ray_frames.h) for one ray.
+bool clip_to_box(const Aabb& box, float eps, const Vec3& o, const Vec3& d, const Vec3& inv, float& t0, float& t1) {
+  return per_lane::clip_to_box<float>(box, eps, o, d, inv, t0, t1);
+}
 
 struct StackEntry {
   std::uint32_t node;
@@ -182,11 +183,9 @@ class Query {
   const TraversalCounters& counters() const { return counters_; }
 
  private:
-  // The slack of a world-space computation: rounding relative to the ray's
-  // origin, its reach and the box's own coordinates.
+  // The slack of a world-space box (traverse/ray_frames.h world_slack).
   float world_eps(const Aabb& box, float t_end) const {
-    const float reach = std::isfinite(t_end) ? t_end * direction_magnitude_ : 0.0f;
-    return kFrameRelativeSlack * (origin_magnitude_ + reach + max_abs(box));
+    return per_lane::world_slack<float>(origin_magnitude_, direction_magnitude_, max_abs(box), t_end);
   }
 
   // Objects overlap several top-level leaves; each is traversed once, over
@@ -222,30 +221,15 @@ class Query {
   bool visit_bone(const InstanceFrame& frame, std::uint32_t bone, float t0, float t1) {
     const Scene::Character& character = scene_.characters()[frame.character];
     const BoneTree& tree = frame.bone_tree(character.fuzzy, bone);
-    const Affine3& to_bone = frame.bone_from_world[bone];
-    const Vec3 o = to_bone.transform_point(ray_.origin);
-    const Vec3 d = to_bone.transform_vector(ray_.direction);
-    // Slack in the bone frame: the escape check's tolerance (a vertex may sit
-    // that far outside its box and still count as inside), twice, for the
-    // rounding of both frame changes, plus the rounding of carrying this ray
-    // over and of the traversal arithmetic.
-    const InstanceFrame::BoneCarry& carry = frame.bone_carry[bone];
-    const float carried = carry.linear_norm * origin_magnitude_ + carry.translation_magnitude;
-    const float eps = 2.0f * frame.tolerance[bone] +
-                      kFrameRelativeSlack * (carried + max_abs(o) + t1 * max_abs(d) + carry.bounds_magnitude);
-    const Vec3 inv(1.0f / d.x, 1.0f / d.y, 1.0f / d.z);
+    // The ray and its slack in the bone frame (traverse/ray_frames.h).
+    const per_lane::FrameRay<float> r =
+        per_lane::to_bone_frame<float>(frame, bone, ray_.origin, ray_.direction, origin_magnitude_, t1);
+    const Vec3& o = r.o;
+    const Vec3& d = r.d;
+    const float eps = r.eps;
+    const Vec3 inv = per_lane::reciprocal<float>(d);
     if (!clip_to_box(tree.bounds, eps, o, d, inv, t0, t1)) return false;
-    const SkinnedMesh& mesh = *character.mesh;
-    const auto leaf = [&](std::span<const std::uint32_t> triangles) {
-      for (const std::uint32_t t : triangles) {
-        if (mailbox_.seen(t)) continue;
-        const auto& v = mesh.triangles[t];
-        if (test(frame.positions[v[0]], frame.positions[v[1]], frame.positions[v[2]], t, frame.instance_id)) {
-          return true;
-        }
-      }
-      return false;
-    };
+    const auto leaf = leaf_of(SkinnedTriangles{*character.mesh, frame});
     if (character.fuzzy.has_bvhs()) {
       return traverse_bvh(character.fuzzy.bvh_view(tree), o, d, inv, eps, t0, t1, t_limit_, counters_.node_visits,
                           leaf);
@@ -255,54 +239,48 @@ class Query {
   }
 
   bool visit_static(const Scene::StaticMesh& mesh, float t0, float t1) {
+    const StaticTriangles triangles{mesh};
     if (mesh.desc.triangles.size() <= detail::kBruteForceStaticTriangles) {
       for (std::uint32_t t = 0; t < mesh.desc.triangles.size(); ++t) {
-        const auto& v = mesh.desc.triangles[t];
-        if (test(mesh.desc.positions[v[0]], mesh.desc.positions[v[1]], mesh.desc.positions[v[2]], t,
-                 mesh.instance_id)) {
-          return true;
-        }
+        if (test(triangles(t))) return true;
       }
       return false;
     }
-    const KdTreeView tree = mesh.tree.view();
-    const float eps = world_eps(tree.bounds, t1);
-    return traverse_tree(tree, ray_.origin, ray_.direction, inv_dir_, eps, t0, t1, t_limit_, counters_.node_visits,
-                         [&](std::span<const std::uint32_t> triangles) {
-                           for (const std::uint32_t t : triangles) {
-                             if (mailbox_.seen(t)) continue;
-                             const auto& v = mesh.desc.triangles[t];
-                             if (test(mesh.desc.positions[v[0]], mesh.desc.positions[v[1]],
-                                      mesh.desc.positions[v[2]], t, mesh.instance_id)) {
-                               return true;
-                             }
-                           }
-                           return false;
-                         });
+    return walk_world_tree(mesh.tree.view(), t0, t1, triangles);
   }
 
   bool visit_fallback(const InstanceFrame& frame, float t0, float t1) {
-    const SkinnedMesh& mesh = *scene_.characters()[frame.character].mesh;
-    const KdTreeView tree = frame.fallback.view();
+    return walk_world_tree(frame.fallback.view(), t0, t1,
+                           EscapedTriangles{*scene_.characters()[frame.character].mesh, frame});
+  }
+
+  // A world-space tree below the top level, its leaf items read by `source`.
+  template <class Source>
+  bool walk_world_tree(const KdTreeView& tree, float t0, float t1, const Source& source) {
     const float eps = world_eps(tree.bounds, t1);
     return traverse_tree(tree, ray_.origin, ray_.direction, inv_dir_, eps, t0, t1, t_limit_, counters_.node_visits,
-                         [&](std::span<const std::uint32_t> items) {
-                           for (const std::uint32_t item : items) {
-                             if (mailbox_.seen(item)) continue;
-                             const std::uint32_t t = frame.escaped_triangles[item];
-                             const auto& v = mesh.triangles[t];
-                             if (test(frame.positions[v[0]], frame.positions[v[1]], frame.positions[v[2]], t,
-                                      frame.instance_id)) {
-                               return true;
-                             }
-                           }
-                           return false;
-                         });
+                         leaf_of(source));
+  }
+
+  // A leaf's test: each item's triangle (from `source`, traverse/
+  // leaf_triangles.h) once per object visit; true when the query is answered.
+  template <class Source>
+  auto leaf_of(const Source& source) {
+    return [this, source](std::span<const std::uint32_t> items) {
+      for (const std::uint32_t item : items) {
+        if (!mailbox_.first_visit(item)) continue;
+        if (test(source(item))) return true;
+      }
+      return false;
+    };
   }
 
   // Tests one world-space triangle; records a nearer hit. Returns true when
   // the query is answered (any-hit found something).
-  bool test(const Vec3& p0, const Vec3& p1, const Vec3& p2, std::uint32_t triangle, std::uint32_t instance) {
+  bool test(const LeafTriangle& tri) {
+    const Vec3& p0 = *tri.p0;
+    const Vec3& p1 = *tri.p1;
+    const Vec3& p2 = *tri.p2;
     ++counters_.triangle_tests;
     TriangleHit h;
     bool hit_found;
@@ -312,7 +290,7 @@ class Query {
       hit_found = intersect_triangle_fast(ray_, t_limit_, p0, p1, p2, h);
     }
     if (!hit_found) return false;
-    best_ = Hit{h.t, h.u, h.v, triangle, instance};
+    best_ = Hit{h.t, h.u, h.v, tri.triangle, tri.instance};
     if constexpr (kAnyHit) return true;
     t_limit_ = h.t;
     return false;
@@ -326,26 +304,18 @@ class Query {
   float t_limit_;
   WatertightRay watertight_;
   Hit best_;
-  Mailbox mailbox_;
+  ItemMailbox<16> mailbox_;
   std::array<std::uint32_t, 32> visited_;  // the first visited_count_ are set
   std::size_t visited_count_ = 0;
   TraversalCounters counters_;
 };
 
 
-void accumulate(TraversalCounters* into, const TraversalCounters& from) {
-  if (!into) return;
-  into->rays += 1;
-  into->node_visits += from.node_visits;
-  into->object_visits += from.object_visits;
-  into->triangle_tests += from.triangle_tests;
-}
-
 template <TriangleTest kTest, bool kAnyHit>
 Hit run_query(const Scene& scene, const Ray& ray, TraversalCounters* counters) {
   Query<kTest, kAnyHit> query(scene, ray);
   query.run();
-  accumulate(counters, query.counters());
+  if (counters) *counters += query.counters().for_rays(1);
   return query.hit();
 }
 

@@ -21,11 +21,28 @@
 
 namespace sinew::rt {
 
+// What a query did, summed over queries (every width counts alike: object
+// visits and triangle tests per lane, node visits per node fetched).
 struct TraversalCounters {
   std::uint64_t rays = 0;
   std::uint64_t node_visits = 0;      // inner and leaf nodes of every tree
   std::uint64_t object_visits = 0;    // bone / static / fallback objects entered
   std::uint64_t triangle_tests = 0;
+
+  TraversalCounters& operator+=(const TraversalCounters& other) {
+    rays += other.rays;
+    node_visits += other.node_visits;
+    object_visits += other.object_visits;
+    triangle_tests += other.triangle_tests;
+    return *this;
+  }
+  // The same work, counted for `n` rays (a query counts its work; its entry
+  // point, the rays it was asked to trace).
+  TraversalCounters for_rays(std::uint64_t n) const {
+    TraversalCounters counted = *this;
+    counted.rays = n;
+    return counted;
+  }
 };
 
 // The nearest hit with ray.t_min <= t < ray.t_max; Hit::valid() is false on a miss.

@@ -70,13 +70,6 @@ struct CountResult {
   rt::TraversalCounters primary, shadow;
 };
 
-void add(rt::TraversalCounters& into, const rt::TraversalCounters& from) {
-  into.rays += from.rays;
-  into.node_visits += from.node_visits;
-  into.object_visits += from.object_visits;
-  into.triangle_tests += from.triangle_tests;
-}
-
 double per_ray(std::uint64_t work, std::uint64_t rays) {
   return rays > 0 ? static_cast<double>(work) / static_cast<double>(rays) : 0.0;
 }
@@ -109,8 +102,8 @@ Expected<CountResult> measure(const DemoBenchOptions& o, int characters, JobSyst
     if (f >= o.warmup) {
       rays += report.render.primary_rays + report.render.shadow_rays;
       r.escaped_triangles += report.scene.escaped_triangles;
-      add(r.primary, report.render.primary);
-      add(r.shadow, report.render.shadow);
+      r.primary += report.render.primary;
+      r.shadow += report.render.shadow;
     }
   }
   r.phases = session->timers().summarize();

@@ -118,10 +118,7 @@ inline Expected<WalkMeasure> measure_walk(const character::Model& model, const r
                            renderer.render(stage.scene, *framing.camera, settings, buffers, jobs));
     result.frame_ms.push_back(prepare_ms + ms_since(render_start));
     for (auto [sum, add] : {std::pair{&result.primary, &stats.primary}, std::pair{&result.shadow, &stats.shadow}}) {
-      sum->rays += add->rays;
-      sum->node_visits += add->node_visits;
-      sum->object_visits += add->object_visits;
-      sum->triangle_tests += add->triangle_tests;
+      *sum += *add;
     }
     if (f == 0) {
       if (!framing.gate) {

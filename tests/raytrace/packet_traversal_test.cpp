@@ -1,8 +1,9 @@
 // Packet traversal (traverse/packet_traversal.h): every lane of an 8-ray
-// packet gets exactly the single-ray answer (same triangle, instance and t,
-// u, v bits; same occlusion), for coherent camera packets, incoherent random
-// packets with partial masks and finite t_max, shadow packets, and with the
-// fallback for escaped triangles in use.
+// packet gets the single-ray answer (the same t, u and v bits; the same
+// triangle and instance, the mannequin's scenes having no exact ties; the
+// same occlusion), for coherent camera packets, incoherent random packets
+// with partial masks and finite t_max, shadow packets, and with the fallback
+// for escaped triangles in use.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -26,7 +27,6 @@
 #include "raytrace/traverse/packet_traversal.h"
 #include "raytrace/traverse/traversal.h"
 #include "runtime/jobs/job_system.h"
-#include "runtime/math/simd.h"
 #include "tests/support/brute_force.h"
 #include "tests/support/idle_mannequin.h"
 
@@ -245,8 +245,8 @@ ShadowTally check_shadow_packets(const rt::Scene& scene) {
   return tally;
 }
 
-// The kick (or idle) pose, and the bone trees' kind. With BVHs a packet's
-// lanes need not walk in their single rays' order, but they still find the
+// The kick (or idle) pose, and the bone trees' kind. A packet's lanes need
+// not meet the cells in their single rays' order, but they still find the
 // same nearest hit (the same t, u and v; on an exact tie of t between two
 // triangles the mannequin's scenes have none).
 class PacketTraversal : public ::testing::TestWithParam<std::tuple<bool, rt::BoneTreeKind>> {
@@ -301,9 +301,6 @@ INSTANTIATE_TEST_SUITE_P(Poses, PacketTraversal,
 // Lanes that share cells share node fetches: a coherent camera packet walks
 // fewer nodes than its eight rays do one by one.
 TEST(PacketTraversalCounters, CoherentPacketsShareNodeVisits) {
-#if !SINEW_AVX2
-  GTEST_SKIP() << "built without AVX2: packets are traced lane by lane";
-#endif
   const auto s = make_scene(false);
   const rt::PinholeCamera camera = test_camera(64);
   rt::TraversalCounters single, packet;
@@ -319,7 +316,11 @@ TEST(PacketTraversalCounters, CoherentPacketsShareNodeVisits) {
     }
   }
   EXPECT_EQ(packet.rays, single.rays);
-  EXPECT_EQ(packet.object_visits, single.object_visits) << "each lane enters the objects its single ray enters";
+  // Object visits and triangle tests count per lane, as the single rays
+  // count them; the packet culls objects and leaves with its own bounds, so
+  // it may enter a few fewer or more than its rays would one by one.
+  EXPECT_GT(packet.object_visits, single.object_visits / 2);
+  EXPECT_LT(packet.object_visits, single.object_visits * 2);
   EXPECT_LT(packet.node_visits, single.node_visits / 2);
   RecordProperty("single_node_visits", std::to_string(single.node_visits));
   RecordProperty("packet_node_visits", std::to_string(packet.node_visits));

@@ -178,7 +178,7 @@ TEST(RayBound, WideFlatBoxesAreCulledByTheirHeightNotTheirWidth) {
       const float eps = rt::kFrameRelativeSlack * (rt::detail::max_abs(light) + t1[lane] * rt::detail::max_abs(dir) +
                                                    rt::detail::max_abs(box));
       float a = t0[lane], b = t1[lane];
-      any = any || rt::detail::clip_to_box(box, eps, light, dir, Vec3(1.0f / dir.x, 1.0f / dir.y, 1.0f / dir.z),
+      any = any || rt::per_lane::clip_to_box<float>(box, eps, light, dir, Vec3(1.0f / dir.x, 1.0f / dir.y, 1.0f / dir.z),
                                            a, b);
     }
     if (any) {
@@ -415,8 +415,8 @@ TEST(RayBound, CullKeepsEveryObjectARayEntersWithFewAndManyObjects) {
   }
 }
 
-// Random packets around the characters: culled (tile bound, then packet
-// cull, as the renderer does) and unculled traversal agree with single rays.
+// Random packets around the characters: culled by a bound over their rays
+// (as the renderer culls a tile's) and unculled, they agree with single rays.
 TEST(PacketCulling, CulledPacketsFindTheSingleRayHits) {
   const rt::Scene& s = scene();
   std::mt19937 g(11);
@@ -449,10 +449,9 @@ TEST(PacketCulling, CulledPacketsFindTheSingleRayHits) {
     const float* const d[3] = {packet.dx, packet.dy, packet.dz};
     rt::RayBound bound;
     bound.add_lanes(o, d, packet.t_min, packet.t_max, packet.active);
-    std::vector<std::uint32_t> tile, candidates;
+    std::vector<std::uint32_t> tile;
     rt::cull_objects(s, bound, tile);
-    rt::cull_objects_for_packet(s, o, d, packet.t_min, packet.t_max, packet.active, tile, candidates);
-    const rt::ObjectFilter filter{candidates};
+    const rt::ObjectFilter filter{tile};
     for (const TriangleTest test : kTests) {
       Hit culled[8];
       rt::intersect_packet(s, packet, test, culled, nullptr, &filter);

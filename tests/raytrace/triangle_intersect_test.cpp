@@ -1,9 +1,6 @@
 #include "raytrace/geometry/triangle_intersect.h"
 
-#include "runtime/math/simd.h"
-#if SINEW_AVX2
 #include "raytrace/geometry/triangle_intersect8.h"
-#endif
 
 #include <gtest/gtest.h>
 
@@ -554,7 +551,6 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> shared_edges(const Mesh& me
   return shared;
 }
 
-#if SINEW_AVX2
 // prepare_common_origin8 (a leaf's triangles eight at a time,
 // traverse/large_packet.cpp) gives each lane what prepare_common_origin gives
 // its triangle, bit for bit: small, huge, far, degenerate and non-finite
@@ -597,7 +593,6 @@ TEST(TriangleIntersectEdgeCases, CommonOriginTermsEightAtATimeMatchOneAtATime) {
   }
   EXPECT_EQ(compared, 3200);
 }
-#endif
 
 TEST(TriangleIntersectWatertight, NoLeaksThroughAJitteredGrid) {
   Random rng(2024);

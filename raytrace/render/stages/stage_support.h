@@ -1,7 +1,6 @@
 // Pieces the tile stages (render/stages/tile_stages.h) share: lane loads and
 // stores over the tile's arrays, the rounding bound, a missed lane, and the
-// per-thread culling lists of a tile and of an eight-ray packet. Private to
-// render/stages.
+// per-thread list of a tile's culled objects. Private to render/stages.
 #pragma once
 
 #include <cstdint>
@@ -10,7 +9,6 @@
 
 #include "raytrace/cull/ray_bound.h"
 #include "raytrace/render/tile_scratch.h"
-#include "raytrace/traverse/packet_traversal.h"
 #include "raytrace/traverse/traversal.h"
 #include "runtime/math/float8.h"
 
@@ -33,36 +31,17 @@ inline void store3(const Vec3x8& v, std::vector<float>& x, std::vector<float>& y
   v.z.store(&z[k]);
 }
 
-// Per-thread lists of the objects a tile's and a packet's rays may enter.
+// Per-thread list of the objects a tile's rays may enter.
 struct CullLists {
   std::vector<std::uint32_t> tile;
-  std::vector<std::uint32_t> packet;
 };
 inline CullLists& cull_lists() {
   thread_local CullLists lists;
   return lists;
 }
 
-// Of the tile's objects, those `packet` may enter, into lists.packet. With
-// one object for the whole tile the packet's own cull could only drop it,
-// which the object's box clip does as cheaply.
-inline void cull_for_packet(const Scene& scene, const RayPacket& packet, CullLists& lists) {
-  lists.packet.clear();
-  if (lists.tile.size() == 1) {
-    lists.packet.push_back(lists.tile[0]);
-    return;
-  }
-  const float* const o[3] = {packet.ox, packet.oy, packet.oz};
-  const float* const d[3] = {packet.dx, packet.dy, packet.dz};
-  cull_objects_for_packet(scene, o, d, packet.t_min, packet.t_max, packet.active, lists.tile, lists.packet);
-}
-
 // A packet query's work added to the tile's (rays are counted by the caller).
-inline void add_work(TraversalCounters& into, const TraversalCounters& from) {
-  into.node_visits += from.node_visits;
-  into.object_visits += from.object_visits;
-  into.triangle_tests += from.triangle_tests;
-}
+inline void add_work(TraversalCounters& into, const TraversalCounters& from) { into += from.for_rays(0); }
 
 inline void set_miss(TileScratch& s, std::size_t k) {
   s.t[k] = kInf;

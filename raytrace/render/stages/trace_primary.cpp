@@ -109,7 +109,7 @@ void trace_primary(const Scene& scene, const PinholeCamera& camera, TriangleTest
     return;
   }
   // One bound over the whole tile picks the objects any of its rays may
-  // enter; each packet then keeps those of its own rays.
+  // enter; each packet culls them again with its own bound.
   CullLists& lists = cull_lists();
   lists.tile.clear();
   RayBound tile_bound;
@@ -122,54 +122,7 @@ void trace_primary(const Scene& scene, const PinholeCamera& camera, TriangleTest
     intersect_static_tile(statics, eye, s, counters);
     return;
   }
-  if (packet_rays > kPacketSize) {
-    trace_primary_large(scene, camera, test, lists.tile, s, counters);
-    return;
-  }
-  RayPacket packet;
-  for (int lane = 0; lane < kPacketSize; ++lane) {
-    packet.ox[lane] = eye.x;
-    packet.oy[lane] = eye.y;
-    packet.oz[lane] = eye.z;
-    packet.t_min[lane] = 0.0f;
-    packet.t_max[lane] = kInf;
-  }
-  for (std::size_t b = 0; b < blocks; ++b) {
-    const std::size_t k0 = b * kBlockLanes;
-    const std::uint32_t pixels = s.block_pixels[b];
-    counters.rays += static_cast<std::uint64_t>(std::popcount(pixels));
-    s.block_hits[b] = 0;
-    std::memcpy(packet.dx, &s.dir_x[k0], sizeof(packet.dx));
-    std::memcpy(packet.dy, &s.dir_y[k0], sizeof(packet.dy));
-    std::memcpy(packet.dz, &s.dir_z[k0], sizeof(packet.dz));
-    packet.active = static_cast<std::uint8_t>(pixels);
-    if (!lists.tile.empty()) cull_for_packet(scene, packet, lists);
-    if (lists.tile.empty() || lists.packet.empty()) {
-      for (int lane = 0; lane < kBlockLanes; ++lane) set_miss(s, k0 + static_cast<std::size_t>(lane));
-      continue;
-    }
-    const ObjectFilter filter{lists.packet};
-    TraversalCounters work;
-    const PacketHits direct{&s.t[k0], &s.u[k0], &s.v[k0], &s.triangle[k0], &s.instance[k0]};
-    if (!intersect_packet_small_statics(scene, packet, test, filter, direct, &work)) {
-      Hit hits[kPacketSize];
-      intersect_packet(scene, packet, test, hits, &work, &filter);
-      for (int lane = 0; lane < kPacketSize; ++lane) {
-        const std::size_t k = k0 + static_cast<std::size_t>(lane);
-        s.t[k] = hits[lane].t;
-        s.u[k] = hits[lane].u;
-        s.v[k] = hits[lane].v;
-        s.triangle[k] = hits[lane].triangle_id;
-        s.instance[k] = hits[lane].instance_id;
-      }
-    }
-    add_work(counters, work);
-    std::uint32_t hit_bits = 0;
-    for (int lane = 0; lane < kPacketSize; ++lane) {
-      hit_bits |= s.triangle[k0 + static_cast<std::size_t>(lane)] != kInvalidId ? (1u << lane) : 0u;
-    }
-    s.block_hits[b] = static_cast<std::uint8_t>(hit_bits & pixels);
-  }
+  trace_primary_large(scene, camera, test, lists.tile, s, counters);
 }
 
 }  // namespace sinew::rt

@@ -138,7 +138,6 @@ std::uint64_t trace_shadow_rays(const Scene& scene, TriangleTest test, int l, Ti
   compact_shadow_rays(s);
   // Pad a group past the last ray (inactive lanes, but the arithmetic
   // reads them; a large packet's groups start anywhere).
-  const std::size_t padded = (s.shadow_count + kPacketSize - 1) / kPacketSize * kPacketSize;
   for (std::size_t i = s.shadow_count; i < s.shadow_count + kPacketSize; ++i) {
     s.so_x[i] = s.so_y[i] = s.so_z[i] = 0.0f;
     s.sd_x[i] = s.sd_y[i] = 0.0f;
@@ -150,34 +149,7 @@ std::uint64_t trace_shadow_rays(const Scene& scene, TriangleTest test, int l, Ti
     counters.rays += s.shadow_count;
     return occluded_static_tile(statics, l, s, counters);
   }
-  if (packet_rays > kPacketSize) return trace_shadow_large(scene, test, lists.tile, l, s, counters);
-  RayPacket packet;
-  std::memcpy(packet.t_min, kZeros, sizeof(packet.t_min));
-  for (std::size_t i = 0; i < padded; i += kPacketSize) {
-    const std::size_t n = std::min<std::size_t>(kPacketSize, s.shadow_count - i);
-    counters.rays += n;
-    if (lists.tile.empty()) continue;
-    std::memcpy(packet.ox, &s.so_x[i], sizeof(packet.ox));
-    std::memcpy(packet.oy, &s.so_y[i], sizeof(packet.oy));
-    std::memcpy(packet.oz, &s.so_z[i], sizeof(packet.oz));
-    std::memcpy(packet.dx, &s.sd_x[i], sizeof(packet.dx));
-    std::memcpy(packet.dy, &s.sd_y[i], sizeof(packet.dy));
-    std::memcpy(packet.dz, &s.sd_z[i], sizeof(packet.dz));
-    std::memcpy(packet.t_max, &s.s_tmax[i], sizeof(packet.t_max));
-    packet.active = static_cast<std::uint8_t>((1u << n) - 1u);
-    cull_for_packet(scene, packet, lists);
-    if (lists.packet.empty()) continue;
-    const ObjectFilter filter{lists.packet};
-    TraversalCounters work;
-    const int small = occluded_packet_small_statics(scene, packet, test, filter, &work);
-    const std::uint32_t blocked =
-        small >= 0 ? static_cast<std::uint32_t>(small) : occluded_packet(scene, packet, test, &work, &filter);
-    add_work(counters, work);
-    for (std::uint32_t m = blocked & packet.active; m != 0; m &= m - 1) {
-      block(i + static_cast<std::size_t>(std::countr_zero(m)));
-    }
-  }
-  return blocked_count;
+  return trace_shadow_large(scene, test, lists.tile, l, s, counters);
 }
 
 }  // namespace sinew::rt
