@@ -160,38 +160,53 @@ bool finite_block_box(std::span<const Vec3> positions, std::size_t v, bool avx2,
   return true;
 }
 
-// `columns`: bone_columns(e); `rigid_usable`: rigid_bones_usable(e);
-// `blocks`: whether the AVX2 block check may run.
-std::size_t count_escapes(const EscapeCheckInput& e, [[maybe_unused]] std::span<const BoneColumns> columns,
-                          std::span<const std::uint8_t> rigid_usable, std::span<const Vec3> positions,
-                          std::span<std::uint8_t> escaped, Range r, bool blocks) {
-  // Local copies of the spans: the byte stores into `escaped` may alias
-  // anything, and locals spare the reloads of pointers and sizes after each.
-  const std::span<const std::uint32_t> check_begin = e.vertex_check_begin;
-  const std::span<const VertexCheck> checks = e.vertex_checks;
-  const std::span<const Affine3> bone_from_world = e.bone_from_world;
-  const std::span<const float> tolerance = e.tolerance;
-  const std::size_t bone_limit = std::min(bone_from_world.size(), tolerance.size());
+// What count_escapes reads and writes over one range. Local copies of the
+// spans: the byte stores into `escaped` may alias anything, and locals spare
+// the reloads of pointers and sizes after each.
+struct EscapeArrays {
+  std::span<const std::uint32_t> check_begin;
+  std::span<const VertexCheck> checks;
+  std::span<const Affine3> bone_from_world;
+  std::span<const float> tolerance;
+  std::size_t bone_limit = 0;  // the bones with both a transform and a tolerance
   // A bone's checks held to its cluster's boxes, when it has one.
-  const std::span<const Aabb* const> bone_boxes =
-      e.check_rank.size() >= checks.size() && e.bone_boxes.size() >= bone_limit ? e.bone_boxes
-                                                                                 : std::span<const Aabb* const>{};
-  const std::span<const std::uint32_t> check_rank = e.check_rank;
-  const auto box_of = [&](const VertexCheck& check, std::size_t c) -> const Aabb& {
+  std::span<const Aabb* const> bone_boxes;
+  std::span<const std::uint32_t> check_rank;
+  std::span<const BoneColumns> columns;  // bone_columns(e), read by the SSE check
+  std::span<const Vec3> positions;
+  std::span<std::uint8_t> escaped;
+
+  const Aabb& box_of(const VertexCheck& check, std::size_t c) const {
     if (bone_boxes.empty()) return check.box;
     const Aabb* boxes_of_bone = bone_boxes[check.bone];
     const std::uint32_t rank = check_rank[c];
     return boxes_of_bone != nullptr && rank != kSharedCheckBox ? boxes_of_bone[rank] : check.box;
-  };
-  const std::size_t end = std::min(r.end, check_begin.empty() ? 0 : check_begin.size() - 1);
-  // This chunk's row of bone boxes, when asked for and sized as documented.
-  const std::size_t bones = bone_from_world.size();
-  const std::size_t row = r.begin / kChunkVertices;
-  Aabb* const boxes = e.chunk_bone_boxes.size() >= (row + 1) * bones && bones > 0
-                          ? e.chunk_bone_boxes.data() + row * bones
-                          : nullptr;
-  if (boxes != nullptr) std::fill(boxes, boxes + bones, Aabb::empty());
+  }
+};
 
+EscapeArrays escape_arrays(const EscapeCheckInput& e, std::span<const BoneColumns> columns,
+                           std::span<const Vec3> positions, std::span<std::uint8_t> escaped) {
+  EscapeArrays a;
+  a.check_begin = e.vertex_check_begin;
+  a.checks = e.vertex_checks;
+  a.bone_from_world = e.bone_from_world;
+  a.tolerance = e.tolerance;
+  a.bone_limit = std::min(a.bone_from_world.size(), a.tolerance.size());
+  a.bone_boxes = e.check_rank.size() >= a.checks.size() && e.bone_boxes.size() >= a.bone_limit
+                     ? e.bone_boxes
+                     : std::span<const Aabb* const>{};
+  a.check_rank = e.check_rank;
+  a.columns = columns;
+  a.positions = positions;
+  a.escaped = escaped;
+  return a;
+}
+
+// A range's row of bone boxes (EscapeCheckInput::chunk_bone_boxes), null
+// when not asked for.
+struct BoneBoxRow {
+  Aabb* boxes = nullptr;
+  std::size_t bones = 0;
 #if SINEW_ESCAPE_SSE
   // The box of the current run of checks against one bone, kept in
   // registers and merged into the bone's box when the bone changes: extending
@@ -202,7 +217,8 @@ std::size_t count_escapes(const EscapeCheckInput& e, [[maybe_unused]] std::span<
   std::size_t run_bone = bones;  // none yet
   __m128 run_lower = _mm_set1_ps(std::numeric_limits<float>::infinity());
   __m128 run_upper = _mm_set1_ps(-std::numeric_limits<float>::infinity());
-  const auto end_run = [&] {
+
+  void end_run() {
     if (run_bone >= bones) return;
     alignas(16) float lower[4];
     alignas(16) float upper[4];
@@ -212,18 +228,91 @@ std::size_t count_escapes(const EscapeCheckInput& e, [[maybe_unused]] std::span<
     run_bone = bones;
     run_lower = _mm_set1_ps(std::numeric_limits<float>::infinity());
     run_upper = _mm_set1_ps(-std::numeric_limits<float>::infinity());
-  };
+  }
   // Grows `bone`'s run by the box [lower, upper] (x, y, z, 0 each).
   // min_ps(a, b) is a < b ? a : b: the run's side stays on ties and NaNs.
-  const auto extend_run = [&](std::size_t bone, __m128 lower, __m128 upper) {
+  void extend_run(std::size_t bone, __m128 lower, __m128 upper) {
     if (bone != run_bone) {
       end_run();
       run_bone = bone;
     }
     run_lower = _mm_min_ps(lower, run_lower);
     run_upper = _mm_max_ps(upper, run_upper);
+  }
+#endif
+};
+
+// The row of range `r`, emptied, when asked for and sized as documented.
+BoneBoxRow bone_box_row(const EscapeCheckInput& e, Range r) {
+  const std::size_t bones = e.bone_from_world.size();
+  const std::size_t row = r.begin / kChunkVertices;
+  Aabb* const boxes = e.chunk_bone_boxes.size() >= (row + 1) * bones && bones > 0
+                          ? e.chunk_bone_boxes.data() + row * bones
+                          : nullptr;
+  if (boxes != nullptr) std::fill(boxes, boxes + bones, Aabb::empty());
+  return BoneBoxRow{boxes, bones};
+}
+
+// Vertex v's checks one by one (a vertex no block check took): their flags
+// written, its position grown into their bones' boxes; returns how many
+// escaped. Inlined into count_escapes's loop, where the row's run stays in
+// registers from vertex to vertex.
+[[gnu::always_inline]] inline std::size_t check_vertex(const EscapeArrays& a, BoneBoxRow& row, std::size_t v) {
+  const std::size_t first = std::min<std::size_t>(a.check_begin[v], a.checks.size());
+  const std::size_t last = std::min<std::size_t>(a.check_begin[v + 1], a.checks.size());
+  const Vec3 world = a.positions[v];
+#if SINEW_ESCAPE_SSE
+  // Four lanes per check (x, y, z and a spare), about a quarter of the
+  // scalar check's instructions: the check is per vertex and per bone, and
+  // at 855,552 triangles it was as long as the skinning itself.
+  const __m128 x = _mm_set1_ps(world.x), y = _mm_set1_ps(world.y), z = _mm_set1_ps(world.z);
+  const auto inside = [&](const VertexCheck& check, const Aabb& box) {
+    const BoneColumns& m = a.columns[check.bone];
+    const __m128 q =
+        _mm_add_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(m.c[0], x), _mm_mul_ps(m.c[1], y)), _mm_mul_ps(m.c[2], z)),
+                   m.c[3]);
+    const __m128 tol = _mm_set1_ps(a.tolerance[check.bone]);
+    // The box's lower corner, and its upper one read from lower.z on (in
+    // bounds), moved down a lane.
+    const __m128 lower = _mm_loadu_ps(&box.lower.x);
+    const __m128 from_z = _mm_loadu_ps(&box.lower.z);
+    const __m128 upper = _mm_shuffle_ps(from_z, from_z, _MM_SHUFFLE(3, 3, 2, 1));
+    const __m128 in = _mm_and_ps(
+        _mm_and_ps(_mm_cmpge_ps(q, _mm_sub_ps(lower, tol)), _mm_cmple_ps(q, _mm_add_ps(upper, tol))),
+        _mm_cmpeq_ps(_mm_sub_ps(q, q), _mm_setzero_ps()));
+    return (_mm_movemask_ps(in) & 7) == 7;
+  };
+#else
+  const auto inside = [&](const VertexCheck& check, const Aabb& box) {
+    return inside_grown_box(a.bone_from_world[check.bone].transform_point(world), box, a.tolerance[check.bone]);
   };
 #endif
+#if SINEW_ESCAPE_SSE
+  const __m128 point = _mm_setr_ps(world.x, world.y, world.z, 0.0f);
+  const auto extend_box = [&](std::size_t bone) { row.extend_run(bone, point, point); };
+#else
+  const auto extend_box = [&](std::size_t bone) { row.boxes[bone].extend(world); };
+#endif
+  std::size_t count = 0;
+  for (std::size_t c = first; c < last; ++c) {
+    const VertexCheck& check = a.checks[c];
+    if (row.boxes != nullptr && check.bone < row.bones) extend_box(check.bone);
+    // A check naming a bone without a transform or tolerance escapes.
+    const bool out = check.bone >= a.bone_limit || !inside(check, a.box_of(check, c));
+    count += static_cast<std::size_t>(out);
+    if (c < a.escaped.size()) a.escaped[c] = static_cast<std::uint8_t>(out);
+  }
+  return count;
+}
+
+// `columns`: bone_columns(e); `rigid_usable`: rigid_bones_usable(e);
+// `blocks`: whether the AVX2 block check may run.
+std::size_t count_escapes(const EscapeCheckInput& e, std::span<const BoneColumns> columns,
+                          std::span<const std::uint8_t> rigid_usable, std::span<const Vec3> positions,
+                          std::span<std::uint8_t> escaped, Range r, bool blocks) {
+  const EscapeArrays a = escape_arrays(e, columns, positions, escaped);
+  const std::size_t end = std::min(r.end, a.check_begin.empty() ? 0 : a.check_begin.size() - 1);
+  BoneBoxRow row = bone_box_row(e, r);
 
   std::size_t count = 0;
   constexpr std::size_t kBlock = detail::kAvx2Lanes;
@@ -235,13 +324,14 @@ std::size_t count_escapes(const EscapeCheckInput& e, [[maybe_unused]] std::span<
     for (std::size_t i = 0; i < kBlock; ++i) {
       const std::uint8_t out = static_cast<std::uint8_t>((flags >> i) & 1u);
       count += out;
-      if (c0 + i < escaped.size()) escaped[c0 + i] = out;
+      if (c0 + i < a.escaped.size()) a.escaped[c0 + i] = out;
     }
-    if (boxes == nullptr) return;
+    if (row.boxes == nullptr) return;
 #if SINEW_ESCAPE_SSE
-    extend_run(bone, _mm_setr_ps(lower[0], lower[1], lower[2], 0.0f), _mm_setr_ps(upper[0], upper[1], upper[2], 0.0f));
+    row.extend_run(bone, _mm_setr_ps(lower[0], lower[1], lower[2], 0.0f),
+                   _mm_setr_ps(upper[0], upper[1], upper[2], 0.0f));
 #else
-    boxes[bone].extend(Aabb{Vec3(lower[0], lower[1], lower[2]), Vec3(upper[0], upper[1], upper[2])});
+    row.boxes[bone].extend(Aabb{Vec3(lower[0], lower[1], lower[2]), Vec3(upper[0], upper[1], upper[2])});
 #endif
   };
   // A block whose checks hold by construction (rigid_checks.h): only its
@@ -254,11 +344,11 @@ std::size_t count_escapes(const EscapeCheckInput& e, [[maybe_unused]] std::span<
     if (block >= rigid.size()) return false;
     const std::uint16_t bone = rigid[block];
     if (bone >= rigid_usable.size() || !rigid_usable[bone]) return false;
-    const std::size_t c0 = check_begin[v];
-    if (check_begin[v + kBlock] != c0 + kBlock || c0 + kBlock > checks.size()) return false;
+    const std::size_t c0 = a.check_begin[v];
+    if (a.check_begin[v + kBlock] != c0 + kBlock || c0 + kBlock > a.checks.size()) return false;
     float lower[3];
     float upper[3];
-    if (!finite_block_box(positions, v, blocks, lower, upper)) return false;
+    if (!finite_block_box(a.positions, v, blocks, lower, upper)) return false;
     finish_block(c0, 0, bone, lower, upper);
     return true;
   };
@@ -266,32 +356,32 @@ std::size_t count_escapes(const EscapeCheckInput& e, [[maybe_unused]] std::span<
   // eight at a time (the AVX2 block check: 92% of the blocks at 855,552
   // triangles, where the check by check loop spent about 30 cycles a
   // check); other blocks, and blocks with a position that is not finite, go
-  // check by check below.
+  // check by check (check_vertex).
   const auto check_block = [&](std::size_t v) -> bool {
-    const std::size_t c0 = check_begin[v];
-    if (c0 + kBlock > checks.size()) return false;
-    const std::uint32_t bone = checks[c0].bone;
-    if (bone >= bone_limit) return false;
+    const std::size_t c0 = a.check_begin[v];
+    if (c0 + kBlock > a.checks.size()) return false;
+    const std::uint32_t bone = a.checks[c0].bone;
+    if (bone >= a.bone_limit) return false;
     // The arrays this reads stream in vertex order but each address waits
     // for the load before it (begin, check, rank, cluster box): prefetched
     // 2 KB ahead, the block check took 17% less (perf samples, 855,552
     // triangles, 1 thread).
-    prefetch_ahead(check_begin.data() + v);
-    prefetch_ahead(checks.data() + c0, 4);
-    if (!bone_boxes.empty() && bone_boxes[bone] != nullptr) {
-      prefetch_ahead(check_rank.data() + c0);
-      const std::uint32_t rank = check_rank[c0];
-      if (rank != kSharedCheckBox) prefetch_ahead(bone_boxes[bone] + rank, 3);
+    prefetch_ahead(a.check_begin.data() + v);
+    prefetch_ahead(a.checks.data() + c0, 4);
+    if (!a.bone_boxes.empty() && a.bone_boxes[bone] != nullptr) {
+      prefetch_ahead(a.check_rank.data() + c0);
+      const std::uint32_t rank = a.check_rank[c0];
+      if (rank != kSharedCheckBox) prefetch_ahead(a.bone_boxes[bone] + rank, 3);
     }
     const float* lane_boxes[kBlock];
     for (std::size_t i = 0; i < kBlock; ++i) {
-      if (check_begin[v + i + 1] != c0 + i + 1 || checks[c0 + i].bone != bone) return false;
-      lane_boxes[i] = &box_of(checks[c0 + i], c0 + i).lower.x;
+      if (a.check_begin[v + i + 1] != c0 + i + 1 || a.checks[c0 + i].bone != bone) return false;
+      lane_boxes[i] = &a.box_of(a.checks[c0 + i], c0 + i).lower.x;
     }
     float lower[3];
     float upper[3];
-    const std::uint32_t result = detail::escape_block_avx2(&positions[v].x, &bone_from_world[bone].rows[0].x,
-                                                           tolerance[bone], lane_boxes, lower, upper);
+    const std::uint32_t result = detail::escape_block_avx2(&a.positions[v].x, &a.bone_from_world[bone].rows[0].x,
+                                                           a.tolerance[bone], lane_boxes, lower, upper);
     if ((result & detail::kEscapeBlockFinite) == 0) return false;
     finish_block(c0, result & 0xFFu, bone, lower, upper);
     return true;
@@ -301,52 +391,10 @@ std::size_t count_escapes(const EscapeCheckInput& e, [[maybe_unused]] std::span<
       v += kBlock - 1;
       continue;
     }
-    const std::size_t first = std::min<std::size_t>(check_begin[v], checks.size());
-    const std::size_t last = std::min<std::size_t>(check_begin[v + 1], checks.size());
-    const Vec3 world = positions[v];
-#if SINEW_ESCAPE_SSE
-    // Four lanes per check (x, y, z and a spare), about a quarter of the
-    // scalar check's instructions: the check is per vertex and per bone, and
-    // at 855,552 triangles it was as long as the skinning itself.
-    const __m128 x = _mm_set1_ps(world.x), y = _mm_set1_ps(world.y), z = _mm_set1_ps(world.z);
-    const auto inside = [&](const VertexCheck& check, const Aabb& box) {
-      const BoneColumns& m = columns[check.bone];
-      const __m128 q =
-          _mm_add_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(m.c[0], x), _mm_mul_ps(m.c[1], y)), _mm_mul_ps(m.c[2], z)),
-                     m.c[3]);
-      const __m128 tol = _mm_set1_ps(tolerance[check.bone]);
-      // The box's lower corner, and its upper one read from lower.z on (in
-      // bounds), moved down a lane.
-      const __m128 lower = _mm_loadu_ps(&box.lower.x);
-      const __m128 from_z = _mm_loadu_ps(&box.lower.z);
-      const __m128 upper = _mm_shuffle_ps(from_z, from_z, _MM_SHUFFLE(3, 3, 2, 1));
-      const __m128 in = _mm_and_ps(
-          _mm_and_ps(_mm_cmpge_ps(q, _mm_sub_ps(lower, tol)), _mm_cmple_ps(q, _mm_add_ps(upper, tol))),
-          _mm_cmpeq_ps(_mm_sub_ps(q, q), _mm_setzero_ps()));
-      return (_mm_movemask_ps(in) & 7) == 7;
-    };
-#else
-    const auto inside = [&](const VertexCheck& check, const Aabb& box) {
-      return inside_grown_box(bone_from_world[check.bone].transform_point(world), box, tolerance[check.bone]);
-    };
-#endif
-#if SINEW_ESCAPE_SSE
-    const __m128 point = _mm_setr_ps(world.x, world.y, world.z, 0.0f);
-    const auto extend_box = [&](std::size_t bone) { extend_run(bone, point, point); };
-#else
-    const auto extend_box = [&](std::size_t bone) { boxes[bone].extend(world); };
-#endif
-    for (std::size_t c = first; c < last; ++c) {
-      const VertexCheck& check = checks[c];
-      if (boxes != nullptr && check.bone < bones) extend_box(check.bone);
-      // A check naming a bone without a transform or tolerance escapes.
-      const bool out = check.bone >= bone_limit || !inside(check, box_of(check, c));
-      count += static_cast<std::size_t>(out);
-      if (c < escaped.size()) escaped[c] = static_cast<std::uint8_t>(out);
-    }
+    count += check_vertex(a, row, v);
   }
 #if SINEW_ESCAPE_SSE
-  end_run();
+  row.end_run();
 #endif
   return count;
 }

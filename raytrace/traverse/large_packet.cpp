@@ -9,88 +9,29 @@
 
 #include "raytrace/cull/grid_frusta.h"
 #include "raytrace/cull/group_frusta.h"
+#include "raytrace/cull/packet_frusta.h"
 #include "raytrace/cull/interval_bound.h"
 #include "raytrace/cull/ray_bound.h"
 #include "raytrace/geometry/triangle_intersect8.h"
 #include "raytrace/traverse/leaf_triangles.h"
 #include "raytrace/traverse/mailbox.h"
+#include "raytrace/traverse/packet_lanes.h"
 #include "raytrace/traverse/ray_frames.h"
 #include "raytrace/traverse/traversal_shared.h"
 #include "runtime/math/float8.h"
 
-
 namespace sinew::rt {
 namespace {
 
-constexpr float kInf = std::numeric_limits<float>::infinity();
-constexpr int kLanes = 8;
-
-}  // namespace
-
-namespace {
-
 using detail::max_abs;
-
-template <class Mask, class Fn>
-void for_each_bit(Mask mask, Fn&& fn) {
-  while (mask != 0) {
-    const int i = std::countr_zero(mask);
-    mask &= mask - 1;
-    fn(i);
-  }
-}
-
-// One group's rays in world space (invalid or inactive lanes hold the
-// default Ray, so eight-wide arithmetic stays finite).
-struct alignas(32) Group {
-  float o[3][kLanes];
-  float d[3][kLanes];
-  float inv[3][kLanes];
-  float t_min[kLanes];
-  float t_limit[kLanes];  // closest hit: the best t so far (exclusive); any-hit: t_max
-  float o_mag[kLanes];    // max |origin| coordinate
-  float d_mag[kLanes];    // max |direction| coordinate
-  Vec3x8 origin() const { return {Float8::load(o[0]), Float8::load(o[1]), Float8::load(o[2])}; }
-  Vec3x8 direction() const { return {Float8::load(d[0]), Float8::load(d[1]), Float8::load(d[2])}; }
-};
-
-// A group's part in one object visit: the lanes that entered the object,
-// their interval, and (in a bone's tree) the group's bound and slack.
-struct alignas(32) VisitGroup {
-  float t0[kLanes];
-  float t1[kLanes];
-  // In a bone's tree: the lanes' rays in the bone frame and their slack,
-  // for the exact lane clip against a leaf's cell.
-  float o[3][kLanes], d[3][kLanes], inv[3][kLanes];
-  float lane_eps[kLanes];
-  std::uint32_t lanes = 0;       // the lanes that entered the object
-  std::uint32_t leaf_lanes = 0;  // of those, the ones whose ray reaches the current leaf (or object)
-  Vec3x8 origin() const { return {Float8::load(o[0]), Float8::load(o[1]), Float8::load(o[2])}; }
-  Vec3x8 direction() const { return {Float8::load(d[0]), Float8::load(d[1]), Float8::load(d[2])}; }
-  Vec3x8 inverse() const { return {Float8::load(inv[0]), Float8::load(inv[1]), Float8::load(inv[2])}; }
-};
-
-// A group's world slack for a box of magnitude `box_magnitude` reached up
-// to t_end (traverse/ray_frames.h world_slack).
-Float8 world_eps(const Group& g, float box_magnitude, Float8 t_end) {
-  return per_lane::world_slack<Float8>(Float8::load(g.o_mag), Float8::load(g.d_mag), box_magnitude, t_end);
-}
-
-// The shared box clip (traverse/ray_frames.h) for the lanes of `mask`.
-std::uint32_t clip_lanes(const Aabb& box, Float8 eps, const Vec3x8& o, const Vec3x8& d, const Vec3x8& inv,
-                         std::uint32_t mask, Float8& t0, Float8& t1) {
-  return per_lane::clip_to_box<Float8>(box, eps, o, d, inv, t0, t1).bits() & mask;
-}
-
-// A kd-tree cell waiting on the stack, with the parameter range that
-// holds every ray's passage through it.
-// Plain arrays: glm's operator[] is a switch on the index.
-struct Cell {
-  float lo[3], hi[3];
-  std::uint32_t node;
-  float t0, t1;
-  Aabb box() const { return {Vec3(lo[0], lo[1], lo[2]), Vec3(hi[0], hi[1], hi[2])}; }
-};
+using packet_lanes::clip_lanes;
+using packet_lanes::Cell;
+using packet_lanes::for_each_bit;
+using packet_lanes::Group;
+using packet_lanes::kInf;
+using packet_lanes::kLanes;
+using packet_lanes::VisitGroup;
+using packet_lanes::world_eps;
 
 template <TriangleTest kTest, bool kAnyHit>
 class LargeQuery {
@@ -100,17 +41,14 @@ class LargeQuery {
   void start(const Scene& scene, const LargePacketRays& rays, PacketHits out) {
     scene_p_ = &scene;
     out_ = out;
-    grid_columns_ = rays.grid_columns;
-    grid_basis_[0] = rays.grid_forward;
-    grid_basis_[1] = rays.grid_right;
-    grid_basis_[2] = rays.grid_up;
+    grid_ = {rays.grid_columns, rays.grid_forward, rays.grid_right, rays.grid_up};
     group_frusta_ = rays.group_frusta;
     clip_leaf_lanes_ = rays.clip_leaf_lanes;
     groups_ = std::clamp(rays.groups, 0, kMaxPacketGroups);
     alive_groups_ = 0;
     limits_lowered_ = 0;
     common_origin_ = false;
-    frusta_on_ = false;
+    frusta_.off();
     counters_ = {};
     const Ray none{};
     for (int g = 0; g < groups_; ++g) {
@@ -260,15 +198,11 @@ class LargeQuery {
   const TraversalCounters& counters() const { return counters_; }
 
  private:
-  // Group frusta (cull/group_frusta.h) for rays from one origin, t >= 0:
-  // camera rays and shadow rays from a point light, whose frusta also get a
-  // far plane at their ends; other packets go without (frusta_on_ stays
-  // false). Each group's own frustum is built when a leaf first needs it
-  // (ensure_frusta).
+  // Frusta (cull/packet_frusta.h) for rays from one origin, t >= 0: camera
+  // rays and shadow rays from a point light, whose frusta also get a far
+  // plane at their ends; other packets go without (frusta_ stays off).
   void prepare_frusta() {
-    frusta_on_ = false;
-    frusta_built_ = 0;
-    grid_.reset();
+    frusta_.off();
     if (!common_origin_) return;
     bool forward = true;
     for_each_bit(alive_groups_, [&](int g) {
@@ -276,50 +210,33 @@ class LargeQuery {
                             Float8(0.0f)).bits() == 0xFFu;
     });
     if (!forward) return;
-    frusta_on_ = true;
-    // A camera's packet: its grid's slabs stand in for the groups' frusta.
-    const auto directions = [&](int g) -> const float (&)[3][kLanes] { return group_[g].d; };
-    const auto lanes = [&](int g) { return live_[g]; };
-    if (grid_columns_ > 0 && grid_.build(common_origin_at_, grid_basis_[0], grid_basis_[1], grid_basis_[2], groups_,
-                                         grid_columns_, directions, lanes)) {
-      return;
-    }
-    frusta_.reset(common_origin_at_, groups_);
-    // Shadow packets: the groups' slabs in the packet's basis
-    // (GroupFrusta::use_slabs), cheaper per triangle than their own frusta
-    // and built with the packet's bound (docs/RAYTRACE.md, "Shadow slabs"),
-    // unless the packet asks for the groups' own (LargePacketRays::group_frusta).
-    slabs_ = kAnyHit && !group_frusta_;
-    frusta_.use_slabs(slabs_);
+    // Shadow packets: the groups' slabs in the packet's basis, cheaper per
+    // triangle than their own frusta and built with the packet's bound
+    // (docs/RAYTRACE.md, "Shadow slabs"), unless the packet asks for the
+    // groups' own (LargePacketRays::group_frusta).
+    frusta_.start(common_origin_at_, groups_, grid_, kAnyHit && !group_frusta_, directions(), lanes());
   }
 
-  // The groups of `groups` whose frustum (or grid slabs) may reach the box.
-  GroupMask frusta_box_reached(const Aabb& box, GroupMask groups) const {
-    return grid_.on() ? grid_.box_reached(box, groups) : frusta_.box_reached(box, groups);
+  // Group g's directions and live lanes, as the frusta read them.
+  auto directions() const {
+    return [this](int g) -> const float (&)[3][kLanes] { return group_[g].d; };
+  }
+  auto lanes() const {
+    return [this](int g) { return live_[g]; };
   }
 
-  // The frusta of `groups` and of every other live group not built yet:
-  // built together, eight at a time, they cost about what one did.
+  // The groups of `groups` whose frustum may reach the box.
+  GroupMask frusta_box_reached(const Aabb& box, GroupMask groups) const { return frusta_.box_reached(box, groups); }
+
+  // The frusta of `groups`, built with every other live group's.
   void ensure_frusta(GroupMask groups) {
-    if (grid_.on() || (groups & ~frusta_built_) == 0) return;
-    const GroupMask unbuilt = alive_groups_ & ~frusta_built_;
-    const auto directions = [&](int g) -> const float (&)[3][kLanes] { return group_[g].d; };
-    const auto lanes = [&](int g) { return live_[g]; };
-    // The packet's own frustum over every group built so far.
-    const GroupMask built = frusta_built_ | unbuilt;
     if constexpr (!kAnyHit) {
-      frusta_.template set_groups<false>(unbuilt, 1.0f, directions, lanes, [](int, float*) {});
-      frusta_.template set_bound<false>(built, 1.0f, directions, lanes, [](int, float*) {});
+      frusta_.template ensure<false>(groups, alive_groups_, directions(), lanes(), [](int, float*) {});
     } else {
       // A lane's points end at t_max (an infinite one: no far plane).
       const auto reach = [&](int g, float* out) { std::copy_n(group_[g].t_limit, kLanes, out); };
-      frusta_.template set_bound<true>(built, 1.0f, directions, lanes, reach);
-      // The groups' own frusta only where the packet's slabs are off.
-      if (!slabs_ || (built & ~frusta_.slab_groups()) != 0) {
-        frusta_.template set_groups<true>(unbuilt, 1.0f, directions, lanes, reach);
-      }
+      frusta_.template ensure<true>(groups, alive_groups_, directions(), lanes(), reach);
     }
-    frusta_built_ = built;
   }
 
   // The largest t any lane of `groups` still looks for: its best hit (or
@@ -357,7 +274,7 @@ class LargeQuery {
     // packet miss most of the objects its bound reaches (a shadow packet's
     // groups enter about one object in three). The others enter nothing.
     GroupMask clipped = alive_groups_;
-    if (frusta_on_) {
+    if (frusta_.on()) {
       ensure_frusta(alive_groups_);
       const Vec3 s(visit_slack_);
       clipped = frusta_box_reached({object.box.lower - s, object.box.upper + s}, alive_groups_);
@@ -391,7 +308,7 @@ class LargeQuery {
       }
     });
     if (groups == 0) return;
-    if (frusta_on_) {
+    if (frusta_.on()) {
       items_seen_.reset();
     } else {
       mailbox_.reset();
@@ -457,7 +374,7 @@ class LargeQuery {
   template <class TriangleSource>
   bool test_leaf(std::span<const std::uint32_t> items, GroupMask groups_here, const TriangleSource& corners,
                  bool listed_once = false) {
-    if (frusta_on_) return test_leaf_in_frusta(items, groups_here, corners, listed_once);
+    if (frusta_.on()) return test_leaf_in_frusta(items, groups_here, corners, listed_once);
     for (const std::uint32_t item : items) {
       GroupMask need = 0;
       for_each_bit(groups_here & alive_groups_, [&](int g) {
@@ -515,8 +432,6 @@ class LargeQuery {
         // groups): the group's frustum test would cost about what its
         // lane test does.
         std::fill(std::begin(reach), std::end(reach), here);
-      } else if (grid_.on()) {
-        grid_.reached8(batch_, lanes, here, reach);
       } else {
         frusta_.reached8(batch_, lanes, here, reach);
       }
@@ -550,7 +465,7 @@ class LargeQuery {
     for_each_bit(groups, [&](int g) {
       const Group& gr = group_[g];
       const Float8 eps = world_eps(gr, box_magnitude, Float8::load(visit_[g].t1));
-      if (frusta_on_) {
+      if (frusta_.on()) {
         // The lanes were just clipped to the object's box, which is the
         // tree's (a static mesh's, the fallback's): a second clip would
         // only narrow their passage by the difference in slack.
@@ -578,7 +493,7 @@ class LargeQuery {
       const Vec3x8& o = r.o;
       const Vec3x8& d = r.d;
       const Float8 eps = r.eps;
-      if (frusta_on_) {
+      if (frusta_.on()) {
         enter_tree_unclipped(entry, g, o, d, eps);
         return;
       }
@@ -586,7 +501,7 @@ class LargeQuery {
     });
     const SkinnedTriangles corners{*character.mesh, frame};
     const auto leaf = [&](std::uint32_t node, std::span<const std::uint32_t> triangles, GroupMask groups_here) {
-      if (frusta_on_) {
+      if (frusta_.on()) {
         // The leaf's triangles as they are this frame (raytrace/scene/leaf_boxes.h):
         // a leaf no frustum reaches costs one box test, not one per triangle.
         ensure_frusta(groups_here & alive_groups_);
@@ -809,8 +724,8 @@ class LargeQuery {
   bool visit_leaf(const Aabb& cell, std::uint32_t node, std::span<const std::uint32_t> items, GroupMask groups,
                   LeafFn& leaf) {
     GroupMask reaching = 0;
-    if (frusta_on_) reaching = groups & alive_groups_;
-    for_each_bit(frusta_on_ ? GroupMask{0} : groups & alive_groups_, [&](int g) {
+    if (frusta_.on()) reaching = groups & alive_groups_;
+    for_each_bit(frusta_.on() ? GroupMask{0} : groups & alive_groups_, [&](int g) {
       const VisitGroup& vg = visit_[g];
       Float8 t0 = Float8::load(vg.t0), t1 = Float8::load(vg.t1);
       if constexpr (!kAnyHit) t1 = min(t1, Float8::load(group_[g].t_limit));
@@ -990,16 +905,11 @@ class LargeQuery {
   Vec3 common_origin_at_{0.0f};
   LaneMailbox<kMaxPacketGroups> mailbox_;
   ItemMailbox<512> items_seen_;
-  GroupFrusta<kMaxPacketGroups> frusta_;
-  GridFrusta grid_;                 // on: a camera packet's slabs, used instead of frusta_
-  int grid_columns_ = 0;            // LargePacketRays::grid_columns
-  std::array<Vec3, 3> grid_basis_{};  // forward, right, up
+  PacketFrusta<kMaxPacketGroups> frusta_;  // on: they pick each leaf triangle's groups
+  PacketFrusta<kMaxPacketGroups>::Grid grid_;  // LargePacketRays' pixel grid
   float visit_slack_ = 0.0f;       // run(): a bound on every lane's slack in an object's box clip
-  bool frusta_on_ = false;         // grid_ (when on) or frusta_ pick each leaf triangle's groups
-  bool slabs_ = false;             // frusta_ tests the groups' slabs in the packet's basis
   bool group_frusta_ = false;      // LargePacketRays::group_frusta
   bool clip_leaf_lanes_ = false;   // LargePacketRays::clip_leaf_lanes
-  GroupMask frusta_built_ = 0;  // the groups whose frustum frusta_ holds
   TraversalCounters counters_;
 };
 
