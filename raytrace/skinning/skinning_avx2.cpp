@@ -119,28 +119,32 @@ Matrix3x4x8 blend_bones(const SkinningArrays& a, std::size_t group) {
   return out;
 }
 
-Vec3x8 transform_point8(const Matrix3x4x8& b, const Vec3x8& p) {
+// b's rows times (x, y, z) added to `start` (per row: start[r]), each
+// product fused: x first, then y, then z.
+Vec3x8 transform8(const Matrix3x4x8& b, const Vec3x8& p, const __m256 (&start)[3]) {
   Vec3x8 out;
   __m256* dst[3] = {&out.x, &out.y, &out.z};
   for (int r = 0; r < 3; ++r) {
     const __m256* row = b.m + 4 * r;
-    __m256 acc = _mm256_fmadd_ps(row[0], p.x, row[3]);
+    __m256 acc = _mm256_fmadd_ps(row[0], p.x, start[r]);
     acc = _mm256_fmadd_ps(row[1], p.y, acc);
     *dst[r] = _mm256_fmadd_ps(row[2], p.z, acc);
   }
   return out;
 }
 
+// A point: the rows' translations start the sums.
+Vec3x8 transform_point8(const Matrix3x4x8& b, const Vec3x8& p) {
+  const __m256 start[3] = {b.m[3], b.m[7], b.m[11]};
+  return transform8(b, p, start);
+}
+
+// A vector: the sums start at -0, which x * y + (-0) leaves exactly x * y
+// (its sign too), as the product alone would be.
 Vec3x8 transform_vector8(const Matrix3x4x8& b, const Vec3x8& n) {
-  Vec3x8 out;
-  __m256* dst[3] = {&out.x, &out.y, &out.z};
-  for (int r = 0; r < 3; ++r) {
-    const __m256* row = b.m + 4 * r;
-    __m256 acc = _mm256_mul_ps(row[0], n.x);
-    acc = _mm256_fmadd_ps(row[1], n.y, acc);
-    *dst[r] = _mm256_fmadd_ps(row[2], n.z, acc);
-  }
-  return out;
+  const __m256 minus_zero = _mm256_set1_ps(-0.0f);
+  const __m256 start[3] = {minus_zero, minus_zero, minus_zero};
+  return transform8(b, n, start);
 }
 
 }  // namespace

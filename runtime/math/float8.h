@@ -9,7 +9,9 @@
 #pragma once
 
 #include <cmath>
+#include <bit>
 #include <cstdint>
+#include <limits>
 
 #include "runtime/math/simd.h"
 
@@ -151,6 +153,28 @@ inline std::uint32_t lanes_equal(const std::uint32_t* values, std::uint32_t valu
   return static_cast<std::uint32_t>(_mm256_movemask_ps(_mm256_castsi256_ps(same)));
 }
 
+// Lanes i = p[i % 4]: four floats repeated.
+inline Float8 repeat4(const float* p) { return {_mm256_broadcast_ps(reinterpret_cast<const __m128*>(p))}; }
+// Lanes 0-3 lo, lanes 4-7 hi.
+inline Float8 halves(float lo, float hi) { return {_mm256_insertf128_ps(_mm256_set1_ps(lo), _mm_set1_ps(hi), 1)}; }
+
+// The next float from x away from zero offsets: towards +inf where
+// offset > 0, towards -inf where offset < 0, x itself where offset is 0 or
+// x is not finite; from zero, the smallest denormal.
+inline Float8 step_away(Float8 x, Float8 offset) {
+  const __m256i bits = _mm256_castps_si256(x.v);
+  const Mask8 up = offset > Float8(0.0f);
+  const Mask8 down = offset < Float8(0.0f);
+  const Mask8 positive = x > Float8(0.0f);
+  // (x > 0) == up: one ulp up in magnitude, else down.
+  const __m256 grow = _mm256_xor_ps(_mm256_xor_ps(positive.m, up.m), _mm256_castsi256_ps(_mm256_set1_epi32(-1)));
+  const __m256i delta = _mm256_blendv_epi8(_mm256_set1_epi32(-1), _mm256_set1_epi32(1), _mm256_castps_si256(grow));
+  Float8 stepped{_mm256_castsi256_ps(_mm256_add_epi32(bits, delta))};
+  const Float8 denorm(std::numeric_limits<float>::denorm_min());
+  stepped = select(x == Float8(0.0f), select(up, denorm, -denorm), stepped);
+  return select((up | down) & is_finite(x), stepped, x);
+}
+
 #else  // lane by lane
 
 struct Mask8 {
@@ -256,6 +280,21 @@ inline std::uint32_t lanes_equal(const std::uint32_t* values, std::uint32_t valu
   std::uint32_t bits = 0;
   for (int i = 0; i < 8; ++i) bits |= values[i] == value ? 1u << i : 0u;
   return bits;
+}
+
+inline Float8 repeat4(const float* p) { return Float8::map([&](int i) { return p[i % 4]; }); }
+inline Float8 halves(float lo, float hi) { return Float8::map([&](int i) { return i < 4 ? lo : hi; }); }
+inline Float8 step_away(Float8 x, Float8 offset) {
+  return Float8::map([&](int i) {
+    const float v = x.v[i];
+    const float o = offset.v[i];
+    if (o == 0.0f || !std::isfinite(v)) return v;
+    const bool up = o > 0.0f;
+    if (v == 0.0f) return up ? std::numeric_limits<float>::denorm_min() : -std::numeric_limits<float>::denorm_min();
+    std::uint32_t b = std::bit_cast<std::uint32_t>(v);
+    b = (v > 0.0f) == up ? b + 1 : b - 1;
+    return std::bit_cast<float>(b);
+  });
 }
 
 #endif

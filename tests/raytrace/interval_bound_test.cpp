@@ -26,6 +26,7 @@
 #include "runtime/math/aabb.h"
 #include "runtime/math/float8.h"
 #include "runtime/math/types.h"
+#include "tests/support/slab_test.h"
 
 namespace sinew {
 namespace {
@@ -39,21 +40,12 @@ Vec3 random_vec(std::mt19937& g) { return Vec3(signed_unit(g), signed_unit(g), s
 float max_abs(const Vec3& v) { return std::max({std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)}); }
 float max_abs(const Aabb& box) { return std::max(max_abs(box.lower), max_abs(box.upper)); }
 
-// The parameter at which the ray o + t d, t in [t0, t1], enters `box`: the
-// slab test in double precision (as tests/support/slab_test.h), keeping
-// where the ray enters; +inf where it does not enter.
+// The parameter at which the ray o + t d, t in [t0, t1], enters `box` (the
+// double-precision slab test of tests/support/slab_test.h); +inf where it
+// does not enter.
 double entry_parameter(const Vec3& o, const Vec3& d, double t0, double t1, const Aabb& box) {
-  for (int a = 0; a < 3; ++a) {
-    const double oa = o[a], da = d[a], lo = box.lower[a], hi = box.upper[a];
-    if (da == 0.0) {
-      if (oa < lo || oa > hi) return kNoEntry;
-      continue;
-    }
-    const double n = (lo - oa) / da, f = (hi - oa) / da;
-    t0 = std::max(t0, std::min(n, f));
-    t1 = std::min(t1, std::max(n, f));
-  }
-  return t0 <= t1 ? t0 : kNoEntry;
+  const auto [enter, leave] = testing_support::ray_box_passage(o, d, t0, t1, box);
+  return enter <= leave ? enter : kNoEntry;
 }
 
 // A set of rays as a large packet holds them: groups of eight lanes,
@@ -495,32 +487,35 @@ TEST(IntervalBound, SlabPassageRunsFromTheLatestEntryToTheEarliestExit) {
   const auto passage = [](float e0, float e1, float e2, float l0, float l1, float l2, float t_lo, float t_hi) {
     return rt::slab_passage(_mm_setr_ps(e0, e1, e2, -kInf), _mm_setr_ps(l0, l1, l2, kInf), t_lo, t_hi);
   };
-  rt::SlabPassage p = passage(1.0f, 3.0f, 2.0f, 10.0f, 5.0f, 7.0f, 0.0f, 8.0f);
-  EXPECT_EQ(p.enter, 3.0f);
-  EXPECT_EQ(p.leave, 5.0f);
-  p = passage(6.0f, -1.0f, 2.0f, 7.0f, 9.0f, 8.0f, 0.0f, 8.0f);
-  EXPECT_EQ(p.enter, 6.0f);
-  EXPECT_EQ(p.leave, 7.0f);
-  p = passage(0.0f, 0.5f, 9.0f, 20.0f, 11.0f, 10.0f, 0.0f, 30.0f);
-  EXPECT_EQ(p.enter, 9.0f);
-  EXPECT_EQ(p.leave, 10.0f);
-  // Clipped to the parameter range.
-  p = passage(1.0f, 3.0f, 2.0f, 10.0f, 5.0f, 7.0f, 4.0f, 8.0f);
-  EXPECT_EQ(p.enter, 4.0f);
-  EXPECT_EQ(p.leave, 5.0f);
-  p = passage(1.0f, 3.0f, 2.0f, 10.0f, 5.0f, 7.0f, 0.0f, 4.5f);
-  EXPECT_EQ(p.enter, 3.0f);
-  EXPECT_EQ(p.leave, 4.5f);
-  // Empty: the range ends before the entry, or an axis is left before
-  // another is entered.
-  p = passage(1.0f, 3.0f, 2.0f, 10.0f, 5.0f, 7.0f, 0.0f, 2.0f);
-  EXPECT_GT(p.enter, p.leave);
-  p = passage(6.0f, 0.0f, 0.0f, 10.0f, 5.0f, 7.0f, 0.0f, 8.0f);
-  EXPECT_GT(p.enter, p.leave);
-  // Unbounded axes leave the parameter range.
-  p = passage(-kInf, -kInf, -kInf, kInf, kInf, kInf, 0.25f, 3.0f);
-  EXPECT_EQ(p.enter, 0.25f);
-  EXPECT_EQ(p.leave, 3.0f);
+  struct Case {
+    float enter[3], leave[3], t_lo, t_hi;
+    float want_enter, want_leave;  // NaN: empty (entry after exit)
+  };
+  const float empty = std::numeric_limits<float>::quiet_NaN();
+  const Case cases[] = {
+      {{1, 3, 2}, {10, 5, 7}, 0, 8, 3, 5},
+      {{6, -1, 2}, {7, 9, 8}, 0, 8, 6, 7},
+      {{0, 0.5f, 9}, {20, 11, 10}, 0, 30, 9, 10},
+      // Clipped to the parameter range.
+      {{1, 3, 2}, {10, 5, 7}, 4, 8, 4, 5},
+      {{1, 3, 2}, {10, 5, 7}, 0, 4.5f, 3, 4.5f},
+      // Empty: the range ends before the entry, or an axis is left before
+      // another is entered.
+      {{1, 3, 2}, {10, 5, 7}, 0, 2, empty, empty},
+      {{6, 0, 0}, {10, 5, 7}, 0, 8, empty, empty},
+      // Unbounded axes leave the parameter range.
+      {{-kInf, -kInf, -kInf}, {kInf, kInf, kInf}, 0.25f, 3, 0.25f, 3},
+  };
+  for (const Case& c : cases) {
+    const rt::SlabPassage p = passage(c.enter[0], c.enter[1], c.enter[2], c.leave[0], c.leave[1], c.leave[2],
+                                      c.t_lo, c.t_hi);
+    if (std::isnan(c.want_enter)) {
+      EXPECT_GT(p.enter, p.leave) << c.enter[0] << " " << c.t_hi;
+      continue;
+    }
+    EXPECT_EQ(p.enter, c.want_enter) << c.enter[0] << " " << c.t_hi;
+    EXPECT_EQ(p.leave, c.want_leave) << c.enter[0] << " " << c.t_hi;
+  }
 }
 
 // What the bound must keep is what a lane's own walk keeps: the single ray

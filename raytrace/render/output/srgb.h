@@ -82,4 +82,24 @@ inline std::uint8_t srgb_byte(float linear) {
   return static_cast<std::uint8_t>(steps[0]);
 }
 
+// Eight RGBA8 pixels, R in the low byte, alpha 255.
+[[gnu::always_inline]] inline void srgb_rgba8(const Vec3x8& linear, std::uint32_t* out) {
+#if SINEW_AVX2
+  const auto bytes = [](Float8 x) { return _mm256_cvttps_epi32(srgb_steps(x).v); };
+  const __m256i rgba = _mm256_or_si256(
+      _mm256_or_si256(bytes(linear.x), _mm256_slli_epi32(bytes(linear.y), 8)),
+      _mm256_or_si256(_mm256_slli_epi32(bytes(linear.z), 16), _mm256_set1_epi32(static_cast<int>(0xFF000000u))));
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(out), rgba);
+#else
+  alignas(32) std::int32_t r[8], g[8], b[8];
+  store_truncated(srgb_steps(linear.x), r);
+  store_truncated(srgb_steps(linear.y), g);
+  store_truncated(srgb_steps(linear.z), b);
+  for (int i = 0; i < 8; ++i) {
+    out[i] = static_cast<std::uint32_t>(r[i]) | static_cast<std::uint32_t>(g[i]) << 8 |
+             static_cast<std::uint32_t>(b[i]) << 16 | 0xFF000000u;
+  }
+#endif
+}
+
 }  // namespace sinew::rt

@@ -46,13 +46,9 @@ void generate_camera_rays(const PinholeCamera& camera, TileScratch& s) {
     // Lane i sits at (i % 4, i / 4) in its block.
     const float* const a = &columns[static_cast<std::size_t>(s.block_dx[b])];
     const float* const r = &rows[static_cast<std::size_t>(s.block_dy[b])];
-#if SINEW_AVX2
-    const Float8 right{_mm256_broadcast_ps(reinterpret_cast<const __m128*>(a))};
-    const Float8 up{_mm256_insertf128_ps(_mm256_set1_ps(r[0]), _mm_set1_ps(r[1]), 1)};
-#else
-    const Float8 right = Float8::map([&](int i) { return a[i % kBlockWidth]; });
-    const Float8 up = Float8::map([&](int i) { return r[i / kBlockWidth]; });
-#endif
+    static_assert(kBlockWidth == 4 && kBlockHeight == 2, "a block's lanes: four columns, two rows");
+    const Float8 right = repeat4(a);
+    const Float8 up = halves(r[0], r[1]);
     store3(camera.directions_from(right, up), s.dir_x, s.dir_y, s.dir_z, b * kBlockLanes);
   }
 }

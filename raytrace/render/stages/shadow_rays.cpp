@@ -17,36 +17,6 @@ using namespace stages;
 
 namespace {
 
-// The next float from x away from zero offsets: towards +inf where
-// offset > 0, towards -inf where offset < 0, x itself where offset is 0 or
-// x is not finite (offset_origin's next_float step, eight lanes).
-Float8 step_away(Float8 x, Float8 offset) {
-#if SINEW_AVX2
-  const __m256i bits = _mm256_castps_si256(x.v);
-  const Mask8 up = offset > Float8(0.0f);
-  const Mask8 down = offset < Float8(0.0f);
-  const Mask8 positive = x > Float8(0.0f);
-  // (x > 0) == up: one ulp up in magnitude, else down.
-  const __m256 grow = _mm256_xor_ps(_mm256_xor_ps(positive.m, up.m), _mm256_castsi256_ps(_mm256_set1_epi32(-1)));
-  const __m256i delta = _mm256_blendv_epi8(_mm256_set1_epi32(-1), _mm256_set1_epi32(1), _mm256_castps_si256(grow));
-  Float8 stepped{_mm256_castsi256_ps(_mm256_add_epi32(bits, delta))};
-  const Float8 denorm = std::numeric_limits<float>::denorm_min();
-  stepped = select(x == Float8(0.0f), select(up, denorm, -denorm), stepped);
-  return select((up | down) & is_finite(x), stepped, x);
-#else
-  return Float8::map([&](int i) {
-    const float v = x.v[i];
-    const float o = offset.v[i];
-    if (o == 0.0f || !std::isfinite(v)) return v;
-    const bool up = o > 0.0f;
-    if (v == 0.0f) return up ? std::numeric_limits<float>::denorm_min() : -std::numeric_limits<float>::denorm_min();
-    std::uint32_t b = std::bit_cast<std::uint32_t>(v);
-    b = (v > 0.0f) == up ? b + 1 : b - 1;
-    return std::bit_cast<float>(b);
-  });
-#endif
-}
-
 // One light's terms for placing shadow rays, eight lanes at a time.
 struct ShadowLight {
   bool point;
