@@ -74,7 +74,7 @@ class RangeAccumulator {
     t_hi_ = Float8(-kInf);
   }
   // Rays o + t d, t in [t0, t1], of the lanes in `mask` (t1 may be +inf).
-  void add(const Vec3x8& o, const Vec3x8& d, Float8 t0, Float8 t1, std::uint32_t mask) {
+  [[gnu::always_inline]] void add(const Vec3x8& o, const Vec3x8& d, Float8 t0, Float8 t1, std::uint32_t mask) {
     if (mask == 0) return;
     constexpr float kInf = std::numeric_limits<float>::infinity();
     const Mask8 use = Mask8::from_bits(mask);
