@@ -32,6 +32,9 @@ inline float min(float a, float b) { return a < b ? a : b; }
 inline float max(float a, float b) { return a > b ? a : b; }
 inline float abs(float a) { return std::fabs(a); }
 inline float select(bool mask, float yes, float no) { return mask ? yes : no; }
+// Lane-wise and: `&` on masks, `&&` on one lane's bool.
+inline bool both(bool a, bool b) { return a && b; }
+inline Mask8 both(Mask8 a, Mask8 b) { return a & b; }
 using sinew::abs;
 using sinew::max;
 using sinew::min;
@@ -77,10 +80,11 @@ template <class F>
 template <class F>
 [[gnu::always_inline]] inline LaneMask<F> valid_rays(const LaneVec<F>& o, const LaneVec<F>& d, F t_min, F t_max) {
   const F big(std::numeric_limits<float>::max());
-  const LaneMask<F> finite = (abs(o.x) <= big) & (abs(o.y) <= big) & (abs(o.z) <= big) & (abs(d.x) <= big) &
-                             (abs(d.y) <= big) & (abs(d.z) <= big);
-  const LaneMask<F> zero = (d.x == F(0.0f)) & (d.y == F(0.0f)) & (d.z == F(0.0f));
-  return (t_min < t_max) & finite & !zero;
+  const auto finite = [&](F x) { return abs(x) <= big; };
+  const LaneMask<F> all_finite = both(both(both(finite(o.x), finite(o.y)), both(finite(o.z), finite(d.x))),
+                                      both(finite(d.y), finite(d.z)));
+  const LaneMask<F> zero = both(both(d.x == F(0.0f), d.y == F(0.0f)), d.z == F(0.0f));
+  return both(both(t_min < t_max, all_finite), !zero);
 }
 
 // The slack of a world-space computation for a box of magnitude
@@ -149,14 +153,14 @@ template <class F>
     const F lo = F(box.lower[a]) - eps;
     const F hi = F(box.upper[a]) + eps;
     const LaneMask<F> parallel = *dc[a] == F(0.0f);
-    inside = inside & !(parallel & !((*oc[a] >= lo) & (*oc[a] <= hi)));
+    inside = both(inside, !both(parallel, !both(*oc[a] >= lo, *oc[a] <= hi)));
     const F n = (lo - *oc[a]) * *ic[a];
     const F f = (hi - *oc[a]) * *ic[a];
     const LaneMask<F> swap = n > f;
     t0 = select(parallel, t0, max(select(swap, f, n), t0));
     t1 = select(parallel, t1, min(select(swap, n, f), t1));
   }
-  return inside & (t0 <= t1);
+  return both(inside, t0 <= t1);
 }
 
 }  // namespace sinew::rt::per_lane
