@@ -71,8 +71,8 @@ struct FuzzyBakeOptions {
   // cell visit, than it costs a single ray: at the kd builder's single-ray
   // ratio (1.5) the trees split about ten times as often as pays. 0.15
   // suits the 256-ray packets the renderer traces by default, most of all on
-  // finely subdivided meshes; single rays and 8-ray packets would prefer
-  // shallower trees (docs/RAYTRACE.md, "Bone tree build").
+  // finely subdivided meshes; single rays would prefer the deeper trees of
+  // the single-ray ratio (docs/RAYTRACE.md, "Bone tree build").
   KdBuildOptions kd{.traversal_cost = 1.0f, .intersection_cost = 0.15f, .empty_bonus = 0.2f, .max_leaf_items = 1,
                     .max_depth = 0};
   // The bone trees' structure (docs/RAYTRACE.md, "Bone trees: kd-tree or

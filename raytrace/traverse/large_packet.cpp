@@ -166,8 +166,7 @@ class LargeQuery {
                     [&](const Candidate& c) { return detail::is_small_static(scene_ref(), all[c.object]); });
     if (small_statics_only) {
       // A ground quad and the like: every triangle against every group, in
-      // order, without box clips (as the 8-ray packets' short cut; the
-      // nearest hit is the same).
+      // order, without box clips (the nearest hit is the same).
       for (std::size_t i = 0; i < count && alive_groups_ != 0; ++i) {
         const Scene::StaticMesh& mesh = scene_ref().static_meshes()[all[begin[i].object].index];
         for_each_bit(alive_groups_, [&](int g) {

@@ -69,8 +69,9 @@ struct LargePacketRays {
 // The nearest hits of every active lane, written to 8 * groups entries of
 // `out` (misses: t = inf, ids kInvalidId). `objects`: the top-level objects
 // (indices into scene.top_level().objects()) the rays may enter, in any
-// order; a superset is fine, the packet culls them again. Counters as the
-// 8-ray packets count them (node visits once per cell the packet fetches).
+// order; a superset is fine, the packet culls them again. Counters: rays,
+// object visits and triangle tests per lane, node visits once per cell the
+// packet fetches.
 void intersect_large_packet(const Scene& scene, const LargePacketRays& rays, TriangleTest test,
                             std::span<const std::uint32_t> objects, PacketHits out, TraversalCounters* counters);
 

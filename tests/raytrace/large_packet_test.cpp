@@ -131,7 +131,8 @@ struct PacketArrays {
 // invalid lanes; given every object or only the tile's cull; lanes clipped to
 // each bone leaf's box or not (LargePacketRays::clip_leaf_lanes). Each lane's
 // nearest hit and occlusion are the single ray's (the fallback instance
-// goes through the 8-ray path, the ground through the small-static tests).
+// goes through the escaped triangles' tree, the ground through the
+// small-static tests).
 TEST(LargePackets, FindTheSingleRayHits) {
   const rt::Scene& s = scene();
   std::mt19937 g(23);
