@@ -13,9 +13,11 @@
 #include "raytrace/cull/interval_bound.h"
 #include "raytrace/cull/ray_bound.h"
 #include "raytrace/geometry/triangle_intersect8.h"
+#include "raytrace/traverse/interval_walk.h"
 #include "raytrace/traverse/leaf_triangles.h"
 #include "raytrace/traverse/mailbox.h"
 #include "raytrace/traverse/packet_lanes.h"
+#include "raytrace/traverse/packet_rays.h"
 #include "raytrace/traverse/ray_frames.h"
 #include "raytrace/traverse/traversal_shared.h"
 #include "runtime/math/float8.h"
@@ -25,86 +27,41 @@ namespace {
 
 using detail::max_abs;
 using packet_lanes::clip_lanes;
-using packet_lanes::Cell;
 using packet_lanes::for_each_bit;
 using packet_lanes::Group;
+using packet_lanes::PacketRays;
+using packet_lanes::walk_bvh_nodes;
+using packet_lanes::walk_kd_cells;
 using packet_lanes::kInf;
 using packet_lanes::kLanes;
 using packet_lanes::VisitGroup;
 using packet_lanes::world_eps;
 
 template <TriangleTest kTest, bool kAnyHit>
-class LargeQuery {
+class LargeQuery : public PacketRays<kTest, kAnyHit> {
+  using Rays = PacketRays<kTest, kAnyHit>;
+  using Rays::alive_groups_;
+  using Rays::common_origin_;
+  using Rays::common_origin_at_;
+  using Rays::counters_;
+  using Rays::group_;
+  using Rays::group_limit;
+  using Rays::groups_;
+  using Rays::limits_lowered_;
+  using Rays::live_;
+  using Rays::packet_limit;
+  using Rays::test_groups;
+  using Rays::test_groups_prepared;
+  using Rays::visit_;
+
  public:
-  // The query's state is tens of kilobytes: one object per thread is
-  // reused, start() resetting what one packet reads.
   void start(const Scene& scene, const LargePacketRays& rays, PacketHits out) {
+    Rays::start(rays, out);
     scene_p_ = &scene;
-    out_ = out;
     grid_ = {rays.grid_columns, rays.grid_forward, rays.grid_right, rays.grid_up};
     group_frusta_ = rays.group_frusta;
     clip_leaf_lanes_ = rays.clip_leaf_lanes;
-    groups_ = std::clamp(rays.groups, 0, kMaxPacketGroups);
-    alive_groups_ = 0;
-    limits_lowered_ = 0;
-    common_origin_ = false;
     frusta_.off();
-    counters_ = {};
-    const Ray none{};
-    for (int g = 0; g < groups_; ++g) {
-      const std::size_t k0 = static_cast<std::size_t>(g) * kLanes;
-      Group& gr = group_[g];
-      // valid_ray() per lane: finite origin and direction, a non-zero
-      // direction, t_min < t_max (false for NaN).
-      const Float8 t_min = Float8::load(rays.t_min + k0), t_max = Float8::load(rays.t_max + k0);
-      Mask8 valid = t_min < t_max;
-      Mask8 nonzero = Mask8::from_bits(0);
-      Float8 o[3], d[3];
-      for (int a = 0; a < 3; ++a) {
-        o[a] = Float8::load(rays.o[a] + k0);
-        d[a] = Float8::load(rays.d[a] + k0);
-        valid = valid & is_finite(o[a]) & is_finite(d[a]);
-        nonzero = nonzero | !(d[a] == Float8(0.0f));
-      }
-      live_[g] = (valid & nonzero).bits() & rays.active[g];
-      valid_[g] = live_[g];
-      blocked_[g] = 0;
-      const Mask8 use = Mask8::from_bits(live_[g]);
-      Float8 o_mag(0.0f), d_mag(0.0f);
-      for (int a = 0; a < 3; ++a) {
-        o[a] = select(use, o[a], Float8(none.origin[a]));
-        d[a] = select(use, d[a], Float8(none.direction[a]));
-        o[a].store(gr.o[a]);
-        d[a].store(gr.d[a]);
-        o_mag = max(o_mag, abs(o[a]));
-        d_mag = max(d_mag, abs(d[a]));
-      }
-      o_mag.store(gr.o_mag);
-      d_mag.store(gr.d_mag);
-      select(use, t_min, Float8(none.t_min)).store(gr.t_min);
-      select(use, t_max, Float8(none.t_max)).store(gr.t_limit);
-      if (live_[g] != 0) {
-        if (alive_groups_ == 0) {
-          const int lane = std::countr_zero(live_[g]);
-          common_origin_at_ = Vec3(gr.o[0][lane], gr.o[1][lane], gr.o[2][lane]);
-          common_origin_ = true;
-        }
-        const Mask8 same = (o[0] == Float8(common_origin_at_.x)) & (o[1] == Float8(common_origin_at_.y)) &
-                           (o[2] == Float8(common_origin_at_.z));
-        common_origin_ = common_origin_ && (same.bits() & live_[g]) == live_[g];
-        alive_groups_ |= GroupMask{1} << g;
-      }
-      if constexpr (kTest == TriangleTest::kWatertight) {
-        for_each_bit(live_[g], [&](int lane) { watertight_[g][lane] = prepare_watertight(world_ray(g, lane)); });
-      }
-      if constexpr (!kAnyHit) {
-        Float8(kInf).store(out_.t + k0);
-        Float8(0.0f).store(out_.u + k0);
-        Float8(0.0f).store(out_.v + k0);
-        std::fill_n(out_.triangle + k0, kLanes, kInvalidId);
-        std::fill_n(out_.instance + k0, kLanes, kInvalidId);
-      }
-    }
   }
 
   void run(std::span<const std::uint32_t> objects) {
@@ -173,7 +130,7 @@ class LargeQuery {
           visit_[g].leaf_lanes = live_[g];
           counters_.object_visits += static_cast<std::uint64_t>(std::popcount(live_[g]));
         });
-        visit_small_static(mesh, alive_groups_);
+        each_triangle(StaticTriangles{mesh}, mesh.desc.triangles.size(), alive_groups_);
       }
       return;
     }
@@ -191,10 +148,6 @@ class LargeQuery {
       visit(all[begin[i].object]);
     }
   }
-
-  std::uint32_t valid_lanes(int g) const { return valid_[g]; }
-  std::uint8_t blocked(int g) const { return static_cast<std::uint8_t>(blocked_[g]); }
-  const TraversalCounters& counters() const { return counters_; }
 
  private:
   // Frusta (cull/packet_frusta.h) for rays from one origin, t >= 0: camera
@@ -238,31 +191,6 @@ class LargeQuery {
     }
   }
 
-  // The largest t any lane of `groups` still looks for: its best hit (or
-  // t_max), capped by its exit from the current object when `visit` holds it.
-  float packet_limit(GroupMask groups, const VisitGroup* visit) const {
-    float limit = -kInf;
-    for_each_bit(groups, [&](int g) { limit = std::max(limit, group_limit(g, visit)); });
-    return limit;
-  }
-  float group_limit(int g, const VisitGroup* visit) const {
-    const std::uint32_t lanes = visit ? visit[g].lanes & live_[g] : live_[g];
-    if (lanes == 0) return -kInf;
-    Float8 t = Float8::load(group_[g].t_limit);
-    if (visit) t = min(t, Float8::load(visit[g].t1));
-    return reduce_max(select(Mask8::from_bits(lanes), t, Float8(-kInf)));
-  }
-
-  Ray world_ray(int g, int lane) const {
-    const Group& gr = group_[g];
-    Ray r;
-    r.origin = Vec3(gr.o[0][lane], gr.o[1][lane], gr.o[2][lane]);
-    r.direction = Vec3(gr.d[0][lane], gr.d[1][lane], gr.d[2][lane]);
-    r.t_min = gr.t_min[lane];
-    r.t_max = gr.t_limit[lane];
-    return r;
-  }
-
   // Enters one object: each group's lanes clipped to its box as the single
   // ray clips them (traverse/traversal.cpp visit).
   void visit(const TopLevelObject& object) {
@@ -288,7 +216,8 @@ class LargeQuery {
         if (live_[g] != 0) groups |= GroupMask{1} << g;
         counters_.object_visits += static_cast<std::uint64_t>(std::popcount(live_[g]));
       });
-      if (groups != 0) visit_small_static(scene_ref().static_meshes()[object.index], groups);
+      const Scene::StaticMesh& mesh = scene_ref().static_meshes()[object.index];
+      if (groups != 0) each_triangle(StaticTriangles{mesh}, mesh.desc.triangles.size(), groups);
       return;
     }
     for_each_bit(clipped, [&](int g) {
@@ -312,47 +241,68 @@ class LargeQuery {
     } else {
       mailbox_.reset();
     }
-    switch (object.kind) {
-      case TopLevelObject::Kind::kBone: {
-        visit_bone(scene_ref().instances()[object.index], object.bone, groups);
-        return;
-      }
-      case TopLevelObject::Kind::kStatic: {
-        const Scene::StaticMesh& mesh = scene_ref().static_meshes()[object.index];
-        if (mesh.desc.triangles.size() <= detail::kBruteForceStaticTriangles) {
-          visit_small_static(mesh, groups);
-          return;
-        }
-        const StaticTriangles triangles{mesh};
-        const auto leaf = [&](std::uint32_t, std::span<const std::uint32_t> items, GroupMask groups_here) {
-          return test_leaf(items, groups_here, triangles);
-        };
-        visit_world_tree(mesh.tree.view(), groups, leaf);
-        return;
-      }
-      case TopLevelObject::Kind::kFallback: {
-        const InstanceFrame& frame = scene_ref().instances()[object.index];
-        const EscapedTriangles triangles{*scene_ref().characters()[frame.character].mesh, frame};
-        const auto leaf = [&](std::uint32_t, std::span<const std::uint32_t> items, GroupMask groups_here) {
-          return test_leaf(items, groups_here, triangles);
-        };
-        visit_world_tree(frame.fallback.view(), groups, leaf);
-        return;
-      }
-    }
+    visit_object(scene_ref(), object, *this, groups);
   }
 
-  void visit_small_static(const Scene::StaticMesh& mesh, GroupMask groups) {
-    for (std::uint32_t t = 0; t < mesh.desc.triangles.size() && groups != 0; ++t) {
-      const auto& v = mesh.desc.triangles[t];
-      const Vec3& p0 = mesh.desc.positions[v[0]];
-      const Vec3& p1 = mesh.desc.positions[v[1]];
-      const Vec3& p2 = mesh.desc.positions[v[2]];
-      test_groups(groups, p0, p1, p2, t, mesh.instance_id);
+ public:
+  // The object kinds' walks (visit_object, traverse/leaf_triangles.h) for
+  // the lanes of `groups` that entered the object (visit_[g].lanes).
+  void each_triangle(const StaticTriangles& triangles, std::size_t count, GroupMask groups) {
+    for (std::uint32_t t = 0; t < count && groups != 0; ++t) {
+      const LeafTriangle tri = triangles(t);
+      test_groups(groups, *tri.p0, *tri.p1, *tri.p2, tri.triangle, tri.instance);
       groups &= alive_groups_;
     }
   }
+  template <class Source>
+  void world_tree(const KdTreeView& tree, const Source& triangles, GroupMask groups) {
+    const auto leaf = [&](std::uint32_t, std::span<const std::uint32_t> items, GroupMask groups_here) {
+      return test_leaf(items, groups_here, triangles);
+    };
+    visit_world_tree(tree, groups, leaf);
+  }
+  void bone_tree(const InstanceFrame& frame, std::uint32_t bone, const Scene::Character& character,
+                 const SkinnedTriangles& corners, GroupMask groups) {
+    const BoneTree& tree = frame.bone_tree(character.fuzzy, bone);
+    if (tree.node_count == 0) return;
+    // Each group's rays in the bone frame, with each lane's slack there
+    // (traverse/ray_frames.h, as the single ray).
+    TreeEntry entry;
+    for_each_bit(groups, [&](int g) {
+      const Group& gr = group_[g];
+      const per_lane::FrameRay<Float8> r =
+          per_lane::to_bone_frame<Float8>(frame, bone, gr.origin(), gr.direction(), Float8::load(gr.o_mag),
+                                       Float8::load(visit_[g].t1), Mask8::from_bits(visit_[g].lanes));
+      const Vec3x8& o = r.o;
+      const Vec3x8& d = r.d;
+      const Float8 eps = r.eps;
+      if (frusta_.on()) {
+        enter_tree_unclipped(entry, g, o, d, eps);
+        return;
+      }
+      enter_tree(entry, tree.bounds, g, o, d, per_lane::reciprocal<Float8>(d), eps);
+    });
+    const auto leaf = [&](std::uint32_t node, std::span<const std::uint32_t> triangles, GroupMask groups_here) {
+      if (frusta_.on()) {
+        // The leaf's triangles as they are this frame (raytrace/scene/leaf_boxes.h):
+        // a leaf no frustum reaches costs one box test, not one per triangle.
+        ensure_frusta(groups_here & alive_groups_);
+        const Aabb box = frame.leaf_boxes.get(bone, node, [&] { return triangles_box(triangles, corners); });
+        groups_here = frusta_box_reached(box, groups_here & alive_groups_);
+        if (clip_leaf_lanes_) groups_here = clip_to_leaf_box(box, groups_here);
+        if (groups_here == 0) return false;
+        return test_leaf_in_frusta(triangles, groups_here, corners, character.fuzzy.has_bvhs(), clip_leaf_lanes_);
+      }
+      return test_leaf(triangles, groups_here, corners, character.fuzzy.has_bvhs());
+    };
+    if (character.fuzzy.has_bvhs()) {
+      walk_bvh(character.fuzzy.bvh_view(tree), entry, leaf);
+    } else {
+      walk_tree(character.fuzzy.tree_view(tree), entry, leaf);
+    }
+  }
 
+ private:
   // The box of the triangles of `items` (corners(item): a LeafTriangle).
   template <class TriangleSource>
   static Aabb triangles_box(std::span<const std::uint32_t> items, const TriangleSource& corners) {
@@ -477,47 +427,6 @@ class LargeQuery {
     walk_tree(tree, entry, leaf);
   }
 
-  void visit_bone(const InstanceFrame& frame, std::uint32_t bone, GroupMask groups) {
-    const Scene::Character& character = scene_ref().characters()[frame.character];
-    const BoneTree& tree = frame.bone_tree(character.fuzzy, bone);
-    if (tree.node_count == 0) return;
-    // Each group's rays in the bone frame, with each lane's slack there
-    // (traverse/ray_frames.h, as the single ray).
-    TreeEntry entry;
-    for_each_bit(groups, [&](int g) {
-      const Group& gr = group_[g];
-      const per_lane::FrameRay<Float8> r =
-          per_lane::to_bone_frame<Float8>(frame, bone, gr.origin(), gr.direction(), Float8::load(gr.o_mag),
-                                       Float8::load(visit_[g].t1), Mask8::from_bits(visit_[g].lanes));
-      const Vec3x8& o = r.o;
-      const Vec3x8& d = r.d;
-      const Float8 eps = r.eps;
-      if (frusta_.on()) {
-        enter_tree_unclipped(entry, g, o, d, eps);
-        return;
-      }
-      enter_tree(entry, tree.bounds, g, o, d, per_lane::reciprocal<Float8>(d), eps);
-    });
-    const SkinnedTriangles corners{*character.mesh, frame};
-    const auto leaf = [&](std::uint32_t node, std::span<const std::uint32_t> triangles, GroupMask groups_here) {
-      if (frusta_.on()) {
-        // The leaf's triangles as they are this frame (raytrace/scene/leaf_boxes.h):
-        // a leaf no frustum reaches costs one box test, not one per triangle.
-        ensure_frusta(groups_here & alive_groups_);
-        const Aabb box = frame.leaf_boxes.get(bone, node, [&] { return triangles_box(triangles, corners); });
-        groups_here = frusta_box_reached(box, groups_here & alive_groups_);
-        if (clip_leaf_lanes_) groups_here = clip_to_leaf_box(box, groups_here);
-        if (groups_here == 0) return false;
-        return test_leaf_in_frusta(triangles, groups_here, corners, character.fuzzy.has_bvhs(), clip_leaf_lanes_);
-      }
-      return test_leaf(triangles, groups_here, corners, character.fuzzy.has_bvhs());
-    };
-    if (character.fuzzy.has_bvhs()) {
-      walk_bvh(character.fuzzy.bvh_view(tree), entry, leaf);
-    } else {
-      walk_tree(character.fuzzy.tree_view(tree), entry, leaf);
-    }
-  }
 
   // The lanes of each group of `groups` whose world ray, over its passage
   // through the object and short of its best hit, meets `box` (a bone-tree
@@ -585,90 +494,31 @@ class LargeQuery {
     entry.groups |= GroupMask{1} << g;
   }
 
+  // The groups of `entry` through a tree (traverse/interval_walk.h), each
+  // reached leaf's lanes picked by visit_leaf.
   template <class LeafFn>
   void walk_tree(const KdTreeView& tree, const TreeEntry& entry, LeafFn& leaf) {
     if (entry.groups == 0) return;
     const IntervalBound bound(entry.ranges.ranges());
     tree_groups_ = entry.groups;
-    traverse(tree, bound, bound.grow_for(tree.bounds, entry.eps), entry.groups, leaf);
+    PacketLimit limit(*this, entry.groups, bound);
+    walk_kd_cells(tree, bound, bound.grow_for(tree.bounds, entry.eps), limit, leaf_of(entry.groups, leaf),
+                  counters_.node_visits);
   }
-
-  // Front to back over the cells the packet's bound reaches, each with a
-  // parameter range [t0, t1] that holds every ray's passage through it: on
-  // a split axis where every ray has one sign, the child ranges are cut at
-  // the bounds on where the rays cross the (thick) split plane, one
-  // product pair per node; elsewhere each child box is tested whole. At a
-  // leaf, the groups whose own bound reaches its cell test its triangles.
-  // `leaf` returns true to stop (every lane answered).
   template <class LeafFn>
-  void traverse(const KdTreeView& tree, const IntervalBound& bound, const IntervalBound::Growth& grow, GroupMask groups,
-                LeafFn& leaf) {
-    PacketLimit limit(*this, groups, bound);
-    std::array<Cell, kMaxTraversalDepth + 2> stack;
-    std::size_t top = 0;
-    Cell cur{{tree.bounds.lower.x, tree.bounds.lower.y, tree.bounds.lower.z},
-             {tree.bounds.upper.x, tree.bounds.upper.y, tree.bounds.upper.z},
-             0,
-             bound.entry(tree.bounds, grow, limit()),
-             bound.t_hi()};
-    if (cur.t0 == kInf) return;
-    for (;;) {
-      cur.t1 = std::min(cur.t1, limit());
-      if (cur.t0 <= cur.t1) {
-        ++counters_.node_visits;
-        const KdNode node = tree.nodes[cur.node];
-        if (!node.is_leaf()) {
-          const int a = node.axis();
-          const float split = node.split();
-          Cell below = cur, above = cur;
-          below.node = cur.node + 1;
-          above.node = node.above_child();
-          below.hi[a] = std::min(below.hi[a], split);
-          above.lo[a] = std::max(above.lo[a], split);
-          const int sign = bound.sign(a);
-          bool below_first = true;
-          if (sign > 0) {
-            // Rising rays: below until they cross split + grow, above from split - grow.
-            below.t1 = std::min(cur.t1, bound.crossing_hi(a, split + grow.axis[a]));
-            above.t0 = std::max(cur.t0, bound.crossing_lo(a, split - grow.axis[a]));
-          } else if (sign < 0) {
-            above.t1 = std::min(cur.t1, bound.crossing_hi(a, split - grow.axis[a]));
-            below.t0 = std::max(cur.t0, bound.crossing_lo(a, split + grow.axis[a]));
-            below_first = false;
-          } else {
-            const float eb = bound.entry(below.box(), grow, cur.t1);
-            const float ea = bound.entry(above.box(), grow, cur.t1);
-            below.t0 = std::max(cur.t0, eb);
-            above.t0 = std::max(cur.t0, ea);
-            if (eb == kInf) below.t0 = kInf;
-            if (ea == kInf) above.t0 = kInf;
-            below_first = !(above.t0 < below.t0);
-          }
-          const Cell& near = below_first ? below : above;
-          const Cell& far = below_first ? above : below;
-          const bool near_open = near.t0 <= near.t1;
-          if (far.t0 <= far.t1) {
-            if (near_open) {
-              stack[top++] = far;
-            } else {
-              cur = far;
-              continue;
-            }
-          }
-          if (near_open) {
-            cur = near;
-            continue;
-          }
-        } else if (node.item_count() > 0) {
-          if (visit_leaf(cur.box(), cur.node, tree.items.subspan(node.first_item(), node.item_count()), groups,
-                         leaf)) {
-            return;
-          }
-        }
-      }
-      if (top == 0) return;
-      cur = stack[--top];
-    }
+  void walk_bvh(const BvhView& tree, const TreeEntry& entry, LeafFn& leaf) {
+    if (entry.groups == 0) return;
+    const IntervalBound bound(entry.ranges.ranges());
+    tree_groups_ = entry.groups;
+    PacketLimit limit(*this, entry.groups, bound);
+    walk_bvh_nodes(tree, bound, bound.grow_for(tree.bounds, entry.eps), limit, leaf_of(entry.groups, leaf),
+                   counters_.node_visits);
+  }
+  template <class LeafFn>
+  auto leaf_of(GroupMask groups, LeafFn& leaf) {
+    return [this, groups, &leaf](const Aabb& cell, std::uint32_t node, std::span<const std::uint32_t> items) {
+      return visit_leaf(cell, node, items, groups, leaf);
+    };
   }
 
   // The packet's limit for pruning a walk's nodes: for any-hit rays the
@@ -735,156 +585,8 @@ class LargeQuery {
     return reaching != 0 && leaf(node, items, reaching);
   }
 
-  // Front to back over the BVH nodes the packet's bound reaches (each
-  // node's box grown as the kd walk grows its cells), the child the bound
-  // enters first first; at a leaf, as the kd walk's.
-  template <class LeafFn>
-  void walk_bvh(const BvhView& tree, const TreeEntry& entry, LeafFn& leaf) {
-    if (entry.groups == 0) return;
-    const IntervalBound bound(entry.ranges.ranges());
-    tree_groups_ = entry.groups;
-    const IntervalBound::Growth grow = bound.grow_for(tree.bounds, entry.eps);
-    const GroupMask groups = entry.groups;
-    PacketLimit limit(*this, groups, bound);
-    struct Pending {
-      std::uint32_t node;
-      float t;
-    };
-    std::array<Pending, kMaxTraversalDepth + 2> stack;
-    std::size_t top = 0;
-    const float t_root = bound.entry(tree.nodes[0].box, grow, limit());
-    if (t_root == kInf) return;
-    stack[top++] = {0, t_root};
-    while (top > 0) {
-      const Pending e = stack[--top];
-      if (e.t > limit()) continue;
-      ++counters_.node_visits;
-      const BvhNode& node = tree.nodes[e.node];
-      if (node.is_leaf()) {
-        if (visit_leaf(node.box, e.node, tree.items.subspan(node.first, node.count), groups, leaf)) return;
-        continue;
-      }
-      const float t_limit = limit();
-      const float ta = bound.entry(tree.nodes[node.first].box, grow, t_limit);
-      const float tb = bound.entry(tree.nodes[node.first + 1].box, grow, t_limit);
-      const bool a_first = ta <= tb;
-      const Pending near{a_first ? node.first : node.first + 1, a_first ? ta : tb};
-      const Pending far{a_first ? node.first + 1 : node.first, a_first ? tb : ta};
-      if (far.t <= t_limit) stack[top++] = far;
-      if (near.t <= t_limit) stack[top++] = near;
-    }
-  }
-
-  // Tests one world-space triangle for the live lanes of each group of
-  // `groups` that reach it (visit_[g].leaf_lanes).
-  void test_groups(GroupMask groups, const Vec3& p0, const Vec3& p1, const Vec3& p2, std::uint32_t triangle,
-                   std::uint32_t instance) {
-    if constexpr (kTest == TriangleTest::kFast) {
-      if (common_origin_) {
-        test_groups_prepared(groups, prepare_common_origin(common_origin_at_, p0, p1, p2), triangle, instance);
-        return;
-      }
-    }
-    for_each_bit(groups, [&](int g) { test(g, visit_[g].leaf_lanes, p0, p1, p2, triangle, instance); });
-  }
-
-  // test_groups with the fast test for rays from common_origin_at_, the
-  // triangle's origin terms prepared: once for every group; the zero-area
-  // check of the scalar test once per triangle, on the hit path.
-  void test_groups_prepared(GroupMask groups, const CommonOriginTriangle& c, std::uint32_t triangle,
-                            std::uint32_t instance) {
-    int zero_area = -1;
-    for_each_bit(groups, [&](int g) {
-      const std::uint32_t lanes = visit_[g].leaf_lanes & live_[g];
-      if (lanes == 0) return;
-      counters_.triangle_tests += static_cast<std::uint64_t>(std::popcount(lanes));
-      Group& gr = group_[g];
-      alignas(32) float t[kLanes], u[kLanes], v[kLanes];
-      const RayLanes8 lanes8{gr.o, gr.d, gr.t_min, gr.t_limit};
-      const std::uint32_t hit = intersect_triangle_fast8_common_origin(lanes8, lanes, c, t, u, v);
-      if (hit == 0) return;
-      if (zero_area < 0) zero_area = detail::zero_area(c.e1, c.e2) ? 1 : 0;
-      if (zero_area == 0) record_lanes(g, hit, t, u, v, triangle, instance);
-    });
-  }
-
-  // Tests one world-space triangle for the live lanes of `lanes` of group g.
-  void test(int g, std::uint32_t lanes, const Vec3& p0, const Vec3& p1, const Vec3& p2, std::uint32_t triangle,
-            std::uint32_t instance) {
-    lanes &= live_[g];
-    if (lanes == 0) return;
-    counters_.triangle_tests += static_cast<std::uint64_t>(std::popcount(lanes));
-    Group& gr = group_[g];
-    if constexpr (kTest == TriangleTest::kWatertight) {
-      for_each_bit(lanes, [&](int lane) {
-        TriangleHit h;
-        if (intersect_triangle_watertight(watertight_[g][lane], world_ray(g, lane), gr.t_limit[lane], p0, p1, p2,
-                                          h)) {
-          if constexpr (kAnyHit) {
-            retire(g, lane);
-          } else {
-            record(g, lane, h.t, h.u, h.v, triangle, instance);
-          }
-        }
-      });
-    } else {
-      alignas(32) float t[kLanes], u[kLanes], v[kLanes];
-      const RayLanes8 lanes8{gr.o, gr.d, gr.t_min, gr.t_limit};
-      const std::uint32_t hit = intersect_triangle_fast8(lanes8, lanes, p0, p1, p2, t, u, v);
-      // The scalar test's last check, once per triangle.
-      if (hit == 0 || detail::zero_area(p1 - p0, p2 - p0)) return;
-      if constexpr (kAnyHit) {
-        for_each_bit(hit, [&](int lane) { retire(g, lane); });
-      } else {
-        record_lanes(g, hit, t, u, v, triangle, instance);
-      }
-    }
-  }
-
-  // The hits of `lanes` of group g, eight lanes at once.
-  void record_lanes(int g, std::uint32_t lanes, const float* t, const float* u, const float* v,
-                    std::uint32_t triangle, std::uint32_t instance) {
-    if constexpr (kAnyHit) {
-      for_each_bit(lanes, [&](int lane) { retire(g, lane); });
-    } else {
-      const std::size_t k0 = static_cast<std::size_t>(g) * kLanes;
-      const Mask8 m = Mask8::from_bits(lanes);
-      const Float8 tt = Float8::load(t);
-      select(m, tt, Float8::load(group_[g].t_limit)).store(group_[g].t_limit);
-      select(m, tt, Float8::load(out_.t + k0)).store(out_.t + k0);
-      select(m, Float8::load(u), Float8::load(out_.u + k0)).store(out_.u + k0);
-      select(m, Float8::load(v), Float8::load(out_.v + k0)).store(out_.v + k0);
-      for_each_bit(lanes, [&](int lane) {
-        out_.triangle[k0 + static_cast<std::size_t>(lane)] = triangle;
-        out_.instance[k0 + static_cast<std::size_t>(lane)] = instance;
-      });
-      limits_lowered_ |= GroupMask{1} << g;
-    }
-  }
-
-  void record(int g, int lane, float t, float u, float v, std::uint32_t triangle, std::uint32_t instance) {
-    group_[g].t_limit[lane] = t;
-    limits_lowered_ |= GroupMask{1} << g;
-    const std::size_t k = static_cast<std::size_t>(g) * kLanes + static_cast<std::size_t>(lane);
-    out_.t[k] = t;
-    out_.u[k] = u;
-    out_.v[k] = v;
-    out_.triangle[k] = triangle;
-    out_.instance[k] = instance;
-  }
-
-  void retire(int g, int lane) {
-    blocked_[g] |= 1u << lane;
-    live_[g] &= ~(1u << lane);
-    if (live_[g] == 0) alive_groups_ &= ~(GroupMask{1} << g);
-  }
-
   const Scene* scene_p_ = nullptr;
   const Scene& scene_ref() const { return *scene_p_; }
-  PacketHits out_{};
-  int groups_ = 0;
-  std::array<Group, kMaxPacketGroups> group_;
-  std::array<VisitGroup, kMaxPacketGroups> visit_;
   std::array<std::uint32_t, kMaxPacketGroups> leaf_lanes_{};  // per group: the lanes reaching the current leaf
   GroupMask tree_groups_ = 0;  // the groups walking the current tree
   // test_leaf_in_frusta: up to eight of a leaf's triangles, their ids and
@@ -893,15 +595,6 @@ class LargeQuery {
   std::array<std::uint32_t, kLanes> batch_triangle_{};
   std::array<std::uint32_t, kLanes> batch_instance_{};
   CommonOriginLanes8 prepared_;
-  std::array<std::array<WatertightRay, kLanes>, kTest == TriangleTest::kWatertight ? kMaxPacketGroups : 1>
-      watertight_;
-  std::array<std::uint32_t, kMaxPacketGroups> live_{};
-  std::array<std::uint32_t, kMaxPacketGroups> valid_{};
-  std::array<std::uint32_t, kMaxPacketGroups> blocked_{};
-  GroupMask alive_groups_ = 0;
-  GroupMask limits_lowered_ = 0;  // the groups that recorded a hit since traverse() last looked
-  bool common_origin_ = false;  // every live lane starts at common_origin_at_
-  Vec3 common_origin_at_{0.0f};
   LaneMailbox<kMaxPacketGroups> mailbox_;
   ItemMailbox<512> items_seen_;
   PacketFrusta<kMaxPacketGroups> frusta_;  // on: they pick each leaf triangle's groups
@@ -909,7 +602,6 @@ class LargeQuery {
   float visit_slack_ = 0.0f;       // run(): a bound on every lane's slack in an object's box clip
   bool group_frusta_ = false;      // LargePacketRays::group_frusta
   bool clip_leaf_lanes_ = false;   // LargePacketRays::clip_leaf_lanes
-  TraversalCounters counters_;
 };
 
 template <TriangleTest kTest, bool kAnyHit>

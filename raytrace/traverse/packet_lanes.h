@@ -1,7 +1,7 @@
 // The packet core's per-group state (traverse/large_packet.cpp): a group's
-// eight rays in world space, its part in one object visit, a kd cell on the
-// walk's stack, and the per-lane pieces of traverse/ray_frames.h bound to
-// a group. Private to traverse/.
+// eight rays in world space, its part in one object visit, and the
+// per-lane pieces of traverse/ray_frames.h bound to a group. Private to
+// traverse/.
 #pragma once
 
 #include <bit>
@@ -67,15 +67,5 @@ inline std::uint32_t clip_lanes(const Aabb& box, Float8 eps, const Vec3x8& o, co
                                 std::uint32_t mask, Float8& t0, Float8& t1) {
   return per_lane::clip_to_box<Float8>(box, eps, o, d, inv, t0, t1).bits() & mask;
 }
-
-// A kd-tree cell waiting on the stack, with the parameter range that
-// holds every ray's passage through it.
-// Plain arrays: glm's operator[] is a switch on the index.
-struct Cell {
-  float lo[3], hi[3];
-  std::uint32_t node;
-  float t0, t1;
-  Aabb box() const { return {Vec3(lo[0], lo[1], lo[2]), Vec3(hi[0], hi[1], hi[2])}; }
-};
 
 }  // namespace sinew::rt::packet_lanes

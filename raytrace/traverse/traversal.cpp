@@ -207,19 +207,14 @@ class Query {
     }
     ++counters_.object_visits;
     mailbox_.reset();
-    switch (object.kind) {
-      case TopLevelObject::Kind::kBone:
-        return visit_bone(scene_.instances()[object.index], object.bone, t0, t1);
-      case TopLevelObject::Kind::kStatic:
-        return visit_static(scene_.static_meshes()[object.index], t0, t1);
-      case TopLevelObject::Kind::kFallback:
-        return visit_fallback(scene_.instances()[object.index], t0, t1);
-    }
-    return false;
+    return visit_object(scene_, object, *this, t0, t1);
   }
 
-  bool visit_bone(const InstanceFrame& frame, std::uint32_t bone, float t0, float t1) {
-    const Scene::Character& character = scene_.characters()[frame.character];
+ public:
+  // The object kinds' walks (visit_object, traverse/leaf_triangles.h) over
+  // the ray's passage [t0, t1] through the object's box.
+  bool bone_tree(const InstanceFrame& frame, std::uint32_t bone, const Scene::Character& character,
+                 const SkinnedTriangles& triangles, float t0, float t1) {
     const BoneTree& tree = frame.bone_tree(character.fuzzy, bone);
     // The ray and its slack in the bone frame (traverse/ray_frames.h).
     const per_lane::FrameRay<float> r =
@@ -229,39 +224,27 @@ class Query {
     const float eps = r.eps;
     const Vec3 inv = per_lane::reciprocal<float>(d);
     if (!clip_to_box(tree.bounds, eps, o, d, inv, t0, t1)) return false;
-    const auto leaf = leaf_of(SkinnedTriangles{*character.mesh, frame});
     if (character.fuzzy.has_bvhs()) {
       return traverse_bvh(character.fuzzy.bvh_view(tree), o, d, inv, eps, t0, t1, t_limit_, counters_.node_visits,
-                          leaf);
+                          leaf_of(triangles));
     }
     return traverse_tree(character.fuzzy.tree_view(tree), o, d, inv, eps, t0, t1, t_limit_, counters_.node_visits,
-                         leaf);
+                         leaf_of(triangles));
   }
-
-  bool visit_static(const Scene::StaticMesh& mesh, float t0, float t1) {
-    const StaticTriangles triangles{mesh};
-    if (mesh.desc.triangles.size() <= detail::kBruteForceStaticTriangles) {
-      for (std::uint32_t t = 0; t < mesh.desc.triangles.size(); ++t) {
-        if (test(triangles(t))) return true;
-      }
-      return false;
-    }
-    return walk_world_tree(mesh.tree.view(), t0, t1, triangles);
-  }
-
-  bool visit_fallback(const InstanceFrame& frame, float t0, float t1) {
-    return walk_world_tree(frame.fallback.view(), t0, t1,
-                           EscapedTriangles{*scene_.characters()[frame.character].mesh, frame});
-  }
-
-  // A world-space tree below the top level, its leaf items read by `source`.
   template <class Source>
-  bool walk_world_tree(const KdTreeView& tree, float t0, float t1, const Source& source) {
+  bool world_tree(const KdTreeView& tree, const Source& triangles, float t0, float t1) {
     const float eps = world_eps(tree.bounds, t1);
     return traverse_tree(tree, ray_.origin, ray_.direction, inv_dir_, eps, t0, t1, t_limit_, counters_.node_visits,
-                         leaf_of(source));
+                         leaf_of(triangles));
+  }
+  bool each_triangle(const StaticTriangles& triangles, std::size_t count, float, float) {
+    for (std::uint32_t t = 0; t < count; ++t) {
+      if (test(triangles(t))) return true;
+    }
+    return false;
   }
 
+ private:
   // A leaf's test: each item's triangle (from `source`, traverse/
   // leaf_triangles.h) once per object visit; true when the query is answered.
   template <class Source>
