@@ -39,7 +39,7 @@ namespace sinew::rt {
 
 // The frusta's one relative margin, 2^-16 (the header comment above derives
 // it). Shared by the group frusta, the camera grid (grid_frusta.h) and the
-// tile cone (traverse/static_tiles.h), in three roles: a side plane is grown
+// tile cone (cull/static_tiles.h), in three roles: a side plane is grown
 // away from its rays by kFrustumMargin of their slope (grown_slope), a far
 // plane pushed out by kFrustumMargin of its reach (far_offset), and a shape
 // is culled only beyond kFrustumMargin of the coordinate magnitudes

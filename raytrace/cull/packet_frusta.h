@@ -9,15 +9,16 @@
 //                       shadow packets each group's slab in the packet's
 //                       basis ("Shadow slabs")
 //
-// Both answer the same two questions, which groups a box may reach and
-// which groups each of eight triangles may reach, with the same margins
-// (kFrustumMargin); the walk never asks which kind it has. Group frusta are
+// Both answer the same questions (cull/frustum_culler.h), which groups a
+// box, a triangle or each of eight triangles may reach, with the same
+// margins (kFrustumMargin); the walk never asks which kind it has. Group frusta are
 // built when a leaf first needs them (ensure), eight groups at a time.
 #pragma once
 
 #include <algorithm>
 #include <cstdint>
 
+#include "raytrace/cull/frustum_culler.h"
 #include "raytrace/cull/grid_frusta.h"
 #include "raytrace/cull/group_frusta.h"
 #include "runtime/math/aabb.h"
@@ -83,6 +84,11 @@ class PacketFrusta {
     return grid_.on() ? grid_.box_reached(box, groups) : frusta_.box_reached(box, groups);
   }
 
+  // The groups of `groups` whose frustum may reach the triangle.
+  std::uint64_t reached(const Vec3& p0, const Vec3& p1, const Vec3& p2, std::uint64_t groups) const {
+    return grid_.on() ? grid_.reached(p0, p1, p2, groups) : frusta_.reached(p0, p1, p2, groups);
+  }
+
   // Per triangle i of `t` in `lanes`, the groups of `groups` whose frustum
   // may reach it.
   void reached8(const TriangleLanes8& t, std::uint32_t lanes, std::uint64_t groups, std::uint64_t (&out)[8]) const {
@@ -100,5 +106,9 @@ class PacketFrusta {
   bool slabs_ = false;            // frusta_ tests the groups' slabs in the packet's basis
   std::uint64_t built_ = 0;       // the groups whose frustum frusta_ holds
 };
+
+static_assert(FrustumCuller<GroupFrusta<64>>);
+static_assert(FrustumCuller<GridFrusta>);
+static_assert(FrustumCuller<PacketFrusta<64>>);
 
 }  // namespace sinew::rt

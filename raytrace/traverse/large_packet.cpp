@@ -30,6 +30,7 @@ using packet_lanes::clip_lanes;
 using packet_lanes::for_each_bit;
 using packet_lanes::Group;
 using packet_lanes::PacketRays;
+using packet_lanes::thread_query;
 using packet_lanes::walk_bvh_nodes;
 using packet_lanes::walk_kd_cells;
 using packet_lanes::kInf;
@@ -607,7 +608,7 @@ class LargeQuery : public PacketRays<kTest, kAnyHit> {
 template <TriangleTest kTest, bool kAnyHit>
 void run_query(const Scene& scene, const LargePacketRays& rays, std::span<const std::uint32_t> objects, PacketHits out,
                std::uint8_t* blocked, TraversalCounters* counters) {
-  thread_local LargeQuery<kTest, kAnyHit> query;
+  LargeQuery<kTest, kAnyHit>& query = thread_query<LargeQuery<kTest, kAnyHit>>();
   query.start(scene, rays, out);
   query.run(objects);
   std::uint64_t rays_valid = 0;

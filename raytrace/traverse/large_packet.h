@@ -31,6 +31,8 @@
 
 namespace sinew::rt {
 
+struct StaticTile;
+
 inline constexpr int kMaxPacketGroups = 64;  // 512 rays: a 32x16-pixel region
 // A set of a packet's groups, bit g for group g.
 using GroupMask = std::uint64_t;
@@ -79,6 +81,17 @@ void intersect_large_packet(const Scene& scene, const LargePacketRays& rays, Tri
 // blocked within [t_min, t_max).
 void occluded_large_packet(const Scene& scene, const LargePacketRays& rays, TriangleTest test,
                            std::span<const std::uint32_t> objects, std::uint8_t* blocked,
+                           TraversalCounters* counters);
+
+// The same packets against a tile's few gathered static triangles
+// (cull/static_tiles.h): every active lane tests each triangle in order,
+// with no top level, no tree and no bound; the lane set-up, the triangle
+// tests and the hits are the ones above (traverse/packet_rays.h). The fast
+// test only, as gather_static_tile requires. Counters as above: object
+// visits per lane and mesh entered, triangle tests per lane.
+void intersect_large_packet(const LargePacketRays& rays, const StaticTile& tile, PacketHits out,
+                            TraversalCounters* counters);
+void occluded_large_packet(const LargePacketRays& rays, const StaticTile& tile, std::uint8_t* blocked,
                            TraversalCounters* counters);
 
 }  // namespace sinew::rt

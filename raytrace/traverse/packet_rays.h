@@ -22,6 +22,16 @@
 
 namespace sinew::rt::packet_lanes {
 
+// The calling thread's query object (tens of kilobytes, reused by every
+// packet). Returned by a call that is never inlined, so a packet looks the
+// thread-local object up once: inlined into the query's loops, each member
+// access would look it up again, behind the register spills of a call.
+template <class Query>
+[[gnu::noinline]] Query& thread_query() {
+  thread_local Query query;
+  return query;
+}
+
 template <TriangleTest kTest, bool kAnyHit>
 class PacketRays {
  public:
@@ -201,10 +211,8 @@ class PacketRays {
       select(m, tt, Float8::load(out_.t + k0)).store(out_.t + k0);
       select(m, Float8::load(u), Float8::load(out_.u + k0)).store(out_.u + k0);
       select(m, Float8::load(v), Float8::load(out_.v + k0)).store(out_.v + k0);
-      for_each_bit(lanes, [&](int lane) {
-        out_.triangle[k0 + static_cast<std::size_t>(lane)] = triangle;
-        out_.instance[k0 + static_cast<std::size_t>(lane)] = instance;
-      });
+      store_where(m, triangle, out_.triangle + k0);
+      store_where(m, instance, out_.instance + k0);
       limits_lowered_ |= GroupMask{1} << g;
     }
   }

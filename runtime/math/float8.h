@@ -93,6 +93,13 @@ inline Float8 fused_multiply_add(Float8 a, Float8 b, Float8 c) {
 inline void store_truncated(Float8 a, std::int32_t* out) {
   _mm256_storeu_si256(reinterpret_cast<__m256i*>(out), _mm256_cvttps_epi32(a.v));
 }
+// p[i] = value in the lanes of `mask`, the others kept: eight 32-bit ids
+// written beside the floats of the same lanes, without a branch per lane.
+inline void store_where(Mask8 mask, std::uint32_t value, std::uint32_t* p) {
+  __m256i* const q = reinterpret_cast<__m256i*>(p);
+  const __m256i ids = _mm256_set1_epi32(static_cast<int>(value));
+  _mm256_storeu_si256(q, _mm256_blendv_epi8(_mm256_loadu_si256(q), ids, _mm256_castps_si256(mask.m)));
+}
 // The smallest and the largest lane (no NaN lanes expected).
 inline float reduce_min(Float8 a) {
   __m128 m = _mm_min_ps(_mm256_castps256_ps128(a.v), _mm256_extractf128_ps(a.v, 1));
@@ -248,6 +255,11 @@ inline Float8 fused_multiply_add(Float8 a, Float8 b, Float8 c) {
 }
 inline void store_truncated(Float8 a, std::int32_t* out) {
   for (int i = 0; i < 8; ++i) out[i] = static_cast<std::int32_t>(a.v[i]);
+}
+inline void store_where(Mask8 mask, std::uint32_t value, std::uint32_t* p) {
+  for (int i = 0; i < 8; ++i) {
+    if (mask.b >> i & 1u) p[i] = value;
+  }
 }
 inline float reduce_min(Float8 a) {
   float m = a.v[0];

@@ -1,4 +1,4 @@
-// Static tiles (traverse/static_tiles.h): tiles that reach only small
+// Static tiles (cull/static_tiles.h): tiles that reach only small
 // static meshes gather their triangles and test them directly, and find
 // each camera ray's hit and each shadow ray's occlusion as single rays and
 // brute force do; a tile's cone never drops a triangle a ray inside it
@@ -21,7 +21,7 @@
 #include "raytrace/cull/ray_bound.h"
 #include "raytrace/render/stages/tile_stages.h"
 #include "raytrace/scene/scene.h"
-#include "raytrace/traverse/static_tiles.h"
+#include "raytrace/cull/static_tiles.h"
 #include "raytrace/traverse/traversal.h"
 #include "runtime/jobs/job_system.h"
 #include "tests/raytrace/render_test_support.h"
@@ -161,7 +161,7 @@ TEST(StaticTiles, SmallMeshesFindTheSingleRayHits) {
   EXPECT_EQ(tile.triangles.size(), 6u) << "small meshes whole";
   EXPECT_EQ(tile.meshes, 3u);
   rt::TraversalCounters counters;
-  rt::intersect_static_tile(tile, camera.eye(), s, counters);
+  rt::intersect_static_tile(tile, camera, s, counters);
   EXPECT_GT(counters.triangle_tests, 0u);
   const std::vector<std::size_t> per_mesh = expect_single_ray_hits(*sc, camera, s);
   for (std::uint32_t m = 0; m < 3; ++m) EXPECT_GT(per_mesh[m], 0u) << "every mesh is seen";
@@ -192,7 +192,8 @@ TEST(StaticTiles, SmallMeshesFindTheSingleRayHits) {
 }
 
 // A tile's cone (static_tiles.h TileCone) never drops a triangle that a
-// ray inside it hits, by either triangle test: random cones of four or
+// ray inside it hits, by either triangle test, nor the box of a triangle
+// it keeps: random cones of four or
 // eight corner directions from apexes near and far from the origin,
 // triangles about and beside them, and rays mixed from the corners (as a
 // tile's pixel rays are). It drops most triangles beside the cone, and the
@@ -235,6 +236,14 @@ TEST(StaticTiles, TheTileConeNeverDropsATriangleARayHits) {
         const bool missed = cone.misses(p0, p1, p2);
         ++tried;
         if (missed) ++dropped;
+        // As a FrustumCuller of one group: the same answer, and the
+        // triangle's box is reached whenever the triangle is.
+        Aabb box = Aabb::empty();
+        for (const Vec3& p : {p0, p1, p2}) box.extend(p);
+        EXPECT_EQ(cone.reached(p0, p1, p2, ~std::uint64_t{0}), missed ? 0u : 1u);
+        if (!missed) {
+          EXPECT_EQ(cone.box_reached(box, ~std::uint64_t{0}), 1u);
+        }
         for (int r = 0; r < 24; ++r) {
           Vec3 d(0.0f);
           for (int i = 0; i < count; ++i) d += unit(g) * glm::normalize(corners[i]);
@@ -325,7 +334,7 @@ TEST(StaticTiles, FloorCellsFindTheSingleRayHits) {
   EXPECT_TRUE(std::is_sorted(tile.triangles.begin(), tile.triangles.end(),
                              [](const rt::StaticTriangle& a, const rt::StaticTriangle& b) { return a.triangle < b.triangle; }));
   rt::TraversalCounters counters;
-  rt::intersect_static_tile(tile, camera.eye(), s, counters);
+  rt::intersect_static_tile(tile, camera, s, counters);
   std::size_t box_hits = 0, floor_hits = 0;
   for (std::size_t k = 0; k < s.lanes; ++k) {
     if (!s.hit(k)) continue;
@@ -341,7 +350,7 @@ TEST(StaticTiles, FloorCellsFindTheSingleRayHits) {
     ASSERT_TRUE(rt::gather_static_tile(sc, TriangleTest::kFast, bound, 0.0f, objects, tile,
                                        rt::camera_tile_cone(camera, s.tile)));
     EXPECT_LT(tile.triangles.size(), by_boxes);
-    rt::intersect_static_tile(tile, camera.eye(), s, counters);
+    rt::intersect_static_tile(tile, camera, s, counters);
     expect_single_ray_hits(sc, camera, s);
     if (HasFatalFailure()) return;
   }

@@ -37,5 +37,20 @@ TEST(Float8Lanes, CompressStoreKeepsTheMaskedLanesInOrder) {
   EXPECT_EQ(ids[1], 47u);
 }
 
+TEST(Float8Lanes, StoreWhereWritesOnlyTheMaskedLanes) {
+  // One word of padding either side: nothing outside the eight is touched,
+  // and ids that read as NaN floats keep their bits.
+  std::array<std::uint32_t, 10> words = {1, 10, 11, 12, 13, 14, 15, 16, 17, 2};
+  store_where(Mask8::from_bits(0b10100101u), 0xFFFFFFFFu, words.data() + 1);
+  EXPECT_EQ(words, (std::array<std::uint32_t, 10>{1, 0xFFFFFFFFu, 11, 0xFFFFFFFFu, 13, 14, 0xFFFFFFFFu, 16,
+                                                    0xFFFFFFFFu, 2}));
+  store_where(Mask8::from_bits(0u), 7u, words.data() + 1);
+  EXPECT_EQ(words[2], 11u);
+  store_where(Mask8::from_bits(0xFFu), 0x7FA00001u, words.data() + 1);  // a signalling NaN's bits
+  for (std::size_t i = 1; i <= 8; ++i) EXPECT_EQ(words[i], 0x7FA00001u) << i;
+  EXPECT_EQ(words[0], 1u);
+  EXPECT_EQ(words[9], 2u);
+}
+
 }  // namespace
 }  // namespace sinew

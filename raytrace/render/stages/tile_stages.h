@@ -19,7 +19,7 @@
 #include "raytrace/render/surface.h"
 #include "raytrace/render/tile_scratch.h"
 #include "raytrace/scene/scene.h"
-#include "raytrace/traverse/static_tiles.h"
+#include "raytrace/cull/static_tiles.h"
 
 namespace sinew::rt {
 
@@ -27,7 +27,7 @@ namespace sinew::rt {
 // the arithmetic stays finite); bit-identical to PinholeCamera::ray.
 void generate_camera_rays(const PinholeCamera& camera, TileScratch& s);
 
-// The cone (traverse/static_tiles.h) holding every camera ray of `tile`'s
+// The cone (cull/static_tiles.h) holding every camera ray of `tile`'s
 // pixels: the rays through its corner pixels span the others (a pinhole
 // camera's direction is affine in the pixel before it is normalised, which
 // does not move a ray). And the one holding every shadow ray
@@ -43,6 +43,13 @@ TileCone shadow_tile_cone(const TileScratch& s);
 // Fills t, u, v, triangle, instance and block_hits.
 void trace_primary(const Scene& scene, const PinholeCamera& camera, TriangleTest test, TileScratch& s,
                    TraversalCounters& counters);
+
+// trace_primary's way for a tile whose rays reach only `tile`'s gathered
+// static triangles (gather_static_tile): the tile's blocks as packets of
+// the core against them. Fills what trace_primary fills; counts object
+// visits and triangle tests, not rays.
+void intersect_static_tile(const StaticTile& tile, const PinholeCamera& camera, TileScratch& s,
+                           TraversalCounters& counters);
 
 // The surfaces at the hits (positions, camera-facing geometric and
 // shading normals, albedo, rounding bound), as surface_at computes them,
@@ -84,6 +91,13 @@ void make_shadow_rays(const Light& light, int l, TileScratch& s);
 // all traced.
 std::uint64_t trace_shadow_rays(const Scene& scene, TriangleTest test, int l, TileScratch& s,
                                 TraversalCounters& counters);
+
+// trace_shadow_rays' way for compacted shadow rays (s.so_*, s.sd_*, t in
+// [0, s.s_tmax), a spare group past the last) that reach only `tile`'s
+// gathered static triangles: as packets of the core against them. Clears
+// bit l of each blocked ray's pixel and returns how many were blocked;
+// counts object visits and triangle tests, not rays.
+std::uint64_t occluded_static_tile(const StaticTile& tile, int l, TileScratch& s, TraversalCounters& counters);
 
 // Diffuse shading (ambient + each unblocked light's N.L) and the requested
 // outputs of the tile's pixels, through s.staging: line-aligned planes get

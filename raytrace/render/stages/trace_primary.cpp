@@ -10,7 +10,7 @@
 
 #include "raytrace/render/stages/stage_support.h"
 #include "raytrace/traverse/large_packet.h"
-#include "raytrace/traverse/static_tiles.h"
+#include "raytrace/cull/static_tiles.h"
 
 namespace sinew::rt {
 
@@ -35,45 +35,58 @@ struct PrimaryLanes {
   }
 };
 
+// The hits of blocks [b0, b1) (at most kMaxPacketGroups) as one packet,
+// traced by `trace(rays, hits, work)` (a large_packet.h query); block_hits
+// set from the triangle ids. `grid_columns`: the blocks' pixel grid
+// (LargePacketRays), 0 for none.
+template <class Trace>
+void trace_blocks(const PinholeCamera& camera, std::size_t b0, std::size_t b1, std::size_t grid_columns,
+                  TileScratch& s, TraversalCounters& counters, Trace&& trace) {
+  thread_local PrimaryLanes shared;
+  shared.set_eye(camera.eye());
+  const std::size_t k0 = b0 * kBlockLanes;
+  LargePacketRays rays;
+  rays.groups = static_cast<int>(b1 - b0);
+  for (int a = 0; a < 3; ++a) rays.o[a] = shared.o[a];
+  rays.d[0] = &s.dir_x[k0];
+  rays.d[1] = &s.dir_y[k0];
+  rays.d[2] = &s.dir_z[k0];
+  rays.t_min = shared.t_min;
+  rays.t_max = shared.t_max;
+  rays.active = &s.block_pixels[b0];
+  rays.grid_columns = static_cast<int>(grid_columns);
+  rays.grid_forward = camera.forward();
+  rays.grid_right = camera.right();
+  rays.grid_up = camera.up();
+  rays.clip_leaf_lanes = s.plan.clip_leaf_lanes;
+  const PacketHits hits{&s.t[k0], &s.u[k0], &s.v[k0], &s.triangle[k0], &s.instance[k0]};
+  TraversalCounters work;
+  trace(rays, hits, work);
+  add_work(counters, work);
+  for (std::size_t b = b0; b < b1; ++b) {
+    std::uint32_t hit_bits = 0;
+    for (int lane = 0; lane < kBlockLanes; ++lane) {
+      hit_bits |= s.triangle[b * kBlockLanes + static_cast<std::size_t>(lane)] != kInvalidId ? (1u << lane) : 0u;
+    }
+    s.block_hits[b] = static_cast<std::uint8_t>(hit_bits & s.block_pixels[b]);
+  }
+}
+
 // One large packet per region: its blocks are consecutive in `s`.
 void trace_primary_large(const Scene& scene, const PinholeCamera& camera, TriangleTest test,
                          const std::vector<std::uint32_t>& objects, TileScratch& s, TraversalCounters& counters) {
-  thread_local PrimaryLanes shared;
-  shared.set_eye(camera.eye());
   for (std::size_t r = 0; r < s.regions(); ++r) {
     const std::size_t b0 = s.region_begin[r], b1 = s.region_begin[r + 1];
-    const std::size_t k0 = b0 * kBlockLanes;
     for (std::size_t b = b0; b < b1; ++b) counters.rays += static_cast<std::uint64_t>(std::popcount(s.block_pixels[b]));
     if (objects.empty()) {
-      for (std::size_t k = k0; k < b1 * kBlockLanes; ++k) set_miss(s, k);
+      for (std::size_t k = b0 * kBlockLanes; k < b1 * kBlockLanes; ++k) set_miss(s, k);
       for (std::size_t b = b0; b < b1; ++b) s.block_hits[b] = 0;
       continue;
     }
-    LargePacketRays rays;
-    rays.groups = static_cast<int>(b1 - b0);
-    for (int a = 0; a < 3; ++a) rays.o[a] = shared.o[a];
-    rays.d[0] = &s.dir_x[k0];
-    rays.d[1] = &s.dir_y[k0];
-    rays.d[2] = &s.dir_z[k0];
-    rays.t_min = shared.t_min;
-    rays.t_max = shared.t_max;
-    rays.active = &s.block_pixels[b0];
-    rays.grid_columns = static_cast<int>(s.region_columns(r));
-    rays.grid_forward = camera.forward();
-    rays.grid_right = camera.right();
-    rays.grid_up = camera.up();
-    rays.clip_leaf_lanes = s.plan.clip_leaf_lanes;
-    TraversalCounters work;
-    intersect_large_packet(scene, rays, test, objects,
-                           PacketHits{&s.t[k0], &s.u[k0], &s.v[k0], &s.triangle[k0], &s.instance[k0]}, &work);
-    add_work(counters, work);
-    for (std::size_t b = b0; b < b1; ++b) {
-      std::uint32_t hit_bits = 0;
-      for (int lane = 0; lane < kBlockLanes; ++lane) {
-        hit_bits |= s.triangle[b * kBlockLanes + static_cast<std::size_t>(lane)] != kInvalidId ? (1u << lane) : 0u;
-      }
-      s.block_hits[b] = static_cast<std::uint8_t>(hit_bits & s.block_pixels[b]);
-    }
+    trace_blocks(camera, b0, b1, s.region_columns(r), s, counters,
+                 [&](const LargePacketRays& rays, const PacketHits& hits, TraversalCounters& work) {
+                   intersect_large_packet(scene, rays, test, objects, hits, &work);
+                 });
   }
 }
 
@@ -119,10 +132,22 @@ void trace_primary(const Scene& scene, const PinholeCamera& camera, TriangleTest
   thread_local StaticTile statics;
   if (gather_static_tile(scene, test, tile_bound, 0.0f, lists.tile, statics, camera_tile_cone(camera, s.tile))) {
     for (std::size_t b = 0; b < blocks; ++b) counters.rays += static_cast<std::uint64_t>(std::popcount(s.block_pixels[b]));
-    intersect_static_tile(statics, eye, s, counters);
+    intersect_static_tile(statics, camera, s, counters);
     return;
   }
   trace_primary_large(scene, camera, test, lists.tile, s, counters);
+}
+
+void intersect_static_tile(const StaticTile& tile, const PinholeCamera& camera, TileScratch& s,
+                           TraversalCounters& counters) {
+  // Packets of whole block rows: the core needs no grid here (no frusta).
+  for (std::size_t b0 = 0; b0 < s.blocks(); b0 += kMaxPacketGroups) {
+    const std::size_t b1 = std::min(s.blocks(), b0 + static_cast<std::size_t>(kMaxPacketGroups));
+    trace_blocks(camera, b0, b1, 0, s, counters,
+                 [&](const LargePacketRays& rays, const PacketHits& hits, TraversalCounters& work) {
+                   intersect_large_packet(rays, tile, hits, &work);
+                 });
+  }
 }
 
 }  // namespace sinew::rt

@@ -10,7 +10,7 @@
 
 #include "raytrace/render/stages/stage_support.h"
 #include "raytrace/traverse/large_packet.h"
-#include "raytrace/traverse/static_tiles.h"
+#include "raytrace/cull/static_tiles.h"
 
 namespace sinew::rt {
 
@@ -18,46 +18,59 @@ using namespace stages;
 
 namespace {
 
+// Shadow rays [i0, i1) (at most kMaxPacketGroups groups) as one packet,
+// traced by `trace(rays, blocked, work)` (a large_packet.h query); each
+// blocked ray clears bit l of its pixel. Returns how many were blocked.
+template <class Trace>
+std::uint64_t occlude_run(std::size_t i0, std::size_t i1, int l, TileScratch& s, TraversalCounters& counters,
+                          Trace&& trace) {
+  static const std::vector<float> zeros(kMaxPacketGroups * kBlockLanes, 0.0f);
+  const std::uint8_t dark = static_cast<std::uint8_t>(~(1u << l));
+  std::array<std::uint8_t, kMaxPacketGroups> active{}, blocked{};
+  for (std::size_t i = i0; i < i1; i += kBlockLanes) {
+    const std::size_t n = std::min<std::size_t>(kBlockLanes, i1 - i);
+    active[(i - i0) / kBlockLanes] = static_cast<std::uint8_t>((1u << n) - 1u);
+  }
+  LargePacketRays rays;
+  rays.groups = static_cast<int>((i1 - i0 + kBlockLanes - 1) / kBlockLanes);
+  rays.o[0] = &s.so_x[i0];
+  rays.o[1] = &s.so_y[i0];
+  rays.o[2] = &s.so_z[i0];
+  rays.d[0] = &s.sd_x[i0];
+  rays.d[1] = &s.sd_y[i0];
+  rays.d[2] = &s.sd_z[i0];
+  rays.t_min = zeros.data();
+  rays.t_max = &s.s_tmax[i0];
+  rays.active = active.data();
+  rays.group_frusta = s.plan.shadow_group_frusta;
+  rays.clip_leaf_lanes = s.plan.clip_leaf_lanes;
+  TraversalCounters work;
+  trace(rays, blocked.data(), work);
+  add_work(counters, work);
+  std::uint64_t blocked_count = 0;
+  for (int g = 0; g < rays.groups; ++g) {
+    for (std::uint32_t m = blocked[static_cast<std::size_t>(g)] & active[static_cast<std::size_t>(g)]; m != 0;
+         m &= m - 1) {
+      const std::size_t i = i0 + static_cast<std::size_t>(g) * kBlockLanes + static_cast<std::size_t>(std::countr_zero(m));
+      s.lit[s.shadow_pixel[i]] &= dark;
+      ++blocked_count;
+    }
+  }
+  return blocked_count;
+}
+
 // One large packet per region's run of shadow rays.
 std::uint64_t trace_shadow_large(const Scene& scene, TriangleTest test, const std::vector<std::uint32_t>& objects,
                                  int l, TileScratch& s, TraversalCounters& counters) {
-  static const std::vector<float> zeros(kMaxPacketGroups * kBlockLanes, 0.0f);
-  const std::uint8_t dark = static_cast<std::uint8_t>(~(1u << l));
   std::uint64_t blocked_count = 0;
-  std::array<std::uint8_t, kMaxPacketGroups> active{}, blocked{};
   for (std::size_t r = 0; r + 1 < s.shadow_region_begin.size(); ++r) {
     const std::size_t i0 = s.shadow_region_begin[r], i1 = s.shadow_region_begin[r + 1];
     counters.rays += i1 - i0;
     if (objects.empty()) continue;
-    for (std::size_t i = i0; i < i1; i += kBlockLanes) {
-      const std::size_t n = std::min<std::size_t>(kBlockLanes, i1 - i);
-      const std::size_t g = (i - i0) / kBlockLanes;
-      active[g] = static_cast<std::uint8_t>((1u << n) - 1u);
-    }
-    LargePacketRays rays;
-    rays.groups = static_cast<int>((i1 - i0 + kBlockLanes - 1) / kBlockLanes);
-    rays.o[0] = &s.so_x[i0];
-    rays.o[1] = &s.so_y[i0];
-    rays.o[2] = &s.so_z[i0];
-    rays.d[0] = &s.sd_x[i0];
-    rays.d[1] = &s.sd_y[i0];
-    rays.d[2] = &s.sd_z[i0];
-    rays.t_min = zeros.data();
-    rays.t_max = &s.s_tmax[i0];
-    rays.active = active.data();
-    rays.group_frusta = s.plan.shadow_group_frusta;
-    rays.clip_leaf_lanes = s.plan.clip_leaf_lanes;
-    TraversalCounters work;
-    occluded_large_packet(scene, rays, test, objects, blocked.data(), &work);
-    add_work(counters, work);
-    for (int g = 0; g < rays.groups; ++g) {
-      for (std::uint32_t m = blocked[static_cast<std::size_t>(g)] & active[static_cast<std::size_t>(g)]; m != 0;
-           m &= m - 1) {
-        const std::size_t i = i0 + static_cast<std::size_t>(g) * kBlockLanes + static_cast<std::size_t>(std::countr_zero(m));
-        s.lit[s.shadow_pixel[i]] &= dark;
-        ++blocked_count;
-      }
-    }
+    blocked_count += occlude_run(i0, i1, l, s, counters,
+                                 [&](const LargePacketRays& rays, std::uint8_t* blocked, TraversalCounters& work) {
+                                   occluded_large_packet(scene, rays, test, objects, blocked, &work);
+                                 });
   }
   return blocked_count;
 }
@@ -150,6 +163,19 @@ std::uint64_t trace_shadow_rays(const Scene& scene, TriangleTest test, int l, Ti
     return occluded_static_tile(statics, l, s, counters);
   }
   return trace_shadow_large(scene, test, lists.tile, l, s, counters);
+}
+
+std::uint64_t occluded_static_tile(const StaticTile& tile, int l, TileScratch& s, TraversalCounters& counters) {
+  std::uint64_t blocked_count = 0;
+  constexpr std::size_t kPacketLanes = kMaxPacketGroups * kBlockLanes;
+  for (std::size_t i0 = 0; i0 < s.shadow_count; i0 += kPacketLanes) {
+    const std::size_t i1 = std::min(s.shadow_count, i0 + kPacketLanes);
+    blocked_count += occlude_run(i0, i1, l, s, counters,
+                                 [&](const LargePacketRays& rays, std::uint8_t* blocked, TraversalCounters& work) {
+                                   occluded_large_packet(rays, tile, blocked, &work);
+                                 });
+  }
+  return blocked_count;
 }
 
 }  // namespace sinew::rt

@@ -2,17 +2,16 @@
 // ground, a checkered floor, walls. Most of a frame's pixels are such
 // pixels, and their shadow rays too. The tile's triangles are gathered once
 // from the tile's bound (small meshes whole, larger ones from the cells of
-// their kd-tree the bound reaches), and every ray of the tile is tested
-// against them directly, eight lanes at a time: no packet bound, no tree
-// walk per packet, no box clip, and a triangle's per-origin terms once per
-// tile for the camera's rays.
+// their kd-tree the bound reaches) and its cone, and the packet core tests
+// every ray of the tile against them directly (traverse/large_packet.h, the
+// StaticTile overloads): no top level, no tree walk, no box clip per packet.
 //
 // Culling is conservative as in cull/ray_bound.h: a triangle is left out
 // only when no ray of the tile can enter its box grown by the traversal's
-// slack bound, so each lane's nearest hit is the single ray's; between two
-// triangles hit at exactly the same t the one gathered first wins (meshes in
-// list order, each mesh's triangles in ascending order, as the single ray
-// meets them in a leaf).
+// slack bound, or the tile's cone misses it, so each lane's nearest hit is
+// the single ray's; between two triangles hit at exactly the same t the one
+// gathered first wins (meshes in list order, each mesh's triangles in
+// ascending order, as the single ray meets them in a leaf).
 #pragma once
 
 #include <array>
@@ -20,12 +19,11 @@
 #include <span>
 #include <vector>
 
+#include "raytrace/cull/frustum_culler.h"
 #include "raytrace/cull/group_frusta.h"
 #include "raytrace/cull/ray_bound.h"
 #include "raytrace/geometry/triangle_intersect.h"
-#include "raytrace/render/tile_scratch.h"
 #include "raytrace/scene/scene.h"
-#include "raytrace/traverse/traversal.h"
 
 namespace sinew::rt {
 
@@ -74,6 +72,15 @@ class TileCone {
   TileCone(const Vec3& apex, const Vec3* directions, int count);
   bool misses(const Vec3& p0, const Vec3& p1, const Vec3& p2) const;
 
+  // As every culler answers (cull/frustum_culler.h), for its one group
+  // (bit 0): the box by the cone's planes, the triangle by misses().
+  std::uint64_t box_reached(const Aabb& box, std::uint64_t groups) const {
+    return on_ ? frustum_.box_reached(box, groups & 1u) : groups & 1u;
+  }
+  std::uint64_t reached(const Vec3& p0, const Vec3& p1, const Vec3& p2, std::uint64_t groups) const {
+    return misses(p0, p1, p2) ? 0u : groups & 1u;
+  }
+
  private:
   bool on_ = false;
   Vec3 apex_{0.0f};
@@ -94,16 +101,6 @@ class TileCone {
 bool gather_static_tile(const Scene& scene, TriangleTest test, const RayBound& bound, float extra_grow,
                         std::span<const std::uint32_t> objects, StaticTile& tile, const TileCone& cone = {});
 
-// The nearest hits of the tile's camera rays (from `eye` along s.dir_*)
-// among the gathered triangles: fills t, u, v, triangle, instance and
-// block_hits as trace_primary does (render/stages/tile_stages.h). Counts object
-// visits and triangle tests, not rays.
-void intersect_static_tile(const StaticTile& tile, const Vec3& eye, TileScratch& s, TraversalCounters& counters);
-
-// Occlusion of the tile's shadow rays for light l (s.so_*, s.sd_*, t in
-// [0, s.s_tmax)) by the gathered triangles: a blocked ray clears bit l of
-// its pixel's s.lit, as trace_shadow_rays does. Returns how many were
-// blocked. Counts object visits and triangle tests, not rays.
-std::uint64_t occluded_static_tile(const StaticTile& tile, int l, TileScratch& s, TraversalCounters& counters);
+static_assert(FrustumCuller<TileCone>);
 
 }  // namespace sinew::rt
