@@ -31,6 +31,11 @@ class Reader {
     std::vector<std::uint32_t> open;      // the elements whose end tag is still to come
     std::vector<std::uint32_t> last_child;  // per open element, and one for the top level
     last_child.push_back(kNoElement);
+    // XML allows a leading UTF-8 byte-order mark, but Cal3D's parser fails
+    // on one with a bare "invalid file format": say what it is instead.
+    if (text_.substr(0, 3) == "\xEF\xBB\xBF") {
+      return refuse("xml", "a UTF-8 byte-order mark, which Cal3D's XML parser cannot read (save without it)");
+    }
     while (pos_ < text_.size()) {
       if (text_[pos_] != '<') {
         const std::size_t end = std::min(text_.find('<', pos_), text_.size());

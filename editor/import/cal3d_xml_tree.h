@@ -24,9 +24,9 @@ namespace sinew::editor::cal3d_detail {
 // tens of thousands of levels; its formats need four (MESH > SUBMESH > VERTEX
 // > INFLUENCE). Anything deeper than this is refused before Cal3D sees it.
 inline constexpr std::size_t kMaxXmlDepth = 16;
-// Far beyond any character file (a 100,000-vertex mesh has about 500,000
+// Far beyond any character file (a 100,000-vertex mesh has about a million
 // elements); bounds the tree's memory whatever the file holds.
-inline constexpr std::size_t kMaxXmlElements = 8u << 20;
+inline constexpr std::size_t kMaxXmlElements = 4u << 20;
 
 inline constexpr std::uint32_t kNoElement = 0xffffffffu;
 
