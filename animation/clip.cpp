@@ -90,6 +90,28 @@ T hermite(const T& v0, const T& out0, const T& in1, const T& v1, float s, float 
          (s3 - s2) * dt * in1;
 }
 
+// An interpolated cubic-spline rotation made unit length. Keys are unit, but
+// the spline between them may pass through zero (two keys of opposite sign
+// with zero tangents reach (0, 0, 0, 0) halfway) or overflow (huge finite
+// tangents), and normalising that gives NaN. Then the nearer key stands in:
+// the spline has no direction there to keep. Lengths are taken in double,
+// as for the keys, so large finite components do not overflow.
+Quat unit_or_nearer_key(const Quat& r, const Quat& key0, const Quat& key1, float u) {
+  const double x = static_cast<double>(r.x), y = static_cast<double>(r.y), z = static_cast<double>(r.z),
+               w = static_cast<double>(r.w);
+  const double len = std::sqrt(x * x + y * y + z * z + w * w);
+  if (!(len > 1e-6) || !std::isfinite(len)) return u < 0.5f ? key0 : key1;
+  return Quat(static_cast<float>(w / len), static_cast<float>(x / len), static_cast<float>(y / len),
+              static_cast<float>(z / len));
+}
+
+// Finite keys far apart (or huge tangents) can overflow float between them;
+// the nearer key stands in for an infinite or NaN result.
+Vec3 finite_or_nearer_key(const Vec3& r, const Vec3& key0, const Vec3& key1, float u) {
+  if (finite(r)) return r;
+  return u < 0.5f ? key0 : key1;
+}
+
 template <typename T>
 T sample_track(const Track<T>& track, float t, std::uint32_t& hint) {
   const std::size_t n = track.times.size();
@@ -108,16 +130,16 @@ T sample_track(const Track<T>& track, float t, std::uint32_t& hint) {
       if constexpr (std::is_same_v<T, Quat>) {
         return slerp_shortest(value(k), value(k + 1), u);
       } else {
-        return lerp(value(k), value(k + 1), u);
+        return finite_or_nearer_key(lerp(value(k), value(k + 1), u), value(k), value(k + 1), u);
       }
     case Interpolation::kCubicSpline: {
       const T out0 = track.values[3 * k + 2];
       const T in1 = track.values[3 * (k + 1)];
       const T r = hermite(value(k), out0, in1, value(k + 1), u, t1 - t0);
       if constexpr (std::is_same_v<T, Quat>) {
-        return glm::normalize(r);  // the glTF spec: normalise after evaluation
+        return unit_or_nearer_key(r, value(k), value(k + 1), u);  // the glTF spec: normalise after evaluation
       } else {
-        return r;
+        return finite_or_nearer_key(r, value(k), value(k + 1), u);
       }
     }
   }

@@ -11,6 +11,14 @@ namespace {
 
 std::string weight_field(std::size_t v) { return "weights[" + std::to_string(v) + "]"; }
 
+// A sum of float weights to six digits: the float rounding of each weight
+// (1.02 summed as 1.01999998) says nothing to the reader.
+std::string sum_text(double sum) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.6g", sum);
+  return text;
+}
+
 
 }  // namespace
 
@@ -63,6 +71,23 @@ Status normalize_skin_weights(SkinnedMesh& mesh, std::string_view source, std::v
     warnings.push_back(std::string(source) + ": " + weight_field(first_off) + ": skin weights sum to " +
                        format_number(first_off_sum) + ", not 1; renormalised (" + std::to_string(off_rows) +
                        " of " + std::to_string(mesh.weights.size()) + " vertices)");
+  }
+  return {};
+}
+
+Status check_skin_weight_sums(const SkinnedMesh& mesh, std::string_view file, std::string_view field_prefix) {
+  for (std::size_t v = 0; v < mesh.weights.size(); ++v) {
+    double sum = 0.0;
+    for (const float w : mesh.weights[v]) sum += static_cast<double>(w);
+    if (!(sum > 0.0)) {
+      return make_error(ErrorCode::kInvalidData, file, std::string(field_prefix) + weight_field(v), "0",
+                        "the vertex's skin weights are all zero: it belongs to no bone");
+    }
+    if (std::fabs(sum - 1.0) > kSkinWeightSumTolerance) {
+      return make_error(ErrorCode::kInvalidData, file, std::string(field_prefix) + weight_field(v),
+                        "sum " + sum_text(sum),
+                        "skin weights must sum to 1 (within " + format_number(kSkinWeightSumTolerance) + ")");
+    }
   }
   return {};
 }

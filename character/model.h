@@ -53,6 +53,13 @@ inline constexpr double kSkinWeightSumTolerance = 0.01;
 // a row whose sum is 0, or a weights array of the wrong length.
 Status normalize_skin_weights(SkinnedMesh& mesh, std::string_view source, std::vector<std::string>& warnings);
 
+// For weights already normalised (a pack's mesh, written after
+// normalize_skin_weights): kInvalidData naming `file`, `field_prefix` +
+// "weights[v]" and the row's sum when a vertex's weights are all zero or sum
+// to more than kSkinWeightSumTolerance away from 1. Each weight is assumed
+// finite and >= 0 (check_skinned_mesh).
+Status check_skin_weight_sums(const SkinnedMesh& mesh, std::string_view file, std::string_view field_prefix);
+
 // The same for a whole model, warnings going to model.warnings.
 inline Status normalize_skin_weights(Model& model) {
   return normalize_skin_weights(model.mesh, model.source, model.warnings);

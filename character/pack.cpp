@@ -283,7 +283,10 @@ Status decode_mesh(SectionDecoder& d, std::size_t joint_count, Model& model) {
   }
   SINEW_RETURN_IF_ERROR(d.finish());
 
-  return check_skinned_mesh(MeshOrigin{d.pack(), "MESH."}, m, joint_count);
+  SINEW_RETURN_IF_ERROR(check_skinned_mesh(MeshOrigin{d.pack(), "MESH."}, m, joint_count));
+  // Packs store weights the importers normalised; a row that is all zero
+  // or far from 1 collapses its vertex (toward the origin) when skinned.
+  return check_skin_weight_sums(m, d.pack(), "MESH.");
 }
 
 template <typename T>

@@ -19,13 +19,15 @@ if(TARGET Cal3D::cal3d)
   target_sources(sinew_editor PRIVATE ${CMAKE_CURRENT_LIST_DIR}/cal3d_importer.cpp
                                       ${CMAKE_CURRENT_LIST_DIR}/cal3d_files.cpp
                                       ${CMAKE_CURRENT_LIST_DIR}/cal3d_validate.cpp
+                                      ${CMAKE_CURRENT_LIST_DIR}/cal3d_xml_tree.cpp
+                                      ${CMAKE_CURRENT_LIST_DIR}/cal3d_xml_check.cpp
                                       ${CMAKE_CURRENT_LIST_DIR}/cal3d_convert.cpp)
   target_link_libraries(sinew_editor PRIVATE Cal3D::cal3d)
   target_compile_definitions(sinew_editor PRIVATE SINEW_HAVE_CAL3D=1)
   # UBSan's vptr check (asan preset) references the typeinfo of Cal3D's
   # polymorphic classes, which the shared libcal3d does not export: the link
   # fails. The check is off for the two files that touch Cal3D objects
-  # (cal3d_files.cpp and cal3d_validate.cpp never include Cal3D).
+  # (cal3d_files.cpp, cal3d_validate.cpp and the cal3d_xml_* files never include Cal3D).
   set_source_files_properties(${CMAKE_CURRENT_LIST_DIR}/cal3d_importer.cpp
                               ${CMAKE_CURRENT_LIST_DIR}/cal3d_convert.cpp
     PROPERTIES COMPILE_OPTIONS -fno-sanitize=vptr)

@@ -90,6 +90,13 @@ using cal3d_detail::lower;
 using cal3d_detail::trim;
 
 Expected<Cal3dConfig> parse_cal3d_config(std::string_view text, std::string_view source) {
+  // Editors on Windows start UTF-8 files with a byte-order mark; left in,
+  // it made the first key unknown (so skipped): a leading scale= was lost.
+  if (text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);
+  if (text.substr(0, 2) == "\xFF\xFE" || text.substr(0, 2) == "\xFE\xFF") {
+    return make_error(ErrorCode::kInvalidData, source, "encoding", "UTF-16",
+                      "a .cfg must be UTF-8 or ASCII text");
+  }
   Cal3dConfig cfg;
   bool have_skeleton = false;
   std::size_t line_no = 0;

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "editor/import/cal3d_files.h"
+#include "editor/import/cal3d_xml_check.h"
 
 namespace sinew::editor::cal3d_detail {
 namespace {
@@ -44,7 +45,7 @@ namespace fs = std::filesystem;
 // (string = int length + length bytes ending in NUL; integers and floats
 // little-endian).
 // Trailing bytes are allowed, as Cal3D allows them. Files with another magic
-// (XML variants, binary .crf materials) are left to Cal3D.
+// are XML (checked by extension below) or binary .crf materials (left to Cal3D).
 class ByteWalker {
  public:
   ByteWalker(const std::string& bytes, const std::string& file) : bytes_(bytes), file_(file) {}
@@ -106,52 +107,6 @@ class ByteWalker {
   const std::string& file_;
   std::size_t pos_ = 0;
 };
-
-// Cal3D computes bone states by recursing from the roots through each
-// bone's child list and looking up each bone's parent by id, unchecked
-// (found by fuzzing: a parent id past the bone count crashed in
-// CalCoreBone::calculateState). So parent and child ids must be in range,
-// each listed child must name its lister as parent, and the parents must
-// form a forest (a cycle of child lists would recurse forever).
-Status check_bone_links(const std::vector<std::int32_t>& parents,
-                        const std::vector<std::vector<std::int32_t>>& children, const std::string& file) {
-  const auto bones = static_cast<std::int32_t>(parents.size());
-  for (std::int32_t b = 0; b < bones; ++b) {
-    const std::string f = "bone[" + std::to_string(b) + "]";
-    const std::int32_t parent = parents[static_cast<std::size_t>(b)];
-    if (parent < -1 || parent >= bones || parent == b) {
-      return make_error(ErrorCode::kOutOfBounds, file, f + ".parentId", std::to_string(parent),
-                        "not -1 or another bone's id (" + std::to_string(bones) + " bones)");
-    }
-    const auto& list = children[static_cast<std::size_t>(b)];
-    for (std::size_t c = 0; c < list.size(); ++c) {
-      const std::int32_t child = list[c];
-      if (child < 0 || child >= bones || parents[static_cast<std::size_t>(child)] != b) {
-        return make_error(ErrorCode::kInvalidData, file, f + ".children[" + std::to_string(c) + "]",
-                          std::to_string(child), "not a bone whose parentId is " + std::to_string(b));
-      }
-    }
-  }
-  // Parent chains longer than the bone count loop.
-  std::vector<std::uint8_t> state(parents.size(), 0);  // 0 unseen, 1 on the chain, 2 reaches a root
-  for (std::size_t start = 0; start < parents.size(); ++start) {
-    std::size_t b = start;
-    while (state[b] == 0) {
-      state[b] = 1;
-      if (parents[b] < 0) break;
-      b = static_cast<std::size_t>(parents[b]);
-    }
-    if (state[b] == 1 && parents[b] >= 0) {
-      return make_error(ErrorCode::kInvalidData, file, "bone[" + std::to_string(b) + "].parentId",
-                        std::to_string(parents[b]), "bone parents form a cycle");
-    }
-    for (b = start; state[b] == 1; b = static_cast<std::size_t>(parents[b])) {
-      state[b] = 2;
-      if (parents[b] < 0) break;
-    }
-  }
-  return {};
-}
 
 Status walk_skeleton(ByteWalker& w) {
   std::int32_t bones = 0;
@@ -383,6 +338,52 @@ class XrfChecker {
 
 }  // namespace
 
+// Cal3D computes bone states by recursing from the roots through each
+// bone's child list and looking up each bone's parent by id, unchecked
+// (found by fuzzing: a parent id past the bone count crashed in
+// CalCoreBone::calculateState). So parent and child ids must be in range,
+// each listed child must name its lister as parent, and the parents must
+// form a forest (a cycle of child lists would recurse forever).
+Status check_bone_links(const std::vector<std::int32_t>& parents,
+                        const std::vector<std::vector<std::int32_t>>& children, const std::string& file) {
+  const auto bones = static_cast<std::int32_t>(parents.size());
+  for (std::int32_t b = 0; b < bones; ++b) {
+    const std::string f = "bone[" + std::to_string(b) + "]";
+    const std::int32_t parent = parents[static_cast<std::size_t>(b)];
+    if (parent < -1 || parent >= bones || parent == b) {
+      return make_error(ErrorCode::kOutOfBounds, file, f + ".parentId", std::to_string(parent),
+                        "not -1 or another bone's id (" + std::to_string(bones) + " bones)");
+    }
+    const auto& list = children[static_cast<std::size_t>(b)];
+    for (std::size_t c = 0; c < list.size(); ++c) {
+      const std::int32_t child = list[c];
+      if (child < 0 || child >= bones || parents[static_cast<std::size_t>(child)] != b) {
+        return make_error(ErrorCode::kInvalidData, file, f + ".children[" + std::to_string(c) + "]",
+                          std::to_string(child), "not a bone whose parentId is " + std::to_string(b));
+      }
+    }
+  }
+  // Parent chains longer than the bone count loop.
+  std::vector<std::uint8_t> state(parents.size(), 0);  // 0 unseen, 1 on the chain, 2 reaches a root
+  for (std::size_t start = 0; start < parents.size(); ++start) {
+    std::size_t b = start;
+    while (state[b] == 0) {
+      state[b] = 1;
+      if (parents[b] < 0) break;
+      b = static_cast<std::size_t>(parents[b]);
+    }
+    if (state[b] == 1 && parents[b] >= 0) {
+      return make_error(ErrorCode::kInvalidData, file, "bone[" + std::to_string(b) + "].parentId",
+                        std::to_string(parents[b]), "bone parents form a cycle");
+    }
+    for (b = start; state[b] == 1; b = static_cast<std::size_t>(parents[b])) {
+      state[b] = 2;
+      if (parents[b] < 0) break;
+    }
+  }
+  return {};
+}
+
 Status validate_binary(const std::string& path) {
   std::error_code ec;
   const std::uintmax_t size = fs::file_size(path, ec);
@@ -406,12 +407,16 @@ Status validate_binary(const std::string& path) {
     return make_error(ErrorCode::kTruncated, path, "magic", std::to_string(bytes.size()) + " bytes",
                       "too short for a Cal3D file");
   }
-  // Cal3D picks its XML loaders by extension; only the material's is
-  // guarded here (see XrfChecker).
-  if (walk == nullptr && lower(fs::path(path).extension().string()) == ".xrf") {
-    return XrfChecker(bytes, path).check();
+  // Cal3D picks its XML loaders by extension, so the extension decides
+  // which XML check a file gets (see XrfChecker and cal3d_xml_check.h).
+  if (walk == nullptr) {
+    const std::string ext = lower(fs::path(path).extension().string());
+    if (ext == ".xrf") return XrfChecker(bytes, path).check();
+    if (ext == ".xsf") return check_cal3d_xml(bytes, path, Cal3dXmlKind::kSkeleton);
+    if (ext == ".xaf") return check_cal3d_xml(bytes, path, Cal3dXmlKind::kAnimation);
+    if (ext == ".xmf") return check_cal3d_xml(bytes, path, Cal3dXmlKind::kMesh);
+    return {};  // binary materials: Cal3D checks those
   }
-  if (walk == nullptr) return {};  // other XML files, binary materials: Cal3D checks those
   ByteWalker w(bytes, path);
   SINEW_RETURN_IF_ERROR(w.skip(4, "magic"));
   std::int32_t version = 0;

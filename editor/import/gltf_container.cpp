@@ -49,9 +49,10 @@ Status check_json_nesting(std::string_view json, std::size_t max_depth, const st
   return {};
 }
 
-Expected<std::string_view> check_glb(std::string_view bytes, const std::string& file) {
+Expected<GlbChunks> check_glb(std::string_view bytes, const std::string& file) {
   constexpr std::size_t kHeader = 12, kChunkHeader = 8;
   constexpr std::uint32_t kJsonChunk = 0x4E4F534Au;  // "JSON"
+  constexpr std::uint32_t kBinChunk = 0x004E4942u;   // "BIN\0"
   if (bytes.size() < kHeader + kChunkHeader) {
     return make_error(ErrorCode::kTruncated, file, "glb.header", std::to_string(bytes.size()) + " bytes",
                       "shorter than the 20-byte header and first chunk header");
@@ -68,19 +69,41 @@ Expected<std::string_view> check_glb(std::string_view bytes, const std::string& 
                       "the file has " + std::to_string(bytes.size()) + " bytes" +
                           (length < bytes.size() ? " (data past the declared end)" : ""));
   }
-  const std::uint32_t json_length = read_u32(bytes, 12);
-  const std::uint32_t type = read_u32(bytes, 16);
-  if (type != kJsonChunk) {
-    return make_error(ErrorCode::kInvalidData, file, "glb.chunks[0].type", std::to_string(type),
-                      "the first chunk must be JSON");
+  GlbChunks chunks;
+  // Every chunk: an 8-byte header, then as many bytes as it claims, all
+  // inside the file (tinygltf takes the BIN chunk's length on trust).
+  std::size_t at = kHeader;
+  for (std::size_t index = 0; at < bytes.size(); ++index) {
+    const std::string field = "glb.chunks[" + std::to_string(index) + "]";
+    const std::size_t left = bytes.size() - at;
+    if (left < kChunkHeader) {
+      return make_error(ErrorCode::kTruncated, file, field, std::to_string(left) + " bytes left",
+                        "a chunk header needs 8 bytes");
+    }
+    const std::uint32_t chunk_length = read_u32(bytes, at);
+    const std::uint32_t type = read_u32(bytes, at + 4);
+    if (chunk_length > left - kChunkHeader) {
+      return make_error(ErrorCode::kTruncated, file, field + ".length", std::to_string(chunk_length),
+                        "past the end of the file (" + std::to_string(left - kChunkHeader) + " bytes left)");
+    }
+    const std::string_view data = bytes.substr(at + kChunkHeader, chunk_length);
+    if (index == 0) {
+      if (type != kJsonChunk) {
+        return make_error(ErrorCode::kInvalidData, file, field + ".type", std::to_string(type),
+                          "the first chunk must be JSON");
+      }
+      chunks.json = data;
+    } else if (type == kBinChunk) {
+      if (index != 1) {
+        return make_error(ErrorCode::kInvalidData, file, field + ".type", "BIN",
+                          "a BIN chunk may only be the second chunk");
+      }
+      chunks.bin = data;
+    }
+    at += kChunkHeader + chunk_length;
   }
-  if (json_length > bytes.size() - kHeader - kChunkHeader) {
-    return make_error(ErrorCode::kTruncated, file, "glb.chunks[0].length", std::to_string(json_length),
-                      "past the end of the file");
-  }
-  const std::string_view json = bytes.substr(kHeader + kChunkHeader, json_length);
-  SINEW_RETURN_IF_ERROR(check_json_nesting(json, kMaxJsonNesting, file, "glb.chunks[0]"));
-  return json;
+  SINEW_RETURN_IF_ERROR(check_json_nesting(chunks.json, kMaxJsonNesting, file, "glb.chunks[0]"));
+  return chunks;
 }
 
 namespace {
@@ -191,6 +214,36 @@ Status check_uris(const nlohmann::json& doc, const std::string& file, const Asse
   return {};
 }
 
+
+// In a .glb, a buffer without a uri is the BIN chunk: only buffers[0] may
+// be, the chunk must exist, and the buffer may not claim more bytes than the
+// chunk holds (tinygltf copied byteLength bytes from it, reading past the
+// input). A byteLength that is not a count is left to tinygltf to refuse.
+Status check_glb_buffers(const nlohmann::json& doc, const std::string& file, const GlbChunks& glb) {
+  const auto it = doc.find("buffers");
+  if (it == doc.end() || !it->is_array()) return {};
+  for (std::size_t i = 0; i < it->size(); ++i) {
+    const nlohmann::json& buffer = (*it)[i];
+    if (!buffer.is_object() || buffer.contains("uri")) continue;
+    const std::string field = "buffers[" + std::to_string(i) + "]";
+    if (i != 0) {
+      return make_error(ErrorCode::kInvalidData, file, field + ".uri", "(none)",
+                        "only buffers[0] can be the .glb's BIN chunk; other buffers need a uri");
+    }
+    if (!glb.bin) {
+      return make_error(ErrorCode::kInvalidData, file, field + ".uri", "(none)",
+                        "the buffer is the .glb's BIN chunk, and the file has none");
+    }
+    const auto length = buffer.find("byteLength");
+    if (length == buffer.end() || !length->is_number_unsigned()) continue;
+    const std::uint64_t claimed = length->get<std::uint64_t>();
+    if (claimed > glb.bin->size()) {
+      return make_error(ErrorCode::kTruncated, file, field + ".byteLength", std::to_string(claimed),
+                        "more than the BIN chunk's " + std::to_string(glb.bin->size()) + " bytes");
+    }
+  }
+  return {};
+}
 
 // Index-valued properties of glTF 2.0 (the spec's "glTFid"s), by where they
 // sit: "a.b[]" is an array of ids, "a[].b" a property of each element.
@@ -307,7 +360,8 @@ Status check_required_extensions(const nlohmann::json& doc, const std::string& f
 
 }  // namespace
 
-Status check_gltf_document(std::string_view json, const std::string& file, const AssetRoots& roots) {
+Status check_gltf_document(std::string_view json, const std::string& file, const AssetRoots& roots,
+                           const GlbChunks* glb) {
   nlohmann::json doc;
   try {
     doc = nlohmann::json::parse(json.begin(), json.end());
@@ -317,6 +371,7 @@ Status check_gltf_document(std::string_view json, const std::string& file, const
   if (!doc.is_object()) return {};
   SINEW_RETURN_IF_ERROR(check_required_extensions(doc, file));
   SINEW_RETURN_IF_ERROR(check_ids(doc, file));
+  if (glb != nullptr) SINEW_RETURN_IF_ERROR(check_glb_buffers(doc, file, *glb));
   return check_uris(doc, file, roots);
 }
 

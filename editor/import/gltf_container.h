@@ -7,6 +7,7 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -24,10 +25,18 @@ inline constexpr std::size_t kMaxJsonNesting = 256;
 Status check_json_nesting(std::string_view json, std::size_t max_depth, const std::string& file,
                           const std::string& field);
 
+// The chunks of a .glb that Sinew reads: the JSON, and the BIN chunk when
+// the file has one (empty otherwise).
+struct GlbChunks {
+  std::string_view json;
+  std::optional<std::string_view> bin;
+};
+
 // A whole .glb file: the 12-byte header's magic, version and length (equal
-// to the file's size), the first chunk being JSON inside the file, and its
-// JSON's nesting. Returns the JSON chunk.
-Expected<std::string_view> check_glb(std::string_view bytes, const std::string& file);
+// to the file's size), the first chunk being JSON, every chunk's header and
+// length inside the file (tinygltf trusted a BIN chunk's length and read
+// past the input), a BIN chunk only second, and the JSON's nesting.
+Expected<GlbChunks> check_glb(std::string_view bytes, const std::string& file);
 
 // Where external buffer and image files may be read from: the asset's own
 // folder, plus `extra` folders the user allows. Paths are compared after
@@ -54,8 +63,12 @@ class AssetRoots {
 //   resolving inside `roots`: absolute paths, other schemes and ".."
 //   escapes are refused (tinygltf's own reads are guarded too: it also
 //   looks in the current directory).
+// - in a .glb (`glb` given; nullptr for a .gltf), buffers[0] without a uri
+//   is the BIN chunk, which must exist, and its byteLength may not pass the
+//   chunk's end; other buffers need a uri.
 // Each error names the field and the value.
-Status check_gltf_document(std::string_view json, const std::string& file, const AssetRoots& roots);
+Status check_gltf_document(std::string_view json, const std::string& file, const AssetRoots& roots,
+                           const GlbChunks* glb = nullptr);
 
 // RFC 3986 percent-decoding ("%2e%2E" -> ".."); false for a malformed escape.
 bool percent_decode(std::string_view uri, std::string& out);

@@ -19,6 +19,7 @@
 #include <filesystem>
 #include <limits>
 #include <new>
+#include <optional>
 #include <string_view>
 #include <utility>
 #include <vector>
@@ -195,16 +196,18 @@ Expected<character::Model> import_gltf(const std::string& path, const GltfImport
   const bool binary = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
   // Bounded nesting before tinygltf's recursive parser sees the JSON.
   std::string_view json = bytes;
+  std::optional<GlbChunks> glb;
   if (binary) {
-    const Expected<std::string_view> chunk = check_glb(bytes, path);
-    if (!chunk.ok()) return chunk.status();
-    json = *chunk;
+    Expected<GlbChunks> chunks = check_glb(bytes, path);
+    if (!chunks.ok()) return chunks.status();
+    glb = *chunks;
+    json = glb->json;
   } else {
     SINEW_RETURN_IF_ERROR(check_json_nesting(bytes, kMaxJsonNesting, path, "json"));
   }
   // External files only from the asset's folder (and the allowed roots).
   const AssetRoots roots(path, options.asset_roots);
-  SINEW_RETURN_IF_ERROR(check_gltf_document(json, path, roots));
+  SINEW_RETURN_IF_ERROR(check_gltf_document(json, path, roots, glb ? &*glb : nullptr));
   const std::string base_dir = std::filesystem::path(path).parent_path().string();
 
   tinygltf::Model model;

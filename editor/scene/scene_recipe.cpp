@@ -1,4 +1,5 @@
 #include "editor/scene/scene_recipe.h"
+#include "editor/import/gltf_container.h"
 #include "runtime/io/regular_file.h"
 
 #include <algorithm>
@@ -13,13 +14,31 @@ namespace {
 
 using Json = nlohmann::json;
 
+// A recipe nests two levels (the object, then clips or pose_space); deeper
+// documents are refused before nlohmann's parser and destructor walk them.
+constexpr std::size_t kMaxRecipeNesting = 16;
+
+// A value as an error message shows it: scalars as written, cut short;
+// arrays and objects by their size. Serialising a container whole would
+// copy the file into the message (and recurse through all its levels).
+std::string cut(std::string_view text) {
+  return text.size() <= 60 ? std::string(text) : std::string(text.substr(0, 60)) + "...";
+}
+
+std::string shown(const Json& value) {
+  if (value.is_array()) return "an array of " + std::to_string(value.size()) + " values";
+  if (value.is_object()) return "an object of " + std::to_string(value.size()) + " fields";
+  return cut(value.dump(-1, ' ', false, Json::error_handler_t::replace));
+}
+
 Status bad(const std::string& source, std::string_view field, const Json& value, std::string_view detail) {
-  return make_error(ErrorCode::kInvalidData, source, field, value.dump(), detail);
+  return make_error(ErrorCode::kInvalidData, source, field, shown(value), detail);
 }
 
 }  // namespace
 
 Expected<SceneRecipe> parse_scene_recipe(std::string_view text, const std::string& source) {
+  SINEW_RETURN_IF_ERROR(check_json_nesting(text, kMaxRecipeNesting, source, "(top level)"));
   const Json j = Json::parse(text, nullptr, /*allow_exceptions=*/false, /*ignore_comments=*/true);
   if (j.is_discarded()) return make_error(ErrorCode::kInvalidData, source, "", "", "not valid JSON");
   if (!j.is_object()) return bad(source, "(top level)", j, "expected an object");
@@ -27,7 +46,7 @@ Expected<SceneRecipe> parse_scene_recipe(std::string_view text, const std::strin
   r.source = source;
   for (const auto& [key, value] : j.items()) {
     if (key != "model" && key != "clips" && key != "pose_space" && key != "description") {
-      return bad(source, key, value, "unknown field (expected model, clips, pose_space, description)");
+      return bad(source, cut(key), value, "unknown field (expected model, clips, pose_space, description)");
     }
   }
   if (j.contains("model")) {
@@ -48,7 +67,7 @@ Expected<SceneRecipe> parse_scene_recipe(std::string_view text, const std::strin
     }
     const std::string name = clips[i].get<std::string>();
     if (std::find(r.clips.begin(), r.clips.end(), name) != r.clips.end()) {
-      return make_error(ErrorCode::kDuplicate, source, field, name, "listed twice");
+      return make_error(ErrorCode::kDuplicate, source, field, cut(name), "listed twice");
     }
     r.clips.push_back(name);
   }
@@ -56,7 +75,7 @@ Expected<SceneRecipe> parse_scene_recipe(std::string_view text, const std::strin
     const Json& p = j["pose_space"];
     if (!p.is_object()) return bad(source, "pose_space", p, "expected an object");
     for (const auto& [key, value] : p.items()) {
-      const std::string field = "pose_space." + key;
+      const std::string field = "pose_space." + cut(key);
       if (key == "samples") {
         if (!value.is_number_integer() || value.get<long long>() < 0 || value.get<long long>() > 10'000'000) {
           return bad(source, field, value, "expected an integer from 0 to 10000000");
@@ -97,9 +116,13 @@ Expected<character::Model> keep_recipe_clips(const character::Model& model, cons
   for (std::size_t i = 0; i < recipe.clips.size(); ++i) {
     const anim::Clip* clip = model.find_clip(recipe.clips[i]);
     if (clip == nullptr) {
+      // The first few names: a model may have any number of clips.
       std::string names;
-      for (const anim::Clip& c : model.clips) names += (names.empty() ? "" : ", ") + c.name();
-      return make_error(ErrorCode::kNotFound, recipe.source, "clips[" + std::to_string(i) + "]", recipe.clips[i],
+      for (std::size_t c = 0; c < model.clips.size() && c < 5; ++c) {
+        names += (c == 0 ? "" : ", ") + cut(model.clips[c].name());
+      }
+      if (model.clips.size() > 5) names += ", ... " + std::to_string(model.clips.size()) + " in all";
+      return make_error(ErrorCode::kNotFound, recipe.source, "clips[" + std::to_string(i) + "]", cut(recipe.clips[i]),
                         "the model has no such clip (it has: " + names + ")");
     }
     kept.clips.push_back(*clip);

@@ -176,6 +176,50 @@ TEST(Clip, HugeAndTinyRotationKeysAreNormalised) {
   for (int i = 0; i < 4; ++i) EXPECT_EQ(c->tracks()[0].rotation.values[0][i], unit[i]) << "bits kept";
 }
 
+// A cubic-spline rotation whose value passes through zero (keys q and -q,
+// zero tangents: (0, 0, 0, 0) halfway) was normalised into NaN, and the
+// body vanished at that instant with exit 0. Huge finite tangents and keys
+// far apart overflow float the same way. Every sample stays finite, and a
+// rotation stays unit length, the nearer key standing in where the spline
+// has no direction.
+TEST(Clip, InterpolationThroughZeroOrOverflowStaysFinite) {
+  const float big = 3.0e38f;
+  RawClip raw;
+  raw.name = "z";
+  raw.tracks.resize(2);
+  JointTracks& spin = raw.tracks[0];
+  spin.joint = 0;
+  spin.rotation.interpolation = Interpolation::kCubicSpline;
+  spin.rotation.times = {0.0f, 1.0f, 2.0f};
+  // (in tangent, value, out tangent) per key.
+  spin.rotation.values = {Quat(0, 0, 0, 0), Quat(1, 0, 0, 0),    Quat(0, 0, 0, 0),
+                          Quat(0, 0, 0, 0), Quat(-1, 0, 0, 0),   Quat(big, big, 0, 0),
+                          Quat(big, 0, big, 0), Quat(0, 0, 1, 0), Quat(0, 0, 0, 0)};
+  spin.translation.interpolation = Interpolation::kLinear;
+  spin.translation.times = {0.0f, 1.0f};
+  spin.translation.values = {Vec3(-big, 0, 0), Vec3(big, 0, 0)};
+  JointTracks& move = raw.tracks[1];
+  move.joint = 1;
+  move.translation.interpolation = Interpolation::kCubicSpline;
+  move.translation.times = {0.0f, 1.0f};
+  move.translation.values = {Vec3(0), Vec3(1, 0, 0), Vec3(big, big, big), Vec3(big, 0, 0), Vec3(2, 0, 0), Vec3(0)};
+  const Clip clip = build(std::move(raw));
+
+  SamplingCache cache;
+  std::vector<JointTransform> pose(3);
+  sample_clip(clip, 0.5f, cache, pose);  // exactly (0, 0, 0, 0) before normalising
+  EXPECT_EQ(pose[0].rotation, Quat(-1, 0, 0, 0)) << "the nearer key (the later one at u = 0.5)";
+  for (int i = 0; i <= 200; ++i) {
+    const float t = 2.0f * static_cast<float>(i) / 200.0f;
+    sample_clip(clip, t, cache, pose);
+    for (const JointTransform& j : pose) {
+      for (int c = 0; c < 4; ++c) ASSERT_TRUE(std::isfinite(j.rotation[c])) << "t = " << t;
+      for (int c = 0; c < 3; ++c) ASSERT_TRUE(std::isfinite(j.translation[c])) << "t = " << t;
+      ASSERT_NEAR(glm::length(j.rotation), 1.0f, 1e-5f) << "t = " << t;
+    }
+  }
+}
+
 TEST(Clip, RejectsBadKeysNamingTheField) {
   auto expect_error = [](RawClip raw, ErrorCode code, const char* field) {
     auto c = Clip::build(std::move(raw), three_joints(), "walk.caf");

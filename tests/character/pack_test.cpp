@@ -441,6 +441,40 @@ TEST_F(CorruptPack, BadMeshSkeletonAndClipDataAreRefused) {
   expect_rejected(*missing, "FBTR");
 }
 
+// Skin weights that are all zero or sum to 2 passed the loader (each weight
+// was finite and >= 0), and the vertex collapsed toward the origin. The
+// importers refuse or renormalise such rows; a pack, written after them, is
+// held to the same tolerance, naming the file, the vertex and the sum.
+TEST_F(CorruptPack, SkinWeightsThatDoNotSumToOneAreRefused) {
+  struct Case {
+    float scale;         // vertex 7's weights multiplied by this
+    std::string value;   // the value the message must show
+  };
+  for (const Case& c : {Case{0.0f, "0"}, Case{2.0f, "sum 2"}, Case{1.02f, "sum 1.02"}}) {
+    character::Model model = baked_->model;
+    for (float& w : model.mesh.weights[7]) w *= c.scale;
+    character::PackContents contents = contents_of(*baked_);
+    contents.model = &model;
+    auto bytes = character::serialize_pack(contents);
+    ASSERT_TRUE(bytes.ok()) << bytes.status().message();
+    auto pack = character::Pack::from_bytes(*bytes, "weights.pack");
+    ASSERT_FALSE(pack.ok()) << "weights scaled by " << c.scale << " were accepted";
+    EXPECT_EQ(pack.status().code(), ErrorCode::kInvalidData);
+    EXPECT_EQ(pack.status().file(), "weights.pack");
+    EXPECT_EQ(pack.status().field(), "MESH.weights[7]") << pack.status().message();
+    EXPECT_EQ(pack.status().value(), c.value) << pack.status().message();
+  }
+  // Within the importers' tolerance (8-bit weights), the pack loads.
+  character::Model model = baked_->model;
+  for (float& w : model.mesh.weights[7]) w *= 1.005f;
+  character::PackContents contents = contents_of(*baked_);
+  contents.model = &model;
+  auto bytes = character::serialize_pack(contents);
+  ASSERT_TRUE(bytes.ok());
+  auto pack = character::Pack::from_bytes(*bytes, "weights.pack");
+  EXPECT_TRUE(pack.ok()) << pack.status().message();
+}
+
 // Random byte changes inside each section, checksums recomputed: whatever
 // the loader accepts must render without tripping the sanitizers.
 // Well-formed but wrong fuzzy data, checksums recomputed: every fuzzy

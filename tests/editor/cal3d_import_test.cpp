@@ -383,6 +383,27 @@ TEST_F(Cal3dBadInput, GarbageCfgLines) {
   EXPECT_EQ(ok->mesh.triangle_count(), 0u);
 }
 
+// A UTF-8 byte-order mark before `scale=` made the key unknown, so it was
+// skipped and the model came out 100 times too large. The mark is dropped;
+// a UTF-16 mark (the file is not UTF-8) is refused, naming the file.
+TEST(Cal3dConfig, ByteOrderMarkIsStripped) {
+  const std::string bom = "\xEF\xBB\xBF";
+  for (const char* first : {"scale=0.01\n", "  scale = 0.01\r\n"}) {
+    auto cfg = parse_cal3d_config(bom + first + "skeleton=a.csf\n", "m.cfg");
+    ASSERT_TRUE(cfg.ok()) << cfg.status().message();
+    EXPECT_FLOAT_EQ(cfg->scale, 0.01f) << first;
+  }
+  auto skeleton_first = parse_cal3d_config(bom + "skeleton=a.csf\n", "m.cfg");
+  ASSERT_TRUE(skeleton_first.ok()) << skeleton_first.status().message();
+  EXPECT_EQ(skeleton_first->skeleton, "a.csf");
+  for (const std::string& utf16 : {std::string("\xFF\xFEs\0k\0", 6), std::string("\xFE\xFF\0s\0k", 6)}) {
+    auto refused = parse_cal3d_config(utf16, "w.cfg");
+    ASSERT_FALSE(refused.ok());
+    EXPECT_EQ(refused.status().file(), "w.cfg");
+    EXPECT_EQ(refused.status().field(), "encoding") << refused.status().message();
+  }
+}
+
 // Bytes after the end of the data: Cal3D's loaders stop reading there and
 // would ignore them; the import refuses them, naming the file.
 TEST_F(Cal3dBadInput, TrailingBytesAreRefused) {

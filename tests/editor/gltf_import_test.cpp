@@ -906,6 +906,65 @@ TEST_F(GltfSynthetic, GlbLengthMustBeTheFileSize) {
   }
 }
 
+// A .glb whose BIN chunk and buffer claimed 8 bytes more than the file
+// holds was accepted, and tinygltf read past the end of its input (valgrind:
+// invalid reads). Every chunk's header and length, and the BIN buffer's
+// byteLength, are now checked against the bytes present before tinygltf
+// sees the file.
+TEST_F(GltfSynthetic, GlbChunkAndBufferLengthsMustFitTheBytesPresent) {
+  const auto u32 = [](std::uint32_t v) { return std::string(reinterpret_cast<const char*>(&v), 4); };
+  // The synthetic model as a .glb whose BIN chunk header says `bin_claim`
+  // bytes (its true size when 0) and whose buffer says `buffer_claim`, with
+  // `bin_chunk` false leaving the chunk out; the header's length is always
+  // the file's size.
+  const auto glb = [&](const std::string& name, std::uint32_t bin_claim, std::uint32_t buffer_claim,
+                       bool bin_chunk = true, const std::string& after = "") {
+    Synthetic s = synthetic();
+    replace(s.json, "\"uri\": \"synthetic.bin\", \"byteLength\": 472",
+            "\"byteLength\": " + std::to_string(buffer_claim));
+    std::string json = s.json;
+    while (json.size() % 4 != 0) json += ' ';
+    std::string bin(s.bin.begin(), s.bin.end());
+    while (bin.size() % 4 != 0) bin += '\0';
+    std::string chunks = u32(static_cast<std::uint32_t>(json.size())) + u32(0x4E4F534Au) + json;
+    if (bin_chunk) chunks += u32(bin_claim != 0 ? bin_claim : static_cast<std::uint32_t>(bin.size())) + u32(0x004E4942u) + bin;
+    chunks += after;
+    const std::string bytes = "glTF" + u32(2) + u32(static_cast<std::uint32_t>(12 + chunks.size())) + chunks;
+    const std::string path = (dir_ / name).string();
+    std::ofstream(path, std::ios::binary) << bytes;
+    return path;
+  };
+  ASSERT_EQ(synthetic().bin.size(), 472u);
+  const auto ok = import_gltf(glb("ok.glb", 0, 472));
+  ASSERT_TRUE(ok.ok()) << ok.status().message();
+
+  struct Case {
+    std::string path;
+    ErrorCode code;
+    std::string field;
+  };
+  const std::vector<Case> cases = {
+      // The probe's file: chunk and buffer both 8 bytes past the end.
+      {glb("both.glb", 480, 480), ErrorCode::kTruncated, "glb.chunks[1].length"},
+      {glb("chunk.glb", 0xfffffff0u, 472), ErrorCode::kTruncated, "glb.chunks[1].length"},
+      {glb("buffer.glb", 0, 480), ErrorCode::kTruncated, "buffers[0].byteLength"},
+      {glb("nobin.glb", 0, 472, /*bin_chunk=*/false), ErrorCode::kInvalidData, "buffers[0].uri"},
+      {glb("header.glb", 0, 472, true, std::string(5, '\0')), ErrorCode::kTruncated, "glb.chunks[2]"},
+      {glb("second.glb", 0, 472, true, u32(4) + u32(0x004E4942u) + std::string(4, '\0')), ErrorCode::kInvalidData,
+       "glb.chunks[2].type"},
+  };
+  for (const Case& c : cases) {
+    const auto m = import_gltf(c.path);
+    ASSERT_FALSE(m.ok()) << c.field;
+    EXPECT_EQ(m.status().code(), c.code) << m.status().message();
+    EXPECT_EQ(m.status().file(), c.path);
+    EXPECT_EQ(m.status().field(), c.field) << m.status().message();
+  }
+  // Chunks of other types are skipped, as the spec asks.
+  const auto extra = import_gltf(glb("extra.glb", 0, 472, true, u32(4) + u32(0x12345678u) + std::string(4, 'x')));
+  EXPECT_TRUE(extra.ok()) << extra.status().message();
+}
+
 // asset.version is major.minor: 2.x is glTF 2.0; 1.0 and 3.0 are other formats.
 TEST_F(GltfSynthetic, AssetVersionMustBeTwo) {
   struct Case {

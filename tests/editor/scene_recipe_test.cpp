@@ -58,6 +58,38 @@ TEST(SceneRecipe, BadRecipesNameTheFieldAndValue) {
   EXPECT_EQ(load_scene_recipe("/nonexistent/scene.json").status().code(), ErrorCode::kNotFound);
 }
 
+// A recipe nested 100,000 levels deep crashed while its error message was
+// built (the value was serialised whole). Nesting is bounded before parsing,
+// and no message carries more of the input than a short excerpt.
+TEST(SceneRecipe, DeepNestingAndHugeValuesGiveShortMessages) {
+  for (const std::size_t depth : {std::size_t{17}, std::size_t{100000}}) {
+    const std::string deep = std::string(depth, '[') + std::string(depth, ']');
+    for (const std::string& json : {R"({"clips": )" + deep + "}", R"({"clips": ["walk"], "camera": )" + deep + "}"}) {
+      auto r = parse_scene_recipe(json, "deep.json");
+      ASSERT_FALSE(r.ok());
+      EXPECT_EQ(r.status().code(), ErrorCode::kLimitExceeded) << r.status().message();
+      EXPECT_EQ(r.status().file(), "deep.json");
+      EXPECT_LE(r.status().message().size(), 300u);
+    }
+  }
+  const std::string huge(1 << 20, 'x');
+  const std::string within = std::string(15, '[') + "\"" + huge + "\"" + std::string(15, ']');
+  const std::string cases[] = {
+      R"({"clips": )" + within + "}",
+      R"({"clips": ["walk"], "camera": )" + within + "}",
+      R"({"clips": [")" + huge + R"(", ")" + huge + R"("]})",
+      R"({"clips": ["walk"], ")" + huge + R"(": 1})",
+      R"({"clips": ["walk"], "pose_space": {")" + huge + R"(": 1}})",
+      R"({"clips": ["walk"], "model": 1e308, "pose_space": {"samples": ")" + huge + R"("}})",
+  };
+  for (const std::string& json : cases) {
+    auto r = parse_scene_recipe(json, "huge.json");
+    ASSERT_FALSE(r.ok());
+    EXPECT_EQ(r.status().file(), "huge.json");
+    EXPECT_LE(r.status().message().size(), 300u) << r.status().message().substr(0, 400);
+  }
+}
+
 TEST(SceneRecipe, KeepsOnlyTheRecipesClipsInItsOrder) {
   auto model = content::make_mannequin();
   ASSERT_TRUE(model.ok());
