@@ -24,12 +24,19 @@
 #include <cstdint>
 #include <limits>
 
-#include <immintrin.h>
-
 #include "runtime/math/aabb.h"
+#include "runtime/math/float4.h"
 #include "runtime/math/float8.h"
 
 namespace sinew::rt {
+
+// The relative widening of every interval product and reciprocal bound
+// (2^-20, far above their 2^-24 rounding), shared by IntervalBound and the
+// tile bounds of cull/ray_bound.h.
+inline constexpr float kBoundRelativeMargin = 0x1.0p-20f;
+// Directions smaller than this on an axis give no reciprocal bound there
+// (1/d may overflow): such an axis simply does not cull.
+inline constexpr float kTinyDirection = 1e-30f;
 
 // A ray set's passage through a box from its per-axis slab entries and exits
 // (lane 3 unused: -inf and +inf): [max(t_lo, latest entry), min(t_hi,
@@ -37,13 +44,67 @@ namespace sinew::rt {
 struct SlabPassage {
   float enter, leave;
 };
-inline SlabPassage slab_passage(__m128 enter, __m128 leave, float t_lo, float t_hi) {
-  __m128 e = _mm_max_ps(enter, _mm_movehl_ps(enter, enter));
-  e = _mm_max_ss(e, _mm_movehdup_ps(e));
-  __m128 l = _mm_min_ps(leave, _mm_movehl_ps(leave, leave));
-  l = _mm_min_ss(l, _mm_movehdup_ps(l));
-  return {std::max(t_lo, _mm_cvtss_f32(e)), std::min(t_hi, _mm_cvtss_f32(l))};
+inline SlabPassage slab_passage(Float4 enter, Float4 leave, float t_lo, float t_hi) {
+  return {std::max(t_lo, reduce_max(enter)), std::min(t_hi, reduce_min(leave))};
 }
+
+// A ray set per axis as its box tests read it: x, y and z in lanes 0 to 2,
+// lane 3 bounding nothing. Built from the set's origin and direction
+// ranges; used by IntervalBound and RayBound::Test alike.
+struct AxisRanges {
+  Float4 o_lo{0.0f}, o_hi{0.0f};  // origins
+  // Reciprocal directions where every direction has one sign (1/d
+  // decreases on each sign, so [1/d_hi, 1/d_lo]), widened; 0 elsewhere.
+  Float4 r_lo{0.0f}, r_hi{0.0f};
+  Mask4 positive{}, negative{};       // every direction >= kTinyDirection (<= -kTinyDirection)
+  Mask4 not_rising{}, not_falling{};  // no direction > 0 (< 0)
+
+  static AxisRanges from(const float (&o_lo)[3], const float (&o_hi)[3], const float (&d_lo)[3],
+                         const float (&d_hi)[3]) {
+    const float ones = std::bit_cast<float>(0xFFFFFFFFu);
+    float olo[4], ohi[4], rlo[4], rhi[4], pos[4], neg[4], nr[4], nf[4];
+    for (int a = 0; a < 4; ++a) {
+      const bool axis = a < 3;
+      olo[a] = axis ? o_lo[a] : 0.0f;
+      ohi[a] = axis ? o_hi[a] : 0.0f;
+      const bool rising = axis && d_lo[a] >= kTinyDirection;
+      const bool falling = axis && d_hi[a] <= -kTinyDirection;
+      pos[a] = rising ? ones : 0.0f;
+      neg[a] = falling ? ones : 0.0f;
+      nr[a] = axis && d_hi[a] <= 0.0f ? ones : 0.0f;
+      nf[a] = axis && d_lo[a] >= 0.0f ? ones : 0.0f;
+      const float lo = rising || falling ? 1.0f / d_hi[a] : 0.0f;
+      const float hi = rising || falling ? 1.0f / d_lo[a] : 0.0f;
+      rlo[a] = lo - std::fabs(lo) * kBoundRelativeMargin;
+      rhi[a] = hi + std::fabs(hi) * kBoundRelativeMargin;
+    }
+    return {Float4::load(olo), Float4::load(ohi), Float4::load(rlo), Float4::load(rhi),
+            Mask4::load(pos),  Mask4::load(neg),  Mask4::load(nr),   Mask4::load(nf)};
+  }
+
+  // The set's passage through the box [lo, hi] (grown by the caller) within
+  // [t_lo, t_hi]; empty (enter > leave) when no ray of the set can enter it.
+  SlabPassage passage(Float4 lo, Float4 hi, float t_lo, float t_hi) const {
+    constexpr float kInf = std::numeric_limits<float>::infinity();
+    // Every origin on one side of a slab, no direction turning towards it.
+    if (((o_hi < lo) & not_rising).any() || ((o_lo > hi) & not_falling).any()) return {kInf, -kInf};
+    // Rising rays enter through the lower plane and leave through the
+    // upper, falling ones the other way; other axes bound nothing. Each
+    // plane's bound is an extreme of the four products of its offset range
+    // and the reciprocal range, widened.
+    const auto products = [&](Float4 plane, auto extreme) {
+      const Float4 a0 = plane - o_hi, a1 = plane - o_lo;
+      return extreme(extreme(a0 * r_lo, a0 * r_hi), extreme(a1 * r_lo, a1 * r_hi));
+    };
+    const Float4 rel(kBoundRelativeMargin);
+    const Float4 lower = products(select(positive, lo, hi), [](Float4 a, Float4 b) { return min(a, b); });
+    const Float4 upper = products(select(positive, hi, lo), [](Float4 a, Float4 b) { return max(a, b); });
+    const Mask4 bounded = positive | negative;
+    const Float4 enter = select(bounded, lower - abs(lower) * rel, Float4(-kInf));
+    const Float4 leave = select(bounded, upper + abs(upper) * rel, Float4(kInf));
+    return slab_passage(enter, leave, t_lo, t_hi);
+  }
+};
 
 // Ranges of a set of rays: origin and direction per axis, parameter.
 struct RayRanges {
@@ -118,54 +179,28 @@ class RangeAccumulator {
 
 class IntervalBound {
  public:
-  static constexpr float kRelativeMargin = 0x1.0p-20f;
+  static constexpr float kRelativeMargin = kBoundRelativeMargin;
 
   IntervalBound() = default;
-  explicit IntervalBound(const RayRanges& r) {
-    // Directions smaller than this on an axis give no reciprocal bound
-    // there (1/d may overflow): such an axis simply does not cull.
-    constexpr float kTinyDirection = 1e-30f;
+  explicit IntervalBound(const RayRanges& r) : ranges_(AxisRanges::from(r.o_lo, r.o_hi, r.d_lo, r.d_hi)) {
     unbounded_ = !r.finite;
     t_lo_ = r.t_lo;
     t_hi_ = r.t_hi;
-    const float ones = std::bit_cast<float>(0xFFFFFFFFu);
-    alignas(16) float olo[4], ohi[4], rlo[4], rhi[4], pos[4], neg[4], nr[4], nf[4];
-    for (int a = 0; a < 4; ++a) {
-      const bool axis = a < 3;
-      olo[a] = axis ? r.o_lo[a] : 0.0f;
-      ohi[a] = axis ? r.o_hi[a] : 0.0f;
-      const bool positive = axis && r.d_lo[a] >= kTinyDirection;
-      const bool negative = axis && r.d_hi[a] <= -kTinyDirection;
-      pos[a] = positive ? ones : 0.0f;
-      neg[a] = negative ? ones : 0.0f;
-      nr[a] = axis && r.d_hi[a] <= 0.0f ? ones : 0.0f;
-      nf[a] = axis && r.d_lo[a] >= 0.0f ? ones : 0.0f;
-      // 1/d decreases on each sign, so [1/d_hi, 1/d_lo], widened.
-      float lo = positive || negative ? 1.0f / r.d_hi[a] : 0.0f;
-      float hi = positive || negative ? 1.0f / r.d_lo[a] : 0.0f;
-      rlo[a] = lo - std::fabs(lo) * kRelativeMargin;
-      rhi[a] = hi + std::fabs(hi) * kRelativeMargin;
-    }
+    alignas(16) float rlo[4], rhi[4];
+    ranges_.r_lo.store(rlo);
+    ranges_.r_hi.store(rhi);
     for (int a = 0; a < 3; ++a) {
-      axis_[a].o_lo = olo[a];
-      axis_[a].o_hi = ohi[a];
+      axis_[a].o_lo = r.o_lo[a];
+      axis_[a].o_hi = r.o_hi[a];
       axis_[a].r_lo = rlo[a];
       axis_[a].r_hi = rhi[a];
-      axis_[a].sign = pos[a] != 0.0f ? 1 : neg[a] != 0.0f ? -1 : 0;
+      axis_[a].sign = r.d_lo[a] >= kTinyDirection ? 1 : r.d_hi[a] <= -kTinyDirection ? -1 : 0;
     }
-    o_lo_ = _mm_load_ps(olo);
-    o_hi_ = _mm_load_ps(ohi);
-    r_lo_ = _mm_load_ps(rlo);
-    r_hi_ = _mm_load_ps(rhi);
-    positive_ = _mm_load_ps(pos);
-    negative_ = _mm_load_ps(neg);
-    not_rising_ = _mm_load_ps(nr);
-    not_falling_ = _mm_load_ps(nf);
   }
 
   // How much to grow boxes by, per axis.
   struct Growth {
-    __m128 v;         // x, y, z, 0
+    Float4 v;         // x, y, z, 0
     float axis[3];
   };
 
@@ -183,7 +218,7 @@ class IntervalBound {
       const float m = box != box || origin != origin ? box + origin : std::max(box, origin);
       v[a] = g.axis[a] = slack + kRelativeMargin * m;
     }
-    g.v = _mm_load_ps(v);
+    g.v = Float4::load(v);
     return g;
   }
 
@@ -195,37 +230,7 @@ class IntervalBound {
   float entry(const Aabb& box, const Growth& grow, float t_hi) const {
     constexpr float kInf = std::numeric_limits<float>::infinity();
     if (unbounded_) return -kInf;
-    const __m128 g = grow.v;
-    const __m128 lo = _mm_sub_ps(_mm_setr_ps(box.lower.x, box.lower.y, box.lower.z, 0.0f), g);
-    const __m128 hi = _mm_add_ps(_mm_setr_ps(box.upper.x, box.upper.y, box.upper.z, 0.0f), g);
-    // Every origin on one side of a slab, no direction turning towards it.
-    const __m128 below = _mm_and_ps(_mm_cmplt_ps(o_hi_, lo), not_rising_);
-    const __m128 above = _mm_and_ps(_mm_cmpgt_ps(o_lo_, hi), not_falling_);
-    if (_mm_movemask_ps(_mm_or_ps(below, above)) != 0) return kInf;
-    const __m128 sign = _mm_set1_ps(-0.0f);
-    const __m128 rel = _mm_set1_ps(kRelativeMargin);
-    // Rising rays enter through the lower plane, falling ones through the
-    // upper; the extremes of the four products of each plane's offset
-    // range and the reciprocal range, widened.
-    const auto lower_bound = [&](__m128 plane) {
-      const __m128 a0 = _mm_sub_ps(plane, o_hi_), a1 = _mm_sub_ps(plane, o_lo_);
-      const __m128 mn = _mm_min_ps(_mm_min_ps(_mm_mul_ps(a0, r_lo_), _mm_mul_ps(a0, r_hi_)),
-                                   _mm_min_ps(_mm_mul_ps(a1, r_lo_), _mm_mul_ps(a1, r_hi_)));
-      return _mm_sub_ps(mn, _mm_mul_ps(_mm_andnot_ps(sign, mn), rel));
-    };
-    const auto upper_bound = [&](__m128 plane) {
-      const __m128 a0 = _mm_sub_ps(plane, o_hi_), a1 = _mm_sub_ps(plane, o_lo_);
-      const __m128 mx = _mm_max_ps(_mm_max_ps(_mm_mul_ps(a0, r_lo_), _mm_mul_ps(a0, r_hi_)),
-                                   _mm_max_ps(_mm_mul_ps(a1, r_lo_), _mm_mul_ps(a1, r_hi_)));
-      return _mm_add_ps(mx, _mm_mul_ps(_mm_andnot_ps(sign, mx), rel));
-    };
-    // Per axis the plane a ray enters by and the one it leaves by.
-    const __m128 enter_plane = _mm_blendv_ps(hi, lo, positive_);
-    const __m128 leave_plane = _mm_blendv_ps(lo, hi, positive_);
-    const __m128 bounded = _mm_or_ps(positive_, negative_);
-    const __m128 enter = _mm_blendv_ps(_mm_set1_ps(-kInf), lower_bound(enter_plane), bounded);
-    const __m128 leave = _mm_blendv_ps(_mm_set1_ps(kInf), upper_bound(leave_plane), bounded);
-    const SlabPassage p = slab_passage(enter, leave, t_lo_, t_hi);
+    const SlabPassage p = ranges_.passage(Float4(box.lower, 0.0f) - grow.v, Float4(box.upper, 0.0f) + grow.v, t_lo_, t_hi);
     return p.enter <= p.leave ? p.enter : kInf;
   }
   float entry(const Aabb& box, const Growth& grow) const { return entry(box, grow, t_hi_); }
@@ -251,8 +256,7 @@ class IntervalBound {
   }
 
  private:
-  __m128 o_lo_{}, o_hi_{}, r_lo_{}, r_hi_{};
-  __m128 positive_{}, negative_{}, not_rising_{}, not_falling_{};
+  AxisRanges ranges_;
   struct Axis {
     float o_lo = 0.0f, o_hi = 0.0f, r_lo = 0.0f, r_hi = 0.0f;
     int sign = 0;

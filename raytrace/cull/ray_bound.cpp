@@ -8,20 +8,13 @@
 
 #include "raytrace/cull/interval_bound.h"
 #include "raytrace/traverse/traversal_shared.h"
+#include "runtime/math/float4.h"
 #include "runtime/math/float8.h"
-
-#include <immintrin.h>
 
 namespace sinew::rt {
 namespace {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
-// Directions smaller than this on an axis give no reciprocal bound there
-// (1/d may overflow); such an axis simply does not cull.
-constexpr float kTinyDirection = 1e-30f;
-// Widening of every interval product and box coordinate: far above the
-// 2^-24 relative rounding of each operation.
-constexpr float kRelativeMargin = 0x1.0p-20f;
 
 }  // namespace
 
@@ -182,70 +175,20 @@ RayBound::Test RayBound::test() const {
   t.unbounded = unbounded_;
   t.t_lo = t_lo_;
   t.t_hi = t_hi_;
-  const float ones = std::bit_cast<float>(0xFFFFFFFFu);
-  for (int a = 0; a < 4; ++a) {
-    const bool axis = a < 3;
-    t.o_lo[a] = axis ? o_lo_[a] : 0.0f;
-    t.o_hi[a] = axis ? o_hi_[a] : 0.0f;
-    const bool positive = axis && d_lo_[a] >= kTinyDirection;
-    const bool negative = axis && d_hi_[a] <= -kTinyDirection;
-    t.positive[a] = positive ? ones : 0.0f;
-    t.negative[a] = negative ? ones : 0.0f;
-    t.not_rising[a] = axis && d_hi_[a] <= 0.0f ? ones : 0.0f;
-    t.not_falling[a] = axis && d_lo_[a] >= 0.0f ? ones : 0.0f;
-    // 1/d decreases on each sign, so [1/d_hi, 1/d_lo], widened.
-    float r_lo = positive || negative ? 1.0f / d_hi_[a] : 0.0f;
-    float r_hi = positive || negative ? 1.0f / d_lo_[a] : 0.0f;
-    r_lo -= std::fabs(r_lo) * kRelativeMargin;
-    r_hi += std::fabs(r_hi) * kRelativeMargin;
-    t.r_lo[a] = r_lo;
-    t.r_hi[a] = r_hi;
-  }
+  t.ranges = AxisRanges::from(o_lo_, o_hi_, d_lo_, d_hi_);
   return t;
 }
 
 bool RayBound::Test::may_enter(const Aabb& box, float grow) const {
   if (unbounded) return true;
-  const __m128 sign = _mm_set1_ps(-0.0f);
-  const __m128 lower = _mm_setr_ps(box.lower.x, box.lower.y, box.lower.z, 0.0f);
-  const __m128 upper = _mm_setr_ps(box.upper.x, box.upper.y, box.upper.z, 0.0f);
-  if (_mm_movemask_ps(_mm_cmpunord_ps(lower, upper)) != 0) return true;  // a NaN box: never culled
-  const __m128 olo = _mm_loadu_ps(o_lo), ohi = _mm_loadu_ps(o_hi);
+  const Float4 lower(box.lower, 0.0f), upper(box.upper, 0.0f);
+  if (unordered(lower, upper).any()) return true;  // a NaN box: never culled
   // The rounding of (plane - origin) on an axis is relative to that axis's
   // coordinates alone: a flat ground's height is not rounded at the scale
   // of its width.
-  const __m128 mag = _mm_max_ps(_mm_max_ps(_mm_andnot_ps(sign, lower), _mm_andnot_ps(sign, upper)),
-                                _mm_max_ps(_mm_andnot_ps(sign, olo), _mm_andnot_ps(sign, ohi)));
-  const __m128 margin = _mm_add_ps(_mm_set1_ps(grow), _mm_mul_ps(_mm_set1_ps(kRelativeMargin), mag));
-  const __m128 lo = _mm_sub_ps(lower, margin);
-  const __m128 hi = _mm_add_ps(upper, margin);
-  // Every origin on one side of a slab, no direction turning towards it.
-  const __m128 below = _mm_and_ps(_mm_cmplt_ps(ohi, lo), _mm_loadu_ps(not_rising));
-  const __m128 above = _mm_and_ps(_mm_cmpgt_ps(olo, hi), _mm_loadu_ps(not_falling));
-  if (_mm_movemask_ps(_mm_or_ps(below, above)) != 0) return false;
-  const __m128 rlo = _mm_loadu_ps(r_lo), rhi = _mm_loadu_ps(r_hi);
-  // Each plane's parameter range over the set: the extremes of the four
-  // products of (plane - origin range) x (reciprocal range), widened.
-  const auto products = [&](__m128 plane, __m128& min_out, __m128& max_out) {
-    const __m128 a0 = _mm_sub_ps(plane, ohi), a1 = _mm_sub_ps(plane, olo);
-    const __m128 p0 = _mm_mul_ps(a0, rlo), p1 = _mm_mul_ps(a0, rhi);
-    const __m128 p2 = _mm_mul_ps(a1, rlo), p3 = _mm_mul_ps(a1, rhi);
-    const __m128 mn = _mm_min_ps(_mm_min_ps(p0, p1), _mm_min_ps(p2, p3));
-    const __m128 mx = _mm_max_ps(_mm_max_ps(p0, p1), _mm_max_ps(p2, p3));
-    const __m128 rel = _mm_set1_ps(kRelativeMargin);
-    min_out = _mm_sub_ps(mn, _mm_mul_ps(_mm_andnot_ps(sign, mn), rel));
-    max_out = _mm_add_ps(mx, _mm_mul_ps(_mm_andnot_ps(sign, mx), rel));
-  };
-  __m128 lo_min, lo_max, hi_min, hi_max;
-  products(lo, lo_min, lo_max);
-  products(hi, hi_min, hi_max);
-  // Rising rays enter through the lower plane and leave through the upper;
-  // falling ones the other way; other axes bound nothing.
-  const __m128 pos = _mm_loadu_ps(positive), neg = _mm_loadu_ps(negative);
-  const __m128 minus_inf = _mm_set1_ps(-kInf), plus_inf = _mm_set1_ps(kInf);
-  const __m128 enter = _mm_blendv_ps(_mm_blendv_ps(minus_inf, hi_min, neg), lo_min, pos);
-  const __m128 leave = _mm_blendv_ps(_mm_blendv_ps(plus_inf, lo_max, neg), hi_max, pos);
-  const SlabPassage p = slab_passage(enter, leave, t_lo, t_hi);
+  const Float4 mag = max(max(abs(lower), abs(upper)), max(abs(ranges.o_lo), abs(ranges.o_hi)));
+  const Float4 margin = Float4(grow) + Float4(kBoundRelativeMargin) * mag;
+  const SlabPassage p = ranges.passage(lower - margin, upper + margin, t_lo, t_hi);
   return !(p.enter > p.leave);
 }
 

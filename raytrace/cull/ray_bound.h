@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "raytrace/accel/kd_tree.h"
+#include "raytrace/cull/interval_bound.h"
 #include "raytrace/scene/scene.h"
 #include "runtime/math/aabb.h"
 #include "runtime/math/types.h"
@@ -83,10 +84,7 @@ class RayBound {
 
    private:
     friend class RayBound;
-    float o_lo[4], o_hi[4];  // origin range per axis (x, y, z, unused)
-    float r_lo[4], r_hi[4];  // reciprocal direction range where the sign is fixed
-    float positive[4], negative[4];         // all-ones where every direction is > 0 (< 0)
-    float not_rising[4], not_falling[4];    // all-ones where no direction is > 0 (< 0)
+    AxisRanges ranges;  // the set's origins and directions per axis
     float t_lo = 0.0f, t_hi = 0.0f;
     bool unbounded = false;  // a non-finite ray: every box may be entered
   };

@@ -18,12 +18,11 @@
 #include <random>
 #include <vector>
 
-#include <immintrin.h>
-
 #include "raytrace/cull/interval_bound.h"
 #include "raytrace/cull/ray_bound.h"
 #include "raytrace/traverse/ray_frames.h"
 #include "runtime/math/aabb.h"
+#include "runtime/math/float4.h"
 #include "runtime/math/float8.h"
 #include "runtime/math/types.h"
 #include "tests/support/slab_test.h"
@@ -364,7 +363,7 @@ TEST(IntervalBound, AnAxisAlignedSetEntersBoxesWhereComputedByHand) {
   EXPECT_EQ(grow.axis[1], 5.0f * 0x1.0p-20f);
   EXPECT_EQ(grow.axis[2], 5.0f * 0x1.0p-20f);
   alignas(16) float v[4];
-  _mm_store_ps(v, grow.v);
+  grow.v.store(v);
   for (int a = 0; a < 3; ++a) EXPECT_EQ(v[a], grow.axis[a]) << a;
   EXPECT_EQ(v[3], 0.0f);
   EXPECT_EQ(bound.grow_for(ahead, 0.25f).axis[0], 0.25f + 20.0f * 0x1.0p-20f);
@@ -485,7 +484,7 @@ TEST(IntervalBound, RangesHoldTheLiveLanesAndNonFiniteRaysBoundNothing) {
 // earliest exit.
 TEST(IntervalBound, SlabPassageRunsFromTheLatestEntryToTheEarliestExit) {
   const auto passage = [](float e0, float e1, float e2, float l0, float l1, float l2, float t_lo, float t_hi) {
-    return rt::slab_passage(_mm_setr_ps(e0, e1, e2, -kInf), _mm_setr_ps(l0, l1, l2, kInf), t_lo, t_hi);
+    return rt::slab_passage(Float4(Vec3(e0, e1, e2), -kInf), Float4(Vec3(l0, l1, l2), kInf), t_lo, t_hi);
   };
   struct Case {
     float enter[3], leave[3], t_lo, t_hi;
