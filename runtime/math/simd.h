@@ -2,7 +2,8 @@
 // AVX2 and FMA (x86-64-v3, the release preset) and 0 otherwise (the
 // portable x86-64-v2 preset), where every eight-lane type and kernel runs
 // the same arithmetic lane by lane. Raw intrinsics appear only in the lane
-// types (float8.h) and in kernels whose file names say so; kernels chosen
+// types (float8.h; float4.h, SSE4.1 in every target) and in kernels whose
+// file names say so; kernels chosen
 // at run time from the CPU (skinning_avx2.cpp, srgb_encode.cpp) compile
 // their own target instead.
 #pragma once

@@ -1,12 +1,10 @@
 #include "raytrace/render/output/output_staging.h"
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
-
 #include <algorithm>
 #include <cstdint>
 #include <cstring>
+
+#include "runtime/memory/streaming_stores.h"
 
 namespace sinew::rt {
 namespace {
@@ -15,27 +13,6 @@ namespace {
 template <class T>
 std::size_t row_bytes(const OutputPlane<T>& plane, const Tile& tile) {
   return static_cast<std::size_t>(tile.x1 - tile.x0) * plane.channels * sizeof(T);
-}
-
-// `n` bytes from `src` to `dst`: the whole 64-byte lines of dst by
-// streaming stores, the ragged ends by ordinary ones (a streaming store to
-// part of a line costs memory far more than the ordinary store does).
-void stream_row(std::byte* dst, const std::byte* src, std::size_t n) {
-#if defined(__SSE2__)
-  const std::size_t misalign = reinterpret_cast<std::uintptr_t>(dst) % kCacheLineBytes;
-  const std::size_t head = std::min(n, misalign == 0 ? 0 : kCacheLineBytes - misalign);
-  std::memcpy(dst, src, head);
-  std::size_t i = head;
-  for (; i + kCacheLineBytes <= n; i += kCacheLineBytes) {
-    for (std::size_t k = 0; k < kCacheLineBytes; k += 16) {
-      const __m128i chunk = _mm_loadu_si128(reinterpret_cast<const __m128i*>(src + i + k));
-      _mm_stream_si128(reinterpret_cast<__m128i*>(dst + i + k), chunk);
-    }
-  }
-  std::memcpy(dst + i, src + i, n - i);
-#else
-  std::memcpy(dst, src, n);
-#endif
 }
 
 // Rows that start on a line: only they leave whole lines to stream.
@@ -50,7 +27,7 @@ void flush_plane(const OutputPlane<T>& staged, const OutputPlane<T>& out, const 
   if (!staged.wanted() || staged.base == out.base) return;
   const std::size_t n = row_bytes(out, tile);
   for (int y = tile.y0; y < tile.y1; ++y) {
-    stream_row(reinterpret_cast<std::byte*>(out.at(tile.x0, y)),
+    stream_copy(reinterpret_cast<std::byte*>(out.at(tile.x0, y)),
                reinterpret_cast<const std::byte*>(staged.at(tile.x0, y)), n);
   }
 }
@@ -87,9 +64,7 @@ const OutputPlanes& OutputStaging::stage(const OutputPlanes& out, const Tile& ti
 
 void OutputStaging::flush(const OutputPlanes& out) const {
   for_each_plane_pair(staged_, out, [&](const auto& staged, const auto& plane) { flush_plane(staged, plane, tile_); });
-#if defined(__SSE2__)
-  _mm_sfence();
-#endif
+  stream_fence();
 }
 
 }  // namespace sinew::rt
