@@ -54,12 +54,7 @@ void run_query(const LargePacketRays& rays, const StaticTile& tile, PacketHits o
   GatheredQuery<kAnyHit>& query = thread_query<GatheredQuery<kAnyHit>>();
   query.start(rays, out);
   query.run(tile);
-  std::uint64_t rays_valid = 0;
-  for (int g = 0; g < std::clamp(rays.groups, 0, kMaxPacketGroups); ++g) {
-    rays_valid += static_cast<std::uint64_t>(std::popcount(query.valid_lanes(g)));
-    if (blocked) blocked[g] = query.blocked(g);
-  }
-  if (counters) *counters += query.counters().for_rays(rays_valid);
+  query.finish(blocked, counters);
 }
 
 }  // namespace

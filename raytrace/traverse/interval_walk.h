@@ -39,7 +39,7 @@ struct Cell {
 // plane, one product pair per node; elsewhere each child box is tested
 // whole. Cells are grown by `grow` (the lanes' slack, IntervalBound::grow_for).
 template <class Limit, class Leaf>
-void walk_kd_cells(const KdTreeView& tree, const IntervalBound& bound, const IntervalBound::Growth& grow,
+void interval_walk(const KdTreeView& tree, const IntervalBound& bound, const IntervalBound::Growth& grow,
                    Limit& limit, Leaf&& leaf, std::uint64_t& node_visits) {
   std::array<Cell, kMaxTraversalDepth + 2> stack;
   std::size_t top = 0;
@@ -109,8 +109,8 @@ void walk_kd_cells(const KdTreeView& tree, const IntervalBound& bound, const Int
 // bound enters first first; a leaf's cell is its box (every item's fuzzy
 // box lies inside it).
 template <class Limit, class Leaf>
-void walk_bvh_nodes(const BvhView& tree, const IntervalBound& bound, const IntervalBound::Growth& grow,
-                    Limit& limit, Leaf&& leaf, std::uint64_t& node_visits) {
+void interval_walk(const BvhView& tree, const IntervalBound& bound, const IntervalBound::Growth& grow,
+                   Limit& limit, Leaf&& leaf, std::uint64_t& node_visits) {
   struct Pending {
     std::uint32_t node;
     float t;

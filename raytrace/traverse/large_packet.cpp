@@ -31,8 +31,7 @@ using packet_lanes::for_each_bit;
 using packet_lanes::Group;
 using packet_lanes::PacketRays;
 using packet_lanes::thread_query;
-using packet_lanes::walk_bvh_nodes;
-using packet_lanes::walk_kd_cells;
+using packet_lanes::interval_walk;
 using packet_lanes::kInf;
 using packet_lanes::kLanes;
 using packet_lanes::VisitGroup;
@@ -297,7 +296,7 @@ class LargeQuery : public PacketRays<kTest, kAnyHit> {
       return test_leaf(triangles, groups_here, corners, character.fuzzy.has_bvhs());
     };
     if (character.fuzzy.has_bvhs()) {
-      walk_bvh(character.fuzzy.bvh_view(tree), entry, leaf);
+      walk_tree(character.fuzzy.bvh_view(tree), entry, leaf);
     } else {
       walk_tree(character.fuzzy.tree_view(tree), entry, leaf);
     }
@@ -495,25 +494,16 @@ class LargeQuery : public PacketRays<kTest, kAnyHit> {
     entry.groups |= GroupMask{1} << g;
   }
 
-  // The groups of `entry` through a tree (traverse/interval_walk.h), each
-  // reached leaf's lanes picked by visit_leaf.
-  template <class LeafFn>
-  void walk_tree(const KdTreeView& tree, const TreeEntry& entry, LeafFn& leaf) {
+  // The groups of `entry` through a kd-tree or a BVH (interval_walk in
+  // traverse/interval_walk.h), each reached leaf's lanes picked by visit_leaf.
+  template <class Tree, class LeafFn>
+  void walk_tree(const Tree& tree, const TreeEntry& entry, LeafFn& leaf) {
     if (entry.groups == 0) return;
     const IntervalBound bound(entry.ranges.ranges());
     tree_groups_ = entry.groups;
     PacketLimit limit(*this, entry.groups, bound);
-    walk_kd_cells(tree, bound, bound.grow_for(tree.bounds, entry.eps), limit, leaf_of(entry.groups, leaf),
+    interval_walk(tree, bound, bound.grow_for(tree.bounds, entry.eps), limit, leaf_of(entry.groups, leaf),
                   counters_.node_visits);
-  }
-  template <class LeafFn>
-  void walk_bvh(const BvhView& tree, const TreeEntry& entry, LeafFn& leaf) {
-    if (entry.groups == 0) return;
-    const IntervalBound bound(entry.ranges.ranges());
-    tree_groups_ = entry.groups;
-    PacketLimit limit(*this, entry.groups, bound);
-    walk_bvh_nodes(tree, bound, bound.grow_for(tree.bounds, entry.eps), limit, leaf_of(entry.groups, leaf),
-                   counters_.node_visits);
   }
   template <class LeafFn>
   auto leaf_of(GroupMask groups, LeafFn& leaf) {
@@ -611,12 +601,7 @@ void run_query(const Scene& scene, const LargePacketRays& rays, std::span<const 
   LargeQuery<kTest, kAnyHit>& query = thread_query<LargeQuery<kTest, kAnyHit>>();
   query.start(scene, rays, out);
   query.run(objects);
-  std::uint64_t rays_valid = 0;
-  for (int g = 0; g < std::clamp(rays.groups, 0, kMaxPacketGroups); ++g) {
-    rays_valid += static_cast<std::uint64_t>(std::popcount(query.valid_lanes(g)));
-    if (blocked) blocked[g] = query.blocked(g);
-  }
-  if (counters) *counters += query.counters().for_rays(rays_valid);
+  query.finish(blocked, counters);
 }
 
 }  // namespace

@@ -102,9 +102,17 @@ class PacketRays {
     }
   }
 
-  std::uint32_t valid_lanes(int g) const { return valid_[g]; }
-  std::uint8_t blocked(int g) const { return static_cast<std::uint8_t>(blocked_[g]); }
-  const TraversalCounters& counters() const { return counters_; }
+  // After a packet: each group's blocked lanes into blocked[g] (any hit;
+  // may be null) and the packet's work added to `counters` (may be null),
+  // counted for its valid rays.
+  void finish(std::uint8_t* blocked, TraversalCounters* counters) const {
+    std::uint64_t rays_valid = 0;
+    for (int g = 0; g < groups_; ++g) {
+      rays_valid += static_cast<std::uint64_t>(std::popcount(valid_[g]));
+      if (blocked) blocked[g] = static_cast<std::uint8_t>(blocked_[g]);
+    }
+    if (counters) *counters += counters_.for_rays(rays_valid);
+  }
 
  protected:
   // The largest t any lane of `groups` still looks for: its best hit (or
