@@ -49,19 +49,15 @@ class PacketRays {
     for (int g = 0; g < groups_; ++g) {
       const std::size_t k0 = static_cast<std::size_t>(g) * kLanes;
       Group& gr = group_[g];
-      // valid_ray() per lane: finite origin and direction, a non-zero
-      // direction, t_min < t_max (false for NaN).
+      // The rays the single ray accepts (traverse/ray_frames.h valid_rays).
       const Float8 t_min = Float8::load(rays.t_min + k0), t_max = Float8::load(rays.t_max + k0);
-      Mask8 valid = t_min < t_max;
-      Mask8 nonzero = Mask8::from_bits(0);
       Float8 o[3], d[3];
       for (int a = 0; a < 3; ++a) {
         o[a] = Float8::load(rays.o[a] + k0);
         d[a] = Float8::load(rays.d[a] + k0);
-        valid = valid & is_finite(o[a]) & is_finite(d[a]);
-        nonzero = nonzero | !(d[a] == Float8(0.0f));
       }
-      live_[g] = (valid & nonzero).bits() & rays.active[g];
+      const Mask8 valid = per_lane::valid_rays<Float8>({o[0], o[1], o[2]}, {d[0], d[1], d[2]}, t_min, t_max);
+      live_[g] = valid.bits() & rays.active[g];
       valid_[g] = live_[g];
       blocked_[g] = 0;
       const Mask8 use = Mask8::from_bits(live_[g]);
