@@ -179,17 +179,37 @@ class Checker {
                   std::to_string(present) + " elements present");
   }
 
+  // The children of `e` (at `path`): as many as its attribute `count`
+  // declares (within [lo, hi]), each a <child>. An element's path in
+  // messages is `prefix` + "CHILD[i]".
+  Expected<std::vector<std::uint32_t>> counted_children(const XmlElement& e, std::string_view count,
+                                                        const std::string& path, std::int64_t lo, std::int64_t hi,
+                                                        std::string_view child, const std::string& prefix) const {
+    SINEW_ASSIGN_OR_RETURN(const std::int64_t declared, int_attribute(e, count, path, lo, hi));
+    std::vector<std::uint32_t> list = children(e);
+    SINEW_RETURN_IF_ERROR(count_matches(declared, list.size(), path + "." + std::string(count)));
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      const XmlElement& c = el(list[i]);
+      if (!same_name(c.name, child)) {
+        return refuse(ErrorCode::kInvalidData, element_path(prefix, child, i), c.name,
+                      "expected <" + std::string(child) + ">");
+      }
+    }
+    return list;
+  }
+  static std::string element_path(const std::string& prefix, std::string_view child, std::size_t i) {
+    return prefix + std::string(child) + "[" + std::to_string(i) + "]";
+  }
+
   Status skeleton(const XmlElement& s) const {
     constexpr auto kMax = static_cast<std::int64_t>(anim::kMaxJoints);
-    SINEW_ASSIGN_OR_RETURN(const std::int64_t declared, int_attribute(s, "NUMBONES", "SKELETON", 0, kMax));
-    const std::vector<std::uint32_t> bones = children(s);
-    SINEW_RETURN_IF_ERROR(count_matches(declared, bones.size(), "SKELETON.NUMBONES"));
+    SINEW_ASSIGN_OR_RETURN(const std::vector<std::uint32_t> bones,
+                           counted_children(s, "NUMBONES", "SKELETON", 0, kMax, "BONE", ""));
     std::vector<std::int32_t> parents(bones.size());
     std::vector<std::vector<std::int32_t>> links(bones.size());
     for (std::size_t b = 0; b < bones.size(); ++b) {
       const XmlElement& bone = el(bones[b]);
-      const std::string path = "BONE[" + std::to_string(b) + "]";
-      if (!same_name(bone.name, "BONE")) return refuse(ErrorCode::kInvalidData, path, bone.name, "expected <BONE>");
+      const std::string path = element_path("", "BONE", b);
       // Links name bones by position, so an ID elsewhere would mislead.
       SINEW_ASSIGN_OR_RETURN(const std::int64_t id, int_attribute(bone, "ID", path, 0, kMax));
       if (id != static_cast<std::int64_t>(b)) {
@@ -223,27 +243,20 @@ class Checker {
 
   Status animation(const XmlElement& a) const {
     SINEW_RETURN_IF_ERROR(number_attribute(a, "DURATION", "ANIMATION"));
-    SINEW_ASSIGN_OR_RETURN(const std::int64_t declared,
-                           int_attribute(a, "NUMTRACKS", "ANIMATION", 0, std::numeric_limits<std::int32_t>::max()));
-    const std::vector<std::uint32_t> tracks = children(a);
-    SINEW_RETURN_IF_ERROR(count_matches(declared, tracks.size(), "ANIMATION.NUMTRACKS"));
+    constexpr auto kIntMax = std::numeric_limits<std::int32_t>::max();
+    SINEW_ASSIGN_OR_RETURN(const std::vector<std::uint32_t> tracks,
+                           counted_children(a, "NUMTRACKS", "ANIMATION", 0, kIntMax, "TRACK", ""));
     for (std::size_t t = 0; t < tracks.size(); ++t) {
       const XmlElement& track = el(tracks[t]);
-      const std::string path = "TRACK[" + std::to_string(t) + "]";
-      if (!same_name(track.name, "TRACK")) return refuse(ErrorCode::kInvalidData, path, track.name, "expected <TRACK>");
+      const std::string path = element_path("", "TRACK", t);
       // Ids past the skeleton are refused after loading, as for .caf files.
       SINEW_RETURN_IF_ERROR(status_of(
           int_attribute(track, "BONEID", path, 0, static_cast<std::int64_t>(anim::kMaxJoints))));
-      SINEW_ASSIGN_OR_RETURN(const std::int64_t keys, int_attribute(track, "NUMKEYFRAMES", path, 1,
-                                                                    std::numeric_limits<std::int32_t>::max()));
-      const std::vector<std::uint32_t> frames = children(track);
-      SINEW_RETURN_IF_ERROR(count_matches(keys, frames.size(), path + ".NUMKEYFRAMES"));
+      SINEW_ASSIGN_OR_RETURN(const std::vector<std::uint32_t> frames,
+                             counted_children(track, "NUMKEYFRAMES", path, 1, kIntMax, "KEYFRAME", path + "."));
       for (std::size_t k = 0; k < frames.size(); ++k) {
         const XmlElement& frame = el(frames[k]);
-        const std::string kpath = path + ".KEYFRAME[" + std::to_string(k) + "]";
-        if (!same_name(frame.name, "KEYFRAME")) {
-          return refuse(ErrorCode::kInvalidData, kpath, frame.name, "expected <KEYFRAME>");
-        }
+        const std::string kpath = element_path(path + ".", "KEYFRAME", k);
         SINEW_RETURN_IF_ERROR(number_attribute(frame, "TIME", kpath));
         const std::vector<std::uint32_t> parts = children(frame);
         std::size_t at = 0;
@@ -311,13 +324,11 @@ class Checker {
 
   Status mesh(const XmlElement& m) const {
     constexpr auto kIntMax = std::numeric_limits<std::int32_t>::max();
-    SINEW_ASSIGN_OR_RETURN(const std::int64_t declared, int_attribute(m, "NUMSUBMESH", "MESH", 0, kIntMax));
-    const std::vector<std::uint32_t> submeshes = children(m);
-    SINEW_RETURN_IF_ERROR(count_matches(declared, submeshes.size(), "MESH.NUMSUBMESH"));
+    SINEW_ASSIGN_OR_RETURN(const std::vector<std::uint32_t> submeshes,
+                           counted_children(m, "NUMSUBMESH", "MESH", 0, kIntMax, "SUBMESH", ""));
     for (std::size_t s = 0; s < submeshes.size(); ++s) {
       const XmlElement& sub = el(submeshes[s]);
-      const std::string path = "SUBMESH[" + std::to_string(s) + "]";
-      if (!same_name(sub.name, "SUBMESH")) return refuse(ErrorCode::kInvalidData, path, sub.name, "expected <SUBMESH>");
+      const std::string path = element_path("", "SUBMESH", s);
       SINEW_ASSIGN_OR_RETURN(const std::int64_t vertices, int_attribute(sub, "NUMVERTICES", path, 0, kIntMax));
       SINEW_ASSIGN_OR_RETURN(const std::int64_t faces, int_attribute(sub, "NUMFACES", path, 0, kIntMax));
       SINEW_RETURN_IF_ERROR(status_of(int_attribute(sub, "MATERIAL", path, -1, kIntMax)));
