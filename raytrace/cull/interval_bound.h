@@ -179,8 +179,6 @@ class RangeAccumulator {
 
 class IntervalBound {
  public:
-  static constexpr float kRelativeMargin = kBoundRelativeMargin;
-
   IntervalBound() = default;
   explicit IntervalBound(const RayRanges& r) : ranges_(AxisRanges::from(r.o_lo, r.o_hi, r.d_lo, r.d_hi)) {
     unbounded_ = !r.finite;
@@ -216,7 +214,7 @@ class IntervalBound {
       const float origin = std::max(std::fabs(axis_[a].o_lo), std::fabs(axis_[a].o_hi));
       // NaN coordinates make the growth NaN, and so every box test pass.
       const float m = box != box || origin != origin ? box + origin : std::max(box, origin);
-      v[a] = g.axis[a] = slack + kRelativeMargin * m;
+      v[a] = g.axis[a] = slack + kBoundRelativeMargin * m;
     }
     g.v = Float4::load(v);
     return g;
@@ -246,13 +244,13 @@ class IntervalBound {
     const Axis& x = axis_[a];
     const float a0 = plane - x.o_hi, a1 = plane - x.o_lo;
     const float mn = std::min(std::min(a0 * x.r_lo, a0 * x.r_hi), std::min(a1 * x.r_lo, a1 * x.r_hi));
-    return mn - std::fabs(mn) * kRelativeMargin;
+    return mn - std::fabs(mn) * kBoundRelativeMargin;
   }
   float crossing_hi(int a, float plane) const {
     const Axis& x = axis_[a];
     const float a0 = plane - x.o_hi, a1 = plane - x.o_lo;
     const float mx = std::max(std::max(a0 * x.r_lo, a0 * x.r_hi), std::max(a1 * x.r_lo, a1 * x.r_hi));
-    return mx + std::fabs(mx) * kRelativeMargin;
+    return mx + std::fabs(mx) * kBoundRelativeMargin;
   }
 
  private:
