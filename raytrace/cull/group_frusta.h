@@ -1,27 +1,11 @@
-// Frusta of a large packet's groups (traverse/large_packet.h): for rays that
-// leave one apex (a camera's primary rays, a point light's shadow rays),
-// each group of eight gets four planes through the apex that hold all of
-// its rays, and rays of finite reach (shadow rays) a far plane. A triangle
-// whose three corners all lie beyond one of a group's planes is missed by
-// every ray of that group, so a leaf's triangle is tested only by the
-// groups whose frustum it reaches: one test of a triangle against eight
-// frusta costs about what one eight-lane triangle test costs, and most
-// groups of a 64-ray packet miss most of the triangles its cells hold (the
-// fuzzy boxes are loose, the triangles are not).
-//
-// Numerical safety (docs/RAYTRACE.md, "Group frusta"). The planes are grown
-// away from the rays by 2^-16 of their slopes, far above the rounding of
-// their construction (tens of float epsilons), so every ray lies inside
-// each plane. A triangle is culled only when its corners lie beyond a plane
-// by 2^-16 of the coordinate magnitudes involved: that margin is hundreds
-// of times the rounding of the corner tests, and it covers where either
-// triangle test can report a hit off the triangle. The watertight test's
-// edge signs are exact; the fast test's rounding moves its hit point off
-// the triangle by a few float epsilons of the origin's distance across the
-// ray (at grazing angles the error grows along the ray, which no side
-// plane sees). A larger margin keeps every answer but tests triangles
-// further beyond a group's rays: at 2^-12 a shadow group on a fine mesh
-// tested its neighbours' triangles a pixel away.
+// GroupFrusta: for each group of eight rays from one apex (camera rays, a
+// point light's shadow rays), four planes through the apex that hold its
+// rays, and for rays that end (shadow rays) a far plane. A triangle whose
+// corners all lie beyond one plane is missed by the whole group, so a leaf's
+// triangle is tested only by the groups it reaches. Also the packet's own
+// frustum, tested first, and each group's slab in the packet's basis
+// (shadow packets). docs/RAYTRACE.md, "Group frusta" and "Shadow slabs";
+// kFrustumMargin's derivation under "Numerical margins".
 #pragma once
 
 #include <algorithm>
@@ -136,75 +120,33 @@ class GroupFrusta {
   // (a shadow ray's shadowed point) cannot block it.
   void set_group(int g, const float (&q)[3][8], std::uint32_t lanes, const float* reach = nullptr) {
     if (lanes == 0 || g < 0 || g >= groups_) return;
-    const Mask8 use = Mask8::from_bits(lanes);
-    const Float8 zero(0.0f);
-    const Vec3x8 d{select(use, Float8::load(q[0]), zero), select(use, Float8::load(q[1]), zero),
-                   select(use, Float8::load(q[2]), zero)};
-    // Any centre in front of every lane will do: the planes come from the
-    // slopes around it, whatever it is. The sum of the directions is one.
-    const Vec3 c = normalized({sum(d.x), sum(d.y), sum(d.z)});
-    if (!(c.x == c.x)) return;
-    // u along a row of the group: from its first lane to the one three on
-    // (a camera block's lanes are two rows of four pixels), or to its last.
-    // Any u bounds the rays; one along the pixel rows bounds a block's
-    // rectangle of rays, where a diagonal one (lane 0 to lane 7) bounded a
-    // rectangle turned by 18 degrees, 1.7 times the area.
-    const int first = std::countr_zero(lanes);
-    const int last = first + 3 < 8 && (lanes >> (first + 3) & 1u) ? first + 3 : 31 - std::countl_zero(lanes);
-    Vec3 u, v;
-    if (!row_basis(c, Vec3(q[0][last] - q[0][first], q[1][last] - q[1][first], q[2][last] - q[2][first]), u, v)) return;
-    Float8 a, b, dc;
-    if (!slopes(d, use, c, u, v, a, b, dc)) return;
-    const float big = std::numeric_limits<float>::max();
-    const float a_lo = reduce_min(select(use, a, Float8(big))), a_hi = reduce_max(select(use, a, Float8(-big)));
-    const float b_lo = reduce_min(select(use, b, Float8(big))), b_hi = reduce_max(select(use, b, Float8(-big)));
-    // Outside: n . (p - apex) > 0. Each plane holds the rays with slopes on
-    // its side: a <= a_hi means (u - a_hi c) . q <= 0.
-    set_plane(0, g, u - (a_hi + grown_slope(a_hi)) * c);
-    set_plane(1, g, (a_lo - grown_slope(a_lo)) * c - u);
-    set_plane(2, g, v - (b_hi + grown_slope(b_hi)) * c);
-    set_plane(3, g, (b_lo - grown_slope(b_lo)) * c - v);
-    sides_[g / 8] = static_cast<std::uint8_t>(sides_[g / 8] | 1u << (g % 8));
+    const auto directions = [&](int) -> const float (&)[3][8] { return q; };
+    const auto lanes_of = [&](int) { return lanes; };
+    const std::uint32_t block = 1u << (g % 8);
     if (reach != nullptr) {
-      // c . (p - apex) <= s (c . q) on every lane's points.
-      const Float8 far = select(use, Float8::load(reach) * dc, Float8(0.0f));
-      const float offset = far_offset(reduce_max(far));
-      if (std::isfinite(offset)) {
-        set_plane(4, g, c);
-        offset_[g] = offset;
-        far_[g / 8] = static_cast<std::uint8_t>(far_[g / 8] | 1u << (g % 8));
-      }
+      const auto reach_of = [&](int, float* out) { std::copy_n(reach, 8, out); };
+      set_block<true>(g - g % 8, block, 1.0f, directions, lanes_of, reach_of);
+    } else {
+      const auto no_reach = [](int, float*) {};
+      set_block<false>(g - g % 8, block, 1.0f, directions, lanes_of, no_reach);
     }
   }
 
   // set_group for every group of `groups`, with group g's directions
   // sign * q(g) (a float[3][8]), its lanes lanes(g) and, with kFar, its
-  // per-lane reach written by reach(g, out). Groups with all eight lanes in
-  // use are built eight at a time, one group per SIMD lane (set_group's
-  // construction transposed: a packet's frusta cost about what one did);
-  // the others one by one.
+  // per-lane reach written by reach(g, out): eight groups at a time, one
+  // group per SIMD lane, so a packet's frusta cost about what one does.
   template <bool kFar, class Q, class Lanes, class Reach>
   void set_groups(std::uint64_t groups, float sign, Q&& q, Lanes&& lanes, Reach&& reach) {
+    groups &= live_groups();
     for (int base = 0; base < groups_; base += 8) {
-      std::uint32_t full = 0;
-      for (std::uint32_t m = static_cast<std::uint32_t>(groups >> base) & 0xFFu; m != 0; m &= m - 1) {
-        const int g = base + std::countr_zero(m);
-        const std::uint32_t l = lanes(g);
-        if (l == 0xFFu) {
-          full |= 1u << (g - base);
-          continue;
-        }
-        alignas(32) float d[3][8], r[8] = {};
-        for (int a = 0; a < 3; ++a) (Float8(sign) * Float8::load(q(g)[a])).store(d[a]);
-        if constexpr (kFar) reach(g, r);
-        set_group(g, d, l, kFar ? r : nullptr);
-      }
-      if (full != 0) set_block<kFar>(base, full, sign, q, reach);
+      const auto block = static_cast<std::uint32_t>(groups >> base) & 0xFFu;
+      if (block != 0) set_block<kFar>(base, block, sign, q, lanes, reach);
     }
   }
 
   // One frustum around every ray of `groups` (set_groups' arguments), the
-  // same construction as set_group's over all their lanes: reached() tests
+  // same construction as a group's over all their lanes: reached() tests
   // a triangle against it first, and most triangles a packet's cells hold
   // lie outside it (seven in ten on Cally), so they cost one plane test
   // instead of one per block of eight groups. Rays spread over more than
@@ -212,7 +154,7 @@ class GroupFrusta {
   template <bool kFar, class Q, class Lanes, class Reach>
   void set_bound(std::uint64_t groups, float sign, Q&& q, Lanes&& lanes, Reach&& reach) {
     bound_groups_ = 0;
-    groups &= groups_ >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << groups_) - 1u;
+    groups &= live_groups();
     if (groups == 0) return;
     const Float8 zero(0.0f);
     const auto directions = [&](int g, std::uint32_t use_bits) {
@@ -234,7 +176,8 @@ class GroupFrusta {
     if (first < 0) return;
     const Vec3 c = normalized({reduce_add(sum.x), reduce_add(sum.y), reduce_add(sum.z)});
     if (!(c.x == c.x)) return;
-    // u along a pixel row of the first group, as set_group's.
+    // u along a pixel row of the first group (a camera block's lanes are
+    // two rows of four): from its first lane to the one three on.
     const std::uint32_t first_lanes = lanes(first);
     const int i0 = std::countr_zero(first_lanes);
     const int i1 = i0 + 3 < 8 && (first_lanes >> (i0 + 3) & 1u) ? i0 + 3 : 31 - std::countl_zero(first_lanes);
@@ -269,7 +212,7 @@ class GroupFrusta {
       for (int i = 0; i < 4; ++i) {
         const float grown = i % 2 == 0 ? ranges[i] - grown_slope(ranges[i]) : ranges[i] + grown_slope(ranges[i]);
         slab_[i][g] = grown;
-        // |n|_1 of the side's plane (u or v minus grown times c), as set_plane.
+        // |n|_1 of the side's plane (u or v minus grown times c), as store_planes.
         slab_scale_[i][g] = 1.001f * ((i < 2 ? u1 : v1) + std::fabs(grown) * c1);
       }
       if constexpr (kFar) {
@@ -350,7 +293,7 @@ class GroupFrusta {
       }
       return;
     }
-    groups &= groups_ >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << groups_) - 1u;
+    groups &= live_groups();
     const detail::ApexTriangles8 x(t, apex_, apex_magnitude_);
     for (std::uint64_t m = groups; m != 0; m &= m - 1) {
       const int g = std::countr_zero(m);
@@ -510,23 +453,26 @@ class GroupFrusta {
     return out;
   }
 
-  // Groups base + k for the bits k of `full` (all eight lanes in use),
-  // lane k of every vector below holding group base + k.
-  template <bool kFar, class Q, class Reach>
-  void set_block(int base, std::uint32_t full, float sign, Q& q, Reach& reach) {
-    alignas(32) float t[3][8][8];  // [axis][ray][group]
+  // The frusta of groups base + k for the bits k of `block`, lane k of
+  // every vector below holding group base + k. A group's lanes not in
+  // lanes(g) repeat its first live lane, so they widen nothing.
+  template <bool kFar, class Q, class Lanes, class Reach>
+  void set_block(int base, std::uint32_t block, float sign, Q& q, Lanes& lanes, Reach& reach) {
+    alignas(32) float t[3][8][8];    // [axis][ray][group]
     alignas(32) float r[8][8] = {};  // [ray][group]
+    std::uint32_t full = 0;          // the groups with live lanes
     for (int k = 0; k < 8; ++k) {
-      const bool used = (full >> k & 1u) != 0;
-      for (int a = 0; a < 3; ++a) {
-        for (int j = 0; j < 8; ++j) t[a][j][k] = used ? sign * q(base + k)[a][j] : (a == 2 ? 1.0f : 0.0f);
-      }
+      const std::uint32_t l = (block >> k & 1u) != 0 ? lanes(base + k) & 0xFFu : 0u;
+      if (l != 0) full |= 1u << k;
+      const int first = l != 0 ? std::countr_zero(l) : 0;
+      alignas(32) float rk[8] = {};
       if constexpr (kFar) {
-        if (used) {
-          alignas(32) float rk[8];
-          reach(base + k, rk);
-          for (int j = 0; j < 8; ++j) r[j][k] = rk[j];
-        }
+        if (l != 0) reach(base + k, rk);
+      }
+      for (int j = 0; j < 8; ++j) {
+        const int lane = (l >> j & 1u) != 0 ? j : first;
+        for (int a = 0; a < 3; ++a) t[a][j][k] = l != 0 ? sign * q(base + k)[a][lane] : (a == 2 ? 1.0f : 0.0f);
+        r[j][k] = rk[lane];
       }
     }
     const Float8 zero(0.0f), one(1.0f);
@@ -541,7 +487,9 @@ class GroupFrusta {
     for (int j = 1; j < 8; ++j) sum = sum + d[j];
     Mask8 c_ok, u_ok, alt_ok;
     const Vec3x8 c = unit(sum, c_ok);
-    Vec3x8 across = d[3] - d[0];  // along a row, as set_group
+    // u along a pixel row (a camera block's lanes are two rows of four): any
+    // u bounds the rays, one along the rows bounds a block most tightly.
+    Vec3x8 across = d[3] - d[0];
     across = across - dot(across, c) * c;
     const Vec3x8 u_across = unit(across, u_ok);
     const Vec3x8 alt = select(abs(c.x) < Float8(0.5f), Vec3x8{zero, zero - c.z, c.y}, Vec3x8{zero - c.z, zero, c.x});
@@ -581,7 +529,8 @@ class GroupFrusta {
       }
     }
   }
-  // set_plane for the groups base + k of the lanes k of `m`.
+  // Plane i of the groups base + k for the lanes k of `m`, and its |n|_1
+  // (slightly more, for the rounding of the products).
   void store_planes(int i, int base, const Vec3x8& n, Mask8 m) {
     const Float8* const axis[3] = {&n.x, &n.y, &n.z};
     for (int a = 0; a < 3; ++a) select(m, *axis[a], Float8::load(&n_[i][a][base])).store(&n_[i][a][base]);
@@ -589,15 +538,15 @@ class GroupFrusta {
     select(m, scale, Float8::load(&scale_[i][base])).store(&scale_[i][base]);
   }
 
+  std::uint64_t live_groups() const { return groups_ >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << groups_) - 1u; }
   static float magnitude(const Vec3& p) { return std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)}); }
   // Near unit length is enough: the planes hold the rays for any centre
-  // and any u (set_group), so one reciprocal serves the three axes.
+  // and any u, so one reciprocal serves the three axes.
   static Vec3 normalized(const Vec3& w) {
     const float length = std::sqrt(glm::dot(w, w));
     return length > 0.0f && std::isfinite(length) ? w * (1.0f / length)
                                                   : Vec3(std::numeric_limits<float>::quiet_NaN());
   }
-  static float sum(Float8 a) { return reduce_add(a); }
   // The frame a frustum's slopes are measured in around the unit centre
   // c: u along `across` (a pixel row) made perpendicular to c, or any
   // perpendicular where that is degenerate, and v = c x u.
@@ -625,15 +574,6 @@ class GroupFrusta {
     b = along(v) * inv_dc;
     return true;
   }
-  void set_plane(int i, int g, const Vec3& n) {
-    n_[i][0][g] = n.x;
-    n_[i][1][g] = n.y;
-    n_[i][2][g] = n.z;
-    // |n|_1 bounds n . e for |e| <= margin per coordinate; slightly more
-    // for the rounding of the products.
-    scale_[i][g] = 1.001f * (std::fabs(n.x) + std::fabs(n.y) + std::fabs(n.z));
-  }
-
   Vec3 apex_{0.0f};
   float apex_magnitude_ = 0.0f;
   int groups_ = 0;
