@@ -1,21 +1,13 @@
-// IntervalBound: interval arithmetic over a set of rays, the one box test
-// a large packet (traverse/large_packet.h) pays per kd-tree cell.
-//
-// The set is kept as ranges: per axis the range of the origins and of the
-// directions, and the range of the ray parameter. A ray of the set inside a
-// box at parameter t satisfies, on every axis whose direction sign is the
-// same for the whole set, entry_a <= t <= exit_a for the box's slab, and
-// the products of (plane - origin range) x (reciprocal range) bound entry_a
-// from below and exit_a from above over every ray of the set. A box no ray
-// of the set can reach gets +inf; otherwise entry() is a lower bound on the
-// parameter at which the first ray enters it (the front-to-back key).
-//
-// Numerical safety: every product is widened by a relative 2^-20 (far above
-// its 2^-24 rounding), reciprocal bounds likewise, and callers grow boxes by
-// grow_for(): their own slack plus, per axis, 2^-20 of the larger of the
-// box's and the origins' magnitudes on that axis, for the rounding of
-// (plane - origin). A set holding
-// a non-finite ray bounds nothing: every box may be entered.
+// IntervalBound: interval arithmetic over a set of rays, kept as ranges per
+// axis (origins, directions) and of the parameter. A ray inside a box at t has
+// entry_a <= t <= exit_a on every axis whose direction sign is the same for
+// the whole set, and interval products bound those over every ray: one box
+// test costs a dozen multiplies whatever the set's size. entry() is a lower
+// bound on where the first ray enters a box (+inf: none can), the walks'
+// front-to-back key. A large packet builds one over its rays, a tile over
+// all of its rays (cull/ray_bound.h). Margins: docs/RAYTRACE.md, "Numerical
+// margins" (kBoundRelativeMargin); a set holding a non-finite ray culls
+// nothing.
 #pragma once
 
 #include <algorithm>
@@ -50,7 +42,7 @@ inline SlabPassage slab_passage(Float4 enter, Float4 leave, float t_lo, float t_
 
 // A ray set per axis as its box tests read it: x, y and z in lanes 0 to 2,
 // lane 3 bounding nothing. Built from the set's origin and direction
-// ranges; used by IntervalBound and RayBound::Test alike.
+// ranges; IntervalBound's arithmetic.
 struct AxisRanges {
   Float4 o_lo{0.0f}, o_hi{0.0f};  // origins
   // Reciprocal directions where every direction has one sign (1/d
@@ -182,8 +174,9 @@ class IntervalBound {
   IntervalBound() = default;
   explicit IntervalBound(const RayRanges& r) : ranges_(AxisRanges::from(r.o_lo, r.o_hi, r.d_lo, r.d_hi)) {
     unbounded_ = !r.finite;
-    t_lo_ = r.t_lo;
-    t_hi_ = r.t_hi;
+    // A set holding a non-finite ray spans every parameter.
+    t_lo_ = unbounded_ ? -std::numeric_limits<float>::infinity() : r.t_lo;
+    t_hi_ = unbounded_ ? std::numeric_limits<float>::infinity() : r.t_hi;
     alignas(16) float rlo[4], rhi[4];
     ranges_.r_lo.store(rlo);
     ranges_.r_hi.store(rhi);
@@ -222,6 +215,19 @@ class IntervalBound {
 
   float t_lo() const { return t_lo_; }
   float t_hi() const { return t_hi_; }
+
+  // Whether some ray of the set may pass through `box` grown by `slack`
+  // plus grow_for's margin for that box alone; false only when none can.
+  // A box with a NaN is never culled.
+  bool may_enter(const Aabb& box, float slack) const {
+    if (unbounded_) return true;
+    const Float4 lower(box.lower, 0.0f), upper(box.upper, 0.0f);
+    if (unordered(lower, upper).any()) return true;
+    const Float4 mag = max(max(abs(lower), abs(upper)), max(abs(ranges_.o_lo), abs(ranges_.o_hi)));
+    const Float4 margin = Float4(slack) + Float4(kBoundRelativeMargin) * mag;
+    const SlabPassage p = ranges_.passage(lower - margin, upper + margin, t_lo_, t_hi_);
+    return !(p.enter > p.leave);
+  }
 
   // A lower bound on the parameter, within [t_lo, t_hi], at which some ray
   // enters `box` grown by `grow` on every side; +inf when no ray does.

@@ -1,27 +1,27 @@
-// The packet core's walks (traverse/large_packet.cpp): front to back over
-// the cells of a kd-tree, or the nodes of a BVH, that a packet's interval
-// bound (cull/interval_bound.h) reaches. A cell costs one box test whatever
-// the number of rays; which lanes a reached leaf tests is the caller's
-// (`leaf`). The single ray walks the same trees with its own walk
+// The walks of a ray set's interval bound (cull/interval_bound.h): front to
+// back over the cells of a kd-tree, or the nodes of a BVH, that the bound
+// reaches, one box test per cell whatever the number of rays. The packet
+// core walks bone and world trees with them (traverse/large_packet.cpp),
+// the tile culls the top level and static meshes (cull/ray_bound.cpp,
+// cull/static_tiles.cpp). The single ray keeps its own stack walk
 // (traverse/traversal.cpp): one ray needs no bound.
 //
-// Both walks read the packet's limit (`limit()`: the largest t any lane
-// still looks for) whenever they pop a cell, since a leaf's hits lower it.
-// `leaf(cell, node, items)` returns true to stop: every lane is answered.
-// Private to traverse/.
+// Both walks read the limit (`limit()`: the largest t any ray still looks
+// for) whenever they pop a cell, since a leaf's hits lower it.
+// `leaf(cell, node, items)` returns true to stop.
 #pragma once
 
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <span>
 
 #include "raytrace/accel/box_bvh.h"
 #include "raytrace/accel/kd_tree.h"
 #include "raytrace/cull/interval_bound.h"
-#include "raytrace/traverse/packet_lanes.h"
 
-namespace sinew::rt::packet_lanes {
+namespace sinew::rt {
 
 // A kd-tree cell waiting on the stack, with the parameter range that
 // holds every ray's passage through it.
@@ -37,10 +37,11 @@ struct Cell {
 // through it: on a split axis where every ray has one sign, the child
 // ranges are cut at the bounds on where the rays cross the (thick) split
 // plane, one product pair per node; elsewhere each child box is tested
-// whole. Cells are grown by `grow` (the lanes' slack, IntervalBound::grow_for).
+// whole. Cells are grown by `grow` (IntervalBound::grow_for).
 template <class Limit, class Leaf>
 void interval_walk(const KdTreeView& tree, const IntervalBound& bound, const IntervalBound::Growth& grow,
                    Limit& limit, Leaf&& leaf, std::uint64_t& node_visits) {
+  constexpr float kInf = std::numeric_limits<float>::infinity();
   std::array<Cell, kMaxTraversalDepth + 2> stack;
   std::size_t top = 0;
   Cell cur{{tree.bounds.lower.x, tree.bounds.lower.y, tree.bounds.lower.z},
@@ -111,6 +112,7 @@ void interval_walk(const KdTreeView& tree, const IntervalBound& bound, const Int
 template <class Limit, class Leaf>
 void interval_walk(const BvhView& tree, const IntervalBound& bound, const IntervalBound::Growth& grow,
                    Limit& limit, Leaf&& leaf, std::uint64_t& node_visits) {
+  constexpr float kInf = std::numeric_limits<float>::infinity();
   struct Pending {
     std::uint32_t node;
     float t;
@@ -140,4 +142,18 @@ void interval_walk(const BvhView& tree, const IntervalBound& bound, const Interv
   }
 }
 
-}  // namespace sinew::rt::packet_lanes
+// Every leaf of `tree` that some ray of `bound` may reach, its cells grown
+// by `slack` (IntervalBound::grow_for), until leaf(items) returns false:
+// the culls of a whole tile's rays (cull/ray_bound.cpp, cull/static_tiles.cpp).
+template <class Leaf>
+void for_each_reached_leaf(const KdTreeView& tree, const IntervalBound& bound, float slack, Leaf&& leaf) {
+  if (tree.empty()) return;
+  const float t_hi = bound.t_hi();
+  const auto limit = [t_hi] { return t_hi; };
+  std::uint64_t node_visits = 0;
+  interval_walk(
+      tree, bound, bound.grow_for(tree.bounds, slack), limit,
+      [&](const Aabb&, std::uint32_t, std::span<const std::uint32_t> items) { return !leaf(items); }, node_visits);
+}
+
+}  // namespace sinew::rt

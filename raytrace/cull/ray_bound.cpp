@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "raytrace/cull/interval_bound.h"
+#include "raytrace/cull/interval_walk.h"
 #include "raytrace/traverse/traversal_shared.h"
 #include "runtime/math/float4.h"
 #include "runtime/math/float8.h"
@@ -169,27 +170,19 @@ float RayBound::world_slack_bound(float scene_magnitude) const {
   return traversal_slack_bound(o_mag_, d_mag_, t_hi_, scene_magnitude);
 }
 
-RayBound::Test RayBound::test() const {
+IntervalBound RayBound::test() const {
   fold();
-  Test t;
-  t.unbounded = unbounded_;
-  t.t_lo = t_lo_;
-  t.t_hi = t_hi_;
-  t.ranges = AxisRanges::from(o_lo_, o_hi_, d_lo_, d_hi_);
-  return t;
-}
-
-bool RayBound::Test::may_enter(const Aabb& box, float grow) const {
-  if (unbounded) return true;
-  const Float4 lower(box.lower, 0.0f), upper(box.upper, 0.0f);
-  if (unordered(lower, upper).any()) return true;  // a NaN box: never culled
-  // The rounding of (plane - origin) on an axis is relative to that axis's
-  // coordinates alone: a flat ground's height is not rounded at the scale
-  // of its width.
-  const Float4 mag = max(max(abs(lower), abs(upper)), max(abs(ranges.o_lo), abs(ranges.o_hi)));
-  const Float4 margin = Float4(grow) + Float4(kBoundRelativeMargin) * mag;
-  const SlabPassage p = ranges.passage(lower - margin, upper + margin, t_lo, t_hi);
-  return !(p.enter > p.leave);
+  RayRanges r;
+  for (int a = 0; a < 3; ++a) {
+    r.o_lo[a] = o_lo_[a];
+    r.o_hi[a] = o_hi_[a];
+    r.d_lo[a] = d_lo_[a];
+    r.d_hi[a] = d_hi_[a];
+  }
+  r.t_lo = t_lo_;
+  r.t_hi = t_hi_;
+  r.finite = !unbounded_;
+  return IntervalBound(r);
 }
 
 void cull_objects(const Scene& scene, const RayBound& bound, std::vector<std::uint32_t>& out, float extra_grow) {
@@ -197,7 +190,7 @@ void cull_objects(const Scene& scene, const RayBound& bound, std::vector<std::ui
   const KdTreeView tree = top.view();
   if (tree.empty() || bound.empty()) return;
   const std::span<const TopLevelObject> objects = top.objects();
-  const RayBound::Test test = bound.test();
+  const IntervalBound test = bound.test();
   // One grow for every box and cell: the largest slack of any box in the
   // scene. A point within an object's slack of the object lies within that
   // much of a cell that lists the object.
@@ -206,12 +199,11 @@ void cull_objects(const Scene& scene, const RayBound& bound, std::vector<std::ui
   if (runs.size() <= kFlatCullObjects) {
     // A few dozen runs (characters, grounds): one box test each, and one
     // per member of the runs a ray may enter, costs less than walking the
-    // tree's cells to them (Cally walk, 2 threads: primary 4.5 -> 4.4 ms,
-    // shadow 3.8 -> 3.6 ms testing every object; most tiles miss the
-    // character's box, which skips its bones at once). A run's box holds
-    // its members' and its margin is no smaller (the margin grows with the
-    // coordinates), so a member a ray may enter never sits in a run it
-    // cannot. In index order, as the walk's sorted output.
+    // tree's cells to them (most tiles miss a character's box, which skips
+    // its bones at once). A run's box holds its members' and its margin is
+    // no smaller (the margin grows with the coordinates), so a member a ray
+    // may enter never sits in a run it cannot. In index order, as the
+    // walk's sorted output.
     for (const ObjectRun& run : runs) {
       if (run.count > 1 && !test.may_enter(run.box, grow)) continue;
       for (std::uint32_t object = run.first; object < run.first + run.count; ++object) {
@@ -230,9 +222,8 @@ void cull_objects(const Scene& scene, const RayBound& bound, std::vector<std::ui
     stamp_value = 1;
   }
   const std::size_t first_out = out.size();
-  for_each_reached_leaf(tree, test, grow, [&](std::uint32_t first, std::uint32_t count) {
-    for (std::uint32_t i = 0; i < count; ++i) {
-      const std::uint32_t object = tree.items[first + i];
+  for_each_reached_leaf(tree, test, grow, [&](std::span<const std::uint32_t> items) {
+    for (const std::uint32_t object : items) {
       if (stamp[object] == stamp_value) continue;
       stamp[object] = stamp_value;
       if (test.may_enter(objects[object].box, grow)) out.push_back(object);

@@ -1,24 +1,9 @@
-// RayBound: a conservative bound on a whole set of rays (a tile's primary
-// rays, a packet's shadow rays), and the culling it pays for: which of the
-// scene's top-level objects any ray of the set may enter.
-//
-// The bound is interval arithmetic over the set: per axis the range of the
-// origins, the range of the directions (and so of their reciprocals, where
-// the sign is the same for every ray), and the range of [t_min, t_max]. A
-// ray of the set inside a box at parameter t satisfies, on every axis whose
-// direction sign is fixed, entry_a <= t <= exit_a for the box's slab; the
-// interval products below bound entry_a from below and exit_a from above
-// over every origin and reciprocal in the ranges. When
-// max(t_lo, max_a entry_a) > min(t_hi, min_a exit_a), no ray of the set
-// reaches the box. One test costs a dozen multiplies whatever the set's size,
-// which is what makes tiles that see only the ground or the sky cheap.
-//
-// Numerical safety: the traversal's own box clips (traverse/traversal.h) grow
-// each box by a slack eps that depends on the ray (its origin, its reach and
-// the box's magnitude). cull_objects() grows every box by an upper bound on
-// that slack over the whole set plus a relative margin for its own rounding,
-// and widens each interval product by a relative 2^-20, so it never rejects a
-// box that a single ray's clip would accept: culling changes no result.
+// RayBound: the ranges of a whole set of rays (a tile's primary rays, its
+// shadow rays), gathered eight lanes at a time and handed on as an
+// IntervalBound; and cull_objects, the top-level objects some ray of the set
+// may enter. Every box grows by a bound on the traversal's own slack
+// (traversal_slack_bound), so culling changes no result. docs/RAYTRACE.md,
+// "RayBound and interval bounds".
 #pragma once
 
 #include <algorithm>
@@ -28,7 +13,6 @@
 #include <span>
 #include <vector>
 
-#include "raytrace/accel/kd_tree.h"
 #include "raytrace/cull/interval_bound.h"
 #include "raytrace/scene/scene.h"
 #include "runtime/math/aabb.h"
@@ -75,20 +59,9 @@ class RayBound {
   // inside a scene of magnitude `scene_magnitude` (traverse/traversal.h).
   float world_slack_bound(float scene_magnitude) const;
 
-  // The bound in the form the box test wants, computed once per set.
-  class Test {
-   public:
-    // Whether some ray of the set may pass through `box` grown by `grow`
-    // on every side within its [t_min, t_max]. False only when none can.
-    bool may_enter(const Aabb& box, float grow) const;
-
-   private:
-    friend class RayBound;
-    AxisRanges ranges;  // the set's origins and directions per axis
-    float t_lo = 0.0f, t_hi = 0.0f;
-    bool unbounded = false;  // a non-finite ray: every box may be entered
-  };
-  Test test() const;
+  // The bound as a box test (IntervalBound::may_enter) and walk
+  // (cull/interval_walk.h), computed once per set.
+  IntervalBound test() const;
 
  private:
   // Folds the directions of `lanes` (not 0) of rays with their own origins
@@ -124,36 +97,6 @@ class RayBound {
   mutable float t_lo_ = 0.0f, t_hi_ = 0.0f;
   mutable float o_mag_ = 0.0f, d_mag_ = 0.0f;
 };
-
-// Calls leaf(first_item, item_count) for every leaf of `tree` whose cell,
-// grown by `grow`, some ray of `test`'s set may enter (empty leaves too),
-// until it returns false.
-template <class LeafFn>
-void for_each_reached_leaf(const KdTreeView& tree, const RayBound::Test& test, float grow, LeafFn&& leaf) {
-  if (tree.empty() || !test.may_enter(tree.bounds, grow)) return;
-  struct Entry {
-    std::uint32_t node;
-    Aabb cell;
-  };
-  std::array<Entry, kMaxTraversalDepth + 2> stack;
-  std::size_t top = 0;
-  stack[top++] = {0, tree.bounds};
-  while (top > 0) {
-    const Entry e = stack[--top];
-    const KdNode node = tree.nodes[e.node];
-    if (node.is_leaf()) {
-      if (!leaf(node.first_item(), node.item_count())) return;
-      continue;
-    }
-    const int a = node.axis();
-    Entry below{e.node + 1, e.cell};
-    Entry above{node.above_child(), e.cell};
-    below.cell.upper[a] = std::min(below.cell.upper[a], node.split());
-    above.cell.lower[a] = std::max(above.cell.lower[a], node.split());
-    if (test.may_enter(below.cell, grow)) stack[top++] = below;
-    if (test.may_enter(above.cell, grow)) stack[top++] = above;
-  }
-}
 
 // Scenes with at most this many runs of top-level objects (characters,
 // static meshes: accel/top_level.h ObjectRun) are culled by testing each

@@ -7,6 +7,7 @@
 
 #include <glm/geometric.hpp>
 
+#include "raytrace/cull/interval_walk.h"
 #include "raytrace/traverse/traversal_shared.h"
 
 namespace sinew::rt {
@@ -25,15 +26,14 @@ void add_triangle(const Scene::StaticMesh& mesh, std::uint32_t t, bool first, St
 
 // Of a larger mesh, the triangles in the cells of its tree that the bound
 // reaches, whose own box it may enter, ascending; false past `room`.
-bool gather_reached(const Scene::StaticMesh& mesh, const RayBound::Test& test, float grow, std::size_t room,
+bool gather_reached(const Scene::StaticMesh& mesh, const IntervalBound& test, float grow, std::size_t room,
                     const TileCone& cone, StaticTile& tile) {
   thread_local std::vector<std::uint32_t> reached;
   reached.clear();
-  const KdTreeView tree = mesh.tree.view();
   bool fits = true;
-  for_each_reached_leaf(tree, test, grow, [&](std::uint32_t first, std::uint32_t count) {
-    for (std::uint32_t i = 0; i < count && fits; ++i) {
-      const std::uint32_t t = tree.items[first + i];
+  for_each_reached_leaf(mesh.tree.view(), test, grow, [&](std::span<const std::uint32_t> items) {
+    for (std::size_t i = 0; i < items.size() && fits; ++i) {
+      const std::uint32_t t = items[i];
       if (std::find(reached.begin(), reached.end(), t) != reached.end()) continue;  // listed in an earlier leaf
       const auto& v = mesh.desc.triangles[t];
       Aabb box = Aabb::empty();
@@ -121,7 +121,7 @@ bool gather_static_tile(const Scene& scene, TriangleTest test, const RayBound& b
                    [&](std::uint32_t o) { return all[o].kind == TopLevelObject::Kind::kStatic; })) {
     return false;
   }
-  const RayBound::Test box_test = bound.test();
+  const IntervalBound box_test = bound.test();
   // The grow cull_objects uses: the largest slack of any box in the scene.
   const float grow = bound.world_slack_bound(detail::max_abs(scene.top_level().bounds())) + extra_grow;
   for (const std::uint32_t object : objects) {

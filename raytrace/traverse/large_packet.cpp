@@ -11,9 +11,9 @@
 #include "raytrace/cull/group_frusta.h"
 #include "raytrace/cull/packet_frusta.h"
 #include "raytrace/cull/interval_bound.h"
+#include "raytrace/cull/interval_walk.h"
 #include "raytrace/cull/ray_bound.h"
 #include "raytrace/geometry/triangle_intersect8.h"
-#include "raytrace/traverse/interval_walk.h"
 #include "raytrace/traverse/leaf_triangles.h"
 #include "raytrace/traverse/mailbox.h"
 #include "raytrace/traverse/packet_lanes.h"
@@ -31,7 +31,6 @@ using packet_lanes::for_each_bit;
 using packet_lanes::Group;
 using packet_lanes::PacketRays;
 using packet_lanes::thread_query;
-using packet_lanes::interval_walk;
 using packet_lanes::kInf;
 using packet_lanes::kLanes;
 using packet_lanes::VisitGroup;
@@ -494,8 +493,8 @@ class LargeQuery : public PacketRays<kTest, kAnyHit> {
     entry.groups |= GroupMask{1} << g;
   }
 
-  // The groups of `entry` through a kd-tree or a BVH (interval_walk in
-  // traverse/interval_walk.h), each reached leaf's lanes picked by visit_leaf.
+  // The groups of `entry` through a kd-tree or a BVH (cull/interval_walk.h),
+  // each reached leaf's lanes picked by visit_leaf.
   template <class Tree, class LeafFn>
   void walk_tree(const Tree& tree, const TreeEntry& entry, LeafFn& leaf) {
     if (entry.groups == 0) return;

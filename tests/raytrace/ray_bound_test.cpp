@@ -58,7 +58,7 @@ TEST(RayBound, NeverCullsABoxThatARayEnters) {
     const float* const op[3] = {o[0], o[1], o[2]};
     const float* const dp[3] = {d[0], d[1], d[2]};
     bound.add_lanes(op, dp, t0, t1, lanes);
-    const rt::RayBound::Test test = bound.test();
+    const rt::IntervalBound test = bound.test();
     for (int b = 0; b < 8; ++b) {
       const Vec3 c(unit(g) * 6 - 3, unit(g) * 6 - 3, unit(g) * 6 - 3);
       const Vec3 e(unit(g) * 0.5f, unit(g) * 0.5f, unit(g) * 0.5f);
@@ -200,7 +200,7 @@ TEST(RayBound, SharedOriginGroupsBoundAsTheirLanesDo) {
       by_lane.add_lanes(op, dp, t0, t1, lanes);
     }
     ASSERT_EQ(mixed.world_slack_bound(10.0f), by_lane.world_slack_bound(10.0f)) << "trial " << trial;
-    const rt::RayBound::Test a = mixed.test(), b = by_lane.test();
+    const rt::IntervalBound a = mixed.test(), b = by_lane.test();
     for (int box = 0; box < 16; ++box) {
       const Vec3 c(unit(g) * 10 - 5, unit(g) * 10 - 5, unit(g) * 10 - 5);
       const Vec3 e(unit(g), unit(g), unit(g));
@@ -239,7 +239,7 @@ TEST(RayBound, SharedOriginGroupsBoundAsTheirLanesDo) {
     if (grouped.empty()) continue;
     ASSERT_EQ(grouped.world_slack_bound(10.0f), one_by_one.world_slack_bound(10.0f)) << "trial " << trial;
     ASSERT_EQ(run.world_slack_bound(10.0f), run_by_lane.world_slack_bound(10.0f)) << "trial " << trial;
-    const rt::RayBound::Test a = grouped.test(), b = one_by_one.test(), c = run.test(), e = run_by_lane.test();
+    const rt::IntervalBound a = grouped.test(), b = one_by_one.test(), c = run.test(), e = run_by_lane.test();
     for (int box = 0; box < 16; ++box) {
       const Vec3 centre(unit(g) * 10 - 5, unit(g) * 10 - 5, unit(g) * 10 - 5);
       const Vec3 half(unit(g), unit(g), unit(g));
