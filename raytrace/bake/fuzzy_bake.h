@@ -39,9 +39,9 @@ struct FuzzyBakeInput {
   std::span<const Affine3> samples;
 };
 
-// Cally subdivided (sinew-editor render, 2 threads, 1024x1024, walk):
-// 0.05 against 0.15 is 11% faster a frame at 855,552 triangles, 15-20% at
-// 213,888, 2-4% at 53,472, even at 13,368 and slower at 3,342.
+// A fine mesh's trees are built with a lower intersection cost (deeper
+// trees, fewer triangles per leaf): faster on fine meshes, slower on coarse
+// ones (docs/BENCHMARKS.md).
 inline constexpr std::size_t kFineMeshTriangles = 25'000;
 inline constexpr float kFineMeshIntersectionCost = 0.05f;
 
@@ -78,10 +78,9 @@ struct FuzzyBakeOptions {
   // The bone trees' structure (docs/RAYTRACE.md, "Bone trees: kd-tree or
   // BVH"): BVHs over the fuzzy boxes (built by `bvh`), each triangle listed
   // once, or the paper's kd-trees (built by `kd`). Measured on every model
-  // in shared/content (256-ray packets, 2 threads, 1024x1024, shadows): the
-  // BVHs trace as fast as the kd-trees on the small models and 10-20%
-  // faster from 53,472 triangles on (Cally subdivided), with packs 10-25%
-  // smaller, in the same images.
+  // in shared/content: the BVHs trace at
+  // least as fast as the kd-trees, faster on fine meshes, with smaller
+  // packs and the same images.
   BoneTreeKind bone_trees = BoneTreeKind::kBvh;
   BvhBuildOptions bvh;
   // When set, a mesh of kFineMeshTriangles or more builds with

@@ -1,20 +1,10 @@
-// Frusta of a camera packet's groups, separable. The groups of a primary
-// packet are the 4x2-pixel blocks of a grid (a tile's region, blocks
-// row-major), and measured in the camera's own basis (forward, right, up)
-// the directions of one block fill a rectangle of slopes: right/forward
-// across, up/forward down the image. So every block of a column shares its
-// two side planes and every block of a row its two others, and a triangle
-// is tested against one plane pair per column and per row (four eight-lane
-// evaluations for up to 8x8 blocks) instead of four planes per group
-// (cull/group_frusta.h): the groups it reaches are the crossings of the
-// columns and rows it reaches.
-//
-// Numerical safety: as group_frusta.h, plane by plane. Each plane holds the
-// slopes of every lane on its side, grown by kFrustumMargin (2^-16) of the slope (far above
-// the rounding of the slopes and of the plane), and a triangle is cut off
-// only when its corners lie beyond the plane by kFrustumMargin of the coordinate
-// magnitudes (corners and apex), the margin beyond which neither triangle
-// test reports a hit off the triangle (group_frusta.h cull_margin).
+// GridFrusta: the frusta of a camera packet's groups, separable. In the
+// camera's basis one 4x2-pixel block's directions fill a rectangle of slopes,
+// so every block of a column shares two side planes and every block of a row
+// the other two: a triangle costs one plane pair per column and per row
+// (four eight-lane evaluations for up to 8x8 blocks), and reaches the
+// crossings of the columns and rows that do not cut it off. Margins as
+// group_frusta.h. docs/RAYTRACE.md, "The camera's grid".
 #pragma once
 
 #include <algorithm>

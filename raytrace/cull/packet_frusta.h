@@ -1,18 +1,8 @@
-// PacketFrusta: the one culler a packet's walk talks to, over the two kinds
-// of frusta for rays from one apex (camera rays, a point light's shadow
-// rays, t >= 0):
-//
-//   the camera's grid   GridFrusta (grid_frusta.h): a plane pair per column
-//                       and row of a camera packet's pixel grid
-//   group frusta        GroupFrusta (group_frusta.h): each group's own four
-//                       planes (+ a far plane at its rays' ends), or for
-//                       shadow packets each group's slab in the packet's
-//                       basis ("Shadow slabs")
-//
-// Both answer the same questions (cull/frustum_culler.h), which groups a
-// box, a triangle or each of eight triangles may reach, with the same
-// margins (kFrustumMargin); the walk never asks which kind it has. Group frusta are
-// built when a leaf first needs them (ensure), eight groups at a time.
+// PacketFrusta: the one culler a packet's walk asks (cull/frustum_culler.h),
+// over the two kinds of frusta for rays from one apex: the camera's grid
+// (GridFrusta), or each group's own frustum or slab (GroupFrusta), built when
+// a leaf first needs them, eight groups at a time. The walk never asks which
+// kind it has.
 #pragma once
 
 #include <algorithm>

@@ -1,17 +1,12 @@
-// Tiles whose rays can reach only a few triangles of static meshes: a
-// ground, a checkered floor, walls. Most of a frame's pixels are such
-// pixels, and their shadow rays too. The tile's triangles are gathered once
-// from the tile's bound (small meshes whole, larger ones from the cells of
-// their kd-tree the bound reaches) and its cone, and the packet core tests
-// every ray of the tile against them directly (traverse/large_packet.h, the
-// StaticTile overloads): no top level, no tree walk, no box clip per packet.
-//
-// Culling is conservative as in cull/ray_bound.h: a triangle is left out
-// only when no ray of the tile can enter its box grown by the traversal's
-// slack bound, or the tile's cone misses it, so each lane's nearest hit is
-// the single ray's; between two triangles hit at exactly the same t the one
-// gathered first wins (meshes in list order, each mesh's triangles in
-// ascending order, as the single ray meets them in a leaf).
+// Static tiles: a tile whose rays can reach only a few triangles of static
+// meshes (a ground, a floor, walls: most pixels of a frame, and their shadow
+// rays). The triangles are gathered once from the tile's bound (small meshes
+// whole, larger ones from the kd cells the bound reaches) less those the
+// tile's cone misses, and the packet core tests every ray against them
+// (traverse/large_packet.h, the StaticTile overloads). Culling is
+// conservative, so each lane's nearest hit is the single ray's; at an exact
+// tie in t the triangle gathered first wins (meshes in list order, triangles
+// ascending). docs/RAYTRACE.md, "Static tiles" and "The tile's cone".
 #pragma once
 
 #include <array>

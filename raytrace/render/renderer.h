@@ -1,15 +1,9 @@
-// Renderer: primary rays, shadow rays and diffuse shading over image tiles
-// in parallel (paper section 4.1), writing only the outputs (AOVs) the
-// caller asks for.
-//
-// Each tile runs the whole frame for its pixels: nearest hits, surfaces,
-// one shadow ray per hit that faces the light, shading and the AOVs. The
-// tile's hits and surfaces stay in cache from one step to the next (three
-// image-wide passes spent a third of the frame re-reading and re-deriving
-// them). The phases ("trace primary", "trace shadow", "shade") are timed per
-// tile and the render's wall time is split in their proportion. Tiles are
-// fixed squares processed in any order; every pixel's result depends only on
-// the scene, so images are identical for any thread count.
+// Renderer: primary rays, shadow rays and diffuse shading over image tiles in
+// parallel (paper section 4.1), writing only the outputs (AOVs) the caller
+// asks for. Each tile runs the whole frame for its pixels, so its hits and
+// surfaces stay in cache from one stage to the next; the phases are timed per
+// tile and the wall time split in their proportion. Every pixel depends only
+// on the scene: images are identical for any thread count.
 #pragma once
 
 #include "raytrace/camera/camera.h"

@@ -1,14 +1,12 @@
 // One tile's working set, structure of arrays, reused by each thread across
-// tiles and frames. The tile's pixels are laid out in blocks of 4x2 (eight
-// lanes: one ray group, one Float8): pixel k = 8 * block + lane, lane =
-// 4 * (y % 2) + x % 4. Blocks are grouped into regions (the large packets
-// of traverse/large_packet.h: 8x8, 16x16 or 32x16 pixels, or one block each),
-// regions row-major over the tile and blocks row-major within a region, so
-// a region's blocks, rays and hits are consecutive. Every stage
-// (render/stages/tile_stages.h) walks the blocks, so the rays, hits and surfaces of
-// a block stay in cache from ray generation through the shadow rays to the
-// shading. Shared by the renderer and by tracers that stand in for it (the
-// Embree peer of the benchmarks), which run the same stages.
+// tiles and frames. Pixels are laid out in blocks of 4x2 (eight lanes: one
+// ray group), pixel k = 8 * block + lane, lane = 4 * (y % 2) + x % 4; blocks
+// are grouped into regions (a large packet's 8x8, 16x16 or 32x16 pixels, or
+// one block each), regions row-major over the tile and blocks row-major
+// within a region, so a region's rays and hits are consecutive. Every stage
+// (render/stages/tile_stages.h) walks the blocks, so a block's data stays in
+// cache from ray generation to shading. Shared with tracers that run the same
+// stages (the Embree peer of the benchmarks).
 #pragma once
 
 #include <cstddef>

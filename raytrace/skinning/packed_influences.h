@@ -1,10 +1,8 @@
 // A mesh's skinning influences repacked for the per-frame skinning kernel.
 //
 // SkinnedMesh keeps kMaxInfluences (8) weights and joints per vertex, 48
-// bytes, though most vertices use one or two: at 855,552 triangles (Cally
-// subdivided four times) 48% of the vertices have one influence, 34% two,
-// and none more than five. Skinning reads every byte every frame, and there
-// the influences were a third of its memory traffic.
+// bytes, though most vertices use one or two. Skinning reads every byte
+// every frame, so the influences are packed to what each vertex uses.
 //
 // Here the vertices go in groups of eight (the AVX2 kernel's lanes). Each
 // vertex's non-zero weights move to its first slots, in their order; a

@@ -211,7 +211,7 @@ struct BoneBoxRow {
   // The box of the current run of checks against one bone, kept in
   // registers and merged into the bone's box when the bone changes: extending
   // the box in memory check after check made each wait for the last one's
-  // store (0.6 of 2.0 ms a frame at 855,552 triangles, 1 thread). Each side
+  // store. Each side
   // keeps the earlier value on ties and NaNs, as Aabb::extend does, so the
   // boxes have the same bits.
   std::size_t run_bone = bones;  // none yet
@@ -353,9 +353,8 @@ std::size_t count_escapes(const EscapeCheckInput& e, std::span<const BoneColumns
     return true;
   };
   // Eight vertices with one check each, all against one bone, are checked
-  // eight at a time (the AVX2 block check: 92% of the blocks at 855,552
-  // triangles, where the check by check loop spent about 30 cycles a
-  // check); other blocks, and blocks with a position that is not finite, go
+  // eight at a time (the AVX2 block check: most blocks of a fine mesh);
+  // other blocks, and blocks with a position that is not finite, go
   // check by check (check_vertex).
   const auto check_block = [&](std::size_t v) -> bool {
     const std::size_t c0 = a.check_begin[v];
@@ -363,9 +362,8 @@ std::size_t count_escapes(const EscapeCheckInput& e, std::span<const BoneColumns
     const std::uint32_t bone = a.checks[c0].bone;
     if (bone >= a.bone_limit) return false;
     // The arrays this reads stream in vertex order but each address waits
-    // for the load before it (begin, check, rank, cluster box): prefetched
-    // 2 KB ahead, the block check took 17% less (perf samples, 855,552
-    // triangles, 1 thread).
+    // for the load before it (begin, check, rank, cluster box), so they are
+    // prefetched 2 KB ahead.
     prefetch_ahead(a.check_begin.data() + v);
     prefetch_ahead(a.checks.data() + c0, 4);
     if (!a.bone_boxes.empty() && a.bone_boxes[bone] != nullptr) {

@@ -59,7 +59,7 @@ struct EscapeCheckInput {
   // skinned positions of the vertices with a check against that bone.
   // Merged in chunk order they are each bone's world bounds of its skinned
   // triangles, gathered while the check reads the checks anyway (a pass of
-  // its own read every check again: 1.7 ms a frame at 855,552 triangles).
+  // of its own would read every check again).
   std::span<Aabb> chunk_bone_boxes;
   // Optional (empty: every check against its own box): per bone, the boxes
   // its checks are held to instead, indexed by check_rank (the bone's

@@ -9,10 +9,9 @@
 // adds 0 * B (exactly 0, skinning matrices are finite), so the result matches
 // the scalar path, which skips zero weights, up to rounding.
 //
-// Loads + transposes instead of _mm256_i32gather_ps for the bones: on the
-// development machine (a virtualised Xeon) 12 gathers per slot made this
-// kernel slower than the scalar path (3.4 ms vs 2.4 ms for 100k vertices with
-// 4 influences); 24 row loads and 24 shuffles per slot take 1.1-1.7 ms.
+// Loads + transposes instead of _mm256_i32gather_ps for the bones: 12
+// gathers per slot made this kernel slower than the scalar path, 24 row
+// loads and 24 shuffles per slot are not.
 //
 // See skinning_kernels.h for why this file uses raw pointers and intrinsics
 // only.
@@ -37,8 +36,6 @@ struct Vec3x8 {
 // 8 consecutive xyz triples <-> one register per coordinate: three
 // 256-bit loads or stores, each coordinate's eight values spread over the
 // three registers at distinct lanes, so two blends and one permute apiece.
-// (Gathers made this kernel half again slower on an AMD EPYC: 45% of its
-// samples sat on the rest positions' and normals' gathers.)
 Vec3x8 load_xyz8(const float* p) {
   const __m256 a = _mm256_loadu_ps(p);       // x0 y0 z0 x1 y1 z1 x2 y2
   const __m256 b = _mm256_loadu_ps(p + 8);   // z2 x3 y3 z3 x4 y4 z4 x5
@@ -91,8 +88,8 @@ void load_bone_row8(const float* const lane_bones[8], int r, __m256 cols[4]) {
 // its joints straight from the slot (no transpose).
 //
 // A group rigid on one bone (PackedInfluences::group_bone: every rigid
-// block of the escape check is one, 44% of the groups at 855,552
-// triangles) takes that bone's entries broadcast, plus zero:
+// block of the escape check is one, and so are many groups of a fine
+// mesh) takes that bone's entries broadcast, plus zero:
 // fma(1, b, 0) to the bit (-0 + 0 is +0), without the row loads and
 // transposes.
 Matrix3x4x8 blend_bones(const SkinningArrays& a, std::size_t group) {

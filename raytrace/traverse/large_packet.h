@@ -1,24 +1,13 @@
-// Packets: one to 64 groups of eight rays (a tile's 4x2-pixel block, or its
-// 8x8-, 16x16- or 32x16-pixel region) traced together through every tree:
-// the one packet core, which 8-ray packets (traverse/packet_traversal.h)
-// run as one group. A packet walks a tree once for all its rays, culling
-// whole cells with a conservative interval bound on the rays
-// (cull/interval_bound.h): a cell costs one box test whatever the number
-// of rays, and a leaf's triangles are tested only by the groups whose own
-// bound reaches its cell, or, for rays from one apex (a camera, a point
-// light), by the groups whose frustum reaches the triangle
-// (cull/group_frusta.h).
-//
-// The bounds are carried into each bone's frame by bounding the rays after
-// the frame change (the transform is affine, so a ray stays a ray), and
-// every cell is grown by an upper bound on the single-ray traversal's
-// slack over the packet, so a lane reaches every cell its single ray
-// reaches. The triangle tests are the single ray's own, in world space, so
-// each lane's nearest hit has the single ray's t, u and v; the triangle can
-// differ only where two triangles give exactly the same t.
-//
-// A point light's shadow rays run from the light (render/stages/tile_stages.h):
-// one apex, as a camera's rays, and their frusta end at the shadowed points.
+// The packet core: one to 64 groups of eight rays (a tile's 4x2-pixel
+// block, or its 8x8-, 16x16- or 32x16-pixel region) walk every tree once
+// together; an 8-ray packet (traverse/packet_traversal.h) is one group. Cells
+// are culled by an interval bound over the rays, carried into each bone's
+// frame and grown by a bound on the single ray's slack, so a lane reaches
+// every cell its single ray reaches; rays from one apex (a camera, a point
+// light) also cull leaf triangles by group frusta. The triangle tests are the
+// single ray's, so each lane's nearest hit has its t, u and v; the triangle
+// can differ only at an exact tie in t. docs/RAYTRACE.md, "Packets: the one
+// core".
 #pragma once
 
 #include <cstdint>

@@ -1,14 +1,9 @@
 // A tile's outputs written into small planes of its own, then stored to the
-// host's planes a row at a time with streaming (non-temporal) stores.
-//
-// Why: a frame's outputs are megabytes (16 MiB for colour, depth and two id
-// planes at 1024x1024), far beyond the caches, and every line of them is
-// written exactly once. Written in place, each 64-byte line is first read
-// from memory (the store's read-for-ownership) and the shading of a 4x2
-// block waits on eight such lines; the tile's rows are also scattered over
-// one page per row and plane. Staged, the shading writes only lines in
-// cache, and each row goes out as whole lines that memory takes without
-// reading them first (docs/RAYTRACE.md, "Output staging"). Hosts get this for planes whose rows are 64-byte aligned.
+// host's planes a row at a time with streaming (non-temporal) stores: a
+// frame's outputs far exceed the caches and each line is written once, so
+// in place every store would first read its line from memory. Hosts get this
+// for planes whose rows are 64-byte aligned. docs/RAYTRACE.md, "Output
+// staging".
 #pragma once
 
 #include <cstddef>

@@ -101,9 +101,8 @@ constexpr double kFineTrianglePixels = 1.5;
 bool fine_geometry(const TileScratch& s, std::size_t b0, std::size_t b1) {
   // Per block, bit i of `across` for the pair (i, i + 1) of a row (bits 0-2
   // the top row, 4-6 the bottom one), bit i of `down` for (i, i + 4); a
-  // pair counts when both its pixels are on a character. Without branches:
-  // scalar pair by pair this was 4% of the shadow rays' time at 3,342
-  // triangles, where no region splits.
+  // pair counts when both its pixels are on a character. Without branches,
+  // since it runs for every region, also where none splits.
   int pairs = 0, changes = 0;
   for (std::size_t b = b0; b < b1; ++b) {
     const unsigned on = s.block_on_character[b];
