@@ -99,4 +99,17 @@ rt::StaticMeshDesc ground_plane_for(const Model& model, int instances) {
 
 // --- the command --------------------------------------------------------------
 
+rt::Light light_from_option(const cli::LightOption& option) {
+  rt::Light light;
+  light.kind = option.directional ? rt::Light::Kind::kDirectional : rt::Light::Kind::kPoint;
+  const Vec3 xyz(option.xyz[0], option.xyz[1], option.xyz[2]);
+  if (option.directional) {
+    light.direction = xyz;
+  } else {
+    light.position = xyz;
+  }
+  light.color = Vec3(option.rgb[0], option.rgb[1], option.rgb[2]);
+  return light;
+}
+
 }  // namespace sinew::character

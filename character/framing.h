@@ -18,7 +18,9 @@
 
 #include "character/model.h"
 #include "raytrace/camera/camera.h"
+#include "raytrace/render/render_settings.h"
 #include "raytrace/scene/scene.h"
+#include "runtime/cli/option_values.h"
 #include "runtime/math/aabb.h"
 
 namespace sinew::character {
@@ -39,5 +41,7 @@ Aabb posed_bounds(const rt::Scene& scene);
 // The default camera framing `box` and the default point light.
 rt::CameraDesc default_camera(const Aabb& box, int up, int width, int height);
 Vec3 default_light(const Aabb& box, int up);
+// The light a tool's --light typed (cli::parse_light).
+rt::Light light_from_option(const cli::LightOption& option);
 
 }  // namespace sinew::character

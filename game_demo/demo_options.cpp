@@ -5,6 +5,7 @@
 #include <type_traits>
 #include <optional>
 
+#include "character/framing.h"
 #include "runtime/cli/command_line.h"
 #include "runtime/cli/option_values.h"
 
@@ -28,7 +29,11 @@ struct DemoFlags {
                         "take the keys from an input script (frame key down|up|tap per\n"
                         "line) with fixed 1/30 s steps, windowed or headless")),
         screenshot(l.option("--screenshot", "PATH", "windowed: write the last frame as shown (HUD included) as PNG")),
-        no_hud(l.flag("--no-hud", "windowed: start with the HUD hidden (F1 shows it)")) {}
+        no_hud(l.flag("--no-hud", "windowed: start with the HUD hidden (F1 shows it)")),
+        lights(l.repeated_option("--light", "X,Y,Z|point:X,Y,Z|dir:X,Y,Z[:R,G,B]",
+                                 "a point light at X,Y,Z or a directional light towards X,Y,Z, with\n"
+                                 "its linear colour (default 1,1,1); up to 8 (default: the arena's\n"
+                                 "point light)")) {}
 
   const bool& headless;
   const std::optional<std::string>& frames;
@@ -41,6 +46,7 @@ struct DemoFlags {
   const std::optional<std::string>& script;
   const std::optional<std::string>& screenshot;
   const bool& no_hud;
+  const std::vector<std::string>& lights;
 };
 
 const char* const kDescription =
@@ -90,6 +96,14 @@ Expected<DemoOptions> parse_demo_options(const std::vector<std::string>& args) {
   if (f.model) o.model_path = *f.model;
   if (f.script) o.script_path = *f.script;
   if (f.screenshot) o.screenshot_path = *f.screenshot;
+  if (f.lights.size() > rt::kMaxLights) {
+    return invalid_argument("--light", f.lights.back(),
+                            "at most " + std::to_string(rt::kMaxLights) + " lights");
+  }
+  for (const std::string& text : f.lights) {
+    SINEW_ASSIGN_OR_RETURN(const cli::LightOption light, cli::parse_light("--light", text));
+    o.lights.push_back(character::light_from_option(light));
+  }
   if (o.headless && o.frames == 0) o.frames = 120;
   return o;
 }

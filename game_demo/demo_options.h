@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "raytrace/render/render_settings.h"
 #include "runtime/core/expected.h"
 
 namespace sinew::demo {
@@ -24,6 +25,7 @@ struct DemoOptions {
   std::string script_path;      // keys from this input script (input_script.h), fixed 1/30 s steps
   std::string screenshot_path;  // windowed: the last frame as shown, HUD included, as PNG
   bool hud = true;              // windowed: HUD shown at start
+  std::vector<rt::Light> lights;  // empty: the arena's point light
   bool help = false;
 };
 

@@ -130,6 +130,10 @@ Expected<std::unique_ptr<DemoSession>> DemoSession::create(const SessionOptions&
   s.settings_.triangle_test = options.triangle_test;
   s.settings_.light.kind = rt::Light::Kind::kPoint;
   s.settings_.light.position = s.arena_.light_position;
+  if (!s.options_.lights.empty()) {
+    const std::size_t count = std::min(s.options_.lights.size(), rt::kMaxLights);
+    s.settings_.lights = std::span<const rt::Light>(s.options_.lights.data(), count);
+  }
   s.settings_.background = Vec3(0.30f, 0.38f, 0.50f);
   s.rgba_.assign(static_cast<std::size_t>(options.width) * static_cast<std::size_t>(options.height) * 4, 0);
   return session;

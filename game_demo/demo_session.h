@@ -40,6 +40,7 @@ struct SessionOptions {
   int height = 1024;
   bool shadows = true;
   rt::TriangleTest triangle_test = rt::TriangleTest::kFast;
+  std::vector<rt::Light> lights;  // at most rt::kMaxLights; empty: the arena's point light
 };
 
 // The third-person camera's free parameters; it follows the player.

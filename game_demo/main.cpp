@@ -167,6 +167,7 @@ int run(const std::vector<std::string>& args) {
   so.seed = opt.seed;
   so.width = opt.width;
   so.height = opt.height;
+  so.lights = opt.lights;
   std::printf("sinew-demo: loading %s...\n", opt.model_path.empty() ? "the mannequin" : opt.model_path.c_str());
   std::fflush(stdout);
   auto session = DemoSession::create(so, *jobs);

@@ -58,7 +58,10 @@ struct RenderFlags {
         seed(l.option("--seed", "S", "seed of the random pose spaces (default 1)")),
         limits(l.option("--limits", "FILE.json", "joint limits, required by --pose-space limits")),
         shadows(l.option("--shadows", "on|off", "shadow rays (default on)")),
-        light(l.option("--light", "x,y,z", "point light position (default: above-front of the model)")),
+        light(l.repeated_option("--light", "X,Y,Z|point:X,Y,Z|dir:X,Y,Z[:R,G,B]",
+                                "a point light at X,Y,Z or a directional light towards X,Y,Z, with\n"
+                                "its linear colour (default 1,1,1); up to 8 (default: one point\n"
+                                "light above-front of the model)")),
         threads(l.option("--threads", "N", "worker threads (default 0: all cores)")),
         instances(l.option("--instances", "N", "copies side by side along +X, each 0.37 s later (default 1)")),
         frames(l.option("--frames", "N", "frames rendered at 30 fps from --time; the last is written (default 1)")),
@@ -97,7 +100,7 @@ struct RenderFlags {
   const std::optional<std::string>& seed;
   const std::optional<std::string>& limits;
   const std::optional<std::string>& shadows;
-  const std::optional<std::string>& light;
+  const std::vector<std::string>& light;
   const std::optional<std::string>& threads;
   const std::optional<std::string>& instances;
   const std::optional<std::string>& frames;
@@ -192,9 +195,12 @@ Status parse_view(const RenderFlags& f, RenderOptions& o) {
     }
     o.camera = desc;
   }
-  if (const std::optional<std::string>& text = f.light) {
-    SINEW_ASSIGN_OR_RETURN(const std::vector<float> v, cli::parse_floats("--light", *text, 3));
-    o.light = Vec3(v[0], v[1], v[2]);
+  if (f.light.size() > rt::kMaxLights) {
+    return invalid_argument("--light", f.light.back(), "at most " + std::to_string(rt::kMaxLights) + " lights");
+  }
+  for (const std::string& text : f.light) {
+    SINEW_ASSIGN_OR_RETURN(const cli::LightOption light, cli::parse_light("--light", text));
+    o.lights.push_back(character::light_from_option(light));
   }
   if (const std::optional<std::string>& text = f.size) {
     SINEW_ASSIGN_OR_RETURN(const cli::Size2 size, cli::parse_size("--size", *text, kMaxImageSide));
@@ -502,8 +508,12 @@ Expected<RenderOutputs> render_model(const RenderOptions& options) {
       // Framed once, on the first frame's pose, so every frame shares one view.
       const Aabb posed = character::posed_bounds(scene);
       out.camera = options.camera ? *options.camera : character::default_camera(posed, up, options.width, options.height);
-      out.light.position = options.light ? *options.light : character::default_light(posed, up);
-      settings.light = out.light;
+      out.lights = options.lights;
+      if (out.lights.empty()) {
+        out.lights.emplace_back();
+        out.lights.back().position = character::default_light(posed, up);
+      }
+      settings.lights = out.lights;
       SINEW_ASSIGN_OR_RETURN(camera, rt::PinholeCamera::create(out.camera, options.width, options.height));
     }
     SINEW_ASSIGN_OR_RETURN(const rt::RenderStats rendered,

@@ -55,8 +55,10 @@ struct RenderOptions {
   anim::PoseSpaceDesc pose_space = character::default_pose_space();
   std::string limits_path;         // joint limits JSON, for pose space "limits"
   bool shadows = true;
-  std::optional<Vec3> light;  // empty: placed automatically
-  int threads = 0;            // 0: all cores
+  // At most rt::kMaxLights; empty: one white point light placed
+  // automatically (character::default_light).
+  std::vector<rt::Light> lights;
+  int threads = 0;  // 0: all cores
   int instances = 1;
   int frames = 1;
   rt::TriangleTest triangle_test = rt::TriangleTest::kFast;
@@ -111,7 +113,7 @@ struct RenderOutputs {
   LineAlignedVector<std::uint32_t> triangle_id;
   LineAlignedVector<std::uint32_t> instance_id;
   rt::CameraDesc camera;   // the camera used (given or framed)
-  rt::Light light;         // the light used
+  std::vector<rt::Light> lights;  // the lights used
   std::string clip_name;   // empty: rest pose
   double last_frame_seconds = 0.0;  // playback time of instance 0 in the written frame
   std::vector<Affine3> instance_placements;  // per instance: model -> world

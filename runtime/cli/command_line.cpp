@@ -79,6 +79,17 @@ const std::optional<std::string>& CommandLine::option(const std::string& names, 
   return text;
 }
 
+const std::vector<std::string>& CommandLine::repeated_option(const std::string& names, const std::string& value_form,
+                                                             const std::string& help) {
+  std::vector<std::string>& texts = lists_.emplace_back();
+  // One value per occurrence, every occurrence kept.
+  app_->add_option(names, texts, help)
+      ->type_name(value_form + " (repeatable)")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  return texts;
+}
+
 const bool& CommandLine::flag(const std::string& names, const std::string& help) {
   bool& given = switches_.emplace_back(false);
   app_->add_flag(names, given, help);

@@ -46,6 +46,10 @@ class CommandLine {
   // (empty when not given) and lives as long as this object.
   const std::optional<std::string>& option(const std::string& names, const std::string& value_form,
                                            const std::string& help);
+  // A value-taking option that may be given several times ("--light"):
+  // its texts in the order given (empty when not given).
+  const std::vector<std::string>& repeated_option(const std::string& names, const std::string& value_form,
+                                                  const std::string& help);
   // A switch: true when given.
   const bool& flag(const std::string& names, const std::string& help);
   // The positional arguments, in order; more than `max` is a usage error.
@@ -77,6 +81,7 @@ class CommandLine {
   // Deques: CLI11 keeps references to them while more are declared.
   std::deque<std::optional<std::string>> texts_;
   std::deque<bool> switches_;
+  std::deque<std::vector<std::string>> lists_;
   std::vector<std::string> positionals_;
   std::size_t max_positionals_ = 0;
   std::vector<std::string> commands_;

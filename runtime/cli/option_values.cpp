@@ -1,6 +1,7 @@
 #include "runtime/cli/option_values.h"
 
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <filesystem>
@@ -74,6 +75,38 @@ Expected<std::vector<float>> parse_floats(std::string_view flag, const std::stri
     values.push_back(*value);
   }
   return values;
+}
+
+Expected<LightOption> parse_light(std::string_view flag, const std::string& text) {
+  LightOption light;
+  std::string rest = text;
+  if (rest.rfind("point:", 0) == 0) {
+    rest = rest.substr(6);
+  } else if (rest.rfind("dir:", 0) == 0) {
+    light.directional = true;
+    rest = rest.substr(4);
+  } else if (!rest.empty() && (std::isalpha(static_cast<unsigned char>(rest[0])) != 0)) {
+    return invalid_argument(flag, text, "expected X,Y,Z, point:X,Y,Z or dir:X,Y,Z, each optionally :R,G,B");
+  }
+  std::string colour;
+  if (const std::size_t colon = rest.find(':'); colon != std::string::npos) {
+    colour = rest.substr(colon + 1);
+    rest = rest.substr(0, colon);
+    if (colour.empty()) return invalid_argument(flag, text, "expected R,G,B after ':'");
+  }
+  SINEW_ASSIGN_OR_RETURN(const std::vector<float> xyz, parse_floats(flag, rest, 3));
+  std::copy(xyz.begin(), xyz.end(), light.xyz);
+  if (light.directional && xyz[0] == 0.0f && xyz[1] == 0.0f && xyz[2] == 0.0f) {
+    return invalid_argument(flag, text, "a directional light needs a non-zero direction");
+  }
+  if (!colour.empty()) {
+    SINEW_ASSIGN_OR_RETURN(const std::vector<float> rgb, parse_floats(flag, colour, 3));
+    if (std::any_of(rgb.begin(), rgb.end(), [](float c) { return c < 0.0f; })) {
+      return invalid_argument(flag, text, "a light's colour is not negative");
+    }
+    std::copy(rgb.begin(), rgb.end(), light.rgb);
+  }
+  return light;
 }
 
 Expected<std::vector<std::string>> parse_list(std::string_view flag, const std::string& text) {

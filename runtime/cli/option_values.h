@@ -41,6 +41,16 @@ Expected<bool> parse_on_off(std::string_view flag, const std::string& text);
 // Folders separated by ':', each existing.
 Expected<std::vector<std::string>> parse_folder_list(std::string_view flag, const std::string& text);
 
+// A light as typed: "X,Y,Z" or "point:X,Y,Z" (a point light's position),
+// or "dir:X,Y,Z" (the direction towards a directional light, any length),
+// either followed by ":R,G,B" (its linear colour, default 1,1,1).
+struct LightOption {
+  bool directional = false;
+  float xyz[3] = {0.0f, 0.0f, 0.0f};
+  float rgb[3] = {1.0f, 1.0f, 1.0f};
+};
+Expected<LightOption> parse_light(std::string_view flag, const std::string& text);
+
 // --threads N, the same everywhere: worker threads, 0 meaning every core
 // the process may use (what JobSystem takes); at most kMaxThreads.
 inline constexpr int kMaxThreads = 1024;

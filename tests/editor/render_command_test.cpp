@@ -362,6 +362,13 @@ TEST(RenderCommand, UsageErrorsNameTheFlagAndValue) {
       {{kCesiumMan, "--out", dir, "--threads", "two"}, "--threads = two: expected an integer"},
       {{kCesiumMan, "--out", dir, "--time", "nan"}, "--time = nan: expected a number"},
       {{kCesiumMan, "--out", dir, "--light", "1,2"}, "--light = 1,2: expected 3"},
+      {{kCesiumMan, "--out", dir, "--light", "sun:1,2,3"}, "--light = sun:1,2,3: expected X,Y,Z, point:X,Y,Z or dir"},
+      {{kCesiumMan, "--out", dir, "--light", "dir:0,0,0"}, "--light = dir:0,0,0: a directional light needs a non-zero"},
+      {{kCesiumMan, "--out", dir, "--light", "point:1,2,3:1,-1,0"}, "--light = point:1,2,3:1,-1,0: a light's colour"},
+      {{kCesiumMan, "--out", dir, "--light", "point:1,2,3:"}, "--light = point:1,2,3:: expected R,G,B"},
+      {{kCesiumMan, "--out", dir, "--light", "1,2,3", "--light", "1,2,3", "--light", "1,2,3", "--light", "1,2,3",
+        "--light", "1,2,3", "--light", "1,2,3", "--light", "1,2,3", "--light", "1,2,3", "--light", "4,5,6"},
+       "--light = 4,5,6: at most 8 lights"},
       {{kCesiumMan, "--out", dir, "--pose-space", "limits"}, "--pose-space = limits: needs --limits"},
       {{kCesiumMan, "--out", dir, "--pose-space", "clip"}, "--pose-space = clip: expected"},
       {{kCesiumMan, "--out", dir, "--pose-space", "arbitrary", "--clips", "a"}, "--clips = a: applies to"},
@@ -436,7 +443,10 @@ TEST(RenderCommand, OptionsMapToTheirSettings) {
   EXPECT_EQ(o->camera->eye, Vec3(1.0f, 2.0f, 3.0f));
   EXPECT_EQ(o->camera->up, Vec3(0.0f, 0.0f, 1.0f));
   EXPECT_EQ(o->camera->fovy_degrees, 30.0f);
-  EXPECT_EQ(o->light, Vec3(4.0f, 5.0f, 6.0f));
+  ASSERT_EQ(o->lights.size(), 1u);
+  EXPECT_EQ(o->lights[0].kind, rt::Light::Kind::kPoint);
+  EXPECT_EQ(o->lights[0].position, Vec3(4.0f, 5.0f, 6.0f));
+  EXPECT_EQ(o->lights[0].color, Vec3(1.0f));
   EXPECT_EQ(o->instances, 3);
   EXPECT_EQ(o->time_seconds, 1.5);
 
@@ -452,6 +462,22 @@ TEST(RenderCommand, OptionsMapToTheirSettings) {
   EXPECT_FALSE(d->camera.has_value());
   EXPECT_EQ(d->pose_space.mode, character::default_pose_space().mode);
   EXPECT_EQ(d->pose_space.every_frame_30hz, character::default_pose_space().every_frame_30hz);
+
+  EXPECT_TRUE(d->lights.empty());
+
+  // Lights of both kinds, in the order given, each with its colour.
+  const auto lit = parse_render_options({"m.glb", "--out", "o", "--light", "point:-2,5,3:0.8,0.5,0.25", "--light",
+                                         "dir:0.5,1,-0.2", "--light=1,2,3:0,0,1"});
+  ASSERT_TRUE(lit.ok()) << lit.status().message();
+  ASSERT_EQ(lit->lights.size(), 3u);
+  EXPECT_EQ(lit->lights[0].kind, rt::Light::Kind::kPoint);
+  EXPECT_EQ(lit->lights[0].position, Vec3(-2.0f, 5.0f, 3.0f));
+  EXPECT_EQ(lit->lights[0].color, Vec3(0.8f, 0.5f, 0.25f));
+  EXPECT_EQ(lit->lights[1].kind, rt::Light::Kind::kDirectional);
+  EXPECT_EQ(lit->lights[1].direction, Vec3(0.5f, 1.0f, -0.2f));
+  EXPECT_EQ(lit->lights[1].color, Vec3(1.0f));
+  EXPECT_EQ(lit->lights[2].position, Vec3(1.0f, 2.0f, 3.0f));
+  EXPECT_EQ(lit->lights[2].color, Vec3(0.0f, 0.0f, 1.0f));
 
   const auto r = parse_render_options({"m.glb", "--out", "o", "--pose-space", "arbitrary", "--samples", "50",
                                        "--seed", "18446744073709551615"});

@@ -94,6 +94,47 @@ TEST(DemoSession, CharactersCastShadowsOnTheGround) {
   EXPECT_EQ(brighter, 0);     // shadows only ever remove light
 }
 
+// --light: the session shades with every light it is given (the renderer's
+// brute-force test checks each light's share; this checks the demo hands
+// them all on). One light per colour channel: with shadows each channel
+// darkens somewhere, so each light casts its own shadow rays.
+TEST(DemoSession, EveryLightGivenCastsItsOwnShadows) {
+  JobSystem jobs(2);
+  SessionOptions options;
+  options.width = 96;
+  options.height = 96;
+  options.lights.resize(3);
+  options.lights[0].position = Vec3(6.0f, 12.0f, 4.0f);
+  options.lights[0].color = Vec3(1.0f, 0.0f, 0.0f);
+  options.lights[1].position = Vec3(-5.0f, 8.0f, 6.0f);
+  options.lights[1].color = Vec3(0.0f, 1.0f, 0.0f);
+  options.lights[2].kind = rt::Light::Kind::kDirectional;
+  options.lights[2].direction = Vec3(0.3f, 1.0f, -0.6f);
+  options.lights[2].color = Vec3(0.0f, 0.0f, 1.0f);
+  auto created = DemoSession::create(options, jobs);
+  ASSERT_TRUE(created.ok()) << created.status().message();
+  DemoSession& session = **created;
+  ASSERT_EQ(session.render_settings().lights.size(), 3u);
+  const auto lit = [&](bool shadows) {
+    session.render_settings().shadows = shadows;
+    FollowCamera camera;
+    auto report = session.frame(shadows ? kStep : 0.0f, PlayerInput{}, camera, jobs);
+    EXPECT_TRUE(report.ok());
+    return std::vector<std::uint8_t>(session.rgba().begin(), session.rgba().end());
+  };
+  const auto with = lit(true);
+  const auto without = lit(false);
+  for (std::size_t c = 0; c < 3; ++c) {
+    int darker = 0, brighter = 0;
+    for (std::size_t i = 0; i < with.size(); i += 4) {
+      darker += with[i + c] + 8 < without[i + c] ? 1 : 0;
+      brighter += with[i + c] > without[i + c] ? 1 : 0;
+    }
+    EXPECT_GT(darker, 10) << "light " << c << " casts no shadow";
+    EXPECT_EQ(brighter, 0) << "light " << c;
+  }
+}
+
 TEST(DemoSession, BadModelPathsAreClearErrors) {
   JobSystem jobs(1);
   SessionOptions options;

@@ -7,6 +7,8 @@
 // render of every output.
 #include <gtest/gtest.h>
 
+#include <glm/geometric.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -349,6 +351,108 @@ TEST(Renderer, ColourAloneHoldsTheBytesOfARenderOfEveryOutput) {
         }
       }
     }
+  }
+}
+
+
+// Several lights, each with its own share of the colour. Two point lights
+// and a directional one, each in one colour channel and with no ambient:
+// channel c of the linear colour is light c's contribution alone. Against
+// brute force over every triangle: where the hit's geometric normal faces
+// light c and a shadow ray from the hit reaches it, the channel is the
+// albedo times N·L of the shading normal; elsewhere it is 0. Pixels whose
+// brute-force answer depends on the shadow ray's offset from the surface,
+// or that lie on the terminator, are left out.
+TEST(Renderer, EachLightsContributionIsItsBruteForceVisibilityTimesNdotL) {
+  const rt::Scene& sc = scene();
+  JobSystem jobs(2);
+  const int w = 80, h = 60;
+  const rt::CameraDesc desc{Vec3(0.5f, 1.8f, 3.5f), Vec3(0.0f, 0.6f, 0.0f), Vec3(0, 1, 0), 50.0f};
+  const auto camera = rt::PinholeCamera::create(desc, w, h).value();
+  rt::Light lights[3];
+  lights[0].position = Vec3(-2.0f, 5.0f, 3.0f);
+  lights[0].color = Vec3(1.0f, 0.0f, 0.0f);
+  lights[1].position = Vec3(3.0f, 3.0f, -1.0f);
+  lights[1].color = Vec3(0.0f, 1.0f, 0.0f);
+  lights[2].kind = rt::Light::Kind::kDirectional;
+  lights[2].direction = Vec3(0.5f, 1.0f, -0.2f);
+  lights[2].color = Vec3(0.0f, 0.0f, 1.0f);
+  rt::RenderSettings settings;
+  settings.lights = lights;
+  settings.ambient = Vec3(0.0f);
+  HostFrame lit(w, h, 64, 0, 0);
+  rt::Renderer renderer;
+  ASSERT_TRUE(renderer.render(sc, camera, settings, lit.buffers, jobs).ok());
+  // The albedo: ambient 1 and dark lights.
+  rt::Light dark[1];
+  dark[0].color = Vec3(0.0f);
+  rt::RenderSettings albedo_settings;
+  albedo_settings.lights = dark;
+  albedo_settings.ambient = Vec3(1.0f);
+  HostFrame albedo(w, h, 64, 0, 0);
+  ASSERT_TRUE(renderer.render(sc, camera, albedo_settings, albedo.buffers, jobs).ok());
+
+  const std::vector<testing_support::SoupTriangle> soup = testing_support::world_triangles(sc);
+  const auto occluded = [&](const Vec3& from, const rt::Light& light) {
+    Ray ray;
+    ray.origin = from;
+    ray.t_min = 0.0f;
+    if (light.kind == rt::Light::Kind::kPoint) {
+      ray.direction = light.position - from;
+      ray.t_max = 1.0f;
+    } else {
+      ray.direction = light.direction;
+      ray.t_max = testing_support::kInf;
+    }
+    return testing_support::nearest(soup, ray, TriangleTest::kWatertight).valid();
+  };
+  const auto pixel = [](const HostFrame& f, std::size_t plane, std::size_t bytes, int x, int y) {
+    return f.planes[plane].bytes.data() + f.planes[plane].offset + static_cast<std::size_t>(y) * f.planes[plane].pitch +
+           bytes * static_cast<std::size_t>(x);
+  };
+  int checked[3] = {0, 0, 0}, shadowed[3] = {0, 0, 0};
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      std::uint32_t triangle, instance;
+      std::memcpy(&triangle, pixel(lit, 4, 4, x, y), 4);
+      std::memcpy(&instance, pixel(lit, 5, 4, x, y), 4);
+      if (instance == kInvalidId) continue;
+      float depth, color[4], base[4];
+      Vec3 n;
+      std::memcpy(&depth, pixel(lit, 2, 4, x, y), 4);
+      std::memcpy(&n, pixel(lit, 3, sizeof(Vec3), x, y), sizeof(Vec3));
+      std::memcpy(color, pixel(lit, 1, 16, x, y), 16);
+      std::memcpy(base, pixel(albedo, 1, 16, x, y), 16);
+      const Ray eye = camera.ray(x, y);
+      const Vec3 p = eye.origin + depth * eye.direction;
+      const auto tri = std::find_if(soup.begin(), soup.end(), [&](const testing_support::SoupTriangle& t) {
+        return t.triangle_id == triangle && t.instance_id == instance;
+      });
+      ASSERT_NE(tri, soup.end()) << "pixel " << x << "," << y;
+      Vec3 g = glm::normalize(glm::cross(tri->p1 - tri->p0, tri->p2 - tri->p0));
+      if (glm::dot(g, eye.direction) > 0.0f) g = -g;
+      for (int c = 0; c < 3; ++c) {
+        const rt::Light& light = lights[c];
+        const Vec3 to = light.kind == rt::Light::Kind::kPoint ? light.position - p : light.direction;
+        const Vec3 l = glm::normalize(to);
+        if (std::fabs(glm::dot(g, l)) < 1e-3f) continue;  // the terminator
+        bool blocked = glm::dot(g, l) < 0.0f;
+        if (!blocked) {
+          const bool near = occluded(p + 1e-4f * g, light), far = occluded(p + 1e-3f * g, light);
+          if (near != far) continue;  // an occluder within the offsets: the test's own rounding decides
+          blocked = near;
+        }
+        const float expected = blocked ? 0.0f : base[c] * std::max(glm::dot(n, l), 0.0f);
+        ++checked[c];
+        shadowed[c] += blocked && glm::dot(g, l) > 0.0f ? 1 : 0;
+        EXPECT_NEAR(color[c], expected, 2e-3f) << "light " << c << " pixel " << x << "," << y << " instance "
+                                               << instance << (blocked ? " (blocked)" : " (lit)");
+      }
+    }
+  }
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_GT(checked[c], w * h / 3) << "light " << c;
+    EXPECT_GT(shadowed[c], 20) << "light " << c << " casts no shadow in view";
   }
 }
 
