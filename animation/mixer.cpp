@@ -197,8 +197,9 @@ void Mixer::update(float dt) {
   if (duration_ == 0.0f) {
     time_ = 0.0f;
   } else {
-    time_ += dt;
-    if (time_ >= duration_) time_ = wrap(time_, duration_);
+    time_ += dt * time_factor_;
+    if (time_ >= duration_ || time_ < 0.0f) time_ = wrap(time_, duration_);
+    if (time_ < 0.0f) time_ += duration_;  // fmod keeps the sign: a clock running backwards
   }
 
   // Newest first, as Cal3D walks its lists.
@@ -223,6 +224,12 @@ void Mixer::update(float dt) {
   }
   duration_ = accumulated_weight > 0.0f ? accumulated_duration / accumulated_weight : 0.0f;
   rebuild_layers();
+}
+
+Status Mixer::set_time_factor(float factor) {
+  if (!std::isfinite(factor)) return invalid_argument("time_factor", std::to_string(factor), "must be finite");
+  time_factor_ = factor;
+  return Status{};
 }
 
 void Mixer::set_synchronized_cycles(bool on) {

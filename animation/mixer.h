@@ -33,6 +33,7 @@
 //  * Layers are emitted in Cal3D's evaluation order: actions (newest first),
 //    then cycles (newest first). Actions take min(sum of weights, 1) of the
 //    pose; cycles share the rest by normalised weights (see blend.h).
+//  * The time factor (setTimeFactor) scales only the sync clock's step.
 //  * Cal3D's blendCycle appends a closing key at the clip's duration when a
 //    track ends earlier (loop closure). Our Clip's duration is its last key
 //    time, so the Cal3D importer appends that key instead; nothing to do here.
@@ -84,6 +85,14 @@ class Mixer {
   // affects cycles started afterwards only.
   void set_synchronized_cycles(bool on);
   bool synchronized_cycles() const { return sync_new_cycles_; }
+
+  // Cal3D's CalMixer::setTimeFactor: update(dt) moves the global sync clock
+  // by dt * factor, so synchronised cycles play faster, slower or (negative)
+  // backwards, the clock wrapping into [0, period). Weight fades, actions
+  // and desynchronised cycles keep real time, as in Cal3D. Default 1.
+  // Errors (kInvalidArgument, nothing changed): a non-finite factor.
+  Status set_time_factor(float factor);
+  float time_factor() const { return time_factor_; }
 
   // The blend for the current state, in evaluation order (see blend.h).
   std::span<const BlendLayer> layers() const { return layers_; }
@@ -150,6 +159,7 @@ class Mixer {
   std::vector<BlendLayer> layers_;
   float time_ = 0.0f;      // Cal3D's m_animationTime
   float duration_ = 0.0f;  // Cal3D's m_animationDuration
+  float time_factor_ = 1.0f;  // Cal3D's m_timeFactor
   bool sync_new_cycles_ = true;
 };
 

@@ -40,24 +40,6 @@ Result<int> clip_index(const Instance& instance, std::string_view clip) {
                                                      "': no such clip (clips: " + (names.empty() ? "none" : names) + ")");
 }
 
-// The instance `id` if it exists and has the wanted driver.
-Result<Instance*> find_instance(World::Impl& world, InstanceId id, Driver wanted, const char* call) {
-  if (id >= world.instances.size() || world.instances[id].is_static || world.instances[id].removed) {
-    const bool removed = id < world.instances.size() && world.instances[id].removed;
-    return detail::api_error(ErrorCode::kNotFound,
-                             std::string(call) + ": instance " + std::to_string(id) + ": " +
-                                 (removed ? "removed (World::remove)" : "no such character instance"));
-  }
-  Instance& instance = world.instances[id];
-  if (instance.driver != wanted) {
-    return detail::api_error(ErrorCode::kInvalidArgument,
-                             std::string(call) + ": instance " + std::to_string(id) + " is " +
-                                 (instance.driver == Driver::kHost ? "host-driven" : "mixer-driven") +
-                                 " (InstanceDesc::driver)");
-  }
-  return &instance;
-}
-
 void reset_mixer(Instance& instance) {
   const auto& model = instance.core->model();
   instance.mixer = std::make_unique<anim::Mixer>(std::span<const anim::Clip>(model.clips));
@@ -78,6 +60,33 @@ Status finish_pose(World::Impl& world, InstanceId id) {
   return detail::to_api_status(world.scene.set_bones(id, instance.skin));
 }
 
+}  // namespace
+
+namespace detail {
+
+Result<Instance*> find_character(World::Impl& world, InstanceId id, const char* call) {
+  if (id >= world.instances.size() || world.instances[id].is_static || world.instances[id].removed) {
+    const bool removed = id < world.instances.size() && world.instances[id].removed;
+    return detail::api_error(ErrorCode::kNotFound,
+                             std::string(call) + ": instance " + std::to_string(id) + ": " +
+                                 (removed ? "removed (World::remove)" : "no such character instance"));
+  }
+  return &world.instances[id];
+}
+
+Result<Instance*> find_instance(World::Impl& world, InstanceId id, Driver wanted, const char* call) {
+  const auto found = find_character(world, id, call);
+  if (!found.ok()) return found.error();
+  Instance& instance = **found;
+  if (instance.driver != wanted) {
+    return detail::api_error(ErrorCode::kInvalidArgument,
+                             std::string(call) + ": instance " + std::to_string(id) + " is " +
+                                 (instance.driver == Driver::kHost ? "host-driven" : "mixer-driven") +
+                                 " (InstanceDesc::driver)");
+  }
+  return &instance;
+}
+
 Status pose_from_mixer(World::Impl& world, InstanceId id) {
   Instance& instance = world.instances[id];
   const character::Model& model = instance.core->model();
@@ -86,7 +95,7 @@ Status pose_from_mixer(World::Impl& world, InstanceId id) {
   return finish_pose(world, id);
 }
 
-}  // namespace
+}  // namespace detail
 
 World::World(std::unique_ptr<Impl> impl) noexcept : impl_(std::move(impl)) {}
 World::~World() = default;
@@ -101,6 +110,11 @@ Result<InstanceId> World::add_instance(const Character& character, const Instanc
   return detail::guarded("World::add_instance", [&]() -> Result<InstanceId> {
     if (!finite(desc.transform)) {
       return detail::api_error(ErrorCode::kInvalidArgument, "World::add_instance: desc.transform: not finite");
+    }
+    if (!finite(desc.playback_speed) || desc.playback_speed < 0.0f) {
+      return detail::api_error(ErrorCode::kInvalidArgument,
+                               "World::add_instance: desc.playback_speed = " + std::to_string(desc.playback_speed) +
+                                   ": expected a finite speed >= 0");
     }
     if (impl_->instances.size() >= kMaxInstances) {
       return detail::api_error(ErrorCode::kLimitExceeded,
@@ -124,6 +138,7 @@ Result<InstanceId> World::add_instance(const Character& character, const Instanc
     instance.driver = desc.driver;
     instance.transform = desc.driver == Driver::kMixer ? detail::to_internal(desc.transform) : Affine3::identity();
     instance.limits = desc.apply_joint_limits;
+    instance.speed = desc.playback_speed;
     const std::size_t joints = core->model().skeleton.joint_count();
     instance.local.resize(joints);
     instance.model_pose.resize(joints);
@@ -180,7 +195,7 @@ Result<InstanceId> World::add_static_mesh(const StaticMeshDesc& mesh) noexcept {
 
 Status World::set_bone_matrices(InstanceId id, std::span<const Matrix3x4> skinning) noexcept {
   return detail::guarded("World::set_bone_matrices", [&]() -> Status {
-    const auto found = find_instance(*impl_, id, Driver::kHost, "World::set_bone_matrices");
+    const auto found = detail::find_instance(*impl_, id, Driver::kHost, "World::set_bone_matrices");
     if (!found.ok()) return found.error();
     Instance& instance = **found;
     if (skinning.size() != instance.skin.size()) {
@@ -205,7 +220,7 @@ Status World::set_bone_matrices(InstanceId id, std::span<const Matrix3x4> skinni
 
 Status World::set_transform(InstanceId id, const Matrix3x4& model_to_world) noexcept {
   return detail::guarded("World::set_transform", [&]() -> Status {
-    const auto found = find_instance(*impl_, id, Driver::kMixer, "World::set_transform");
+    const auto found = detail::find_instance(*impl_, id, Driver::kMixer, "World::set_transform");
     if (!found.ok()) return found.error();
     if (!finite(model_to_world)) {
       return detail::api_error(ErrorCode::kInvalidArgument, "World::set_transform: model_to_world: not finite");
@@ -217,7 +232,7 @@ Status World::set_transform(InstanceId id, const Matrix3x4& model_to_world) noex
 
 Status World::play_cycle(InstanceId id, std::string_view clip, float weight, float fade_seconds) noexcept {
   return detail::guarded("World::play_cycle", [&]() -> Status {
-    const auto found = find_instance(*impl_, id, Driver::kMixer, "World::play_cycle");
+    const auto found = detail::find_instance(*impl_, id, Driver::kMixer, "World::play_cycle");
     if (!found.ok()) return found.error();
     const auto index = clip_index(**found, clip);
     if (!index.ok()) return index.error();
@@ -232,7 +247,7 @@ Status World::play_cycle(InstanceId id, std::string_view clip, float weight, flo
 
 Status World::stop_cycle(InstanceId id, std::string_view clip, float fade_seconds) noexcept {
   return detail::guarded("World::stop_cycle", [&]() -> Status {
-    const auto found = find_instance(*impl_, id, Driver::kMixer, "World::stop_cycle");
+    const auto found = detail::find_instance(*impl_, id, Driver::kMixer, "World::stop_cycle");
     if (!found.ok()) return found.error();
     const auto index = clip_index(**found, clip);
     if (!index.ok()) return index.error();
@@ -243,7 +258,7 @@ Status World::stop_cycle(InstanceId id, std::string_view clip, float fade_second
 Status World::play_action(InstanceId id, std::string_view clip, float fade_in_seconds,
                           float fade_out_seconds) noexcept {
   return detail::guarded("World::play_action", [&]() -> Status {
-    const auto found = find_instance(*impl_, id, Driver::kMixer, "World::play_action");
+    const auto found = detail::find_instance(*impl_, id, Driver::kMixer, "World::play_action");
     if (!found.ok()) return found.error();
     const auto index = clip_index(**found, clip);
     if (!index.ok()) return index.error();
@@ -253,7 +268,7 @@ Status World::play_action(InstanceId id, std::string_view clip, float fade_in_se
 
 Status World::pose_at(InstanceId id, std::string_view clip, double seconds) noexcept {
   return detail::guarded("World::pose_at", [&]() -> Status {
-    const auto found = find_instance(*impl_, id, Driver::kMixer, "World::pose_at");
+    const auto found = detail::find_instance(*impl_, id, Driver::kMixer, "World::pose_at");
     if (!found.ok()) return found.error();
     if (!std::isfinite(seconds)) {
       return detail::api_error(ErrorCode::kInvalidArgument, "World::pose_at: seconds: not finite");
@@ -278,11 +293,22 @@ Status World::advance(float dt_seconds) noexcept {
                                "World::advance: dt_seconds = " + std::to_string(dt_seconds) +
                                    ": expected a finite time >= 0");
     }
+    const auto moves = [](const Instance& i) { return !i.removed && !i.is_static && i.driver == Driver::kMixer; };
+    // Checked for every instance first, so an error leaves all of them unmoved.
+    for (InstanceId id = 0; id < impl_->instances.size(); ++id) {
+      const Instance& instance = impl_->instances[id];
+      if (moves(instance) && !std::isfinite(dt_seconds * instance.speed)) {
+        return detail::api_error(ErrorCode::kInvalidArgument,
+                                 "World::advance: instance " + std::to_string(id) + ": dt_seconds = " +
+                                     std::to_string(dt_seconds) + " times playback speed " +
+                                     std::to_string(instance.speed) + " is not a finite time");
+      }
+    }
     for (InstanceId id = 0; id < impl_->instances.size(); ++id) {
       Instance& instance = impl_->instances[id];
-      if (instance.removed || instance.is_static || instance.driver != Driver::kMixer) continue;
-      instance.mixer->update(dt_seconds);
-      const Status posed = pose_from_mixer(*impl_, id);
+      if (!moves(instance)) continue;
+      instance.mixer->update(dt_seconds * instance.speed);
+      const Status posed = detail::pose_from_mixer(*impl_, id);
       if (!posed.ok()) return posed;
     }
     return Status();

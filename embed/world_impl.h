@@ -26,6 +26,7 @@ struct World::Impl {
     Affine3 transform = Affine3::identity();
     bool limits = false;
     // Mixer-driven only.
+    float speed = 1.0f;  // advance(dt) moves the mixer by speed * dt
     std::unique_ptr<anim::Mixer> mixer;
     std::vector<anim::SamplingCache> caches;
     std::vector<anim::JointTransform> local;
@@ -51,4 +52,15 @@ struct World::Impl {
   void changed() { ++changes; }
 };
 
+namespace detail {
+
+// The character instance `id` (not removed, not a static mesh); `call`
+// names the API call in the kNotFound error.
+Result<World::Impl::Instance*> find_character(World::Impl& world, InstanceId id, const char* call);
+// The same, and driven by `wanted` (kInvalidArgument otherwise).
+Result<World::Impl::Instance*> find_instance(World::Impl& world, InstanceId id, Driver wanted, const char* call);
+// Evaluates the mixer's layers and poses the instance in the scene.
+Status pose_from_mixer(World::Impl& world, InstanceId id);
+
+}  // namespace detail
 }  // namespace sinew::api

@@ -71,6 +71,7 @@ struct EditorApp::Impl {
   std::unique_ptr<BakeJob> bake;
   Viewport viewport;
   PanelState panels;
+  WidgetLog widgets;  // the last frame's
   std::vector<Affine3> skinning;
 
   bool playing = true;
@@ -113,6 +114,8 @@ Expected<std::unique_ptr<EditorApp>> EditorApp::create(const GuiOptions& options
   impl->display = std::make_unique<PixelDisplay>();
   impl->jobs = std::make_unique<JobSystem>(options.threads);
   impl->viewport.overlay = options.overlay;
+  copy_text(impl->panels.pack_path, options.pack_path);
+  copy_text(impl->panels.limits_path, options.limits_path);
   std::unique_ptr<EditorApp> app(new EditorApp(std::move(impl)));
   if (!options.model_path.empty()) SINEW_RETURN_IF_ERROR(app->load(options.model_path));
   return app;
@@ -307,6 +310,8 @@ Status EditorApp::Impl::draw_panels(int x, int height) {
   ctx.bake_phase = bake ? bake->phase() : std::string();
   ctx.can_save_pack = loaded && loaded->baked;
   ctx.message = message;
+  widgets.clear();
+  ctx.widgets = &widgets;
   const PanelActions actions = draw_editor_panels(panels, ctx, static_cast<float>(x), static_cast<float>(height));
   if (actions.load) return load_path(panels.load_path_text());
   if (actions.bake) return start_bake(panels.bake);
@@ -386,6 +391,9 @@ const std::string& EditorApp::message() const { return impl_->message; }
 
 void EditorApp::set_capture(bool on) { impl_->capture = on; }
 const Screenshot& EditorApp::last_shown() const { return impl_->shown; }
+
+const WidgetLog& EditorApp::widgets() const { return impl_->widgets; }
+void EditorApp::window_position(int* x, int* y) const { impl_->window->position(x, y); }
 
 const character::Model* EditorApp::model() const { return impl_->loaded ? &impl_->loaded->model() : nullptr; }
 rt::FuzzyCharacterView EditorApp::fuzzy() const {

@@ -26,6 +26,7 @@
 #include "character/model.h"
 #include "editor/gui/overlays.h"
 #include "editor/gui/viewport.h"
+#include "editor/gui/widget_log.h"
 #include "runtime/core/expected.h"
 
 namespace sinew::editor::gui {
@@ -41,6 +42,8 @@ struct GuiOptions {
   std::string clip;  // clip A; empty: the first clip
   std::optional<double> time;  // playback time; given: starts paused there
   int threads = 0;             // render threads, 0: all cores
+  std::string pack_path = "/tmp/editor.pack";            // the panel's first "Save as pack" target
+  std::string limits_path = "/tmp/editor_limits.json";  // and "Save limits" target
   bool visible = true;
   bool help = false;
 };
@@ -115,6 +118,12 @@ class EditorApp {
   // it costs a GPU round trip).
   void set_capture(bool on);
   const Screenshot& last_shown() const;
+
+  // Every panel widget the last frame drew, in window pixels, and the
+  // window's top-left corner on the screen: where a test moves the real
+  // pointer to click one.
+  const WidgetLog& widgets() const;
+  void window_position(int* x, int* y) const;
 
   const character::Model* model() const;
   rt::FuzzyCharacterView fuzzy() const;

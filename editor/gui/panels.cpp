@@ -6,11 +6,31 @@
 #include <cstdio>
 #include <cstring>
 
+#include "editor/gui/widget_log.h"
+
 namespace sinew::editor::gui {
 namespace {
 
-void copy_text(std::array<char, 512>& dst, const std::string& text) {
-  std::snprintf(dst.data(), dst.size(), "%s", text.c_str());
+// Every widget goes through these, so the frame's WidgetLog (when asked
+// for) holds all of them.
+bool header(const PanelContext& ctx, const char* label, ImGuiTreeNodeFlags flags = 0) {
+  const bool open = ImGui::CollapsingHeader(label, flags);
+  log_last_item(ctx.widgets, label, WidgetKind::kHeader, ImGui::IsItemToggledOpen());
+  return open;
+}
+
+bool button(const PanelContext& ctx, const char* label, bool small = false) {
+  const bool pressed = small ? ImGui::SmallButton(label) : ImGui::Button(label);
+  log_last_item(ctx.widgets, label, WidgetKind::kButton, pressed);
+  return pressed;
+}
+
+// A value widget: `draw(label)` draws it and returns whether it changed.
+template <typename Draw>
+bool field(const PanelContext& ctx, const char* label, Draw&& draw) {
+  const bool changed = draw(label);
+  log_last_item(ctx.widgets, label, WidgetKind::kField, changed);
+  return changed;
 }
 
 const char* clip_name(const character::Model& model, int index) {
@@ -19,9 +39,12 @@ const char* clip_name(const character::Model& model, int index) {
 }
 
 // A combo over the model's clips; `allow_none` adds "(none)" as -1.
-bool clip_combo(const char* label, const character::Model& model, int& index, bool allow_none) {
+bool clip_combo(const PanelContext& ctx, const char* label, const character::Model& model, int& index,
+                bool allow_none) {
   bool changed = false;
-  if (ImGui::BeginCombo(label, clip_name(model, index))) {
+  const bool open = ImGui::BeginCombo(label, clip_name(model, index));
+  log_last_item(ctx.widgets, label, WidgetKind::kField, false);
+  if (open) {
     if (allow_none && ImGui::Selectable("(none)", index < 0)) {
       index = -1;
       changed = true;
@@ -40,31 +63,35 @@ bool clip_combo(const char* label, const character::Model& model, int& index, bo
 }
 
 void model_panel(PanelState& state, const PanelContext& ctx, PanelActions& actions) {
-  if (!ImGui::CollapsingHeader("Model", ImGuiTreeNodeFlags_DefaultOpen)) return;
-  ImGui::InputText("path", state.load_path.data(), state.load_path.size());
-  if (ImGui::Button("Load")) actions.load = true;
+  if (!header(ctx, "Model", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  field(ctx, "path",
+        [&](const char* l) { return ImGui::InputText(l, state.load_path.data(), state.load_path.size()); });
+  if (button(ctx, "Load")) actions.load = true;
   if (!ctx.message.empty()) ImGui::TextWrapped("%s", ctx.message.c_str());
 }
 
 void clips_panel(PanelState& state, const PanelContext& ctx, PanelActions& actions) {
-  if (ctx.model == nullptr || !ImGui::CollapsingHeader("Clips", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  if (ctx.model == nullptr || !header(ctx, "Clips", ImGuiTreeNodeFlags_DefaultOpen)) return;
   const character::Model& model = *ctx.model;
   PosePlayer& player = *ctx.player;
   if (model.clips.empty()) {
     ImGui::TextUnformatted("no clips: rest pose");
     return;
   }
-  bool cycles_changed = clip_combo("clip", model, state.clip_a, false);
-  cycles_changed |= clip_combo("second clip", model, state.clip_b, true);
-  if (state.clip_b >= 0) cycles_changed |= ImGui::SliderFloat("blend", &state.blend, 0.0f, 1.0f);
+  bool cycles_changed = clip_combo(ctx, "clip", model, state.clip_a, false);
+  cycles_changed |= clip_combo(ctx, "second clip", model, state.clip_b, true);
+  if (state.clip_b >= 0) {
+    cycles_changed |=
+        field(ctx, "blend", [&](const char* l) { return ImGui::SliderFloat(l, &state.blend, 0.0f, 1.0f); });
+  }
   if (cycles_changed) (void)player.set_cycles(state.clip_a, state.clip_b, state.blend);
-  if (ImGui::Button(*ctx.playing ? "Pause" : "Play")) *ctx.playing = !*ctx.playing;
+  if (button(ctx, *ctx.playing ? "Pause" : "Play")) *ctx.playing = !*ctx.playing;
   ImGui::SameLine();
   float t = static_cast<float>(player.time());
   const float span = static_cast<float>(player.duration());
   // The slider spans one loop; playback keeps counting past it.
   float shown = span > 0.0f ? std::fmod(t, span) : 0.0f;
-  if (ImGui::SliderFloat("time", &shown, 0.0f, span, "%.2f s")) {
+  if (field(ctx, "time", [&](const char* l) { return ImGui::SliderFloat(l, &shown, 0.0f, span, "%.2f s"); })) {
     *ctx.playing = false;
     (void)player.seek(static_cast<double>(shown));
   }
@@ -72,20 +99,23 @@ void clips_panel(PanelState& state, const PanelContext& ctx, PanelActions& actio
   for (int i = 0; i < static_cast<int>(model.clips.size()); ++i) {
     ImGui::PushID(1000 + i);
     if (i % 3 != 0) ImGui::SameLine();
-    if (ImGui::SmallButton(clip_name(model, i))) actions.action_clip = i;
+    if (button(ctx, clip_name(model, i), true)) actions.action_clip = i;
     ImGui::PopID();
   }
 }
 
 void overlay_panel(PanelState& state, const PanelContext& ctx) {
-  if (ctx.model == nullptr || !ImGui::CollapsingHeader("Overlay", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  if (ctx.model == nullptr || !header(ctx, "Overlay", ImGuiTreeNodeFlags_DefaultOpen)) return;
   Viewport& viewport = *ctx.viewport;
   int mode = static_cast<int>(viewport.overlay);
   const char* names[] = {"none", "fuzzy boxes", "leaf heat map", "escaped triangles"};
-  if (ImGui::Combo("overlay", &mode, names, 4)) viewport.overlay = static_cast<Overlay>(mode);
+  if (field(ctx, "overlay", [&](const char* l) { return ImGui::Combo(l, &mode, names, 4); })) {
+    viewport.overlay = static_cast<Overlay>(mode);
+  }
   const auto& joint_names = ctx.model->skeleton.names();
   const int bones = static_cast<int>(joint_names.size());
-  if (bones > 0 && ImGui::SliderInt("bone", &state.bone, 0, bones - 1)) {
+  const auto bone_slider = [&](const char* l) { return ImGui::SliderInt(l, &state.bone, 0, bones - 1); };
+  if (bones > 0 && field(ctx, "bone", bone_slider)) {
     viewport.bone = static_cast<std::uint32_t>(state.bone);
   }
   if (bones > 0 && state.bone < bones) {
@@ -93,64 +123,76 @@ void overlay_panel(PanelState& state, const PanelContext& ctx) {
     const std::uint32_t triangles = b < ctx.fuzzy.bone_trees.size() ? ctx.fuzzy.bone_trees[b].triangle_count : 0;
     ImGui::Text("%s: %u triangles", joint_names[b].c_str(), triangles);
   }
-  ImGui::Checkbox("shadows", &viewport.settings.shadows);
-  if (ImGui::Button("Reframe camera")) viewport.request_reframe();
+  field(ctx, "shadows", [&](const char* l) { return ImGui::Checkbox(l, &viewport.settings.shadows); });
+  if (button(ctx, "Reframe camera")) viewport.request_reframe();
 }
 
 void bake_panel(PanelState& state, const PanelContext& ctx, PanelActions& actions) {
-  if (ctx.model == nullptr || !ImGui::CollapsingHeader("Bake", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  if (ctx.model == nullptr || !header(ctx, "Bake", ImGuiTreeNodeFlags_DefaultOpen)) return;
   int mode = static_cast<int>(state.bake.mode);
   const char* modes[] = {"arbitrary", "joint limits", "clips", "one clip"};
-  if (ImGui::Combo("pose space", &mode, modes, 4)) state.bake.mode = static_cast<anim::PoseSpaceMode>(mode);
+  if (field(ctx, "pose space", [&](const char* l) { return ImGui::Combo(l, &mode, modes, 4); })) {
+    state.bake.mode = static_cast<anim::PoseSpaceMode>(mode);
+  }
   if (state.bake.mode == anim::PoseSpaceMode::kClip) {
-    clip_combo("bake clip", *ctx.model, state.bake_clip, false);
+    clip_combo(ctx, "bake clip", *ctx.model, state.bake_clip, false);
     state.bake.clip = clip_name(*ctx.model, state.bake_clip);
   }
-  ImGui::InputInt("samples", &state.bake.samples);
+  field(ctx, "samples", [&](const char* l) { return ImGui::InputInt(l, &state.bake.samples); });
   state.bake.samples = std::max(0, state.bake.samples);
-  ImGui::SliderFloat("padding", &state.bake.padding, 0.0f, 0.1f, "%.3f");
+  field(ctx, "padding",
+        [&](const char* l) { return ImGui::SliderFloat(l, &state.bake.padding, 0.0f, 0.1f, "%.3f"); });
   if (ctx.bake_running) {
     char label[64];
     std::snprintf(label, sizeof(label), "%s %.0f%%", ctx.bake_phase.c_str(), ctx.bake_progress * 100.0);
     ImGui::ProgressBar(static_cast<float>(ctx.bake_progress), ImVec2(-1.0f, 0.0f), label);
-    if (ImGui::Button("Cancel")) actions.cancel_bake = true;
-  } else if (ImGui::Button("Bake")) {
+    if (button(ctx, "Cancel")) actions.cancel_bake = true;
+  } else if (button(ctx, "Bake##start")) {
+    // "##start" keeps the label and gives the button its own ID: the
+    // header above is "Bake" too, and one ID for both swallows the click.
     actions.bake = true;
   }
   if (ctx.can_save_pack) {
-    ImGui::InputText("pack", state.pack_path.data(), state.pack_path.size());
-    if (ImGui::Button("Save as pack")) actions.save_pack = true;
+    field(ctx, "pack",
+          [&](const char* l) { return ImGui::InputText(l, state.pack_path.data(), state.pack_path.size()); });
+    if (button(ctx, "Save as pack")) actions.save_pack = true;
   }
 }
 
 void limits_panel(PanelState& state, const PanelContext& ctx, PanelActions& actions) {
-  if (ctx.model == nullptr || !ImGui::CollapsingHeader("Joint limits")) return;
+  if (ctx.model == nullptr || !header(ctx, "Joint limits")) return;
   const auto& names = ctx.model->skeleton.names();
   const int joints = static_cast<int>(names.size());
   if (joints == 0 || state.limits.size() != names.size()) return;
   state.joint = std::clamp(state.joint, 0, joints - 1);
-  ImGui::SliderInt("joint", &state.joint, 0, joints - 1);
+  field(ctx, "joint", [&](const char* l) { return ImGui::SliderInt(l, &state.joint, 0, joints - 1); });
   ImGui::TextUnformatted(names[static_cast<std::size_t>(state.joint)].c_str());
   anim::JointLimit& limit = state.limits[static_cast<std::size_t>(state.joint)];
   bool euler = limit.kind == anim::LimitKind::kEuler;
   if (limit.kind == anim::LimitKind::kSwingTwist) ImGui::TextUnformatted("swing-twist limit (edit as Euler to replace)");
-  if (ImGui::Checkbox("Euler limit", &euler)) limit.kind = euler ? anim::LimitKind::kEuler : anim::LimitKind::kFree;
+  if (field(ctx, "Euler limit", [&](const char* l) { return ImGui::Checkbox(l, &euler); })) {
+    limit.kind = euler ? anim::LimitKind::kEuler : anim::LimitKind::kFree;
+  }
   if (euler) {
     Vec3 min_deg = glm::degrees(limit.euler.min);
     Vec3 max_deg = glm::degrees(limit.euler.max);
-    if (ImGui::SliderFloat3("min (deg)", &min_deg.x, -180.0f, 180.0f, "%.0f")) {
+    const auto slider = [](Vec3& v) {
+      return [&v](const char* l) { return ImGui::SliderFloat3(l, &v.x, -180.0f, 180.0f, "%.0f"); };
+    };
+    if (field(ctx, "min (deg)", slider(min_deg))) {
       limit.euler.min = glm::radians(glm::min(min_deg, max_deg));
     }
-    if (ImGui::SliderFloat3("max (deg)", &max_deg.x, -180.0f, 180.0f, "%.0f")) {
+    if (field(ctx, "max (deg)", slider(max_deg))) {
       limit.euler.max = glm::radians(glm::max(min_deg, max_deg));
     }
   }
-  ImGui::InputText("limits file", state.limits_path.data(), state.limits_path.size());
-  if (ImGui::Button("Save limits")) actions.save_limits = true;
+  field(ctx, "limits file",
+        [&](const char* l) { return ImGui::InputText(l, state.limits_path.data(), state.limits_path.size()); });
+  if (button(ctx, "Save limits")) actions.save_limits = true;
 }
 
 void stats_panel(const PanelContext& ctx) {
-  if (!ImGui::CollapsingHeader("Stats", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  if (!header(ctx, "Stats", ImGuiTreeNodeFlags_DefaultOpen)) return;
   const EditorStats& s = *ctx.stats;
   ImGui::Text("%.1f fps", s.fps);
   for (const auto& [name, ms] : s.phases_ms) ImGui::Text("  %-12s %7.2f ms", name.c_str(), ms);
@@ -162,6 +204,10 @@ void stats_panel(const PanelContext& ctx) {
 
 }  // namespace
 
+void copy_text(std::array<char, 512>& dst, const std::string& text) {
+  std::snprintf(dst.data(), dst.size(), "%s", text.c_str());
+}
+
 void PanelState::reset_for(const character::Model& model, std::span<const anim::JointLimit> stored_limits) {
   clip_a = model.clips.empty() ? -1 : 0;
   clip_b = -1;
@@ -171,8 +217,6 @@ void PanelState::reset_for(const character::Model& model, std::span<const anim::
   limits.assign(model.skeleton.joint_count(), anim::JointLimit{});
   if (stored_limits.size() == limits.size()) limits.assign(stored_limits.begin(), stored_limits.end());
   if (load_path[0] == '\0') copy_text(load_path, model.source);
-  if (pack_path[0] == '\0') copy_text(pack_path, "/tmp/editor.pack");
-  if (limits_path[0] == '\0') copy_text(limits_path, "/tmp/editor_limits.json");
 }
 
 PanelActions draw_editor_panels(PanelState& state, const PanelContext& ctx, float x, float height) {

@@ -1,7 +1,9 @@
 // The editor's ImGui panels, in one fixed column right of the viewport:
 // model, clips, overlay, bake, joint limits, stats. Drawing returns the
 // actions the user asked for; EditorApp carries them out (loading and
-// baking touch state the panels do not own).
+// baking touch state the panels do not own). Each widget has its own ImGui
+// ID: a label shared inside the window gets a "##" suffix (see
+// widget_log.h for the test that walks them).
 #pragma once
 
 #include <array>
@@ -12,6 +14,7 @@
 #include "editor/gui/editor_app.h"
 #include "editor/gui/pose_player.h"
 #include "editor/gui/viewport.h"
+#include "editor/gui/widget_log.h"
 
 namespace sinew::editor::gui {
 
@@ -28,11 +31,16 @@ struct PanelState {
   anim::JointLimits limits;
   int joint = 0;
 
+  // Clip, joint and limit state for a newly loaded model; the paths keep
+  // what they hold (an empty load path takes the model's source).
   void reset_for(const character::Model& model, std::span<const anim::JointLimit> stored_limits);
   std::string load_path_text() const { return load_path.data(); }
   std::string pack_path_text() const { return pack_path.data(); }
   std::string limits_path_text() const { return limits_path.data(); }
 };
+
+// Copies `text` into a text field's buffer, cut to fit.
+void copy_text(std::array<char, 512>& dst, const std::string& text);
 
 struct PanelContext {
   const character::Model* model = nullptr;  // null: nothing loaded
@@ -46,6 +54,7 @@ struct PanelContext {
   std::string bake_phase;
   bool can_save_pack = false;
   std::string message;
+  WidgetLog* widgets = nullptr;  // when set, every widget drawn is appended
 };
 
 struct PanelActions {

@@ -8,6 +8,7 @@
 // pass itself runs its work on many threads (sinew/pass.h).
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <limits>
 #include <memory>
@@ -66,6 +67,10 @@ struct InstanceDesc {
   // Mixer-driven: clamp each pose to the pack's joint limits (when it has
   // any) before skinning.
   bool apply_joint_limits = false;
+  // Mixer-driven: advance(dt) moves this instance's mixer by
+  // playback_speed * dt (cycles, fades and actions alike): 2 plays at double
+  // speed, 0 holds the pose. Finite and >= 0 (kInvalidArgument otherwise).
+  float playback_speed = 1.0f;
 };
 
 // A static triangle mesh in world space; copied, its kd-tree built once.
@@ -114,8 +119,33 @@ class SINEW_API World {
   // Poses the instance at `seconds` of one clip alone (looping), bypassing
   // and resetting its mixer: scrubbing, thumbnails, tests.
   Status pose_at(InstanceId instance, std::string_view clip, double seconds) noexcept;
-  // Advances every mixer-driven instance's mixer by dt seconds and poses it.
+  // Advances every mixer-driven instance's mixer by dt seconds (times its
+  // playback speed) and poses it. Errors: kInvalidArgument (dt negative or
+  // not finite, or dt times an instance's speed not finite: nothing moves).
   Status advance(float dt_seconds) noexcept;
+
+  // Each mixer-driven instance's own clock, so a crowd on one clip need not
+  // walk in lockstep. set_playback_speed: InstanceDesc::playback_speed,
+  // changed. offset_time: moves this instance alone `seconds` ahead now
+  // (its speed not applied), so it poses exactly as one that advance() had
+  // moved `seconds` further; call it after play_cycle, since an idle mixer
+  // has no clock to move. set_time_factor: Cal3D's CalMixer::setTimeFactor,
+  // the clock of the synchronised cycles runs at `factor` (negative:
+  // backwards) while fades, actions and desynchronised cycles keep real
+  // time; default 1. Errors: kNotFound (no such instance), kInvalidArgument
+  // (a host-driven instance; a negative or non-finite speed or seconds; a
+  // non-finite factor), nothing changed.
+  Status set_playback_speed(InstanceId instance, float speed) noexcept;
+  Status offset_time(InstanceId instance, float seconds) noexcept;
+  Status set_time_factor(InstanceId instance, float factor) noexcept;
+
+  // Bone `bone`'s world transform as posed now, bone space -> world (its
+  // last column is the joint's position): where to attach a sword to a hand
+  // or a camera to a head. Mixer-driven: the placement times the joint's
+  // model-space transform; host-driven: the skinning matrix set times
+  // Character::bind_pose(bone). Errors: kNotFound (no such character
+  // instance, or a static mesh), kInvalidArgument (a bone past the end).
+  Result<Matrix3x4> bone_transform(InstanceId instance, std::size_t bone) const noexcept;
 
   // Removes a character instance or a static mesh (a host despawning it):
   // it leaves the next pass and query, and its per-frame memory is freed.

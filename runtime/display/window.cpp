@@ -72,6 +72,7 @@ bool Window::key_down(int glfw_key) const { return glfwGetKey(window_, glfw_key)
 bool Window::mouse_button_down(int glfw_button) const {
   return glfwGetMouseButton(window_, glfw_button) == GLFW_PRESS;
 }
+void Window::position(int* x, int* y) const { glfwGetWindowPos(window_, x, y); }
 void Window::cursor_position(double* x, double* y) const { glfwGetCursorPos(window_, x, y); }
 
 std::vector<std::uint8_t> Window::read_back_buffer(int* width, int* height) const {

@@ -38,6 +38,8 @@ class Window {
   void framebuffer_size(int* width, int* height) const;
   bool key_down(int glfw_key) const;
   bool mouse_button_down(int glfw_button) const;
+  // The window's top-left corner in screen coordinates.
+  void position(int* x, int* y) const;
   // Cursor position in window coordinates (pixels from the top-left).
   void cursor_position(double* x, double* y) const;
   // Reads the back buffer (what the next swap_buffers() shows) as RGBA8,

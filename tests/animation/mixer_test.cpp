@@ -227,6 +227,51 @@ TEST(Mixer, GlobalTimeAdvancesWithThePreviousPeriod) {
   EXPECT_NEAR(m.animation_time(), 0.25f, kEps);
 }
 
+TEST(Mixer, TimeFactorScalesTheSyncClockOnly) {
+  // Cal3D's setTimeFactor: the global clock moves dt * factor; weight fades,
+  // actions and async cycles keep real time.
+  const std::vector<Clip> clips{ramp_clip(1, 1.0f), ramp_clip(2, 2.0f)};
+  Mixer m(clips);
+  EXPECT_EQ(m.time_factor(), 1.0f);
+  ASSERT_TRUE(m.set_time_factor(2.0f).ok());
+  ASSERT_TRUE(m.blend_cycle(0, 1.0f, 0.0f).ok());
+  m.update(0.0f);  // the period becomes 1 s
+  m.update(0.2f);
+  EXPECT_NEAR(m.animation_time(), 0.4f, kEps);  // 2 x 0.2
+  EXPECT_NEAR(m.cycle_time(0), 0.4f, kEps);
+
+  ASSERT_TRUE(m.execute_action(1, 0.4f, 0.0f).ok());
+  m.update(0.2f);
+  EXPECT_NEAR(m.animation_time(), 0.8f, kEps);
+  EXPECT_NEAR(m.action_time(1), 0.2f, kEps);    // real time
+  EXPECT_NEAR(m.action_weight(1), 0.5f, kEps);  // 0.2 of the 0.4 s fade-in
+
+  ASSERT_TRUE(m.blend_cycle(0, 0.5f, 0.5f).ok());
+  m.update(0.05f);
+  EXPECT_NEAR(m.animation_time(), 0.9f, kEps);
+  EXPECT_NEAR(m.cycle_weight(0), 0.95f, kEps);  // 1 + (0.5 - 1) x 0.05 / 0.5, real time
+
+  // Negative: the clock runs backwards and wraps into [0, period) as in Cal3D.
+  ASSERT_TRUE(m.set_time_factor(-0.5f).ok());
+  m.update(0.2f);
+  EXPECT_NEAR(m.animation_time(), 0.8f, kEps);  // 0.9 - 0.1
+  m.update(2.0f);
+  EXPECT_NEAR(m.animation_time(), 0.8f, kEps);  // 0.8 - 1.0 wraps to 0.8
+  EXPECT_NEAR(m.cycle_time(0), 0.8f, kEps);
+
+  // An async cycle keeps the rate it had on the clock (1 s of 1 s), not the factor.
+  ASSERT_TRUE(m.set_time_factor(3.0f).ok());
+  ASSERT_TRUE(m.clear_cycle(0, 10.0f).ok());
+  EXPECT_NEAR(m.cycle_time(0), 0.8f, kEps);
+  m.update(0.05f);
+  EXPECT_NEAR(m.cycle_time(0), 0.85f, kEps);
+
+  const Status bad = m.set_time_factor(kNaN);
+  EXPECT_EQ(bad.code(), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(bad.field(), "time_factor");
+  EXPECT_EQ(m.time_factor(), 3.0f);
+}
+
 TEST(Mixer, ClearCycleDesynchronisesKeepingPhaseAndRate) {
   const std::vector<Clip> clips{ramp_clip(1, 1.0f), ramp_clip(2, 0.5f)};
   Mixer m(clips);
