@@ -401,6 +401,7 @@ rt::FuzzyCharacterView EditorApp::fuzzy() const {
 }
 std::span<const Affine3> EditorApp::skinning() const { return impl_->skinning; }
 const Viewport& EditorApp::viewport() const { return impl_->viewport; }
+Viewport& EditorApp::viewport() { return impl_->viewport; }
 EditorStats EditorApp::stats() const { return impl_->stats; }
 
 }  // namespace sinew::editor::gui

@@ -129,6 +129,7 @@ class EditorApp {
   rt::FuzzyCharacterView fuzzy() const;
   std::span<const Affine3> skinning() const;  // of the last frame
   const Viewport& viewport() const;
+  Viewport& viewport();
   EditorStats stats() const;
 
  private:

@@ -127,6 +127,36 @@ void overlay_panel(PanelState& state, const PanelContext& ctx) {
   if (button(ctx, "Reframe camera")) viewport.request_reframe();
 }
 
+// The view's lights: each point or directional, its position or the
+// direction towards it, its colour; up to rt::kMaxLights, at least one.
+void lights_panel(const PanelContext& ctx) {
+  if (ctx.model == nullptr || !header(ctx, "Lights")) return;
+  std::vector<rt::Light>& lights = ctx.viewport->lights;
+  const char* kinds[] = {"point", "directional"};
+  std::size_t remove = lights.size();
+  for (std::size_t i = 0; i < lights.size(); ++i) {
+    rt::Light& light = lights[i];
+    ImGui::PushID(static_cast<int>(i));
+    ImGui::Text("light %zu", i + 1);
+    int kind = light.kind == rt::Light::Kind::kDirectional ? 1 : 0;
+    if (field(ctx, "kind", [&](const char* l) { return ImGui::Combo(l, &kind, kinds, 2); })) {
+      light.kind = kind == 1 ? rt::Light::Kind::kDirectional : rt::Light::Kind::kPoint;
+    }
+    Vec3& where = kind == 1 ? light.direction : light.position;
+    field(ctx, kind == 1 ? "towards" : "position",
+          [&](const char* l) { return ImGui::DragFloat3(l, &where.x, 0.05f); });
+    field(ctx, "colour", [&](const char* l) { return ImGui::ColorEdit3(l, &light.color.x, ImGuiColorEditFlags_Float); });
+    if (lights.size() > 1 && button(ctx, "Remove light", true)) remove = i;
+    ImGui::PopID();
+  }
+  if (remove < lights.size()) lights.erase(lights.begin() + static_cast<std::ptrdiff_t>(remove));
+  if (lights.size() < rt::kMaxLights && button(ctx, "Add light")) {
+    rt::Light added = lights.empty() ? rt::Light{} : lights.back();
+    added.color = Vec3(0.5f);
+    lights.push_back(added);
+  }
+}
+
 void bake_panel(PanelState& state, const PanelContext& ctx, PanelActions& actions) {
   if (ctx.model == nullptr || !header(ctx, "Bake", ImGuiTreeNodeFlags_DefaultOpen)) return;
   int mode = static_cast<int>(state.bake.mode);
@@ -229,6 +259,7 @@ PanelActions draw_editor_panels(PanelState& state, const PanelContext& ctx, floa
     model_panel(state, ctx, actions);
     clips_panel(state, ctx, actions);
     overlay_panel(state, ctx);
+    lights_panel(ctx);
     bake_panel(state, ctx, actions);
     limits_panel(state, ctx, actions);
     stats_panel(ctx);

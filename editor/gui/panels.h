@@ -1,5 +1,5 @@
 // The editor's ImGui panels, in one fixed column right of the viewport:
-// model, clips, overlay, bake, joint limits, stats. Drawing returns the
+// model, clips, overlay, lights, bake, joint limits, stats. Drawing returns the
 // actions the user asked for; EditorApp carries them out (loading and
 // baking touch state the panels do not own). Each widget has its own ImGui
 // ID: a label shared inside the window gets a "##" suffix (see

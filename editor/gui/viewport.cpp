@@ -22,7 +22,10 @@ Status Viewport::reset(const character::Model& model, const rt::FuzzyCharacterVi
   fuzzy_ = fuzzy;
   heat_ = leaf_heat(fuzzy, model.mesh.triangle_count());
   bone = std::min<std::uint32_t>(bone, fuzzy.bone_count > 0 ? fuzzy.bone_count - 1 : 0);
-  if (reframe) reframe_ = true;
+  if (reframe) {
+    reframe_ = true;
+    lights.clear();  // a new model gets its own default light
+  }
   return Status{};
 }
 
@@ -41,9 +44,14 @@ Expected<ViewportFrame> Viewport::render(std::span<const Affine3> skinning, JobS
   if (reframe_) {
     const Aabb posed = character::posed_bounds(*scene_);
     camera_ = character::default_camera(posed, up_, width_, height_);
-    settings.light.position = character::default_light(posed, up_);
+    if (lights.empty()) {
+      lights.emplace_back();
+      lights.back().position = character::default_light(posed, up_);
+    }
     reframe_ = false;
   }
+  if (lights.size() > rt::kMaxLights) lights.resize(rt::kMaxLights);
+  settings.lights = lights;
   SINEW_ASSIGN_OR_RETURN(const rt::PinholeCamera camera, rt::PinholeCamera::create(camera_, width_, height_));
   const std::size_t pixels = static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_);
   raw_.resize(4 * pixels);

@@ -47,6 +47,10 @@ class Viewport {
   std::uint32_t bone = 0;  // for the boxes overlay
   rt::RenderSettings settings;
   rt::FrameOptions frame_options;
+  // The lights the view shades with (1 to rt::kMaxLights; the Lights panel
+  // edits them). Empty until a model is framed, which places one point
+  // light above and in front of it (character::default_light).
+  std::vector<rt::Light> lights;
 
   int width() const { return width_; }
   int height() const { return height_; }

@@ -85,6 +85,39 @@ class EditorGuiTest : public ::testing::Test {
     return app_->last_shown();
   }
 
+  // The view's pose and camera rendered by a fresh scene over the same
+  // mesh and trees, with `settings`: RGBA bytes, and the instance ids.
+  static std::vector<std::uint8_t> headless_render(const rt::RenderSettings& settings,
+                                                   std::vector<std::uint32_t>* instance_id = nullptr,
+                                                   std::uint32_t* character_instance = nullptr) {
+    const Viewport& view = app_->viewport();
+    const int vw = view.width(), vh = view.height();
+    rt::Scene scene;
+    auto character = scene.add_character(app_->model()->mesh, app_->fuzzy());
+    EXPECT_TRUE(character.ok());
+    auto instance = scene.add_instance(*character);
+    EXPECT_TRUE(instance.ok());
+    EXPECT_TRUE(scene.add_static_mesh(character::ground_plane_for(*app_->model())).ok());
+    EXPECT_TRUE(scene.set_bones(*instance, app_->skinning()).ok());
+    JobSystem jobs(2);
+    EXPECT_TRUE(scene.prepare_frame(rt::FrameOptions{}, jobs).ok());
+    auto camera = rt::PinholeCamera::create(view.camera(), vw, vh);
+    EXPECT_TRUE(camera.ok());
+    const std::size_t pixels = static_cast<std::size_t>(vw) * static_cast<std::size_t>(vh);
+    std::vector<std::uint8_t> color(4 * pixels);
+    std::vector<std::uint32_t> ids(pixels);
+    rt::FrameBuffers buffers;
+    buffers.width = vw;
+    buffers.height = vh;
+    buffers.color_rgba8 = color;
+    buffers.instance_id = ids;
+    rt::Renderer renderer;
+    EXPECT_TRUE(renderer.render(scene, *camera, settings, buffers, jobs).ok());
+    if (instance_id != nullptr) *instance_id = std::move(ids);
+    if (character_instance != nullptr) *character_instance = *instance;
+    return color;
+  }
+
   static void wait_for_bake() {
     for (int i = 0; i < 6000 && app_->bake_running(); ++i) {
       ASSERT_TRUE(app_->step().ok());
@@ -108,27 +141,10 @@ TEST_F(EditorGuiTest, WindowShowsTheCharacterExactlyAsAHeadlessRender) {
   ASSERT_EQ(shot.height, kWindowHeight);
 
   // Independent render: a fresh scene over the same mesh, trees, pose and camera.
-  rt::Scene scene;
-  auto character = scene.add_character(app_->model()->mesh, app_->fuzzy());
-  ASSERT_TRUE(character.ok());
-  auto instance = scene.add_instance(*character);
-  ASSERT_TRUE(instance.ok());
-  ASSERT_TRUE(scene.add_static_mesh(character::ground_plane_for(*app_->model())).ok());
-  ASSERT_TRUE(scene.set_bones(*instance, app_->skinning()).ok());
-  JobSystem jobs(2);
-  ASSERT_TRUE(scene.prepare_frame(rt::FrameOptions{}, jobs).ok());
-  auto camera = rt::PinholeCamera::create(view.camera(), vw, vh);
-  ASSERT_TRUE(camera.ok());
+  std::vector<std::uint32_t> instance_id;
+  std::uint32_t instance = 0;
+  const std::vector<std::uint8_t> color = headless_render(view.settings, &instance_id, &instance);
   const std::size_t pixels = static_cast<std::size_t>(vw) * static_cast<std::size_t>(vh);
-  std::vector<std::uint8_t> color(4 * pixels);
-  std::vector<std::uint32_t> instance_id(pixels);
-  rt::FrameBuffers buffers;
-  buffers.width = vw;
-  buffers.height = vh;
-  buffers.color_rgba8 = color;
-  buffers.instance_id = instance_id;
-  rt::Renderer renderer;
-  ASSERT_TRUE(renderer.render(scene, *camera, view.settings, buffers, jobs).ok());
 
   std::size_t mismatches = 0;
   std::size_t character_pixels = 0;
@@ -139,7 +155,7 @@ TEST_F(EditorGuiTest, WindowShowsTheCharacterExactlyAsAHeadlessRender) {
       const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(vw) + static_cast<std::size_t>(x);
       const Rgb p = shot_pixel(shot, x, y);
       mismatches += p.r != color[4 * i] || p.g != color[4 * i + 1] || p.b != color[4 * i + 2];
-      character_pixels += instance_id[i] == *instance;
+      character_pixels += instance_id[i] == instance;
       const bool central = x > vw / 4 && x < 3 * vw / 4 && y > vh / 8 && y < 7 * vh / 8;
       central_differs_from_background += central && (p.r != background.r || p.g != background.g || p.b != background.b);
     }
@@ -147,6 +163,44 @@ TEST_F(EditorGuiTest, WindowShowsTheCharacterExactlyAsAHeadlessRender) {
   EXPECT_EQ(mismatches, 0u);
   EXPECT_GT(character_pixels, pixels / 50);  // framed: a visible share of the view
   EXPECT_GT(central_differs_from_background, character_pixels / 2);
+}
+
+// The Lights panel's list is what the view shades with: three lights, one
+// per colour channel, give exactly a headless render with those three, and
+// differ from a render with the first alone.
+TEST_F(EditorGuiTest, TheViewShadesWithEveryLightInItsList) {
+  Viewport& view = app_->viewport();
+  (void)show("idle", 0.5, Overlay::kNone);
+  ASSERT_EQ(view.lights.size(), 1u);  // the default light of a framed model
+  const std::vector<rt::Light> saved = view.lights;
+  std::vector<rt::Light> lights(3);
+  lights[0].position = saved[0].position;
+  lights[0].color = Vec3(1.0f, 0.0f, 0.0f);
+  lights[1].position = Vec3(-saved[0].position.x, saved[0].position.y, -saved[0].position.z);
+  lights[1].color = Vec3(0.0f, 1.0f, 0.0f);
+  lights[2].kind = rt::Light::Kind::kDirectional;
+  lights[2].direction = Vec3(0.3f, 1.0f, -0.6f);
+  lights[2].color = Vec3(0.0f, 0.0f, 1.0f);
+  view.lights = lights;
+  const Screenshot shot = show("idle", 0.5, Overlay::kNone);
+  rt::RenderSettings settings = view.settings;
+  settings.lights = lights;
+  const std::vector<std::uint8_t> all = headless_render(settings);
+  settings.lights = std::span<const rt::Light>(lights.data(), 1);
+  const std::vector<std::uint8_t> first = headless_render(settings);
+  view.lights = saved;
+  const int vw = view.width(), vh = view.height();
+  std::size_t mismatches = 0, differ_from_first = 0;
+  for (int y = 0; y < vh; ++y) {
+    for (int x = 0; x < vw; ++x) {
+      const std::size_t i = 4 * (static_cast<std::size_t>(y) * static_cast<std::size_t>(vw) + static_cast<std::size_t>(x));
+      const Rgb p = shot_pixel(shot, x, y);
+      mismatches += p.r != all[i] || p.g != all[i + 1] || p.b != all[i + 2];
+      differ_from_first += all[i + 1] != first[i + 1] || all[i + 2] != first[i + 2];
+    }
+  }
+  EXPECT_EQ(mismatches, 0u);
+  EXPECT_GT(differ_from_first, static_cast<std::size_t>(vw * vh / 50));
 }
 
 TEST_F(EditorGuiTest, BoxesOverlayDrawsTheBoneBoxWireframe) {
