@@ -6,6 +6,7 @@
 #include <string>
 
 #include "animation/pose.h"
+#include "character/renderable.h"
 #include "runtime/jobs/job_system.h"
 #include "runtime/timing/stopwatch.h"
 
@@ -85,6 +86,8 @@ Expected<std::vector<Affine3>> clip_skinning(const Model& model, const anim::Cli
 }
 
 Expected<InMemoryBake> bake_in_memory(const Model& model, const BakeRequest& request, JobSystem& jobs) {
+  // A model the consumers of its pack would refuse is not baked.
+  SINEW_RETURN_IF_ERROR(check_renderable(model, model.source));
   InMemoryBake bake;
   // The fuzzy bake holds an inverse per sample matrix beside its boxes.
   if (request.max_memory_bytes <= request.fuzzy.memory_budget_bytes) {

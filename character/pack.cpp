@@ -5,6 +5,7 @@
 #include <cstring>
 #include <utility>
 
+#include "character/renderable.h"
 #include "raytrace/bake/fuzzy_bake.h"
 #include "runtime/mesh/mesh_checks.h"
 #include "runtime/pack/pack_writer.h"
@@ -585,6 +586,8 @@ Expected<Pack> Pack::load(PackReader reader) {
     SectionDecoder d = decoder(r, kClips);
     SINEW_ASSIGN_OR_RETURN(pack.model_.clips, decode_clips(d, pack.model_.skeleton));
   }
+  // What every consumer needs to frame and trace it, checked once here.
+  SINEW_RETURN_IF_ERROR(check_renderable(pack.model_, r.name(), kPackFields));
   if (const SectionInfo* limits = r.find(kLimits)) {
     if (limits->version != kLimitsVersion) {
       return make_error(ErrorCode::kUnsupportedVersion, r.name(), "LIMT.version", std::to_string(limits->version),

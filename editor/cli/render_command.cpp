@@ -412,10 +412,9 @@ Expected<RenderOutputs> render_model(const RenderOptions& options) {
     SINEW_ASSIGN_OR_RETURN(imported, load_model(options.model_path, options.gltf));
     for (const std::string& warning : imported.warnings) report(options, "warning: " + warning);
   }
+  // Packs were checked on load, imported models are by the bake below
+  // (character::check_renderable): the one check every consumer shares.
   const character::Model& model = pack ? pack->model() : imported;
-  if (model.mesh.triangle_count() == 0) {
-    return make_error(ErrorCode::kInvalidData, options.model_path, "triangles", "0", "the model has no triangles");
-  }
   SINEW_ASSIGN_OR_RETURN(const anim::Clip* clip, resolve_clip(model, options));
 
   if (!pack || !pack->has_fuzzy()) {

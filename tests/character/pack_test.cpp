@@ -26,6 +26,7 @@
 #include "runtime/io/atomic_file.h"
 #include "runtime/jobs/job_system.h"
 #include "runtime/pack/pack_writer.h"
+#include "tests/support/damaged_packs.h"
 #include "tests/support/repack.h"
 #include "tests/support/same_model.h"
 #if SINEW_HAVE_CAL3D
@@ -531,25 +532,16 @@ TEST_F(CorruptPack, WellFormedButInconsistentFuzzyDataIsRefused) {
 }
 
 TEST_F(CorruptPack, RandomDamageNeverCrashes) {
-  auto reader = PackReader::from_bytes(*bytes_, "pristine");
-  ASSERT_TRUE(reader.ok());
-  std::mt19937 random(1234);
   JobSystem jobs(1);
   int accepted = 0, refused = 0;
-  for (const SectionInfo& s : reader->sections()) {
-    if (s.size == 0) continue;
-    for (int trial = 0; trial < 12; ++trial) {
-      const auto bytes = repack(s.id, [&](std::vector<std::byte>& p) {
-        for (int k = 0; k < 3; ++k) p[random() % p.size()] = static_cast<std::byte>(random() & 0xffu);
-      });
-      auto pack = character::Pack::from_bytes(bytes, "damaged.pack");
-      if (!pack.ok()) {
-        ++refused;
-        continue;
-      }
-      ++accepted;
-      if (pack->has_fuzzy()) render(pack->model(), pack->fuzzy(), jobs, /*strict=*/false);
+  for (const testing_support::DamagedPack& damaged : testing_support::randomly_damaged_packs(*bytes_, 12, 1234)) {
+    auto pack = character::Pack::from_bytes(damaged.bytes, "damaged.pack");
+    if (!pack.ok()) {
+      ++refused;
+      continue;
     }
+    ++accepted;
+    if (pack->has_fuzzy()) render(pack->model(), pack->fuzzy(), jobs, /*strict=*/false);
   }
   EXPECT_GT(refused, 0);
   RecordProperty("accepted", accepted);

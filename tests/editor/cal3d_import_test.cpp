@@ -18,7 +18,9 @@
 #include "animation/clip.h"
 #include "animation/pose.h"
 #include "animation/reference_skinning.h"
+#include "character/bake.h"
 #include "editor/import/cal3d_importer.h"
+#include "runtime/jobs/job_system.h"
 #include "tests/support/cal3d_support.h"
 
 namespace sinew::editor {
@@ -543,6 +545,22 @@ TEST_F(Cal3dBadInput, CorruptSkeletonLinksAndNames) {
   // The unpatched file still loads.
   auto m = import_cal3d(write("s.cfg", "skeleton=" + write("s.csf", csf) + "\n"));
   ASSERT_TRUE(m.ok()) << m.status().message();
+}
+
+// A .cfg without meshes imports (a skeleton and clips are a model), but
+// such a model has nothing to trace: the bake refuses it in one line naming
+// the .cfg, where it used to write a pack that validate accepted and
+// render refused.
+TEST_F(Cal3dBadInput, ACfgWithoutMeshesIsNotBaked) {
+  const std::string cfg = write("s.cfg", "skeleton=" + model_file("cally", "cally.csf") + "\n");
+  auto m = import_cal3d(cfg);
+  ASSERT_TRUE(m.ok()) << m.status().message();
+  ASSERT_EQ(m->mesh.triangle_count(), 0u);
+  JobSystem jobs(1);
+  auto bake = character::bake_in_memory(*m, character::BakeRequest{}, jobs);
+  ASSERT_FALSE(bake.ok());
+  EXPECT_EQ(bake.status().message(),
+            cfg + ": mesh.triangle_count = 0: the model has no triangles: nothing to frame or trace");
 }
 
 // XML materials go to Cal3D's XML loader, which dereferences missing
