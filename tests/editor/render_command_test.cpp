@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <set>
@@ -319,6 +320,51 @@ TEST(RenderCommand, GroundOffLeavesTheCharactersAlone) {
   const std::set<std::uint32_t> seen(outputs->instance_id.begin(), outputs->instance_id.end());
   EXPECT_EQ(seen, (std::set<std::uint32_t>{0u, kInvalidId})) << "the character and misses only";
 }
+
+#if SINEW_HAVE_CAL3D
+// Cally's skeleton and meshes (paths made absolute) under a .cfg of our own
+// with `scale=` first.
+std::string cally_at_scale(const std::string& dir, const std::string& scale) {
+  std::ifstream in(kCally);
+  std::stringstream text;
+  text << in.rdbuf();
+  const Cal3dConfig cally = parse_cal3d_config(text.str(), kCally).value();
+  const std::string folder = std::filesystem::path(kCally).parent_path().string() + "/";
+  std::string cfg = "scale=" + scale + "\nskeleton=" + folder + cally.skeleton + "\n";
+  for (const std::string& mesh : cally.meshes) cfg += "mesh=" + folder + mesh + "\n";
+  std::filesystem::create_directories(dir);
+  const std::string path = dir + "/scaled.cfg";
+  std::ofstream(path) << cfg;
+  return path;
+}
+
+// A .cfg scale of 1e-10 rendered an image without the character. Scales
+// outside what the tracer frames are refused naming the limit; at the
+// smallest one it takes, Cally fills the picture as at scale 1.
+TEST(RenderCommand, Cal3dScalesTheTracerCannotFrameAreRefused) {
+  const std::string dir = fresh_dir("cal3d_scale");
+  for (const std::string scale : {"1e-10", "1e-7", "1e7"}) {
+    const auto refused = render_model(small_options(cally_at_scale(dir, scale)));
+    ASSERT_FALSE(refused.ok()) << scale;
+    EXPECT_EQ(refused.status().field(), "line 1: scale") << refused.status().message();
+    EXPECT_EQ(refused.status().value(), scale) << refused.status().message();
+    EXPECT_NE(refused.status().message().find("[1e-06, 1e+06]"), std::string::npos) << refused.status().message();
+  }
+  auto character_pixels = [&](const std::string& scale) {
+    RenderOptions o = small_options(cally_at_scale(dir, scale));
+    o.ground = false;
+    const auto outputs = render_model(o);
+    EXPECT_TRUE(outputs.ok()) << scale << ": " << outputs.status().message();
+    return outputs.ok() ? std::count(outputs->instance_id.begin(), outputs->instance_id.end(), 0u) : 0;
+  };
+  const auto at_one = character_pixels("1");
+  EXPECT_GT(at_one, 96 * 96 / 20);
+  const auto smallest = character_pixels("1e-6");
+  EXPECT_GT(smallest, at_one / 2);
+  const auto largest = character_pixels("1e6");
+  EXPECT_GT(largest, at_one / 2);
+}
+#endif
 
 TEST(RenderCommand, UpAxisIsTheLargerOfYAndZ) {
   EXPECT_EQ(character::up_axis_of(Aabb{Vec3(0.0f), Vec3(5.0f, 2.0f, 1.0f)}), 1);
