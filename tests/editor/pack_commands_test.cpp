@@ -225,9 +225,10 @@ TEST_F(PackCommands, RenderingFromThePackEqualsTheInMemoryBake) {
   o.height = 80;
   o.threads = 2;
   o.time_seconds = 0.4;
-  o.pose_space.mode = anim::PoseSpaceMode::kArbitrary;
-  o.pose_space.samples = 16;
-  o.pose_space.every_frame_30hz = false;
+  o.pose_space.emplace();
+  o.pose_space->mode = anim::PoseSpaceMode::kArbitrary;
+  o.pose_space->samples = 16;
+  o.pose_space->every_frame_30hz = false;
   EXPECT_EQ(expect_pack_renders_like_source(o, kCesiumMan, pack), 16u);
 }
 
@@ -246,6 +247,7 @@ TEST_F(PackCommands, RenderingCallyFromThePackEqualsTheInMemoryBakeBitForBit) {
   o.threads = 2;
   o.clip = "walk";
   o.time_seconds = 0.3;
+  o.pose_space = character::default_pose_space();  // the pack's
   rt::CameraDesc camera;
   camera.eye = Vec3(0.0f, -400.0f, 100.0f);
   camera.target = Vec3(0.0f, 0.0f, 90.0f);
