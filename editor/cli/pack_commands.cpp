@@ -1,4 +1,5 @@
 #include "editor/cli/pack_commands.h"
+#include "editor/cli/shown_text.h"
 
 #include <sys/resource.h>
 #include <unistd.h>
@@ -443,18 +444,24 @@ std::string utc_text(std::int64_t unix_time) {
   return text;
 }
 
+Json shown_all(const std::vector<std::string>& texts) {
+  Json out = Json::array();
+  for (const std::string& t : texts) out.push_back(shown(t));
+  return out;
+}
+
 Json inspect_json(const character::Pack& pack) {
   const character::Model& m = pack.model();
   Json sections = Json::array();
   for (const SectionInfo& s : pack.reader().sections()) {
-    sections.push_back({{"id", section_id_name(s.id)}, {"version", s.version}, {"bytes", s.size}});
+    sections.push_back({{"id", shown(section_id_name(s.id))}, {"version", s.version}, {"bytes", s.size}});
   }
   Json clips = Json::array();
-  for (const anim::Clip& c : m.clips) clips.push_back({{"name", c.name()}, {"seconds", c.duration()}});
+  for (const anim::Clip& c : m.clips) clips.push_back({{"name", shown(c.name())}, {"seconds", c.duration()}});
   const character::PoseSpaceRecord& ps = pack.pose_space();
   const character::Provenance& p = pack.provenance();
   Json out = {
-      {"file", pack.reader().name()},
+      {"file", shown(pack.reader().name())},
       {"bytes", pack.reader().bytes().size()},
       {"format_version", std::to_string(pack.reader().version().major) + "." +
                              std::to_string(pack.reader().version().minor)},
@@ -462,11 +469,11 @@ Json inspect_json(const character::Pack& pack) {
       {"model", {{"joints", m.skeleton.joint_count()}, {"vertices", m.mesh.vertex_count()},
                  {"triangles", m.mesh.triangle_count()}, {"materials", m.mesh.material_colors.size()},
                  {"clips", clips}, {"joint_limits", !pack.limits().empty()}}},
-      {"pose_space", {{"mode", std::string(anim::pose_space_mode_name(ps.desc.mode))}, {"clips", ps.desc.clips},
+      {"pose_space", {{"mode", std::string(anim::pose_space_mode_name(ps.desc.mode))}, {"clips", shown_all(ps.desc.clips)},
                       {"samples_requested", ps.desc.samples}, {"every_frame_30hz", ps.desc.every_frame_30hz},
                       {"seed", ps.desc.seed}, {"padding", ps.padding},
                       {"candidates", ps.candidates == rt::CandidateBones::kAll ? "all" : "influencing"}}},
-      {"provenance", {{"source", p.source_name}, {"source_xxh3", p.source_hash}, {"tool", p.tool_version},
+      {"provenance", {{"source", shown(p.source_name)}, {"source_xxh3", p.source_hash}, {"tool", shown(p.tool_version)},
                       {"bake_date", utc_text(p.bake_unix_time)}, {"bake_unix_time", p.bake_unix_time},
                       {"pose_sampling_ms", p.pose_sampling_ms}, {"sampling_ms", p.sampling_ms},
                       {"assignment_ms", p.assignment_ms}, {"build_ms", p.build_ms}}},
@@ -487,7 +494,7 @@ Json inspect_json(const character::Pack& pack) {
     max_depth = std::max(max_depth, t.max_depth);
     depth_sum += t.mean_depth_of_leaves * static_cast<double>(t.leaves);
     leaves += t.leaves;
-    bones.push_back({{"bone", m.skeleton.names()[b]}, {"triangles", f.bone_trees[b].triangle_count},
+    bones.push_back({{"bone", shown(m.skeleton.names()[b])}, {"triangles", f.bone_trees[b].triangle_count},
                      {"nodes", f.bone_trees[b].node_count}, {"max_depth", t.max_depth}});
   }
   out["fuzzy"] = {{"pose_samples", st.sample_count},

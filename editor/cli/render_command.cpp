@@ -1,4 +1,5 @@
 #include "editor/cli/render_command.h"
+#include "editor/cli/shown_text.h"
 
 #include <array>
 #include <unistd.h>
@@ -330,8 +331,8 @@ Expected<std::string> stats_document(const RenderOptions& options, const charact
   const rt::FuzzyBakeStats& b = bake.fuzzy.stats;
   const RenderStatsSummary& s = outputs.stats;
   nlohmann::ordered_json doc;
-  doc["model"] = options.model_path;
-  doc["clip"] = outputs.clip_name;
+  doc["model"] = shown(options.model_path);
+  doc["clip"] = shown(outputs.clip_name);
   doc["time"] = options.time_seconds;
   doc["triangles"] = model.mesh.triangle_count();
   doc["bones"] = model.skeleton.joint_count();
@@ -576,9 +577,9 @@ void print_summary(const RenderOptions& options, const RenderOutputs& o, std::os
   std::ostringstream text;
   text.setf(std::ios::fixed);
   text.precision(2);
-  text << options.model_path << ": " << s.triangles << " triangles, " << s.bones << " bones, " << options.instances
+  text << shown(options.model_path) << ": " << s.triangles << " triangles, " << s.bones << " bones, " << options.instances
        << (options.instances == 1 ? " instance" : " instances") << ", clip "
-       << (o.clip_name.empty() ? std::string("(rest pose)") : "'" + o.clip_name + "'") << ", " << s.pose_samples
+       << (o.clip_name.empty() ? std::string("(rest pose)") : "'" + shown(o.clip_name) + "'") << ", " << s.pose_samples
        << " pose samples\n";
   text << o.width << "x" << o.height << ", " << options.frames << (options.frames == 1 ? " frame" : " frames")
        << ": " << s.fps << " fps (median frame " << s.median_frame_ms << " ms)\n";
@@ -602,7 +603,7 @@ void print_summary(const RenderOptions& options, const RenderOutputs& o, std::os
          << " bones on a cluster's tree (last frame), " << s.total_cluster_misses
          << " bones back on their full tree over all frames\n";
   }
-  text << "wrote " << options.out_dir << "/{color.png,depth.exr,triangle_id.exr,stats.json}\n";
+  text << "wrote " << shown(options.out_dir) << "/{color.png,depth.exr,triangle_id.exr,stats.json}\n";
   out << text.str();
 }
 

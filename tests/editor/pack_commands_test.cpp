@@ -20,8 +20,10 @@
 #include <thread>
 #include <vector>
 
+#include "character/pack.h"
 #include "editor/cli/pack_commands.h"
 #include "editor/cli/render_command.h"
+#include "editor/import/model_loader.h"
 #include "runtime/io/mapped_file.h"
 #include "runtime/pack/checksum.h"
 
@@ -440,6 +442,57 @@ TEST_F(PackCommands, MessagesAreOneLineOfPrintableText) {
       EXPECT_TRUE(c >= 0x20 && c < 0x7f) << "byte " << int{c} << " at " << i << " in " << r.err;
     }
   }
+}
+
+// True when `text` holds no control byte but newlines and no byte of
+// invalid UTF-8 (here: no byte >= 0x80 at all; the names below are ASCII
+// but for their odd bytes).
+bool plain_terminal_text(const std::string& text) {
+  return std::none_of(text.begin(), text.end(), [](char c) {
+    const auto u = static_cast<unsigned char>(c);
+    return (u < 0x20 && u != '\n') || u >= 0x7f;
+  });
+}
+
+// A path holding a byte of invalid UTF-8 made `inspect --json` and
+// `render` (its stats.json) fail with nlohmann's internal error, where bake
+// took the same path; `inspect` printed clip and source names as they were,
+// so a file could send control sequences to the terminal. Both are written
+// escaped (\xHH) now.
+TEST_F(PackCommands, OddBytesInPathsAndNamesAreWrittenEscaped) {
+  const std::string dir = fresh_dir("odd_bytes");
+  auto model = load_model(kCesiumMan);
+  ASSERT_TRUE(model.ok()) << model.status().message();
+  anim::RawClip raw;
+  raw.name = "evil\x1b]0;title\x07\xff";
+  raw.tracks.assign(model->clips.front().tracks().begin(), model->clips.front().tracks().end());
+  model->clips.front() = anim::Clip::build(std::move(raw), model->skeleton, "test").value();
+  character::PackContents contents;
+  contents.model = &*model;
+  contents.provenance.source_name = "source\x1b[2J\xfe";
+  const auto bytes = character::serialize_pack(contents);
+  ASSERT_TRUE(bytes.ok()) << bytes.status().message();
+  const std::string pack = dir + "/odd\xff\x1b[31mname.pack";
+  std::ofstream(pack, std::ios::binary).write(reinterpret_cast<const char*>(bytes->data()),
+                                              static_cast<std::streamsize>(bytes->size()));
+
+  const CommandRun json = run(run_inspect, {pack, "--json"});
+  ASSERT_EQ(json.code, 0) << json.err;
+  const auto j = nlohmann::json::parse(json.out);
+  EXPECT_EQ(j["file"], dir + "/odd\\xff\\x1b[31mname.pack");
+  EXPECT_EQ(j["model"]["clips"][0]["name"], "evil\\x1b]0;title\\x07\\xff");
+  EXPECT_EQ(j["provenance"]["source"], "source\\x1b[2J\\xfe");
+  const CommandRun text = run(run_inspect, {pack});
+  ASSERT_EQ(text.code, 0) << text.err;
+  EXPECT_TRUE(plain_terminal_text(text.out)) << text.out;
+  EXPECT_NE(text.out.find("clip evil\\x1b]0;title\\x07\\xff"), std::string::npos) << text.out;
+
+  const CommandRun render = run(run_render, {pack, "--out", dir + "/out\xff", "--size", "16x16", "--threads", "1"});
+  ASSERT_EQ(render.code, 0) << render.err;
+  EXPECT_TRUE(plain_terminal_text(render.out)) << render.out;
+  const auto stats = nlohmann::json::parse(read_file(dir + "/out\xff/stats.json"));
+  EXPECT_EQ(stats["model"], dir + "/odd\\xff\\x1b[31mname.pack");
+  EXPECT_EQ(stats["clip"], "evil\\x1b]0;title\\x07\\xff");
 }
 
 TEST_F(PackCommands, UsageAndUserErrorsHaveTheirExitCodes) {
