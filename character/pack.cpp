@@ -549,13 +549,18 @@ Expected<std::vector<std::byte>> serialize_pack(const PackContents& contents) {
   return writer.serialize();
 }
 
-Status write_pack(const std::string& path, const PackContents& contents) {
+Status write_pack(const std::string& path, const PackContents& contents, const std::function<bool()>& cancelled) {
   SINEW_ASSIGN_OR_RETURN(const PackWriter writer, character_pack_writer(contents));
-  return writer.write(path, [](const std::string& written) -> Status {
+  return writer.write(path, [&cancelled](const std::string& written) -> Status {
     auto loaded = Pack::open(written);
-    if (loaded.ok()) return {};
-    return make_error(loaded.status().code(), "", "", "",
-                      "the written pack does not load, so nothing was replaced: " + loaded.status().message());
+    if (!loaded.ok()) {
+      return make_error(loaded.status().code(), "", "", "",
+                        "the written pack does not load, so nothing was replaced: " + loaded.status().message());
+    }
+    if (cancelled && cancelled()) {
+      return make_error(ErrorCode::kCancelled, "", "", "", "interrupted while writing, so nothing was replaced");
+    }
+    return {};
   });
 }
 

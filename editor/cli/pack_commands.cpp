@@ -294,8 +294,11 @@ Expected<BakeOptions> parse_bake_options(const std::vector<std::string>& args, c
 
 // --- progress and interruption -----------------------------------------------------
 
-// SIGINT during a bake cancels it through the progress callback: the bake
-// stops, nothing is written, and an existing OUT.pack is untouched.
+// SIGINT or SIGTERM during a bake cancels it through the progress
+// callback: the bake stops, nothing is written, and an existing OUT.pack is
+// untouched. During the final write the written file is discarded before
+// it replaces anything (character::write_pack's `cancelled`), so no
+// temporary file is left either.
 std::atomic<bool> g_interrupted{false};
 extern "C" void on_interrupt(int) { g_interrupted.store(true); }
 
@@ -303,14 +306,19 @@ class ScopedInterruptHandler {
  public:
   ScopedInterruptHandler() {
     g_interrupted.store(false);
-    previous_ = std::signal(SIGINT, on_interrupt);
+    previous_int_ = std::signal(SIGINT, on_interrupt);
+    previous_term_ = std::signal(SIGTERM, on_interrupt);
   }
-  ~ScopedInterruptHandler() { std::signal(SIGINT, previous_); }
+  ~ScopedInterruptHandler() {
+    std::signal(SIGINT, previous_int_);
+    std::signal(SIGTERM, previous_term_);
+  }
   ScopedInterruptHandler(const ScopedInterruptHandler&) = delete;
   ScopedInterruptHandler& operator=(const ScopedInterruptHandler&) = delete;
 
  private:
-  void (*previous_)(int) = SIG_DFL;
+  void (*previous_int_)(int) = SIG_DFL;
+  void (*previous_term_)(int) = SIG_DFL;
 };
 
 // A bar with percent, phase and ETA on a terminal; plain lines otherwise
@@ -632,17 +640,17 @@ int run_bake(const std::vector<std::string>& args, std::ostream& out, std::ostre
       << " pose space on " << jobs.thread_count() << " threads\n"
       << std::flush;
   const long rss_before_kib = max_rss_kib();
-  Expected<character::InMemoryBake> bake = [&] {
-    ScopedInterruptHandler interrupts;
-    return character::bake_in_memory(*model, request, jobs);
-  }();
+  // Until the pack is in place, an interrupt cancels the bake or the write.
+  std::optional<ScopedInterruptHandler> interrupts(std::in_place);
+  const auto interrupted = [&] {
+    err << "sinew-editor bake: interrupted; " << o.out_path << " was not written (an existing file is unchanged)\n";
+    return 1;
+  };
+  Expected<character::InMemoryBake> bake = character::bake_in_memory(*model, request, jobs);
   progress.done();
   if (bake.ok()) print_bake_memory(bake->memory, rss_before_kib, max_rss_kib(), out);
   if (!bake.ok()) {
-    if (bake.status().code() == ErrorCode::kCancelled) {
-      err << "sinew-editor bake: interrupted; " << o.out_path << " was not written (an existing file is unchanged)\n";
-      return 1;
-    }
+    if (bake.status().code() == ErrorCode::kCancelled) return interrupted();
     return fail(err, "bake", bake.status());
   }
 
@@ -662,7 +670,11 @@ int run_bake(const std::vector<std::string>& args, std::ostream& out, std::ostre
     p.assignment_ms = bake->fuzzy.stats.assignment_ms;
     p.build_ms = bake->fuzzy.stats.build_ms;
   }
-  if (Status s = character::write_pack(o.out_path, contents); !s.ok()) return fail(err, "bake", s);
+  if (Status s = character::write_pack(o.out_path, contents, [] { return g_interrupted.load(); }); !s.ok()) {
+    if (s.code() == ErrorCode::kCancelled) return interrupted();
+    return fail(err, "bake", s);
+  }
+  interrupts.reset();  // the pack is in place: an interrupt stops the program again
   const rt::FuzzyBakeStats& st = bake->fuzzy.stats;
   out << "wrote " << o.out_path << ": " << std::filesystem::file_size(o.out_path) << " bytes, " << st.sample_count
       << " pose samples, fuzzy area " << std::fixed << std::setprecision(3)

@@ -4,6 +4,10 @@
 // after an in-memory bake of the same pose space.
 #include <gtest/gtest.h>
 #include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
+#include <sys/inotify.h>
+#include <sys/wait.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -493,6 +497,72 @@ TEST_F(PackCommands, OddBytesInPathsAndNamesAreWrittenEscaped) {
   const auto stats = nlohmann::json::parse(read_file(dir + "/out\xff/stats.json"));
   EXPECT_EQ(stats["model"], dir + "/odd\\xff\\x1b[31mname.pack");
   EXPECT_EQ(stats["clip"], "evil\\x1b]0;title\\x07\\xff");
+}
+
+// SIGTERM during bake's final write killed the program and left its hidden
+// temporary file beside the output (SIGINT was handled only while baking).
+// Both are handled alike until the pack is in place. A real sinew-editor is
+// stopped the moment its temporary file appears (inotify), sent SIGTERM
+// there, and continued: it exits 1 leaving the old pack and nothing else.
+// (Stopped after its last check, it may still finish: then the new pack is
+// whole; either way it is never killed and leaves no temporary file.)
+TEST_F(PackCommands, SigtermDuringTheFinalWriteLeavesTheOldPackAndNoTemporaryFile) {
+  const std::string dir = fresh_dir("sigterm");
+  const std::string out = dir + "/keep.pack";
+  const int watch = inotify_init1(IN_CLOEXEC);
+  ASSERT_GE(watch, 0);
+  ASSERT_GE(inotify_add_watch(watch, dir.c_str(), IN_CREATE), 0);
+  int interrupted = 0;
+  for (int attempt = 0; attempt < 20 && interrupted == 0; ++attempt) {
+    std::ofstream(out, std::ios::binary | std::ios::trunc) << "previous";
+    const pid_t child = fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+      const int null = open("/dev/null", O_WRONLY);
+      dup2(null, 1);
+      dup2(null, 2);
+      execl(SINEW_EDITOR, "sinew-editor", "bake", kCesiumMan.c_str(), "-o", out.c_str(), "--samples", "4",
+            "--threads", "1", static_cast<char*>(nullptr));
+      _exit(127);
+    }
+    // The pack's temporary file: "dir/.keep.tmp-<pid>-<n>.pack".
+    std::string temp;
+    alignas(inotify_event) char events[4096];
+    pollfd ready{watch, POLLIN, 0};
+    while (temp.empty() && poll(&ready, 1, 120'000) > 0) {  // a guard against a child that never writes
+      const ssize_t n = read(watch, events, sizeof events);
+      for (ssize_t at = 0; at < n;) {
+        const auto* e = reinterpret_cast<const inotify_event*>(events + at);
+        if (e->len > 0 && std::string_view(e->name).starts_with(".keep.tmp-")) temp = dir + "/" + e->name;
+        at += static_cast<ssize_t>(sizeof(inotify_event) + e->len);
+      }
+    }
+    int status = 0;
+    kill(child, SIGSTOP);
+    waitpid(child, &status, WUNTRACED);
+    if (WIFSTOPPED(status)) {
+      const bool writing = !temp.empty() && std::filesystem::exists(temp);
+      if (writing) kill(child, SIGTERM);
+      kill(child, SIGCONT);
+      waitpid(child, &status, 0);
+      if (!writing) continue;  // stopped after the write: try again
+    } else {
+      continue;  // finished before it stopped: try again
+    }
+    ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+    std::vector<std::string> left;
+    for (const auto& entry : std::filesystem::directory_iterator(dir)) left.push_back(entry.path().filename().string());
+    EXPECT_EQ(left, std::vector<std::string>{"keep.pack"});
+    if (WEXITSTATUS(status) == 1) {
+      ++interrupted;
+      EXPECT_EQ(read_file(out), "previous");
+    } else {
+      EXPECT_EQ(WEXITSTATUS(status), 0);
+      EXPECT_TRUE(character::Pack::open(out).ok());
+    }
+  }
+  close(watch);
+  EXPECT_EQ(interrupted, 1) << "no attempt was stopped inside its write";
 }
 
 TEST_F(PackCommands, UsageAndUserErrorsHaveTheirExitCodes) {
