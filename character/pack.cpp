@@ -221,6 +221,14 @@ std::span<const std::byte> bytes_of(std::span<const T> values) {
 
 // --- decoding ------------------------------------------------------------------
 
+// An error of a validating builder run over a section's contents, named as
+// the section's own are: "x.pack: SKEL.joints[3].rest = ..." (the builders
+// name no file; the pack path used to run into the section's name).
+Status in_section(const SectionDecoder& d, const Status& s, const std::string& prefix = "") {
+  const std::string field = prefix + std::string(s.field());
+  return make_error(s.code(), d.pack(), field.empty() ? d.section() : d.section() + "." + field, s.value(), s.detail());
+}
+
 Expected<anim::Skeleton> decode_skeleton(SectionDecoder& d) {
   std::uint32_t count = 0;
   SINEW_RETURN_IF_ERROR(d.get(count, "joint_count"));
@@ -250,8 +258,8 @@ Expected<anim::Skeleton> decode_skeleton(SectionDecoder& d) {
   }
   SINEW_RETURN_IF_ERROR(d.finish());
   // Parent-first input keeps its order exactly (Skeleton::build).
-  auto skeleton = anim::Skeleton::build(raw, d.pack() + " " + d.section());
-  if (!skeleton.ok()) return skeleton.status();
+  auto skeleton = anim::Skeleton::build(raw, "");
+  if (!skeleton.ok()) return in_section(d, skeleton.status());
   return std::move(*skeleton);
 }
 
@@ -333,8 +341,8 @@ Expected<std::vector<anim::Clip>> decode_clips(SectionDecoder& d, const anim::Sk
       SINEW_RETURN_IF_ERROR(decode_track(d, tf + ".rotation", raw.tracks[t].rotation));
       SINEW_RETURN_IF_ERROR(decode_track(d, tf + ".scale", raw.tracks[t].scale));
     }
-    auto clip = anim::Clip::build(std::move(raw), skeleton, d.pack() + " " + d.section() + "." + f);
-    if (!clip.ok()) return clip.status();
+    auto clip = anim::Clip::build(std::move(raw), skeleton, "");
+    if (!clip.ok()) return in_section(d, clip.status(), f + ".");
     clips.push_back(std::move(*clip));
   }
   SINEW_RETURN_IF_ERROR(d.finish());
@@ -420,7 +428,7 @@ Expected<anim::JointLimits> decode_limits(SectionDecoder& d, const anim::Skeleto
   }
   SINEW_RETURN_IF_ERROR(d.finish());
   // Ranges, finiteness and unit axes, as for limits read from JSON.
-  SINEW_RETURN_IF_ERROR(anim::validate_joint_limits(limits, d.pack() + " " + d.section()));
+  if (Status s = anim::validate_joint_limits(limits, ""); !s.ok()) return in_section(d, s);
   return limits;
 }
 

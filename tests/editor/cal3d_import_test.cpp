@@ -563,6 +563,20 @@ TEST_F(Cal3dBadInput, ACfgWithoutMeshesIsNotBaked) {
             cfg + ": mesh.triangle_count = 0: the model has no triangles: nothing to frame or trace");
 }
 
+// A symbolic link to a .cfg looked for the model's files beside the link;
+// they are found beside the .cfg it links to, as if it were opened there.
+TEST_F(Cal3dBadInput, ASymlinkedCfgReadsTheFilesBesideItsTarget) {
+  const fs::path link = dir_ / "linked.cfg";
+  fs::create_symlink(model_file("cally", "cally.cfg"), link);
+  auto linked = import_cal3d(link.string());
+  ASSERT_TRUE(linked.ok()) << linked.status().message();
+  auto direct = import_cal3d(model_file("cally", "cally.cfg"));
+  ASSERT_TRUE(direct.ok()) << direct.status().message();
+  EXPECT_EQ(linked->mesh.triangle_count(), direct->mesh.triangle_count());
+  ASSERT_EQ(linked->clips.size(), direct->clips.size());
+  for (std::size_t c = 0; c < direct->clips.size(); ++c) EXPECT_EQ(linked->clips[c].name(), direct->clips[c].name());
+}
+
 // XML materials go to Cal3D's XML loader, which dereferences missing
 // attributes and element texts (found by fuzzing: a HEADER without MAGIC
 // crashed in strcasecmp(nullptr)); the importer refuses them first. The
