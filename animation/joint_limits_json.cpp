@@ -11,6 +11,7 @@
 #include "animation/joint_limits.h"
 #include "animation/skeleton.h"
 #include "runtime/io/atomic_file.h"
+#include "runtime/io/json_nesting.h"
 
 namespace sinew::anim {
 namespace {
@@ -20,6 +21,8 @@ using nlohmann::json;
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kRadPerDeg = kPi / 180.0;
 constexpr int kVersion = 1;
+// The format nests four levels (root, joints, a joint, its euler block).
+constexpr std::size_t kMaxNesting = 16;
 
 struct OrderName {
   RotationOrder order;
@@ -205,6 +208,7 @@ double shortest(float v) {
 
 Expected<JointLimits> parse_joint_limits(std::string_view text, const Skeleton& skeleton,
                                          std::string_view source) {
+  SINEW_RETURN_IF_ERROR(check_json_nesting(text, kMaxNesting, std::string(source), "(top level)"));
   json root;
   try {
     root = json::parse(text.begin(), text.end());

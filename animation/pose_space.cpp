@@ -1,6 +1,7 @@
 #include "animation/pose_space.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <cmath>
 #include <random>
 #include <string>
@@ -290,9 +291,15 @@ Status for_each_pose(const PoseSpaceDesc& desc, const Skeleton& skeleton, std::s
   };
   std::vector<Sample> all;
   for (const Clip* c : chosen) {
-    if (desc.every_frame_30hz && static_cast<double>(c->duration()) * 30.0 > kMaxPoseSamples) {
-      return make_error(ErrorCode::kLimitExceeded, "", "pose_space.clips", c->name(),
-                        "clip too long to sample every 1/30 s (" + std::to_string(c->duration()) + " s)");
+    const double seconds = static_cast<double>(c->duration());
+    const double limit = desc.samples == 0 ? kMaxClipSecondsEveryFrame : kMaxPoseSamples / 30.0;
+    if (desc.every_frame_30hz && seconds > limit) {
+      char text[160];
+      std::snprintf(text, sizeof text, "lasts %.6g s: sampling every 1/30 s takes clips of up to %.6g s (%s)",
+                    seconds, limit,
+                    desc.samples == 0 ? "anim::kMaxClipSecondsEveryFrame; or sample N poses of it"
+                                      : "anim::kMaxPoseSamples at 30 Hz");
+      return make_error(ErrorCode::kLimitExceeded, "", "pose_space.clips", printable(c->name(), 60), text);
     }
     for (float t : clip_sample_times(*c, desc.every_frame_30hz)) all.push_back({c, t});
   }

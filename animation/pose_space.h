@@ -39,6 +39,13 @@ Expected<PoseSpaceMode> parse_pose_space_mode(std::string_view name);
 // queueing days of work.
 inline constexpr int kMaxPoseSamples = 10'000'000;
 
+// A clip sampled every 1/30 s at every time found (kClips/kClip with
+// every_frame_30hz and samples = 0) may last this long: 18,000 poses, each
+// skinned over every vertex and bone by the bake. A longer clip is refused
+// naming it, its length and this limit; `samples` N bounds the work
+// instead (N poses chosen evenly over its times), whatever its length.
+inline constexpr double kMaxClipSecondsEveryFrame = 600.0;
+
 struct PoseSpaceDesc {
   PoseSpaceMode mode = PoseSpaceMode::kArbitrary;
   std::vector<std::string> clips;  // kClips: names (empty = every clip); kClip: one name
@@ -57,8 +64,9 @@ struct PoseSpaceDesc {
 // sampled alone). `limits` is needed by kLimits only (one per joint; an
 // empty span there is kInvalidArgument: nothing to be "within").
 // Errors: kInvalidArgument (bad samples, limits size, kClip without exactly
-// one name), kNotFound naming an unknown clip, or whatever `visit` returns,
-// which stops the walk.
+// one name), kNotFound naming an unknown clip, kLimitExceeded naming a clip
+// too long to sample every 1/30 s, or whatever `visit` returns, which stops
+// the walk.
 Status for_each_pose(const PoseSpaceDesc& desc, const Skeleton& skeleton, std::span<const Clip> clips,
                      std::span<const JointLimit> limits,
                      const std::function<Status(std::span<const JointTransform>)>& visit);

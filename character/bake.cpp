@@ -6,6 +6,7 @@
 #include <string>
 
 #include "animation/pose.h"
+#include "character/renderable.h"
 #include "runtime/jobs/job_system.h"
 #include "runtime/timing/stopwatch.h"
 
@@ -85,6 +86,8 @@ Expected<std::vector<Affine3>> clip_skinning(const Model& model, const anim::Cli
 }
 
 Expected<InMemoryBake> bake_in_memory(const Model& model, const BakeRequest& request, JobSystem& jobs) {
+  // A model the consumers of its pack would refuse is not baked.
+  SINEW_RETURN_IF_ERROR(check_renderable(model, model.source));
   InMemoryBake bake;
   // The fuzzy bake holds an inverse per sample matrix beside its boxes.
   if (request.max_memory_bytes <= request.fuzzy.memory_budget_bytes) {
@@ -93,9 +96,17 @@ Expected<InMemoryBake> bake_in_memory(const Model& model, const BakeRequest& req
                                 std::to_string(request.fuzzy.memory_budget_bytes) + " bytes)");
   }
   const std::size_t sample_bound = (request.max_memory_bytes - request.fuzzy.memory_budget_bytes) / 2;
+  const std::size_t joints = model.skeleton.joint_count();
+  if (!request.poses.empty() && (joints == 0 || request.poses.size() % joints != 0)) {
+    return invalid_argument("poses", std::to_string(request.poses.size()) + " matrices",
+                            "not a whole number of poses of " + std::to_string(joints) + " joints");
+  }
   const auto start = std::chrono::steady_clock::now();
-  SINEW_ASSIGN_OR_RETURN(std::vector<Affine3> samples,
-                         pose_space_skinning(model, request.pose_space, request.limits, sample_bound));
+  Expected<std::vector<Affine3>> sampled =
+      request.poses.empty() ? pose_space_skinning(model, request.pose_space, request.limits, sample_bound)
+                            : Expected<std::vector<Affine3>>(request.poses);
+  if (!sampled.ok()) return sampled.status().with_file(model.source);
+  const std::vector<Affine3>& samples = *sampled;
   bake.memory.pose_samples = samples.capacity() * sizeof(Affine3);
   bake.pose_sampling_ms = ms_since(start);
   rt::FuzzyBakeInput input;

@@ -50,6 +50,10 @@ Expected<std::vector<Affine3>> rest_skinning(const Model& model, const Affine3& 
 
 struct BakeRequest {
   anim::PoseSpaceDesc pose_space = default_pose_space();
+  // When not empty: the pose samples themselves, skinning matrices
+  // sample-major (a whole number of poses), baked instead of pose_space.
+  // `render` bakes only the poses it draws this way.
+  std::vector<Affine3> poses;
   std::vector<anim::JointLimit> limits;  // kLimits only
   rt::FuzzyBakeOptions fuzzy;
   // The bake's working set may not exceed this. The fuzzy boxes already fit
@@ -75,9 +79,10 @@ struct InMemoryBake {
 };
 
 // Errors besides the fuzzy bake's: kInvalidArgument when max_memory_bytes
-// leaves no room beside fuzzy.memory_budget_bytes; kLimitExceeded when the
-// pose space needs more than that room (refused while sampling, before the
-// matrices outgrow the bound).
+// leaves no room beside fuzzy.memory_budget_bytes, or `poses` is not a
+// whole number of poses; kLimitExceeded when the pose space needs more than
+// that room (refused while sampling, before the matrices outgrow the bound)
+// or has a clip too long for it (naming the model's file).
 
 Expected<InMemoryBake> bake_in_memory(const Model& model, const BakeRequest& request, JobSystem& jobs);
 

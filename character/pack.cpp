@@ -5,6 +5,7 @@
 #include <cstring>
 #include <utility>
 
+#include "character/renderable.h"
 #include "raytrace/bake/fuzzy_bake.h"
 #include "runtime/mesh/mesh_checks.h"
 #include "runtime/pack/pack_writer.h"
@@ -220,6 +221,14 @@ std::span<const std::byte> bytes_of(std::span<const T> values) {
 
 // --- decoding ------------------------------------------------------------------
 
+// An error of a validating builder run over a section's contents, named as
+// the section's own are: "x.pack: SKEL.joints[3].rest = ..." (the builders
+// name no file; the pack path used to run into the section's name).
+Status in_section(const SectionDecoder& d, const Status& s, const std::string& prefix = "") {
+  const std::string field = prefix + std::string(s.field());
+  return make_error(s.code(), d.pack(), field.empty() ? d.section() : d.section() + "." + field, s.value(), s.detail());
+}
+
 Expected<anim::Skeleton> decode_skeleton(SectionDecoder& d) {
   std::uint32_t count = 0;
   SINEW_RETURN_IF_ERROR(d.get(count, "joint_count"));
@@ -249,8 +258,8 @@ Expected<anim::Skeleton> decode_skeleton(SectionDecoder& d) {
   }
   SINEW_RETURN_IF_ERROR(d.finish());
   // Parent-first input keeps its order exactly (Skeleton::build).
-  auto skeleton = anim::Skeleton::build(raw, d.pack() + " " + d.section());
-  if (!skeleton.ok()) return skeleton.status();
+  auto skeleton = anim::Skeleton::build(raw, "");
+  if (!skeleton.ok()) return in_section(d, skeleton.status());
   return std::move(*skeleton);
 }
 
@@ -332,8 +341,8 @@ Expected<std::vector<anim::Clip>> decode_clips(SectionDecoder& d, const anim::Sk
       SINEW_RETURN_IF_ERROR(decode_track(d, tf + ".rotation", raw.tracks[t].rotation));
       SINEW_RETURN_IF_ERROR(decode_track(d, tf + ".scale", raw.tracks[t].scale));
     }
-    auto clip = anim::Clip::build(std::move(raw), skeleton, d.pack() + " " + d.section() + "." + f);
-    if (!clip.ok()) return clip.status();
+    auto clip = anim::Clip::build(std::move(raw), skeleton, "");
+    if (!clip.ok()) return in_section(d, clip.status(), f + ".");
     clips.push_back(std::move(*clip));
   }
   SINEW_RETURN_IF_ERROR(d.finish());
@@ -419,7 +428,7 @@ Expected<anim::JointLimits> decode_limits(SectionDecoder& d, const anim::Skeleto
   }
   SINEW_RETURN_IF_ERROR(d.finish());
   // Ranges, finiteness and unit axes, as for limits read from JSON.
-  SINEW_RETURN_IF_ERROR(anim::validate_joint_limits(limits, d.pack() + " " + d.section()));
+  if (Status s = anim::validate_joint_limits(limits, ""); !s.ok()) return in_section(d, s);
   return limits;
 }
 
@@ -548,13 +557,18 @@ Expected<std::vector<std::byte>> serialize_pack(const PackContents& contents) {
   return writer.serialize();
 }
 
-Status write_pack(const std::string& path, const PackContents& contents) {
+Status write_pack(const std::string& path, const PackContents& contents, const std::function<bool()>& cancelled) {
   SINEW_ASSIGN_OR_RETURN(const PackWriter writer, character_pack_writer(contents));
-  return writer.write(path, [](const std::string& written) -> Status {
+  return writer.write(path, [&cancelled](const std::string& written) -> Status {
     auto loaded = Pack::open(written);
-    if (loaded.ok()) return {};
-    return make_error(loaded.status().code(), "", "", "",
-                      "the written pack does not load, so nothing was replaced: " + loaded.status().message());
+    if (!loaded.ok()) {
+      return make_error(loaded.status().code(), "", "", "",
+                        "the written pack does not load, so nothing was replaced: " + loaded.status().message());
+    }
+    if (cancelled && cancelled()) {
+      return make_error(ErrorCode::kCancelled, "", "", "", "interrupted while writing, so nothing was replaced");
+    }
+    return {};
   });
 }
 
@@ -585,6 +599,8 @@ Expected<Pack> Pack::load(PackReader reader) {
     SectionDecoder d = decoder(r, kClips);
     SINEW_ASSIGN_OR_RETURN(pack.model_.clips, decode_clips(d, pack.model_.skeleton));
   }
+  // What every consumer needs to frame and trace it, checked once here.
+  SINEW_RETURN_IF_ERROR(check_renderable(pack.model_, r.name(), kPackFields));
   if (const SectionInfo* limits = r.find(kLimits)) {
     if (limits->version != kLimitsVersion) {
       return make_error(ErrorCode::kUnsupportedVersion, r.name(), "LIMT.version", std::to_string(limits->version),

@@ -16,6 +16,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <span>
 #include <string>
@@ -62,8 +63,11 @@ Expected<std::vector<std::byte>> serialize_pack(const PackContents& contents);
 // Written atomically: `path` keeps its old contents unless the whole new
 // pack is in place, and the new pack replaces it only after it loaded and
 // validated (Pack::open) from the written bytes: a pack that
-// would not load is never left behind.
-Status write_pack(const std::string& path, const PackContents& contents);
+// would not load is never left behind. `cancelled`, when given, is asked
+// after that check: true (a signal arrived while writing) discards the
+// written file and returns kCancelled, `path` untouched.
+Status write_pack(const std::string& path, const PackContents& contents,
+                  const std::function<bool()>& cancelled = {});
 
 class Pack {
  public:

@@ -1,4 +1,5 @@
 #include "editor/cli/pack_commands.h"
+#include "editor/cli/shown_text.h"
 
 #include <sys/resource.h>
 #include <unistd.h>
@@ -293,8 +294,11 @@ Expected<BakeOptions> parse_bake_options(const std::vector<std::string>& args, c
 
 // --- progress and interruption -----------------------------------------------------
 
-// SIGINT during a bake cancels it through the progress callback: the bake
-// stops, nothing is written, and an existing OUT.pack is untouched.
+// SIGINT or SIGTERM during a bake cancels it through the progress
+// callback: the bake stops, nothing is written, and an existing OUT.pack is
+// untouched. During the final write the written file is discarded before
+// it replaces anything (character::write_pack's `cancelled`), so no
+// temporary file is left either.
 std::atomic<bool> g_interrupted{false};
 extern "C" void on_interrupt(int) { g_interrupted.store(true); }
 
@@ -302,14 +306,19 @@ class ScopedInterruptHandler {
  public:
   ScopedInterruptHandler() {
     g_interrupted.store(false);
-    previous_ = std::signal(SIGINT, on_interrupt);
+    previous_int_ = std::signal(SIGINT, on_interrupt);
+    previous_term_ = std::signal(SIGTERM, on_interrupt);
   }
-  ~ScopedInterruptHandler() { std::signal(SIGINT, previous_); }
+  ~ScopedInterruptHandler() {
+    std::signal(SIGINT, previous_int_);
+    std::signal(SIGTERM, previous_term_);
+  }
   ScopedInterruptHandler(const ScopedInterruptHandler&) = delete;
   ScopedInterruptHandler& operator=(const ScopedInterruptHandler&) = delete;
 
  private:
-  void (*previous_)(int) = SIG_DFL;
+  void (*previous_int_)(int) = SIG_DFL;
+  void (*previous_term_)(int) = SIG_DFL;
 };
 
 // A bar with percent, phase and ETA on a terminal; plain lines otherwise
@@ -443,18 +452,24 @@ std::string utc_text(std::int64_t unix_time) {
   return text;
 }
 
+Json shown_all(const std::vector<std::string>& texts) {
+  Json out = Json::array();
+  for (const std::string& t : texts) out.push_back(shown(t));
+  return out;
+}
+
 Json inspect_json(const character::Pack& pack) {
   const character::Model& m = pack.model();
   Json sections = Json::array();
   for (const SectionInfo& s : pack.reader().sections()) {
-    sections.push_back({{"id", section_id_name(s.id)}, {"version", s.version}, {"bytes", s.size}});
+    sections.push_back({{"id", shown(section_id_name(s.id))}, {"version", s.version}, {"bytes", s.size}});
   }
   Json clips = Json::array();
-  for (const anim::Clip& c : m.clips) clips.push_back({{"name", c.name()}, {"seconds", c.duration()}});
+  for (const anim::Clip& c : m.clips) clips.push_back({{"name", shown(c.name())}, {"seconds", c.duration()}});
   const character::PoseSpaceRecord& ps = pack.pose_space();
   const character::Provenance& p = pack.provenance();
   Json out = {
-      {"file", pack.reader().name()},
+      {"file", shown(pack.reader().name())},
       {"bytes", pack.reader().bytes().size()},
       {"format_version", std::to_string(pack.reader().version().major) + "." +
                              std::to_string(pack.reader().version().minor)},
@@ -462,11 +477,11 @@ Json inspect_json(const character::Pack& pack) {
       {"model", {{"joints", m.skeleton.joint_count()}, {"vertices", m.mesh.vertex_count()},
                  {"triangles", m.mesh.triangle_count()}, {"materials", m.mesh.material_colors.size()},
                  {"clips", clips}, {"joint_limits", !pack.limits().empty()}}},
-      {"pose_space", {{"mode", std::string(anim::pose_space_mode_name(ps.desc.mode))}, {"clips", ps.desc.clips},
+      {"pose_space", {{"mode", std::string(anim::pose_space_mode_name(ps.desc.mode))}, {"clips", shown_all(ps.desc.clips)},
                       {"samples_requested", ps.desc.samples}, {"every_frame_30hz", ps.desc.every_frame_30hz},
                       {"seed", ps.desc.seed}, {"padding", ps.padding},
                       {"candidates", ps.candidates == rt::CandidateBones::kAll ? "all" : "influencing"}}},
-      {"provenance", {{"source", p.source_name}, {"source_xxh3", p.source_hash}, {"tool", p.tool_version},
+      {"provenance", {{"source", shown(p.source_name)}, {"source_xxh3", p.source_hash}, {"tool", shown(p.tool_version)},
                       {"bake_date", utc_text(p.bake_unix_time)}, {"bake_unix_time", p.bake_unix_time},
                       {"pose_sampling_ms", p.pose_sampling_ms}, {"sampling_ms", p.sampling_ms},
                       {"assignment_ms", p.assignment_ms}, {"build_ms", p.build_ms}}},
@@ -487,7 +502,7 @@ Json inspect_json(const character::Pack& pack) {
     max_depth = std::max(max_depth, t.max_depth);
     depth_sum += t.mean_depth_of_leaves * static_cast<double>(t.leaves);
     leaves += t.leaves;
-    bones.push_back({{"bone", m.skeleton.names()[b]}, {"triangles", f.bone_trees[b].triangle_count},
+    bones.push_back({{"bone", shown(m.skeleton.names()[b])}, {"triangles", f.bone_trees[b].triangle_count},
                      {"nodes", f.bone_trees[b].node_count}, {"max_depth", t.max_depth}});
   }
   out["fuzzy"] = {{"pose_samples", st.sample_count},
@@ -625,17 +640,17 @@ int run_bake(const std::vector<std::string>& args, std::ostream& out, std::ostre
       << " pose space on " << jobs.thread_count() << " threads\n"
       << std::flush;
   const long rss_before_kib = max_rss_kib();
-  Expected<character::InMemoryBake> bake = [&] {
-    ScopedInterruptHandler interrupts;
-    return character::bake_in_memory(*model, request, jobs);
-  }();
+  // Until the pack is in place, an interrupt cancels the bake or the write.
+  std::optional<ScopedInterruptHandler> interrupts(std::in_place);
+  const auto interrupted = [&] {
+    err << "sinew-editor bake: interrupted; " << o.out_path << " was not written (an existing file is unchanged)\n";
+    return 1;
+  };
+  Expected<character::InMemoryBake> bake = character::bake_in_memory(*model, request, jobs);
   progress.done();
   if (bake.ok()) print_bake_memory(bake->memory, rss_before_kib, max_rss_kib(), out);
   if (!bake.ok()) {
-    if (bake.status().code() == ErrorCode::kCancelled) {
-      err << "sinew-editor bake: interrupted; " << o.out_path << " was not written (an existing file is unchanged)\n";
-      return 1;
-    }
+    if (bake.status().code() == ErrorCode::kCancelled) return interrupted();
     return fail(err, "bake", bake.status());
   }
 
@@ -655,7 +670,11 @@ int run_bake(const std::vector<std::string>& args, std::ostream& out, std::ostre
     p.assignment_ms = bake->fuzzy.stats.assignment_ms;
     p.build_ms = bake->fuzzy.stats.build_ms;
   }
-  if (Status s = character::write_pack(o.out_path, contents); !s.ok()) return fail(err, "bake", s);
+  if (Status s = character::write_pack(o.out_path, contents, [] { return g_interrupted.load(); }); !s.ok()) {
+    if (s.code() == ErrorCode::kCancelled) return interrupted();
+    return fail(err, "bake", s);
+  }
+  interrupts.reset();  // the pack is in place: an interrupt stops the program again
   const rt::FuzzyBakeStats& st = bake->fuzzy.stats;
   out << "wrote " << o.out_path << ": " << std::filesystem::file_size(o.out_path) << " bytes, " << st.sample_count
       << " pose samples, fuzzy area " << std::fixed << std::setprecision(3)

@@ -1,4 +1,5 @@
 #include "editor/cli/render_command.h"
+#include "editor/cli/shown_text.h"
 
 #include <array>
 #include <unistd.h>
@@ -51,8 +52,9 @@ struct RenderFlags {
                         "posed model from the front, +Z for Y-up models, -Y for Z-up)")),
         size(l.option("--size", "WxH", "image size (default 512x512)")),
         pose_space(l.option("--pose-space", "MODE",
-                            "arbitrary|limits|clips|clip:NAME (default: clips, every key\n"
-                            "and every 1/30 s of every clip)")),
+                            "arbitrary|limits|clips|clip:NAME of an in-memory bake (default:\n"
+                            "only the poses rendered; with --clips, --samples or --seed alone:\n"
+                            "clips, every key and every 1/30 s of every clip)")),
         clips(l.option("--clips", "a,b,c", "the clips of --pose-space clips (default: all)")),
         samples(l.option("--samples", "N", "pose samples (random modes: default 1000; clip modes: 0 = all)")),
         seed(l.option("--seed", "S", "seed of the random pose spaces (default 1)")),
@@ -134,6 +136,8 @@ std::unique_ptr<cli::CommandLine> render_command_line() {
 // --- option parsing -------------------------------------------------------
 
 Status parse_pose_space(const RenderFlags& f, RenderOptions& o) {
+  if (!f.pose_space && !f.clips && !f.samples && !f.seed && !f.limits) return {};  // the rendered poses only
+  anim::PoseSpaceDesc& space = o.pose_space.emplace(character::default_pose_space());
   if (const std::optional<std::string>& text = f.pose_space) {
     std::string mode_name = *text;
     std::string clip_name;
@@ -147,28 +151,28 @@ Status parse_pose_space(const RenderFlags& f, RenderOptions& o) {
       return invalid_argument("--pose-space", *text, "expected arbitrary, limits, clips or clip:NAME");
     }
     if (*mode == anim::PoseSpaceMode::kArbitrary || *mode == anim::PoseSpaceMode::kLimits) {
-      o.pose_space = anim::PoseSpaceDesc{};  // random poses: 1000 samples, seed 1
-      o.pose_space.mode = *mode;
+      space = anim::PoseSpaceDesc{};  // random poses: 1000 samples, seed 1
+      space.mode = *mode;
     } else {
-      o.pose_space.mode = *mode;  // keeps character::default_pose_space()'s every key + 1/30 s
-      if (clip_mode) o.pose_space.clips = {clip_name};
+      space.mode = *mode;  // keeps character::default_pose_space()'s every key + 1/30 s
+      if (clip_mode) space.clips = {clip_name};
     }
   }
-  const anim::PoseSpaceMode mode = o.pose_space.mode;
+  const anim::PoseSpaceMode mode = space.mode;
   const bool random = mode == anim::PoseSpaceMode::kArbitrary || mode == anim::PoseSpaceMode::kLimits;
   if (const std::optional<std::string>& text = f.clips) {
     if (mode != anim::PoseSpaceMode::kClips) {
       return invalid_argument("--clips", *text, "applies to --pose-space clips only");
     }
-    SINEW_ASSIGN_OR_RETURN(o.pose_space.clips, cli::parse_list("--clips", *text));
+    SINEW_ASSIGN_OR_RETURN(space.clips, cli::parse_list("--clips", *text));
   }
   if (const std::optional<std::string>& text = f.samples) {
     SINEW_ASSIGN_OR_RETURN(const std::int64_t n,
                            cli::parse_int("--samples", *text, random ? 1 : 0, anim::kMaxPoseSamples));
-    o.pose_space.samples = static_cast<int>(n);
+    space.samples = static_cast<int>(n);
   }
   if (const std::optional<std::string>& text = f.seed) {
-    SINEW_ASSIGN_OR_RETURN(o.pose_space.seed, cli::parse_uint64("--seed", *text));
+    SINEW_ASSIGN_OR_RETURN(space.seed, cli::parse_uint64("--seed", *text));
   }
   if (const std::optional<std::string>& text = f.limits) {
     if (mode != anim::PoseSpaceMode::kLimits) {
@@ -284,6 +288,26 @@ Expected<std::vector<Affine3>> pose_instance(const character::Model& model, cons
   return character::clip_skinning(model, *clip, seconds, placement);
 }
 
+// The skinning matrices of every pose the frames draw (each instance at its
+// time offset, in model space): an in-memory bake without a pose space
+// samples these and nothing else.
+Expected<std::vector<Affine3>> rendered_poses(const character::Model& model, const anim::Clip* clip,
+                                              const RenderOptions& options) {
+  std::vector<Affine3> poses;
+  for (int f = 0; f < options.frames; ++f) {
+    for (int i = 0; i < options.instances; ++i) {
+      const double seconds = options.time_seconds + f / kFramesPerSecond + character::instance_time_offset(i);
+      SINEW_ASSIGN_OR_RETURN(const std::vector<Affine3> pose, pose_instance(model, clip, seconds, Affine3::identity()));
+      poses.insert(poses.end(), pose.begin(), pose.end());
+    }
+  }
+  return poses;
+}
+
+std::string pose_space_name(const RenderOptions& options) {
+  return options.pose_space ? std::string(anim::pose_space_mode_name(options.pose_space->mode)) : "rendered poses";
+}
+
 Expected<const anim::Clip*> resolve_clip(const character::Model& model, const RenderOptions& options) {
   if (options.clip.empty()) return model.clips.empty() ? nullptr : &model.clips.front();
   if (const anim::Clip* clip = model.find_clip(options.clip)) return clip;
@@ -313,8 +337,8 @@ Expected<std::string> stats_document(const RenderOptions& options, const charact
   const rt::FuzzyBakeStats& b = bake.fuzzy.stats;
   const RenderStatsSummary& s = outputs.stats;
   nlohmann::ordered_json doc;
-  doc["model"] = options.model_path;
-  doc["clip"] = outputs.clip_name;
+  doc["model"] = shown(options.model_path);
+  doc["clip"] = shown(outputs.clip_name);
   doc["time"] = options.time_seconds;
   doc["triangles"] = model.mesh.triangle_count();
   doc["bones"] = model.skeleton.joint_count();
@@ -322,7 +346,7 @@ Expected<std::string> stats_document(const RenderOptions& options, const charact
   doc["frames"] = options.frames;
   doc["size"] = {options.width, options.height};
   doc["samples"] = b.sample_count;
-  doc["pose_space"] = anim::pose_space_mode_name(options.pose_space.mode);
+  doc["pose_space"] = pose_space_name(options);
   doc["bake"] = {{"sampling_ms", b.sampling_ms},
                  {"assignment_ms", b.assignment_ms},
                  {"build_ms", b.build_ms},
@@ -418,22 +442,25 @@ Expected<RenderOutputs> render_model(const RenderOptions& options) {
     SINEW_ASSIGN_OR_RETURN(imported, load_model(options.model_path, options.gltf));
     for (const std::string& warning : imported.warnings) report(options, "warning: " + warning);
   }
+  // Packs were checked on load, imported models are by the bake below
+  // (character::check_renderable): the one check every consumer shares.
   const character::Model& model = pack ? pack->model() : imported;
-  if (model.mesh.triangle_count() == 0) {
-    return make_error(ErrorCode::kInvalidData, options.model_path, "triangles", "0", "the model has no triangles");
-  }
   SINEW_ASSIGN_OR_RETURN(const anim::Clip* clip, resolve_clip(model, options));
 
   if (!pack || !pack->has_fuzzy()) {
     character::BakeRequest request;
-    request.pose_space = options.pose_space;
+    if (options.pose_space) {
+      request.pose_space = *options.pose_space;
+    } else {
+      SINEW_ASSIGN_OR_RETURN(request.poses, rendered_poses(model, clip, options));
+    }
     request.fuzzy.pose_clusters = options.pose_clusters.value_or(0);
     request.fuzzy.fine_mesh_clusters = !options.pose_clusters.has_value();
     request.fuzzy.bone_trees = options.bone_trees;
     if (!options.limits_path.empty()) {
       SINEW_ASSIGN_OR_RETURN(request.limits, anim::load_joint_limits(options.limits_path, model.skeleton));
     }
-    report(options, "baking (" + std::string(anim::pose_space_mode_name(request.pose_space.mode)) + " pose space)");
+    report(options, "baking (" + pose_space_name(options) + " pose space)");
     SINEW_ASSIGN_OR_RETURN(bake, character::bake_in_memory(model, request, jobs));
   }
   const rt::FuzzyCharacterView fuzzy = pack && pack->has_fuzzy() ? pack->fuzzy() : bake.fuzzy.view();
@@ -560,9 +587,9 @@ void print_summary(const RenderOptions& options, const RenderOutputs& o, std::os
   std::ostringstream text;
   text.setf(std::ios::fixed);
   text.precision(2);
-  text << options.model_path << ": " << s.triangles << " triangles, " << s.bones << " bones, " << options.instances
+  text << shown(options.model_path) << ": " << s.triangles << " triangles, " << s.bones << " bones, " << options.instances
        << (options.instances == 1 ? " instance" : " instances") << ", clip "
-       << (o.clip_name.empty() ? std::string("(rest pose)") : "'" + o.clip_name + "'") << ", " << s.pose_samples
+       << (o.clip_name.empty() ? std::string("(rest pose)") : "'" + shown(o.clip_name) + "'") << ", " << s.pose_samples
        << " pose samples\n";
   text << o.width << "x" << o.height << ", " << options.frames << (options.frames == 1 ? " frame" : " frames")
        << ": " << s.fps << " fps (median frame " << s.median_frame_ms << " ms)\n";
@@ -586,7 +613,7 @@ void print_summary(const RenderOptions& options, const RenderOutputs& o, std::os
          << " bones on a cluster's tree (last frame), " << s.total_cluster_misses
          << " bones back on their full tree over all frames\n";
   }
-  text << "wrote " << options.out_dir << "/{color.png,depth.exr,triangle_id.exr,stats.json}\n";
+  text << "wrote " << shown(options.out_dir) << "/{color.png,depth.exr,triangle_id.exr,stats.json}\n";
   out << text.str();
 }
 

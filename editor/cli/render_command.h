@@ -52,7 +52,9 @@ struct RenderOptions {
   int width = 512;
   int height = 512;
   std::string out_dir;  // empty: nothing is written (in-process use)
-  anim::PoseSpaceDesc pose_space = character::default_pose_space();
+  // The pose space of an in-memory bake; empty: only the poses the frames
+  // render (the default, so a long clip costs its one pose, not its length).
+  std::optional<anim::PoseSpaceDesc> pose_space;
   std::string limits_path;         // joint limits JSON, for pose space "limits"
   bool shadows = true;
   // At most rt::kMaxLights; empty: one white point light placed

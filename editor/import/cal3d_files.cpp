@@ -129,6 +129,11 @@ Expected<Cal3dConfig> parse_cal3d_config(std::string_view text, std::string_view
         return make_error(ErrorCode::kInvalidData, source, field + ": scale", std::string(value),
                           "scale must be a finite positive number");
       }
+      if (s < kMinCal3dScale || s > kMaxCal3dScale) {
+        return make_error(ErrorCode::kLimitExceeded, source, field + ": scale", std::string(value),
+                          "outside [1e-06, 1e+06] (kMinCal3dScale, kMaxCal3dScale), the scales the tracer "
+                          "can frame and trace");
+      }
       cfg.scale = s;
     } else if (key == "skeleton") {
       if (have_skeleton) {

@@ -102,8 +102,14 @@ Expected<character::Model> import_impl(const std::string& cfg_path, std::string&
   if (in.bad()) return make_error(ErrorCode::kIoError, cfg_path, "", "", "read failed");
   SINEW_ASSIGN_OR_RETURN(Cal3dConfig cfg, parse_cal3d_config(text.str(), cfg_path));
 
-  const fs::path folder = fs::path(cfg_path).parent_path();
-  const std::string model_name = fs::path(cfg_path).stem().string();
+  // A .cfg reached through a symbolic link names its files relative to the
+  // file it links to, beside which they lie, not relative to the link.
+  std::error_code link_error;
+  const fs::path target =
+      fs::is_symlink(cfg_path, link_error) ? fs::canonical(cfg_path, link_error) : fs::path(cfg_path);
+  const fs::path cfg_file = link_error ? fs::path(cfg_path) : target;
+  const fs::path folder = cfg_file.parent_path();
+  const std::string model_name = cfg_file.stem().string();
 
   CalCoreModel core(model_name);
   const CoreModelTrackReleaser release_tracks(core);

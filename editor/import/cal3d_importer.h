@@ -55,6 +55,14 @@
 
 namespace sinew::editor {
 
+// The range of a .cfg's scale= the tracer handles: the default camera
+// frames a character of at least a millionth of a unit (a Cal3D model is
+// tens of units tall), and a million times keeps Cally's hundred-odd units
+// far inside character::kMaxCoordinate. A scale of 1e-10 used to render an
+// image without the character.
+inline constexpr float kMinCal3dScale = 1e-6f;
+inline constexpr float kMaxCal3dScale = 1e6f;
+
 // The parts of a Cal3D .cfg the importer uses. Paths are as written in the
 // file (relative to the .cfg's folder unless absolute).
 struct Cal3dConfig {
@@ -68,7 +76,8 @@ struct Cal3dConfig {
 // Parses .cfg text: `key=value` lines, `#` comments, blank lines; keys and
 // values are trimmed; unknown keys are ignored. Errors (naming `source` and
 // the line): a non-blank line without '=', an empty value, a scale that is
-// not a finite positive number, a second skeleton line, no skeleton line.
+// not a finite number in [kMinCal3dScale, kMaxCal3dScale], a second
+// skeleton line, no skeleton line.
 Expected<Cal3dConfig> parse_cal3d_config(std::string_view text, std::string_view source);
 
 // Imports the model of `cfg_path`: its skeleton and meshes, the animations

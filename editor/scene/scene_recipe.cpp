@@ -1,5 +1,5 @@
 #include "editor/scene/scene_recipe.h"
-#include "editor/import/gltf_container.h"
+#include "runtime/io/json_nesting.h"
 #include "runtime/io/regular_file.h"
 
 #include <algorithm>

@@ -110,20 +110,58 @@ std::string printable(std::string_view text, std::size_t max_bytes) {
   return out;
 }
 
+namespace {
+
+// The longest message, in bytes (docs/ROBUSTNESS.md, "Hostile input"), and
+// each part's share of it.
+constexpr std::size_t kMaxMessageBytes = 300;
+constexpr std::size_t kMaxPartBytes = 100;
+
+// `text` cut to at most `max` bytes between UTF-8 sequences, from its start
+// (keep_end false) or its end.
+std::string cut_between_sequences(std::string text, std::size_t max, bool keep_end) {
+  if (text.size() <= max) return text;
+  const auto continuation = [&](std::size_t at) { return (static_cast<unsigned char>(text[at]) & 0xC0u) == 0x80u; };
+  if (!keep_end) {
+    std::size_t end = max;
+    while (end > 0 && continuation(end)) --end;
+    return text.substr(0, end);
+  }
+  std::size_t begin = text.size() - max;
+  while (begin < text.size() && continuation(begin)) ++begin;
+  return text.substr(begin);
+}
+
+// A part of a message through printable(), at most kMaxPartBytes: a longer
+// one keeps its start and its end (a path's file name), "..." between.
+std::string part(std::string_view text) {
+  std::string whole = printable(text, std::string_view::npos);
+  if (whole.size() <= kMaxPartBytes) return whole;
+  const std::size_t head = (kMaxPartBytes - 3) / 2;
+  const std::size_t tail = kMaxPartBytes - 3 - head;
+  return cut_between_sequences(whole, head, false) + "..." + cut_between_sequences(whole, tail, true);
+}
+
+}  // namespace
+
 std::string Status::message() const {
   if (!info_) return "ok";
+  // File, field and value have their share of the line, and the line as a
+  // whole is cut at kMaxMessageBytes (between UTF-8 sequences): no input,
+  // however long (a data URI, a path), makes a message longer.
   std::string out;
-  if (!info_->file.empty()) out += printable(info_->file);
+  if (!info_->file.empty()) out += part(info_->file);
   if (!info_->field.empty()) {
     if (!out.empty()) out += ": ";
-    out += printable(info_->field);
-    if (!info_->value.empty()) out += " = " + printable(info_->value, 200);
+    out += part(info_->field);
+    if (!info_->value.empty()) out += " = " + part(info_->value);
   } else if (!info_->value.empty()) {
     if (!out.empty()) out += ": ";
-    out += "value " + printable(info_->value, 200);
+    out += "value " + part(info_->value);
   }
   if (!out.empty()) out += ": ";
-  out += info_->detail.empty() ? std::string(error_code_name(info_->code)) : printable(info_->detail, 2048);
+  out += info_->detail.empty() ? std::string(error_code_name(info_->code)) : printable(info_->detail, kMaxMessageBytes);
+  if (out.size() > kMaxMessageBytes) out = cut_between_sequences(std::move(out), kMaxMessageBytes - 3, false) + "...";
   return out;
 }
 

@@ -457,6 +457,25 @@ TEST(JointLimitsJson, ErrorsNameTheField) {
   EXPECT_EQ(load_joint_limits("/nonexistent/sinew/limits.json", sk).status().code(), ErrorCode::kNotFound);
 }
 
+// Every JSON reader bounds nesting before it parses: a limits file nested
+// 100,000 levels deep inside a joint is refused by the byte where it passed
+// the limit, and one nested as deep as the format needs still loads.
+TEST(JointLimitsJson, DeepNestingIsRefusedBeforeParsing) {
+  const Skeleton sk = named_skeleton();
+  const std::string head = R"({"version": 1, "joints": {"neck": {"type": "free", "x": )";
+  const std::string deep = head + std::string(100'000, '[') + std::string(100'000, ']') + "}}}";
+  const auto r = parse_joint_limits(deep, sk, "deep.json");
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.status().code(), ErrorCode::kLimitExceeded) << r.status().message();
+  EXPECT_EQ(r.status().file(), "deep.json");
+  EXPECT_EQ(r.status().value(), "byte " + std::to_string(head.size() + 13)) << r.status().message();
+  EXPECT_LE(r.status().message().size(), 300u);
+  const auto shallow = parse_joint_limits(
+      R"({"version": 1, "joints": {"neck": {"type": "euler", "order": "xyz", "min_deg": [0,0,0], "max_deg": [0,0,0]}}})",
+      sk, "shallow.json");
+  EXPECT_TRUE(shallow.ok()) << shallow.status().message();
+}
+
 TEST(JointLimits, ValidateAndApply) {
   const Skeleton sk = named_skeleton();
   JointLimits limits(5);

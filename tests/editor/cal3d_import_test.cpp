@@ -18,7 +18,9 @@
 #include "animation/clip.h"
 #include "animation/pose.h"
 #include "animation/reference_skinning.h"
+#include "character/bake.h"
 #include "editor/import/cal3d_importer.h"
+#include "runtime/jobs/job_system.h"
 #include "tests/support/cal3d_support.h"
 
 namespace sinew::editor {
@@ -543,6 +545,36 @@ TEST_F(Cal3dBadInput, CorruptSkeletonLinksAndNames) {
   // The unpatched file still loads.
   auto m = import_cal3d(write("s.cfg", "skeleton=" + write("s.csf", csf) + "\n"));
   ASSERT_TRUE(m.ok()) << m.status().message();
+}
+
+// A .cfg without meshes imports (a skeleton and clips are a model), but
+// such a model has nothing to trace: the bake refuses it in one line naming
+// the .cfg, where it used to write a pack that validate accepted and
+// render refused.
+TEST_F(Cal3dBadInput, ACfgWithoutMeshesIsNotBaked) {
+  const std::string cfg = write("s.cfg", "skeleton=" + model_file("cally", "cally.csf") + "\n");
+  auto m = import_cal3d(cfg);
+  ASSERT_TRUE(m.ok()) << m.status().message();
+  ASSERT_EQ(m->mesh.triangle_count(), 0u);
+  JobSystem jobs(1);
+  auto bake = character::bake_in_memory(*m, character::BakeRequest{}, jobs);
+  ASSERT_FALSE(bake.ok());
+  EXPECT_EQ(bake.status().message(),
+            cfg + ": mesh.triangle_count = 0: the model has no triangles: nothing to frame or trace");
+}
+
+// A symbolic link to a .cfg looked for the model's files beside the link;
+// they are found beside the .cfg it links to, as if it were opened there.
+TEST_F(Cal3dBadInput, ASymlinkedCfgReadsTheFilesBesideItsTarget) {
+  const fs::path link = dir_ / "linked.cfg";
+  fs::create_symlink(model_file("cally", "cally.cfg"), link);
+  auto linked = import_cal3d(link.string());
+  ASSERT_TRUE(linked.ok()) << linked.status().message();
+  auto direct = import_cal3d(model_file("cally", "cally.cfg"));
+  ASSERT_TRUE(direct.ok()) << direct.status().message();
+  EXPECT_EQ(linked->mesh.triangle_count(), direct->mesh.triangle_count());
+  ASSERT_EQ(linked->clips.size(), direct->clips.size());
+  for (std::size_t c = 0; c < direct->clips.size(); ++c) EXPECT_EQ(linked->clips[c].name(), direct->clips[c].name());
 }
 
 // XML materials go to Cal3D's XML loader, which dereferences missing

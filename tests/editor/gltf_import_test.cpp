@@ -1029,6 +1029,20 @@ TEST_F(GltfSynthetic, LongNodeChainsImportInLinearTime) {
 // paths, other schemes and links out of the folder are refused before any
 // read, naming the field; tinygltf's own fallback to the current directory
 // is refused too. data: URIs and subfolders still work.
+// A bad data URI of a few KB was echoed whole into one line of the error.
+// Messages are one line of at most 300 bytes, whatever the input.
+TEST_F(GltfSynthetic, ABadDataUriIsNotEchoed) {
+  Synthetic s = synthetic();
+  replace(s.json, "\"uri\": \"synthetic.bin\"",
+          "\"uri\": \"data:application/octet-stream;base64," + std::string(5000, '!') + "\"");
+  const auto m = import_gltf(write(s));
+  ASSERT_FALSE(m.ok());
+  const std::string message = m.status().message();
+  EXPECT_LE(message.size(), 300u) << message;
+  EXPECT_EQ(message.find('\n'), std::string::npos);
+  EXPECT_EQ(message.rfind((dir_ / "synthetic.gltf").string() + ": ", 0), 0u) << message;
+}
+
 TEST_F(GltfSynthetic, ExternalFilesStayInsideTheAssetFolder) {
   const fs::path outside = dir_ / "outside";
   const fs::path asset = dir_ / "asset";

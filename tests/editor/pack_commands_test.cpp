@@ -4,6 +4,10 @@
 // after an in-memory bake of the same pose space.
 #include <gtest/gtest.h>
 #include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
+#include <sys/inotify.h>
+#include <sys/wait.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -20,8 +24,10 @@
 #include <thread>
 #include <vector>
 
+#include "character/pack.h"
 #include "editor/cli/pack_commands.h"
 #include "editor/cli/render_command.h"
+#include "editor/import/model_loader.h"
 #include "runtime/io/mapped_file.h"
 #include "runtime/pack/checksum.h"
 
@@ -225,9 +231,10 @@ TEST_F(PackCommands, RenderingFromThePackEqualsTheInMemoryBake) {
   o.height = 80;
   o.threads = 2;
   o.time_seconds = 0.4;
-  o.pose_space.mode = anim::PoseSpaceMode::kArbitrary;
-  o.pose_space.samples = 16;
-  o.pose_space.every_frame_30hz = false;
+  o.pose_space.emplace();
+  o.pose_space->mode = anim::PoseSpaceMode::kArbitrary;
+  o.pose_space->samples = 16;
+  o.pose_space->every_frame_30hz = false;
   EXPECT_EQ(expect_pack_renders_like_source(o, kCesiumMan, pack), 16u);
 }
 
@@ -246,6 +253,7 @@ TEST_F(PackCommands, RenderingCallyFromThePackEqualsTheInMemoryBakeBitForBit) {
   o.threads = 2;
   o.clip = "walk";
   o.time_seconds = 0.3;
+  o.pose_space = character::default_pose_space();  // the pack's
   rt::CameraDesc camera;
   camera.eye = Vec3(0.0f, -400.0f, 100.0f);
   camera.target = Vec3(0.0f, 0.0f, 90.0f);
@@ -438,6 +446,123 @@ TEST_F(PackCommands, MessagesAreOneLineOfPrintableText) {
       EXPECT_TRUE(c >= 0x20 && c < 0x7f) << "byte " << int{c} << " at " << i << " in " << r.err;
     }
   }
+}
+
+// True when `text` holds no control byte but newlines and no byte of
+// invalid UTF-8 (here: no byte >= 0x80 at all; the names below are ASCII
+// but for their odd bytes).
+bool plain_terminal_text(const std::string& text) {
+  return std::none_of(text.begin(), text.end(), [](char c) {
+    const auto u = static_cast<unsigned char>(c);
+    return (u < 0x20 && u != '\n') || u >= 0x7f;
+  });
+}
+
+// A path holding a byte of invalid UTF-8 made `inspect --json` and
+// `render` (its stats.json) fail with nlohmann's internal error, where bake
+// took the same path; `inspect` printed clip and source names as they were,
+// so a file could send control sequences to the terminal. Both are written
+// escaped (\xHH) now.
+TEST_F(PackCommands, OddBytesInPathsAndNamesAreWrittenEscaped) {
+  const std::string dir = fresh_dir("odd_bytes");
+  auto model = load_model(kCesiumMan);
+  ASSERT_TRUE(model.ok()) << model.status().message();
+  anim::RawClip raw;
+  raw.name = "evil\x1b]0;title\x07\xff";
+  raw.tracks.assign(model->clips.front().tracks().begin(), model->clips.front().tracks().end());
+  model->clips.front() = anim::Clip::build(std::move(raw), model->skeleton, "test").value();
+  character::PackContents contents;
+  contents.model = &*model;
+  contents.provenance.source_name = "source\x1b[2J\xfe";
+  const auto bytes = character::serialize_pack(contents);
+  ASSERT_TRUE(bytes.ok()) << bytes.status().message();
+  const std::string pack = dir + "/odd\xff\x1b[31mname.pack";
+  std::ofstream(pack, std::ios::binary).write(reinterpret_cast<const char*>(bytes->data()),
+                                              static_cast<std::streamsize>(bytes->size()));
+
+  const CommandRun json = run(run_inspect, {pack, "--json"});
+  ASSERT_EQ(json.code, 0) << json.err;
+  const auto j = nlohmann::json::parse(json.out);
+  EXPECT_EQ(j["file"], dir + "/odd\\xff\\x1b[31mname.pack");
+  EXPECT_EQ(j["model"]["clips"][0]["name"], "evil\\x1b]0;title\\x07\\xff");
+  EXPECT_EQ(j["provenance"]["source"], "source\\x1b[2J\\xfe");
+  const CommandRun text = run(run_inspect, {pack});
+  ASSERT_EQ(text.code, 0) << text.err;
+  EXPECT_TRUE(plain_terminal_text(text.out)) << text.out;
+  EXPECT_NE(text.out.find("clip evil\\x1b]0;title\\x07\\xff"), std::string::npos) << text.out;
+
+  const CommandRun render = run(run_render, {pack, "--out", dir + "/out\xff", "--size", "16x16", "--threads", "1"});
+  ASSERT_EQ(render.code, 0) << render.err;
+  EXPECT_TRUE(plain_terminal_text(render.out)) << render.out;
+  const auto stats = nlohmann::json::parse(read_file(dir + "/out\xff/stats.json"));
+  EXPECT_EQ(stats["model"], dir + "/odd\\xff\\x1b[31mname.pack");
+  EXPECT_EQ(stats["clip"], "evil\\x1b]0;title\\x07\\xff");
+}
+
+// SIGTERM during bake's final write killed the program and left its hidden
+// temporary file beside the output (SIGINT was handled only while baking).
+// Both are handled alike until the pack is in place. A real sinew-editor is
+// stopped the moment its temporary file appears (inotify), sent SIGTERM
+// there, and continued: it exits 1 leaving the old pack and nothing else.
+// (Stopped after its last check, it may still finish: then the new pack is
+// whole; either way it is never killed and leaves no temporary file.)
+TEST_F(PackCommands, SigtermDuringTheFinalWriteLeavesTheOldPackAndNoTemporaryFile) {
+  const std::string dir = fresh_dir("sigterm");
+  const std::string out = dir + "/keep.pack";
+  const int watch = inotify_init1(IN_CLOEXEC);
+  ASSERT_GE(watch, 0);
+  ASSERT_GE(inotify_add_watch(watch, dir.c_str(), IN_CREATE), 0);
+  int interrupted = 0;
+  for (int attempt = 0; attempt < 20 && interrupted == 0; ++attempt) {
+    std::ofstream(out, std::ios::binary | std::ios::trunc) << "previous";
+    const pid_t child = fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+      const int null = open("/dev/null", O_WRONLY);
+      dup2(null, 1);
+      dup2(null, 2);
+      execl(SINEW_EDITOR, "sinew-editor", "bake", kCesiumMan.c_str(), "-o", out.c_str(), "--samples", "4",
+            "--threads", "1", static_cast<char*>(nullptr));
+      _exit(127);
+    }
+    // The pack's temporary file: "dir/.keep.tmp-<pid>-<n>.pack".
+    std::string temp;
+    alignas(inotify_event) char events[4096];
+    pollfd ready{watch, POLLIN, 0};
+    while (temp.empty() && poll(&ready, 1, 120'000) > 0) {  // a guard against a child that never writes
+      const ssize_t n = read(watch, events, sizeof events);
+      for (ssize_t at = 0; at < n;) {
+        const auto* e = reinterpret_cast<const inotify_event*>(events + at);
+        if (e->len > 0 && std::string_view(e->name).starts_with(".keep.tmp-")) temp = dir + "/" + e->name;
+        at += static_cast<ssize_t>(sizeof(inotify_event) + e->len);
+      }
+    }
+    int status = 0;
+    kill(child, SIGSTOP);
+    waitpid(child, &status, WUNTRACED);
+    if (WIFSTOPPED(status)) {
+      const bool writing = !temp.empty() && std::filesystem::exists(temp);
+      if (writing) kill(child, SIGTERM);
+      kill(child, SIGCONT);
+      waitpid(child, &status, 0);
+      if (!writing) continue;  // stopped after the write: try again
+    } else {
+      continue;  // finished before it stopped: try again
+    }
+    ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+    std::vector<std::string> left;
+    for (const auto& entry : std::filesystem::directory_iterator(dir)) left.push_back(entry.path().filename().string());
+    EXPECT_EQ(left, std::vector<std::string>{"keep.pack"});
+    if (WEXITSTATUS(status) == 1) {
+      ++interrupted;
+      EXPECT_EQ(read_file(out), "previous");
+    } else {
+      EXPECT_EQ(WEXITSTATUS(status), 0);
+      EXPECT_TRUE(character::Pack::open(out).ok());
+    }
+  }
+  close(watch);
+  EXPECT_EQ(interrupted, 1) << "no attempt was stopped inside its write";
 }
 
 TEST_F(PackCommands, UsageAndUserErrorsHaveTheirExitCodes) {

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <set>
@@ -18,6 +19,7 @@
 
 #include "character/bake.h"
 #include "character/framing.h"
+#include "character/pack.h"
 #include "runtime/cli/command_line.h"
 #include "runtime/cli/option_values.h"
 #include "editor/cli/render_command.h"
@@ -27,6 +29,7 @@
 #include "raytrace/skinning/skinning.h"
 #include "runtime/image/image_io.h"
 #include "runtime/io/atomic_file.h"
+#include "runtime/jobs/job_system.h"
 #if SINEW_HAVE_CAL3D
 #include "editor/import/cal3d_importer.h"
 #endif
@@ -50,7 +53,8 @@ RenderOptions small_options(const std::string& model) {
   o.model_path = model;
   o.width = 96;
   o.height = 96;
-  o.pose_space.samples = 24;
+  o.pose_space = character::default_pose_space();
+  o.pose_space->samples = 24;
   o.threads = 2;
   return o;
 }
@@ -320,6 +324,101 @@ TEST(RenderCommand, GroundOffLeavesTheCharactersAlone) {
   EXPECT_EQ(seen, (std::set<std::uint32_t>{0u, kInvalidId})) << "the character and misses only";
 }
 
+#if SINEW_HAVE_CAL3D
+// Cally's skeleton and meshes (paths made absolute) under a .cfg of our own
+// with `scale=` first.
+std::string cally_at_scale(const std::string& dir, const std::string& scale) {
+  std::ifstream in(kCally);
+  std::stringstream text;
+  text << in.rdbuf();
+  const Cal3dConfig cally = parse_cal3d_config(text.str(), kCally).value();
+  const std::string folder = std::filesystem::path(kCally).parent_path().string() + "/";
+  std::string cfg = "scale=" + scale + "\nskeleton=" + folder + cally.skeleton + "\n";
+  for (const std::string& mesh : cally.meshes) cfg += "mesh=" + folder + mesh + "\n";
+  std::filesystem::create_directories(dir);
+  const std::string path = dir + "/scaled.cfg";
+  std::ofstream(path) << cfg;
+  return path;
+}
+
+// A .cfg scale of 1e-10 rendered an image without the character. Scales
+// outside what the tracer frames are refused naming the limit; at the
+// smallest one it takes, Cally fills the picture as at scale 1.
+TEST(RenderCommand, Cal3dScalesTheTracerCannotFrameAreRefused) {
+  const std::string dir = fresh_dir("cal3d_scale");
+  for (const std::string scale : {"1e-10", "1e-7", "1e7"}) {
+    const auto refused = render_model(small_options(cally_at_scale(dir, scale)));
+    ASSERT_FALSE(refused.ok()) << scale;
+    EXPECT_EQ(refused.status().field(), "line 1: scale") << refused.status().message();
+    EXPECT_EQ(refused.status().value(), scale) << refused.status().message();
+    EXPECT_NE(refused.status().message().find("[1e-06, 1e+06]"), std::string::npos) << refused.status().message();
+  }
+  auto character_pixels = [&](const std::string& scale) {
+    RenderOptions o = small_options(cally_at_scale(dir, scale));
+    o.ground = false;
+    const auto outputs = render_model(o);
+    EXPECT_TRUE(outputs.ok()) << scale << ": " << outputs.status().message();
+    return outputs.ok() ? std::count(outputs->instance_id.begin(), outputs->instance_id.end(), 0u) : 0;
+  };
+  const auto at_one = character_pixels("1");
+  EXPECT_GT(at_one, 96 * 96 / 20);
+  const auto smallest = character_pixels("1e-6");
+  EXPECT_GT(smallest, at_one / 2);
+  const auto largest = character_pixels("1e6");
+  EXPECT_GT(largest, at_one / 2);
+}
+#endif
+
+// A glTF whose clips lasted 10,000 s ran `render` past a minute and took
+// `bake` 99 s: every 1/30 s of them was sampled. Render now bakes only the
+// pose it draws; the bake refuses such a clip for the every-1/30-s pose
+// space in one line naming the clip, its length and the limit.
+TEST(RenderCommand, ALongClipCostsRenderOnePoseAndIsRefusedByTheBake) {
+  auto model = import_gltf(kCesiumMan);
+  ASSERT_TRUE(model.ok()) << model.status().message();
+  anim::RawClip raw;
+  raw.name = "long";
+  anim::JointTracks& track = raw.tracks.emplace_back();
+  track.joint = 1;
+  track.rotation.times = {0.0f, 10'000.0f};
+  track.rotation.values = {Quat(1.0f, 0.0f, 0.0f, 0.0f), glm::angleAxis(1.0f, Vec3(1.0f, 0.0f, 0.0f))};
+  model->clips.push_back(anim::Clip::build(std::move(raw), model->skeleton, "test").value());
+
+  const std::string dir = fresh_dir("long_clip");
+  std::filesystem::create_directories(dir);
+  character::PackContents contents;
+  contents.model = &*model;
+  const auto bytes = character::serialize_pack(contents);
+  ASSERT_TRUE(bytes.ok()) << bytes.status().message();
+  const std::string pack = dir + "/long.pack";  // model only: render bakes it in memory
+  std::ofstream(pack, std::ios::binary).write(reinterpret_cast<const char*>(bytes->data()),
+                                              static_cast<std::streamsize>(bytes->size()));
+  RenderOptions o;
+  o.model_path = pack;
+  o.clip = "long";
+  o.time_seconds = 5'000.0;
+  o.width = o.height = 32;
+  o.threads = 2;
+  const auto rendered = render_model(o);
+  ASSERT_TRUE(rendered.ok()) << rendered.status().message();
+  EXPECT_EQ(rendered->stats.pose_samples, 1u);
+
+  JobSystem jobs(1);
+  const auto baked = character::bake_in_memory(*model, character::BakeRequest{}, jobs);
+  ASSERT_FALSE(baked.ok());
+  EXPECT_EQ(baked.status().code(), ErrorCode::kLimitExceeded);
+  EXPECT_EQ(baked.status().message(),
+            kCesiumMan + ": pose_space.clips = long: lasts 10000 s: sampling every 1/30 s takes clips of up to "
+                         "600 s (anim::kMaxClipSecondsEveryFrame; or sample N poses of it)");
+  // N poses of it are fine, whatever its length.
+  character::BakeRequest some;
+  some.pose_space.clips = {"long"};
+  some.pose_space.samples = 8;
+  const auto sampled = character::bake_in_memory(*model, some, jobs);
+  ASSERT_TRUE(sampled.ok()) << sampled.status().message();
+  EXPECT_EQ(sampled->fuzzy.stats.sample_count, 8u);
+}
+
 TEST(RenderCommand, UpAxisIsTheLargerOfYAndZ) {
   EXPECT_EQ(character::up_axis_of(Aabb{Vec3(0.0f), Vec3(5.0f, 2.0f, 1.0f)}), 1);
   EXPECT_EQ(character::up_axis_of(Aabb{Vec3(0.0f), Vec3(5.0f, 1.0f, 2.0f)}), 2);
@@ -433,8 +532,8 @@ TEST(RenderCommand, OptionsMapToTheirSettings) {
   EXPECT_EQ(o->out_dir, "o");
   EXPECT_EQ(o->width, 64);
   EXPECT_EQ(o->height, 32);
-  EXPECT_EQ(o->pose_space.mode, anim::PoseSpaceMode::kClip);
-  EXPECT_EQ(o->pose_space.clips, std::vector<std::string>{"walk"});
+  EXPECT_EQ(o->pose_space->mode, anim::PoseSpaceMode::kClip);
+  EXPECT_EQ(o->pose_space->clips, std::vector<std::string>{"walk"});
   EXPECT_EQ(o->triangle_test, rt::TriangleTest::kWatertight);
   EXPECT_EQ(o->bone_boxes, rt::BoneBoxMode::kCheap);
   EXPECT_FALSE(o->fallback);
@@ -460,8 +559,12 @@ TEST(RenderCommand, OptionsMapToTheirSettings) {
   EXPECT_EQ(d->instances, 1);
   EXPECT_EQ(d->threads, 0);
   EXPECT_FALSE(d->camera.has_value());
-  EXPECT_EQ(d->pose_space.mode, character::default_pose_space().mode);
-  EXPECT_EQ(d->pose_space.every_frame_30hz, character::default_pose_space().every_frame_30hz);
+  EXPECT_FALSE(d->pose_space.has_value()) << "an in-memory bake samples only the rendered poses";
+  const auto samples_only = parse_render_options({"m.glb", "--out", "o", "--samples", "7"});
+  ASSERT_TRUE(samples_only.ok());
+  EXPECT_EQ(samples_only->pose_space->mode, character::default_pose_space().mode);
+  EXPECT_EQ(samples_only->pose_space->every_frame_30hz, character::default_pose_space().every_frame_30hz);
+  EXPECT_EQ(samples_only->pose_space->samples, 7);
 
   EXPECT_TRUE(d->lights.empty());
 
@@ -482,9 +585,9 @@ TEST(RenderCommand, OptionsMapToTheirSettings) {
   const auto r = parse_render_options({"m.glb", "--out", "o", "--pose-space", "arbitrary", "--samples", "50",
                                        "--seed", "18446744073709551615"});
   ASSERT_TRUE(r.ok()) << r.status().message();
-  EXPECT_EQ(r->pose_space.mode, anim::PoseSpaceMode::kArbitrary);
-  EXPECT_EQ(r->pose_space.samples, 50);
-  EXPECT_EQ(r->pose_space.seed, 18446744073709551615ull);
+  EXPECT_EQ(r->pose_space->mode, anim::PoseSpaceMode::kArbitrary);
+  EXPECT_EQ(r->pose_space->samples, 50);
+  EXPECT_EQ(r->pose_space->seed, 18446744073709551615ull);
 
   // The glTF import limits, each from its option; 0 is refused naming it.
   const auto limits = parse_render_options({"m.glb", "--out", "o", "--max-triangles", "7", "--max-clips", "8",

@@ -79,9 +79,14 @@ TEST(Status, MessagesArePrintableAndOneLine) {
     EXPECT_EQ(message, shown + ": " + shown + " = " + shown + ": " + shown);
     EXPECT_EQ(message.find('\n'), std::string::npos);
   }
-  const std::string long_value(1000, 'v');
+  // A long part keeps its start and its end; the line is at most 300 bytes.
+  const std::string long_value = std::string(500, 'a') + std::string(500, 'z');
   const std::string cut = make_error(ErrorCode::kInvalidData, "f", "field", long_value, "d").message();
-  EXPECT_EQ(cut, "f: field = " + std::string(200, 'v') + "...: d");
+  EXPECT_EQ(cut, "f: field = " + std::string(48, 'a') + "..." + std::string(49, 'z') + ": d");
+  const std::string huge(5000, 'x');
+  const std::string line = make_error(ErrorCode::kInvalidData, huge, huge, huge, huge).message();
+  EXPECT_EQ(line.size(), 300u);
+  EXPECT_EQ(line.substr(line.size() - 3), "...");
 }
 
 TEST(Status, EveryCodeHasAName) {
