@@ -22,6 +22,7 @@
 #include "tests/bench/demo_bench.h"
 #include "tests/bench/embree_bench.h"
 #include "tests/bench/paper_bench.h"
+#include "tests/bench/readme_headline.h"
 #include "tests/bench/raytrace_bench.h"
 #include "tests/bench/report_plots.h"
 #include "tests/bench/structures_bench.h"
@@ -605,8 +606,8 @@ std::string document(const Options& o, const Report& report, const std::string& 
   md += "Reproduce (the release preset; Embree 3 optional):\n\n```sh\n./sinew build release\n" +
         std::string("build/release/tests/bench/sinew-bench report") + (o.quick ? " --quick" : "") +
         "\n```\n\nThe raw numbers are in `bench-data/*.json` beside this file; each section names the command that "
-        "measured it. Earlier, per-issue measurements (animation against Cal3D, the bake's memory bound, the game "
-        "demo) are in [MEASUREMENTS.md](MEASUREMENTS.md).\n\n";
+        "measured it. `sinew-bench animation` and `sinew-bench bake` measure the animation (against Cal3D) and "
+        "the bake (its candidate bones and memory bound) on their own.\n\n";
   md += headlines(report.find("paper"), report.find("embree"), report.find("embree-large"), report.find("demo"),
                   report.find("tradeoff"));
 
@@ -792,6 +793,27 @@ void run_all(const Options& o, const std::string& data_dir, Report& report) {
   }
 }
 
+// The README's headline table (tests/bench/readme_headline.h), from the
+// runs this report shows; only for the report in the source tree's docs/.
+bool write_readme_headline(const Report& report) {
+  const std::string path = std::string(SINEW_SOURCE_DIR) + "/README.md";
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  const Run* small = report.find("embree");
+  const Run* large = report.find("embree-large");
+  const std::string table = headline_table(small ? &small->json : nullptr, large ? &large->json : nullptr);
+  const std::optional<std::string> updated = replace_headline(text.str(), table);
+  if (!in || !updated) {
+    std::fprintf(stderr, "sinew-bench report: %s: no headline table markers (%s ... %s) to write between\n",
+                 path.c_str(), kHeadlineBegin, kHeadlineEnd);
+    return false;
+  }
+  if (!write_output("report", "README headline", path, *updated)) return false;
+  std::printf("sinew-bench report: wrote the headline table of %s\n", path.c_str());
+  return true;
+}
+
 }  // namespace
 
 int run_report_bench(const std::vector<std::string>& args, const std::string& command_line) {
@@ -833,6 +855,7 @@ int run_report_bench(const std::vector<std::string>& args, const std::string& co
     return 1;
   }
   std::printf("\nsinew-bench report: wrote %s (%.1f minutes)\n", path.c_str(), minutes);
+  if (o.out_dir == std::string(SINEW_SOURCE_DIR) + "/docs" && !write_readme_headline(report)) return 1;
   int exit_code = plots.failed ? 1 : 0;
   for (const Run& r : report.runs) {
     if (r.exit_code != 0) exit_code = 1;

@@ -8,29 +8,11 @@
 # Variables: BUILD_DIR SOURCE_DIR WORK_DIR EDITOR IMAGE_DIFF MODEL CXX
 cmake_minimum_required(VERSION 3.25)
 
-# Leaves the command's standard output in run_output, for expect_output.
-function(run)
-  execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
-  message("$ ${ARGN}\n${out}${err}")
-  if(NOT rc EQUAL 0)
-    message(FATAL_ERROR "failed (${rc}): ${ARGN}")
-  endif()
-  set(run_output "${out}" PARENT_SCOPE)
-endfunction()
-
-function(expect_output text)
-  string(FIND "${run_output}" "${text}" at)
-  if(at EQUAL -1)
-    message(FATAL_ERROR "the output lacks '${text}'")
-  endif()
-endfunction()
-
-file(REMOVE_RECURSE ${WORK_DIR})
-file(MAKE_DIRECTORY ${WORK_DIR})
-set(prefix ${WORK_DIR}/prefix)
+include(${CMAKE_CURRENT_LIST_DIR}/package_steps.cmake)
 
 # 1. Install: headers, libsinew, the CMake package and sinew.pc.
-run(${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${prefix} --component sinew)
+set(prefix ${WORK_DIR}/prefix)
+install_package(${BUILD_DIR} ${WORK_DIR} ${prefix})
 
 # 2. A separate project finds it.
 run(${CMAKE_COMMAND} -S ${SOURCE_DIR}/examples/host_engine -B ${WORK_DIR}/host-build -G Ninja
@@ -41,13 +23,7 @@ run(${CMAKE_COMMAND} --build ${WORK_DIR}/host-build)
 # 3. pkg-config alone is enough too (the source before the libraries:
 #    Debian's GCC links with --as-needed). Its Libs carry the rpath, so the
 #    program finds libsinew without LD_LIBRARY_PATH (step 8 runs it so).
-execute_process(COMMAND ${CMAKE_COMMAND} -E env PKG_CONFIG_PATH=${prefix}/lib/pkgconfig
-                        pkg-config --cflags --libs sinew
-                OUTPUT_VARIABLE pc_flags RESULT_VARIABLE rc OUTPUT_STRIP_TRAILING_WHITESPACE)
-if(NOT rc EQUAL 0)
-  message(FATAL_ERROR "pkg-config does not find sinew.pc under ${prefix}")
-endif()
-separate_arguments(pc_flags UNIX_COMMAND "${pc_flags}")
+pkg_config_flags(${prefix} pc_flags)
 run(${CXX} ${SOURCE_DIR}/examples/minimal/minimal.cpp ${pc_flags} -o ${WORK_DIR}/minimal)
 
 # 4. One frame: the editor's and the host's, same pack, pose, camera, light.

@@ -31,4 +31,12 @@ if(NOT CMAKE_CXX_FLAGS MATCHES "-fsanitize" AND EXISTS ${consumer_model})
       -DIMAGE_DIFF=$<TARGET_FILE:sinew-image-diff> -DMODEL=${consumer_model} -DCXX=${CMAKE_CXX_COMPILER}
       -P ${CMAKE_CURRENT_LIST_DIR}/consumer_test.cmake)
   set_tests_properties(package.consumer PROPERTIES LABELS "package" TIMEOUT 600 RUN_SERIAL TRUE)
+  # The README's host example, as printed there.
+  add_test(NAME package.readme_example
+    COMMAND ${CMAKE_COMMAND}
+      -DBUILD_DIR=${PROJECT_BINARY_DIR} -DSOURCE_DIR=${PROJECT_SOURCE_DIR}
+      -DWORK_DIR=${PROJECT_BINARY_DIR}/readme-example-test -DEDITOR=$<TARGET_FILE:sinew-editor>
+      -DMODEL=${consumer_model} -DCXX=${CMAKE_CXX_COMPILER}
+      -P ${CMAKE_CURRENT_LIST_DIR}/readme_example_test.cmake)
+  set_tests_properties(package.readme_example PROPERTIES LABELS "package" TIMEOUT 600 RUN_SERIAL TRUE)
 endif()
