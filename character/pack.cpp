@@ -5,6 +5,7 @@
 #include <cstring>
 #include <utility>
 
+#include "character/pack_textures.h"
 #include "character/renderable.h"
 #include "raytrace/bake/fuzzy_bake.h"
 #include "runtime/mesh/mesh_checks.h"
@@ -486,6 +487,9 @@ Expected<PackWriter> character_pack_writer(const PackContents& c) {
   PackWriter w;
   SINEW_RETURN_IF_ERROR(w.add_section(kSkeleton, kSectionVersion, encode_skeleton(c.model->skeleton)));
   SINEW_RETURN_IF_ERROR(w.add_section(kMesh, kSectionVersion, encode_mesh(*c.model)));
+  if (has_textures(c.model->mesh)) {
+    SINEW_RETURN_IF_ERROR(w.add_section(kTexturesSection, kTexturesVersion, encode_textures(c.model->mesh)));
+  }
   SINEW_RETURN_IF_ERROR(w.add_section(kClips, kSectionVersion, encode_clips(c.model->clips)));
   if (!c.limits.empty()) {
     if (c.limits.size() != c.model->skeleton.joint_count()) {
@@ -594,6 +598,11 @@ Expected<Pack> Pack::load(PackReader reader) {
   {
     SectionDecoder d = decoder(r, kMesh);
     SINEW_RETURN_IF_ERROR(decode_mesh(d, pack.model_.skeleton.joint_count(), pack.model_));
+  }
+  if (r.contains(kTexturesSection)) {
+    SINEW_RETURN_IF_ERROR(check_version(r, kTexturesSection, kTexturesVersion));
+    SectionDecoder d = decoder(r, kTexturesSection);
+    SINEW_RETURN_IF_ERROR(decode_textures(d, pack.model_.mesh));
   }
   {
     SectionDecoder d = decoder(r, kClips);

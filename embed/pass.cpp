@@ -21,7 +21,8 @@ namespace {
 
 constexpr int kMaxSide = 16384;
 constexpr std::uint32_t kAllOutputs = (Output::kColorRgba8 | Output::kColorRgba32f | Output::kDepth |
-                                      Output::kNormal | Output::kInstanceId | Output::kTriangleId)
+                                      Output::kNormal | Output::kInstanceId | Output::kTriangleId | Output::kUv |
+                                      Output::kBarycentrics | Output::kMaterialId)
                                          .bits();
 
 struct OutputInfo {
@@ -37,6 +38,9 @@ constexpr OutputInfo kOutputs[] = {
     {Output::kNormal, "normal", 12, &PassOutputs::normal},
     {Output::kInstanceId, "instance_id", 4, &PassOutputs::instance_id},
     {Output::kTriangleId, "triangle_id", 4, &PassOutputs::triangle_id},
+    {Output::kUv, "uv", 8, &PassOutputs::uv},
+    {Output::kBarycentrics, "barycentrics", 8, &PassOutputs::barycentrics},
+    {Output::kMaterialId, "material_id", 4, &PassOutputs::material_id},
 };
 
 Error bad(const std::string& what) { return Error{ErrorCode::kInvalidArgument, "RayTracePass: " + what}; }
@@ -164,6 +168,18 @@ Result<PassStats> RayTracePass::execute(World& world, const PassInputs& inputs, 
     if (wanted(Output::kTriangleId)) {
       buffers.triangle_id = host_span<std::uint32_t>(outputs.triangle_id, 1, w, h);
       buffers.row_pitch.triangle_id = outputs.triangle_id.row_pitch;
+    }
+    if (wanted(Output::kUv)) {
+      buffers.uv = host_span<Vec2>(outputs.uv, 1, w, h);
+      buffers.row_pitch.uv = outputs.uv.row_pitch;
+    }
+    if (wanted(Output::kBarycentrics)) {
+      buffers.barycentric = host_span<Vec2>(outputs.barycentrics, 1, w, h);
+      buffers.row_pitch.barycentric = outputs.barycentrics.row_pitch;
+    }
+    if (wanted(Output::kMaterialId)) {
+      buffers.material_id = host_span<std::uint32_t>(outputs.material_id, 1, w, h);
+      buffers.row_pitch.material_id = outputs.material_id.row_pitch;
     }
 
     // Inputs.

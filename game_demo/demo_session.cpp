@@ -127,6 +127,7 @@ Expected<std::unique_ptr<DemoSession>> DemoSession::create(const SessionOptions&
     s.instances_.push_back(instance);
   }
   s.settings_.shadows = options.shadows;
+  s.settings_.textures = options.textures;
   s.settings_.triangle_test = options.triangle_test;
   s.settings_.light.kind = rt::Light::Kind::kPoint;
   s.settings_.light.position = s.arena_.light_position;

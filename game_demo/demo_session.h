@@ -39,6 +39,7 @@ struct SessionOptions {
   int width = 1024;
   int height = 1024;
   bool shadows = true;
+  bool textures = true;  // textured materials show their textures (RenderSettings::textures)
   rt::TriangleTest triangle_test = rt::TriangleTest::kFast;
   std::vector<rt::Light> lights;  // at most rt::kMaxLights; empty: the arena's point light
 };

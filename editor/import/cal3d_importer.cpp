@@ -6,6 +6,7 @@
 #include "editor/import/cal3d_files.h"
 #include "editor/import/cal3d_importer.h"
 #include "editor/import/cal3d_validate.h"
+#include "editor/import/material_maps.h"
 #include "runtime/io/regular_file.h"
 
 #include <exception>
@@ -172,9 +173,11 @@ Expected<character::Model> import_impl(const std::string& cfg_path, std::string&
     SINEW_RETURN_IF_ERROR(convert_mesh(*mesh, mesh_files[i], ctx));
   }
 
+  std::vector<std::string> maps(material_ids.size());  // each material's first map: its diffuse texture
   for (std::size_t i = 0; i < material_ids.size(); ++i) {
     CalCoreMaterial* mat = core.getCoreMaterial(material_ids[i]);
     Vec3 color(1.0f);
+    if (mat != nullptr && mat->getMapCount() > 0) maps[i] = mat->getMapFilename(0);
     if (mat != nullptr) {
       const CalCoreMaterial::Color& c = mat->getDiffuseColor();
       // Bytes 0..255 taken as linear: Cal3D's fixed-function demos feed them
@@ -188,6 +191,7 @@ Expected<character::Model> import_impl(const std::string& cfg_path, std::string&
     out.mesh.material_colors.emplace_back(1.0f);
     out.material_names.emplace_back("default");
   }
+  load_material_maps(maps, out.material_names, folder.string(), out.mesh, out.warnings);
 
   for (std::size_t i = 0; i < clips.size(); ++i) {
     CalCoreAnimation* anim = core.getCoreAnimation(clip_ids[i]);

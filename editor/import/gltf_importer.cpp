@@ -7,6 +7,7 @@
 #include "editor/import/gltf_importer.h"
 #include "editor/import/gltf_mesh.h"
 #include "editor/import/gltf_skeleton.h"
+#include "editor/import/gltf_textures.h"
 #include "runtime/io/atomic_file.h"
 #include "runtime/io/regular_file.h"
 
@@ -40,7 +41,7 @@ using gltf_detail::NodeGraph;
 using gltf_detail::plan_skeleton;
 using gltf_detail::SkeletonPlan;
 
-Expected<character::Model> convert(const Ctx& c) {
+Expected<character::Model> convert(const Ctx& c, const gltf_detail::ImageBytes& images) {
   character::Model out;
   out.source = c.file;
   SINEW_ASSIGN_OR_RETURN(NodeGraph g, build_graph(c));
@@ -112,6 +113,7 @@ Expected<character::Model> convert(const Ctx& c) {
   if (out.mesh.triangles.empty()) {
     return c.error(ErrorCode::kNotFound, "meshes", "", "the file has no triangles");
   }
+  gltf_detail::import_textures(c, images, out.material_names, out.mesh, out.warnings);
 
   SINEW_ASSIGN_OR_RETURN(out.clips, build_clips(c, plan, out.skeleton, raw_to_sorted));
   // Weights that do not sum to 1 are renormalised here, with a warning when
@@ -120,10 +122,18 @@ Expected<character::Model> convert(const Ctx& c) {
   return out;
 }
 
-// Images are irrelevant to Sinew (colours come from baseColorFactor):
-// skipping their decoding keeps a broken texture from failing the import.
-bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, int,
-                const unsigned char*, int, void*) {
+// tinygltf hands each image's encoded bytes here (from a buffer view, a
+// data URI or a file read through guarded_read); they are kept, not
+// decoded: only the base colour textures are decoded later
+// (gltf_textures.h), so a broken image that no material uses costs nothing
+// and one that a material uses is a warning, not a failed import.
+bool keep_image_bytes(tinygltf::Image*, const int image_idx, std::string*, std::string*, int, int,
+                      const unsigned char* bytes, int size, void* user) {
+  auto& images = *static_cast<gltf_detail::ImageBytes*>(user);
+  if (image_idx < 0 || bytes == nullptr || size <= 0) return true;
+  const auto i = static_cast<std::size_t>(image_idx);
+  if (images.size() <= i) images.resize(i + 1);
+  images[i].assign(bytes, bytes + size);
   return true;
 }
 
@@ -212,7 +222,8 @@ Expected<character::Model> import_gltf(const std::string& path, const GltfImport
 
   tinygltf::Model model;
   tinygltf::TinyGLTF loader;
-  loader.SetImageLoader(skip_image, nullptr);
+  gltf_detail::ImageBytes images;
+  loader.SetImageLoader(keep_image_bytes, &images);
   GuardedFs guarded{&roots, max_bytes - bytes.size(), max_bytes, {}, {}, false};
   loader.SetFsCallbacks(tinygltf::FsCallbacks{&tinygltf::FileExists, &tinygltf::ExpandFilePath, &guarded_read,
                                               &tinygltf::WriteWholeFile, &guarded});
@@ -254,7 +265,7 @@ Expected<character::Model> import_gltf(const std::string& path, const GltfImport
                                                   : "only glTF 2.x is supported");
   }
   const Ctx c{model, path, options.limits};
-  return convert(c);
+  return convert(c, images);
 }
 
 }  // namespace sinew::editor

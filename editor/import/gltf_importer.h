@@ -30,9 +30,13 @@
 //   weights are renormalised to sum 1. A joint index past the skin's joint
 //   list is an error when its weight is non-zero and is cleared to joint 0
 //   when its weight is zero (some exporters pad unused slots that way).
-//   Missing normals are computed (area-weighted); TEXCOORD_0 is optional.
+//   Missing normals are computed (area-weighted); texture coordinates are
+//   optional, read from the set the material's base colour texture names
+//   (TEXCOORD_0 without one).
 // * Materials. Every glTF material in array order, its colour the
-//   baseColorFactor rgb (white by default); primitives without a material
+//   baseColorFactor rgb (white by default) and its colour map the
+//   baseColorTexture's image with its sampler's wrap modes (gltf_textures.h;
+//   one that cannot be read is a warning); primitives without a material
 //   use an extra "<default>" white material appended at the end.
 // * Clips. One per animation, named by `name` or "animation_<index>".
 //   Translation, rotation and scale channels on joints become tracks with

@@ -106,11 +106,18 @@ Status add_primitive(const Ctx& c, const NodeGraph& g, const SkeletonPlan& plan,
     }
   }
 
+  // The set the material's base colour texture reads (TEXCOORD_0 without one).
   std::vector<Vec2> uvs;
-  const int uv_acc = attribute(prim, "TEXCOORD_0");
+  int uv_set = 0;
+  if (material < c.model.materials.size()) {
+    const int set = c.model.materials[material].pbrMetallicRoughness.baseColorTexture.texCoord;
+    if (set > 0 && set < 16) uv_set = set;
+  }
+  const std::string uv_name = "TEXCOORD_" + std::to_string(uv_set);
+  const int uv_acc = attribute(prim, uv_name.c_str());
   if (uv_acc >= 0) {
     AccessorData uv;
-    SINEW_RETURN_IF_ERROR(counted(uv_acc, "TEXCOORD_0", uv, {TINYGLTF_TYPE_VEC2},
+    SINEW_RETURN_IF_ERROR(counted(uv_acc, uv_name.c_str(), uv, {TINYGLTF_TYPE_VEC2},
                                   kWeightComponentTypes));
     uvs.resize(vcount);
     for (std::size_t v = 0; v < vcount; ++v) {

@@ -37,6 +37,9 @@ enum class Output : std::uint32_t {
   kNormal = 1u << 3,        // 3 x float: unit shading normal facing the camera; 0 on a miss
   kInstanceId = 1u << 4,    // uint32: World's InstanceId; kNoHit on a miss
   kTriangleId = 1u << 5,    // uint32: the character's (or static mesh's) triangle; kNoHit on a miss
+  kUv = 1u << 6,            // 2 x float: texture coordinates (the corners' uvs blended); 0 without uvs or on a miss
+  kBarycentrics = 1u << 7,  // 2 x float: u, v, the hit's weights of the triangle's corners 1 and 2; 0 on a miss
+  kMaterialId = 1u << 8,    // uint32: the triangle's material, as the pack numbers them; kNoHit without one or on a miss
 };
 // A set of outputs: `Output::kColorRgba8 | Output::kDepth`, or one Output.
 class OutputMask {
@@ -118,6 +121,9 @@ struct PassOutputs {
   OutputBuffer normal;
   OutputBuffer instance_id;
   OutputBuffer triangle_id;
+  OutputBuffer uv;
+  OutputBuffer barycentrics;
+  OutputBuffer material_id;
 };
 
 // One declared resource, for a render graph's bookkeeping.

@@ -56,6 +56,9 @@ class PinholeCamera {
     return inv_length * d;
   }
 
+  // The angle one pixel subtends at the image's centre (radians): how fast
+  // a pixel's footprint grows with distance, for texture filtering.
+  float pixel_spread() const { return 2.0f * tan_half_fovy_ / static_cast<float>(height_); }
   int width() const { return width_; }
   int height() const { return height_; }
   const Vec3& eye() const { return eye_; }

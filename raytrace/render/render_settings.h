@@ -27,6 +27,9 @@ inline constexpr std::size_t kMaxLights = 8;
 struct RenderSettings {
   TriangleTest triangle_test = TriangleTest::kFast;
   bool shadows = true;
+  // Textured materials sample their texture (docs/RAYTRACE.md, "Textures");
+  // off, every material shows its colour alone.
+  bool textures = true;
   Light light;
   // When non-empty, these lights (1 to kMaxLights; kept by the caller for
   // the render's duration) replace `light`.
@@ -65,6 +68,13 @@ struct FrameBuffers {
   std::span<Vec3> normal;          // unit shading normal facing the camera; 0 on a miss
   std::span<std::uint32_t> triangle_id;  // kInvalidId on a miss
   std::span<std::uint32_t> instance_id;  // kInvalidId on a miss
+  // The hit's texture coordinates (the corners' uvs blended; 0 without
+  // uvs), its barycentrics (u, v: the weights of corners 1 and 2) and its
+  // triangle's material (kInvalidId without one); 0, 0 and kInvalidId on a
+  // miss.
+  std::span<Vec2> uv;
+  std::span<Vec2> barycentric;
+  std::span<std::uint32_t> material_id;
 
   // Bytes from the start of one row to the next, per output (a host's
   // texture or staging buffer with padded rows); 0: rows packed. A pitch
@@ -80,6 +90,9 @@ struct FrameBuffers {
     std::size_t normal = 0;
     std::size_t triangle_id = 0;
     std::size_t instance_id = 0;
+    std::size_t uv = 0;
+    std::size_t barycentric = 0;
+    std::size_t material_id = 0;
   };
   RowPitches row_pitch;
 };

@@ -51,6 +51,11 @@ Expected<OutputPlanes> output_planes(const FrameBuffers& buffers) {
                          output_plane(buffers.triangle_id, pitch.triangle_id, 1, w, h, "buffers.triangle_id"));
   SINEW_ASSIGN_OR_RETURN(out.instance,
                          output_plane(buffers.instance_id, pitch.instance_id, 1, w, h, "buffers.instance_id"));
+  SINEW_ASSIGN_OR_RETURN(out.uv, output_plane(buffers.uv, pitch.uv, 1, w, h, "buffers.uv"));
+  SINEW_ASSIGN_OR_RETURN(out.barycentric,
+                         output_plane(buffers.barycentric, pitch.barycentric, 1, w, h, "buffers.barycentric"));
+  SINEW_ASSIGN_OR_RETURN(out.material,
+                         output_plane(buffers.material_id, pitch.material_id, 1, w, h, "buffers.material_id"));
   return out;
 }
 
@@ -73,7 +78,7 @@ void render_tile(const Scene& scene, const PinholeCamera& camera, const RenderSe
   }
   std::fill(s.lit.begin(), s.lit.begin() + static_cast<std::ptrdiff_t>(s.lanes),
             static_cast<std::uint8_t>((1u << lights.size()) - 1u));
-  if (out.want_surface()) reconstruct_surfaces(scene, settings.default_albedo, s);
+  if (out.want_surface()) reconstruct_surfaces(scene, surface_settings(settings, camera, out), s);
   double shadow_ns = 0.0;
   if (out.want_color() && settings.shadows) {
     const auto shadow_start = Clock::now();

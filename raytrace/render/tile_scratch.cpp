@@ -47,11 +47,12 @@ void TileScratch::prepare(const Tile& area, const TracePlan& frame_plan) {
     for (std::vector<float>* a : {&dir_x, &dir_y, &dir_z, &t, &u, &v, &px, &py, &pz, &gx, &gy, &gz, &nx, &ny,
                                   &nz, &ar, &ag, &ab, &error, &so_x, &so_y, &so_z, &sd_x, &sd_y, &sd_z, &s_tmax,
                                   &shadow_lane_x, &shadow_lane_y, &shadow_lane_z, &shadow_push_x,
-                                  &shadow_push_y, &shadow_push_z, &lr, &lg, &lb}) {
+                                  &shadow_push_y, &shadow_push_z, &lr, &lg, &lb, &uv_x, &uv_y}) {
       a->resize(arrays);
     }
     triangle.resize(arrays);
     instance.resize(arrays);
+    material.resize(arrays);
     rgba8.resize(arrays);
     lit.resize(arrays);
     shadow_pixel.resize(arrays);

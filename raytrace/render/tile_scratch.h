@@ -50,6 +50,11 @@ struct TileScratch {
   std::vector<float> nx, ny, nz;     // unit shading normal facing the camera
   std::vector<float> ar, ag, ab;     // albedo
   std::vector<float> error;          // rounding bound of the position, every axis
+  // The hit's texture coordinates and material, when an output asks for
+  // them (SurfaceSettings::hit_attributes): 0 without uvs, kInvalidId
+  // without a material.
+  std::vector<float> uv_x, uv_y;
+  std::vector<std::uint32_t> material;
   std::vector<std::uint8_t> lit;     // bit l: light l reaches the hit
   // A colour-only frame's shading (render/stages/tile_stages.h shade_and_write):
   // the linear colour of each hit, and its RGBA8 pixel, encoded sixteen

@@ -99,7 +99,32 @@ Status check_skinned_mesh(const MeshOrigin& origin, const SkinnedMesh& mesh, std
       }
     }
   }
+  SINEW_RETURN_IF_ERROR(check_material_textures(origin, mesh));
   return check_triangle_mesh(origin, mesh.positions, mesh.triangles, mesh.triangle_material, mesh.material_colors);
+}
+
+Status check_material_textures(const MeshOrigin& origin, const SkinnedMesh& mesh) {
+  const Reporter report(origin);
+  if (!mesh.material_texture.empty() && mesh.material_texture.size() != mesh.material_colors.size()) {
+    return report.count("material_texture", mesh.material_texture.size(),
+                        "expected none or one per material (" + std::to_string(mesh.material_colors.size()) + ")");
+  }
+  for (std::size_t m = 0; m < mesh.material_texture.size(); ++m) {
+    const std::uint32_t texture = mesh.material_texture[m];
+    if (texture == kNoTexture) continue;
+    if (texture >= mesh.textures.size()) {
+      return report.error("material_texture", at(m), std::to_string(texture),
+                          "no such texture (" + std::to_string(mesh.textures.size()) + " textures)");
+    }
+    if (mesh.uvs.empty()) {
+      return report.error("material_texture", at(m), std::to_string(texture), "a texture needs the mesh's uvs");
+    }
+  }
+  for (std::size_t t = 0; t < mesh.textures.size(); ++t) {
+    const std::string field = std::string(origin.field_prefix) + "textures" + at(t);
+    SINEW_RETURN_IF_ERROR(check_texture(mesh.textures[t], origin.file, field));
+  }
+  return {};
 }
 
 }  // namespace sinew

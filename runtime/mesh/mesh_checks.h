@@ -43,6 +43,12 @@ Status check_triangle_mesh(const MeshOrigin& origin, std::span<const Vec3> posit
 // uvs empty or one per position and finite, every influence slot's joint
 // below `joint_count` (SIMD skinning reads every slot, weighted or not) and
 // its weight finite and >= 0.
+// Also checks the material textures (check_material_textures).
 Status check_skinned_mesh(const MeshOrigin& origin, const SkinnedMesh& mesh, std::size_t joint_count);
+
+// `material_texture` empty or one per material, each kNoTexture or naming
+// a texture, only where the mesh has uvs; every texture's levels
+// (check_texture).
+Status check_material_textures(const MeshOrigin& origin, const SkinnedMesh& mesh);
 
 }  // namespace sinew

@@ -13,11 +13,13 @@
 #include <cstdint>
 #include <vector>
 
+#include "runtime/image/texture.h"
 #include "runtime/math/types.h"
 
 namespace sinew {
 
 inline constexpr int kMaxInfluences = 8;
+inline constexpr std::uint32_t kNoTexture = 0xFFFFFFFFu;
 
 struct SkinnedMesh {
   std::vector<Vec3> positions;  // bind pose, model space
@@ -28,6 +30,11 @@ struct SkinnedMesh {
   std::vector<std::array<std::uint32_t, 3>> triangles;
   std::vector<std::uint32_t> triangle_material;  // per triangle, index into material_colors
   std::vector<Vec3> material_colors;             // linear RGB diffuse
+  // Per material, its colour map in `textures` or kNoTexture (empty: none
+  // has one). A textured material's albedo is its colour times the map's
+  // RGB at the hit's uv.
+  std::vector<std::uint32_t> material_texture;
+  std::vector<Texture> textures;
 
   std::size_t vertex_count() const { return positions.size(); }
   std::size_t triangle_count() const { return triangles.size(); }

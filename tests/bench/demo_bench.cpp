@@ -1,5 +1,6 @@
 #include "tests/bench/demo_bench.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -27,6 +28,7 @@ struct DemoBenchOptions {
   int frames = 30;
   int warmup = 5;
   bool shadows = true;
+  std::string textures = "on";  // on, off, or both (alternating frames)
   std::string model_path;  // empty: the mannequin
   std::string json_path;
   bool help = false;
@@ -40,6 +42,7 @@ std::vector<BenchFlag> demo_flags() {
       frames_flag("measured frames per count (default 30), after"),
       {"--warmup", "N", "unmeasured frames (default 5)"},
       {"--shadows", "on|off", "shadow rays (default on)"},
+      {"--textures", "on|off|both", "textured materials (default on); both: alternate frames off and on"},
       {"--model", "PATH", "glTF or Cal3D character (default the procedural mannequin)"},
       json_flag(),
   };
@@ -54,6 +57,10 @@ Status read_options(const BenchArgs& parsed, DemoBenchOptions& o) {
   SINEW_RETURN_IF_ERROR(parsed.read("--frames", 1, 100000, o.frames));
   SINEW_RETURN_IF_ERROR(parsed.read("--warmup", 0, 100000, o.warmup));
   SINEW_RETURN_IF_ERROR(parsed.read("--shadows", o.shadows));
+  SINEW_RETURN_IF_ERROR(parsed.read("--textures", o.textures));
+  if (o.textures != "on" && o.textures != "off" && o.textures != "both") {
+    return invalid_argument("--textures", o.textures, "expected on, off or both");
+  }
   SINEW_RETURN_IF_ERROR(parsed.read("--model", o.model_path));
   SINEW_RETURN_IF_ERROR(parsed.read("--json", o.json_path));
   return {};
@@ -66,6 +73,9 @@ struct CountResult {
   double rays_per_frame = 0.0;
   std::uint64_t escaped_triangles = 0;
   std::size_t triangles = 0;
+  // --textures both: the shade phase's per-frame medians with textures off
+  // and on (alternate frames of one session, so both see the same views).
+  double shade_off_ms = 0.0, shade_on_ms = 0.0;
   // Over the measured frames: the tracers' work, and the rays it was for.
   rt::TraversalCounters primary, shadow;
 };
@@ -94,12 +104,17 @@ Expected<CountResult> measure(const DemoBenchOptions& o, int characters, JobSyst
   r.triangles = session->bake_info().triangles;
   demo::FollowCamera camera;
   std::uint64_t rays = 0;
+  const bool alternate = o.textures == "both";
+  session->render_settings().textures = o.textures != "off";
+  std::vector<double> shade[2];  // textures off, on
   for (int f = 0; f < o.warmup + o.frames; ++f) {
     if (f == o.warmup) session->timers().clear();
     const demo::PlayerInput input = demo::scripted_input(f);
     camera.yaw = input.camera_yaw;
+    if (alternate) session->render_settings().textures = f % 2 == 1;
     SINEW_ASSIGN_OR_RETURN(const demo::FrameReport report, session->frame(1.0f / 30.0f, input, camera, jobs));
     if (f >= o.warmup) {
+      shade[session->render_settings().textures ? 1 : 0].push_back(report.render.shade_ms);
       rays += report.render.primary_rays + report.render.shadow_rays;
       r.escaped_triangles += report.scene.escaped_triangles;
       r.primary += report.render.primary;
@@ -109,6 +124,13 @@ Expected<CountResult> measure(const DemoBenchOptions& o, int characters, JobSyst
   r.phases = session->timers().summarize();
   r.frame_ms = session->timers().median_total_ms();
   r.rays_per_frame = static_cast<double>(rays) / o.frames;
+  const auto median = [](std::vector<double> v) {
+    if (v.empty()) return 0.0;
+    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+    return v[v.size() / 2];
+  };
+  r.shade_off_ms = median(shade[0]);
+  r.shade_on_ms = median(shade[1]);
   return r;
 }
 
@@ -134,6 +156,13 @@ void print_table(const DemoBenchOptions& o, const std::vector<CountResult>& resu
                 per_ray(p.object_visits, p.rays), per_ray(p.triangle_tests, p.rays), per_ray(s.node_visits, s.rays),
                 per_ray(s.object_visits, s.rays), per_ray(s.triangle_tests, s.rays));
   }
+  if (o.textures == "both") {
+    std::printf("\n| characters | shade ms, textures off | shade ms, textures on | on / off |\n|---:|---:|---:|---:|\n");
+    for (const CountResult& r : results) {
+      std::printf("| %d | %.2f | %.2f | %.3f |\n", r.characters, r.shade_off_ms, r.shade_on_ms,
+                  r.shade_off_ms > 0.0 ? r.shade_on_ms / r.shade_off_ms : 0.0);
+    }
+  }
   std::printf("\nPhase columns are per-frame medians in ms over %d frames after %d warm-up frames; fps = 1000 /"
               " their sum. M rays/s counts primary and shadow rays over the whole frame time. The second table is the"
               " tracers' work per ray (render/renderer.h TraversalCounters) over the same frames.\n",
@@ -153,6 +182,7 @@ int run_demo_bench(const std::vector<std::string>& args, const std::string& comm
   Json& doc = record.doc();
   doc["size"] = {o.width, o.height};
   doc["shadows"] = o.shadows;
+  doc["textures"] = o.textures;
   doc["counts"] = Json::array();
   std::vector<CountResult> results;
   for (int characters : o.characters) {
@@ -173,6 +203,10 @@ int run_demo_bench(const std::vector<std::string>& args, const std::string& comm
     doc["counts"].push_back({{"characters", r.characters}, {"fps", r.frame_ms > 0.0 ? 1000.0 / r.frame_ms : 0.0},
                              {"frame_ms", r.frame_ms}, {"phases_ms", phases},
                              {"rays_per_frame", r.rays_per_frame}});
+    if (o.textures == "both") {
+      doc["counts"].back()["shade_ms_textures_off"] = r.shade_off_ms;
+      doc["counts"].back()["shade_ms_textures_on"] = r.shade_on_ms;
+    }
   }
   return record.finish(o.json_path);
 }

@@ -380,7 +380,7 @@ Expected<EmbreeRenderStats> EmbreeTracer::render(const rt::Scene& scene, const r
       record.hits += static_cast<std::uint64_t>(std::popcount(static_cast<unsigned>(s.block_hits[b])));
     }
     std::fill(s.lit.begin(), s.lit.begin() + static_cast<std::ptrdiff_t>(s.lanes), std::uint8_t{1});
-    if (out.want_color()) rt::reconstruct_surfaces(scene, settings.default_albedo, s);
+    if (out.want_color()) rt::reconstruct_surfaces(scene, rt::surface_settings(settings, camera, out), s);
     double shadow_ns = 0.0;
     if (settings.shadows && out.want_color()) {
       const Clock::time_point shadow_start = Clock::now();

@@ -6,6 +6,7 @@ if(TARGET Cal3D::cal3d)
             ${CMAKE_CURRENT_LIST_DIR}/cal3d_mixer_oracle_test.cpp
             ${CMAKE_CURRENT_LIST_DIR}/cally_limits_test.cpp
             ${CMAKE_CURRENT_LIST_DIR}/cal3d_xml_test.cpp
+            ${CMAKE_CURRENT_LIST_DIR}/cal3d_texture_import_test.cpp
     LIBS sinew::editor Cal3D::cal3d)
   # As for the importer (editor/import/cal3d.cmake): libcal3d exports no
   # typeinfo for UBSan's vptr check to reference.

@@ -72,6 +72,9 @@ void expect_same_frame(const Frame& a, const Frame& b) {
   EXPECT_EQ(std::memcmp(a.normal.data(), b.normal.data(), a.normal.size() * sizeof(Vec3)), 0);
   EXPECT_EQ(a.instance_id, b.instance_id);
   EXPECT_EQ(a.triangle_id, b.triangle_id);
+  EXPECT_EQ(std::memcmp(a.uv.data(), b.uv.data(), a.uv.size() * sizeof(Vec2)), 0);
+  EXPECT_EQ(std::memcmp(a.barycentric.data(), b.barycentric.data(), a.barycentric.size() * sizeof(Vec2)), 0);
+  EXPECT_EQ(a.material_id, b.material_id);
 }
 
 std::size_t hit_pixels(const Frame& f) {
@@ -264,8 +267,10 @@ TEST(ApiPass, WritesOnlyTheRequestedOutputs) {
   Frame all(kW, kH);
   ASSERT_TRUE(make_pass(kEveryOutput).execute(*world, inputs_with(light), all.outputs()).ok());
 
-  for (const api::Output only : {api::Output::kColorRgba8, api::Output::kColorRgba32f, api::Output::kDepth,
-                                 api::Output::kNormal, api::Output::kInstanceId, api::Output::kTriangleId}) {
+  for (const api::Output only :
+       {api::Output::kColorRgba8, api::Output::kColorRgba32f, api::Output::kDepth, api::Output::kNormal,
+        api::Output::kInstanceId, api::Output::kTriangleId, api::Output::kUv, api::Output::kBarycentrics,
+        api::Output::kMaterialId}) {
     SCOPED_TRACE(static_cast<int>(only));
     Frame f(kW, kH);
     // Sentinels everywhere: the outputs not asked for must keep them.
@@ -275,6 +280,9 @@ TEST(ApiPass, WritesOnlyTheRequestedOutputs) {
     std::fill(f.normal.begin(), f.normal.end(), Vec3(-7.0f));
     std::fill(f.instance_id.begin(), f.instance_id.end(), 0xABABABABu);
     std::fill(f.triangle_id.begin(), f.triangle_id.end(), 0xABABABABu);
+    std::fill(f.uv.begin(), f.uv.end(), Vec2(-7.0f));
+    std::fill(f.barycentric.begin(), f.barycentric.end(), Vec2(-7.0f));
+    std::fill(f.material_id.begin(), f.material_id.end(), 0xABABABABu);
     ASSERT_TRUE(make_pass(only).execute(*world, inputs_with(light), f.outputs()).ok());
     const bool rgba8 = only == api::Output::kColorRgba8, rgba32f = only == api::Output::kColorRgba32f;
     const bool depth = only == api::Output::kDepth, normal = only == api::Output::kNormal;
@@ -285,6 +293,9 @@ TEST(ApiPass, WritesOnlyTheRequestedOutputs) {
     EXPECT_EQ(f.normal == all.normal, normal);
     EXPECT_EQ(f.instance_id == all.instance_id, instance);
     EXPECT_EQ(f.triangle_id == all.triangle_id, triangle);
+    EXPECT_EQ(f.uv == all.uv, only == api::Output::kUv);
+    EXPECT_EQ(f.barycentric == all.barycentric, only == api::Output::kBarycentrics);
+    EXPECT_EQ(f.material_id == all.material_id, only == api::Output::kMaterialId);
     if (!rgba8) {
       EXPECT_TRUE(std::all_of(f.rgba8.begin(), f.rgba8.end(), [](std::uint8_t v) { return v == 0xAB; }));
     }
@@ -319,6 +330,9 @@ TEST(ApiPass, RowPitchesPlaceRowsAndNeverTouchThePadding) {
   PitchedBuffer normal(12 * w, kH, 4);  // not a multiple of 12: only float alignment matters
   PitchedBuffer instance(4 * w, kH, 8);
   PitchedBuffer triangle(4 * w, kH, 12);
+  PitchedBuffer uv(8 * w, kH, 4);
+  PitchedBuffer barycentrics(8 * w, kH, 64);
+  PitchedBuffer material(4 * w, kH, 20);
   api::PassOutputs out;
   out.color_rgba8 = {rgba8.bytes.data(), rgba8.pitch};
   out.color_rgba32f = {rgba32f.bytes.data(), rgba32f.pitch};
@@ -326,6 +340,9 @@ TEST(ApiPass, RowPitchesPlaceRowsAndNeverTouchThePadding) {
   out.normal = {normal.bytes.data(), normal.pitch};
   out.instance_id = {instance.bytes.data(), instance.pitch};
   out.triangle_id = {triangle.bytes.data(), triangle.pitch};
+  out.uv = {uv.bytes.data(), uv.pitch};
+  out.barycentrics = {barycentrics.bytes.data(), barycentrics.pitch};
+  out.material_id = {material.bytes.data(), material.pitch};
   const auto done = make_pass(kEveryOutput).execute(*world, inputs_with(light), out);
   ASSERT_TRUE(done.ok()) << done.error().message;
 
@@ -346,6 +363,9 @@ TEST(ApiPass, RowPitchesPlaceRowsAndNeverTouchThePadding) {
   check(normal, packed.normal.data(), 12 * w, "normal");
   check(instance, packed.instance_id.data(), 4 * w, "instance_id");
   check(triangle, packed.triangle_id.data(), 4 * w, "triangle_id");
+  check(uv, packed.uv.data(), 8 * w, "uv");
+  check(barycentrics, packed.barycentric.data(), 8 * w, "barycentrics");
+  check(material, packed.material_id.data(), 4 * w, "material_id");
 }
 
 // --- threads: the host's scheduler --------------------------------------------

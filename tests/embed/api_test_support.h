@@ -68,13 +68,17 @@ struct Frame : AovFrame {
     o.normal = {normal.data(), 0};
     o.instance_id = {instance_id.data(), 0};
     o.triangle_id = {triangle_id.data(), 0};
+    o.uv = {uv.data(), 0};
+    o.barycentrics = {barycentric.data(), 0};
+    o.material_id = {material_id.data(), 0};
     return o;
   }
 };
 
 inline constexpr api::OutputMask kEveryOutput =
     api::Output::kColorRgba8 | api::Output::kColorRgba32f | api::Output::kDepth | api::Output::kNormal |
-    api::Output::kInstanceId | api::Output::kTriangleId;
+    api::Output::kInstanceId | api::Output::kTriangleId | api::Output::kUv | api::Output::kBarycentrics |
+    api::Output::kMaterialId;
 
 // The camera and light the API tests use, in both vocabularies.
 inline api::Camera test_camera() { return {{0.4f, 1.1f, 3.2f}, {0.0f, 0.9f, 0.0f}, {0.0f, 1.0f, 0.0f}, 45.0f}; }

@@ -76,7 +76,7 @@ TEST(TileStages, SurfacesAndShadowOriginsAreTheScalarOnes) {
         rt::TraversalCounters counters;
         rt::trace_primary(sc, camera, TriangleTest::kFast, s, counters);
         std::fill(s.lit.begin(), s.lit.end(), std::uint8_t{1});
-        rt::reconstruct_surfaces(sc, Vec3(0.7f), s);
+        rt::reconstruct_surfaces(sc, {Vec3(0.7f), camera.pixel_spread()}, s);
         rt::make_shadow_rays(light, 0, s);
         const auto on_character = [&](std::size_t k) {
           return sc.object_slots()[s.instance[k]].kind == rt::Scene::ObjectKind::kCharacter;
@@ -220,7 +220,7 @@ TEST(TileStages, SurfacesOfBlocksOnSeveralTrianglesAreTheScalarOnes) {
       }
       s.block_hits[b] = static_cast<std::uint8_t>(hits);
     }
-    rt::reconstruct_surfaces(sc, Vec3(0.7f), s);
+    rt::reconstruct_surfaces(sc, {Vec3(0.7f), camera.pixel_spread()}, s);
     for (std::size_t k = 0; k < s.lanes; ++k) {
       if (!s.hit(k)) continue;
       const rt::SurfacePoint p = rt::surface_at(sc, Hit{s.t[k], s.u[k], s.v[k], s.triangle[k], s.instance[k]}, Vec3(0.7f));

@@ -22,6 +22,9 @@ struct AovFrame {
   std::vector<Vec3> normal;
   std::vector<std::uint32_t> instance_id;
   std::vector<std::uint32_t> triangle_id;
+  std::vector<Vec2> uv;
+  std::vector<Vec2> barycentric;
+  std::vector<std::uint32_t> material_id;
 
   AovFrame(int w, int h)
       : width(w),
@@ -31,7 +34,10 @@ struct AovFrame {
         depth(pixels()),
         normal(pixels()),
         instance_id(pixels()),
-        triangle_id(pixels()) {}
+        triangle_id(pixels()),
+        uv(pixels()),
+        barycentric(pixels()),
+        material_id(pixels()) {}
 
   std::size_t pixels() const { return static_cast<std::size_t>(width) * static_cast<std::size_t>(height); }
 
@@ -44,6 +50,9 @@ struct AovFrame {
     std::fill(normal.begin(), normal.end(), Vec3(nan));
     std::fill(instance_id.begin(), instance_id.end(), 0xDEADBEEFu);
     std::fill(triangle_id.begin(), triangle_id.end(), 0xDEADBEEFu);
+    std::fill(uv.begin(), uv.end(), Vec2(nan));
+    std::fill(barycentric.begin(), barycentric.end(), Vec2(nan));
+    std::fill(material_id.begin(), material_id.end(), 0xDEADBEEFu);
   }
 
   rt::FrameBuffers buffers() {
@@ -56,6 +65,9 @@ struct AovFrame {
     b.normal = normal;
     b.instance_id = instance_id;
     b.triangle_id = triangle_id;
+    b.uv = uv;
+    b.barycentric = barycentric;
+    b.material_id = material_id;
     return b;
   }
 };

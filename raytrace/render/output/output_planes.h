@@ -77,9 +77,19 @@ struct OutputPlanes {
   OutputPlane<Vec3> normal;
   OutputPlane<std::uint32_t> triangle;
   OutputPlane<std::uint32_t> instance;
+  OutputPlane<Vec2> uv;
+  OutputPlane<Vec2> barycentric;
+  OutputPlane<std::uint32_t> material;
 
   bool want_color() const { return rgba8.wanted() || rgba32f.wanted(); }
-  bool want_surface() const { return want_color() || normal.wanted(); }
+  // The hit's uv and material: read from the mesh with the surfaces.
+  bool want_hit_attributes() const { return uv.wanted() || material.wanted(); }
+  bool want_surface() const { return want_color() || normal.wanted() || want_hit_attributes(); }
+  // Any output besides colour RGBA8 (which has a path of its own).
+  bool want_other_than_rgba8() const {
+    return rgba32f.wanted() || depth.wanted() || normal.wanted() || triangle.wanted() || instance.wanted() ||
+           uv.wanted() || barycentric.wanted() || material.wanted();
+  }
 };
 
 // fn(a.p, b.p) for every plane p, the planes of `a` and `b` paired by kind
@@ -92,6 +102,9 @@ void for_each_plane_pair(A& a, B& b, Fn&& fn) {
   fn(a.normal, b.normal);
   fn(a.triangle, b.triangle);
   fn(a.instance, b.instance);
+  fn(a.uv, b.uv);
+  fn(a.barycentric, b.barycentric);
+  fn(a.material, b.material);
 }
 
 }  // namespace sinew::rt

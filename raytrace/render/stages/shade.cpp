@@ -144,8 +144,7 @@ void shade_and_write(const RenderSettings& settings, std::span<const Light> ligh
                      TileScratch& s) {
   // Written to the tile's staging planes, stored to the host's at the end.
   const OutputPlanes& out = s.staging.stage(host, s.tile);
-  if (host.rgba8.wanted() && !host.rgba32f.wanted() && !host.depth.wanted() && !host.normal.wanted() &&
-      !host.triangle.wanted() && !host.instance.wanted()) {
+  if (host.rgba8.wanted() && !host.want_other_than_rgba8()) {
     shade_rgba8_only(settings, lights, out.rgba8, s);
     s.staging.flush(host);
     return;
@@ -160,6 +159,7 @@ void shade_and_write(const RenderSettings& settings, std::span<const Light> ligh
   std::uint32_t background_row[kBlockWidth];
   for (std::uint32_t& pixel : background_row) std::memcpy(&pixel, background_bytes.data(), 4);
   static constexpr float kMissDepths[kBlockWidth] = {kInf, kInf, kInf, kInf};
+  static constexpr std::uint32_t kMissIds[kBlockWidth] = {kInvalidId, kInvalidId, kInvalidId, kInvalidId};
   for (std::size_t b = 0; b < blocks; ++b) {
     const std::size_t k0 = b * kBlockLanes;
     const std::uint32_t pixels = s.block_pixels[b];
@@ -193,9 +193,12 @@ void shade_and_write(const RenderSettings& settings, std::span<const Light> ligh
         if (out.instance.wanted()) std::memcpy(out.instance.at(bx, y), &s.instance[k], 4 * sizeof(std::uint32_t));
         if (hits == 0u) {
           if (out.depth.wanted()) std::memcpy(out.depth.at(bx, y), kMissDepths, sizeof(kMissDepths));
+          if (out.material.wanted()) std::memcpy(out.material.at(bx, y), kMissIds, sizeof(kMissIds));
           if (out.rgba8.wanted()) std::memcpy(out.rgba8.at(bx, y), background_row, sizeof(background_row));
           for (int i = 0; i < kBlockWidth; ++i) {
             if (out.normal.wanted()) out.normal.at(bx, y)[i] = Vec3(0.0f);
+            if (out.uv.wanted()) out.uv.at(bx, y)[i] = Vec2(0.0f);
+            if (out.barycentric.wanted()) out.barycentric.at(bx, y)[i] = Vec2(0.0f);
             if (out.rgba32f.wanted()) {
               float* rgba = out.rgba32f.at(bx + i, y);
               for (int c = 0; c < 3; ++c) rgba[c] = settings.background[c];
@@ -209,6 +212,11 @@ void shade_and_write(const RenderSettings& settings, std::span<const Light> ligh
         if (out.normal.wanted()) {
           for (int i = 0; i < kBlockWidth; ++i) out.normal.at(bx, y)[i] = Vec3(s.nx[k + i], s.ny[k + i], s.nz[k + i]);
         }
+        for (int i = 0; i < kBlockWidth; ++i) {
+          if (out.uv.wanted()) out.uv.at(bx, y)[i] = Vec2(s.uv_x[k + i], s.uv_y[k + i]);
+          if (out.barycentric.wanted()) out.barycentric.at(bx, y)[i] = Vec2(s.u[k + i], s.v[k + i]);
+        }
+        if (out.material.wanted()) std::memcpy(out.material.at(bx, y), &s.material[k], 4 * sizeof(std::uint32_t));
         if (out.rgba8.wanted()) std::memcpy(out.rgba8.at(bx, y), &pixels_rgba8[l0], 4 * sizeof(std::uint32_t));
         if (out.rgba32f.wanted()) {
           float* rgba = out.rgba32f.at(bx, y);
@@ -230,6 +238,9 @@ void shade_and_write(const RenderSettings& settings, std::span<const Light> ligh
       if (!(hits >> lane & 1u)) {
         if (out.depth.wanted()) *out.depth.at(x, y) = kInf;
         if (out.normal.wanted()) *out.normal.at(x, y) = Vec3(0.0f);
+        if (out.uv.wanted()) *out.uv.at(x, y) = Vec2(0.0f);
+        if (out.barycentric.wanted()) *out.barycentric.at(x, y) = Vec2(0.0f);
+        if (out.material.wanted()) *out.material.at(x, y) = kInvalidId;
         if (out.rgba32f.wanted()) {
           float* rgba = out.rgba32f.at(x, y);
           for (int c = 0; c < 3; ++c) rgba[c] = settings.background[c];
@@ -240,6 +251,9 @@ void shade_and_write(const RenderSettings& settings, std::span<const Light> ligh
       }
       if (out.depth.wanted()) *out.depth.at(x, y) = depth[lane];
       if (out.normal.wanted()) *out.normal.at(x, y) = Vec3(s.nx[k], s.ny[k], s.nz[k]);
+      if (out.uv.wanted()) *out.uv.at(x, y) = Vec2(s.uv_x[k], s.uv_y[k]);
+      if (out.barycentric.wanted()) *out.barycentric.at(x, y) = Vec2(s.u[k], s.v[k]);
+      if (out.material.wanted()) *out.material.at(x, y) = s.material[k];
       if (out.rgba32f.wanted()) {
         float* rgba = out.rgba32f.at(x, y);
         for (int c = 0; c < 3; ++c) rgba[c] = linear[c][lane];

@@ -51,10 +51,23 @@ void trace_primary(const Scene& scene, const PinholeCamera& camera, TriangleTest
 void intersect_static_tile(const StaticTile& tile, const PinholeCamera& camera, TileScratch& s,
                            TraversalCounters& counters);
 
+// What reconstruct_surfaces needs beside the hits.
+struct SurfaceSettings {
+  Vec3 default_albedo{0.7f};  // RenderSettings::default_albedo
+  float pixel_spread = 0.0f;  // PinholeCamera::pixel_spread: how fast a pixel's footprint grows
+  bool textures = true;       // RenderSettings::textures
+  bool hit_attributes = false;  // fill s.uv_x, s.uv_y and s.material (OutputPlanes::want_hit_attributes)
+};
+SurfaceSettings surface_settings(const RenderSettings& settings, const PinholeCamera& camera,
+                                 const OutputPlanes& out);
+
 // The surfaces at the hits (positions, camera-facing geometric and
 // shading normals, albedo, rounding bound), as surface_at computes them,
-// and which hits are on characters (s.block_on_character).
-void reconstruct_surfaces(const Scene& scene, const Vec3& default_albedo, TileScratch& s);
+// and which hits are on characters (s.block_on_character). With textures
+// on, a textured material's albedo is also multiplied by its texture at
+// the hit's uv (which surface_at leaves out), from the mip level the
+// pixel's footprint asks for (docs/RAYTRACE.md, "Textures").
+void reconstruct_surfaces(const Scene& scene, const SurfaceSettings& settings, TileScratch& s);
 
 // Light `l`'s shadow rays for the hits whose surface faces it, placed lane
 // by lane (s.shadow_lanes, s.shadow_lane_*); hits facing away lose bit l of
