@@ -11,6 +11,7 @@ namespace {
 
 constexpr double kInstanceTimeStep = 0.37;  // seconds between instances' clip times
 constexpr float kInstanceSpacing = 1.2f;    // x the rest bounds' largest extent
+constexpr float kGroundReach = 50.0f;       // x the character's height, beyond half the layout
 constexpr float kDefaultFovyDegrees = 40.0f;
 
 Vec3 axis_vector(int axis, float sign = 1.0f) {
@@ -61,25 +62,48 @@ int up_axis_of(const Aabb& rest) {
   return e.y >= e.z ? 1 : 2;
 }
 
-Affine3 instance_placement(const Aabb& rest, int index) {
+int layout_columns(int instances, Layout layout) {
+  const int n = std::max(instances, 1);
+  if (layout == Layout::kRow) return n;
+  int cols = 1;
+  while (cols * cols < n) ++cols;  // ceil(sqrt(n)), exactly
+  return cols;
+}
+
+Affine3 instance_placement(const Aabb& rest, int index, int instances, Layout layout) {
   const Vec3 e = rest.extent();
   const float spacing = kInstanceSpacing * std::max({e.x, e.y, e.z});
-  return Affine3::translation(axis_vector(0, static_cast<float>(index) * spacing));
+  if (layout == Layout::kRow) return Affine3::translation(axis_vector(0, static_cast<float>(index) * spacing));
+  const int cols = layout_columns(instances, layout);
+  const int up = up_axis_of(rest);
+  const float column = static_cast<float>(index % cols);
+  const float row = static_cast<float>(index / cols);
+  return Affine3::translation(axis_vector(0, column * spacing) - (row * spacing) * front_of(up));
 }
 
 double instance_time_offset(int index) { return kInstanceTimeStep * index; }
 
-rt::StaticMeshDesc ground_plane_for(const Aabb& rest, int instances) {
+Aabb layout_bounds(const Aabb& rest, int instances, Layout layout) {
+  Aabb box;
+  for (int i = 0; i < std::max(instances, 1); ++i) {
+    const Vec3 t = instance_placement(rest, i, instances, layout).translation_part();
+    box.extend(rest.lower + t);
+    box.extend(rest.upper + t);
+  }
+  return box;
+}
+
+rt::StaticMeshDesc ground_plane_for(const Aabb& rest, int instances, Layout layout) {
   const int up = up_axis_of(rest);
-  const Vec3 e = rest.extent();
-  const float largest = std::max({e.x, e.y, e.z, 1e-3f});
-  // Centred under the row of instances and reaching well past it, so the
-  // ground fills the background of the default camera.
-  const Vec3 row_end = instance_placement(rest, std::max(instances - 1, 0)).translation_part();
-  const Vec3 centre = rest.center() + 0.5f * row_end;
-  const float reach = 10.0f * largest + 0.5f * glm::length(row_end);
   const int a = (up + 1) % 3;
   const int b = (up + 2) % 3;
+  const float height = std::max(rest.extent()[up], 1e-3f);
+  // Centred under the layout and reaching far past it, so the ground fills
+  // the background of the default camera.
+  const Aabb layout_box = layout_bounds(rest, instances, layout);
+  const Vec3 centre = layout_box.center();
+  const Vec3 extent = layout_box.extent();
+  const float reach = kGroundReach * height + 0.5f * std::hypot(extent[a], extent[b]);
   rt::StaticMeshDesc ground;
   for (int corner = 0; corner < 4; ++corner) {
     Vec3 p(0.0f);
@@ -93,8 +117,8 @@ rt::StaticMeshDesc ground_plane_for(const Aabb& rest, int instances) {
   return ground;
 }
 
-rt::StaticMeshDesc ground_plane_for(const Model& model, int instances) {
-  return ground_plane_for(rest_bounds(model), instances);
+rt::StaticMeshDesc ground_plane_for(const Model& model, int instances, Layout layout) {
+  return ground_plane_for(rest_bounds(model), instances, layout);
 }
 
 // --- the command --------------------------------------------------------------

@@ -7,14 +7,23 @@
 //   characters are Y-up, Cal3D ones usually Z-up). Front: +Z for Y-up
 //   models, -Y for Z-up models; right: +X in both (the image's right-hand
 //   side when the camera looks back along -front with that up).
-// * Instances: instance i is moved by i * 1.2 * (largest rest extent) along
-//   +X and plays its clip 0.37 s * i later than instance 0.
+// * Instances, in one of two layouts, `spacing` = 1.2 * (largest rest
+//   extent): kRow moves instance i by i * spacing along +X; kGrid has
+//   cols = ceil(sqrt(N)) columns, instance i in column i % cols (along +X)
+//   and row i / cols along the ground's other axis, away from the default
+//   camera (-front: +Y for Z-up models, -Z for Y-up). In both, instance i
+//   plays its clip 0.37 s * i later than instance 0.
 // * Ground: a quad (2 triangles) at the rest bounds' lowest up coordinate,
-//   reaching far beyond them.
+//   centred on the layout (the box of every instance's rest bounds) and
+//   reaching 50 * the character's height (its rest extent along up) plus
+//   half the layout's diagonal along the ground from that centre, so it
+//   covers every instance and fills the view to the horizon.
 // * Camera: looks at the centre of a box from the front, slightly above,
 //   far enough that the box's sphere fits the smaller of the two fields of
 //   view, fovy 40 degrees. Light: a point light above-front-right of it.
 #pragma once
+
+#include <cstdint>
 
 #include "character/model.h"
 #include "raytrace/camera/camera.h"
@@ -30,12 +39,22 @@ namespace sinew::character {
 Aabb rest_bounds(const Model& model);
 // 1 (Y) or 2 (Z).
 int up_axis_of(const Aabb& rest);
-// Instance i's placement and clip time offset.
-Affine3 instance_placement(const Aabb& rest, int index);
+// How instances are laid out: a row along +X, or a grid (above).
+enum class Layout : std::uint8_t { kRow, kGrid };
+inline constexpr const char* kLayoutNames[] = {"row", "grid"};  // by Layout, as options spell them
+// The layout's columns for `instances` instances: all of them in a row,
+// ceil(sqrt(instances)) in a grid.
+int layout_columns(int instances, Layout layout);
+// Instance `index`'s placement (model -> world) among `instances`, and its
+// clip time offset (the same in both layouts).
+Affine3 instance_placement(const Aabb& rest, int index, int instances = 1, Layout layout = Layout::kRow);
 double instance_time_offset(int index);
-// The ground quad under `rest` sized for `instances` instances, in world space.
-rt::StaticMeshDesc ground_plane_for(const Aabb& rest, int instances);
-rt::StaticMeshDesc ground_plane_for(const Model& model, int instances = 1);
+// The box of every instance's rest bounds, placed.
+Aabb layout_bounds(const Aabb& rest, int instances, Layout layout = Layout::kRow);
+// The ground quad under `rest` sized for `instances` instances laid out by
+// `layout`, in world space.
+rt::StaticMeshDesc ground_plane_for(const Aabb& rest, int instances, Layout layout = Layout::kRow);
+rt::StaticMeshDesc ground_plane_for(const Model& model, int instances = 1, Layout layout = Layout::kRow);
 // The bounds of every instance's skinned vertices (after prepare_frame).
 Aabb posed_bounds(const rt::Scene& scene);
 // The default camera framing `box` and the default point light.

@@ -131,6 +131,7 @@ Result<InstanceId> World::add_instance(const Character& character, const Instanc
     }
     const auto id = impl_->scene.add_instance(scene_character);
     if (!id.ok()) return detail::to_api_error(id.status());
+    SINEW_RETURN_IF_ERROR_API(impl_->scene.set_mask(*id, desc.mask));
 
     if (impl_->instances.size() <= *id) impl_->instances.resize(*id + 1);
     Instance& instance = impl_->instances[*id];
@@ -186,6 +187,7 @@ Result<InstanceId> World::add_static_mesh(const StaticMeshDesc& mesh) noexcept {
     desc.material_colors = {detail::to_internal(mesh.color)};
     const auto id = impl_->scene.add_static_mesh(std::move(desc));
     if (!id.ok()) return detail::to_api_error(id.status());
+    SINEW_RETURN_IF_ERROR_API(impl_->scene.set_mask(*id, mesh.mask));
     if (impl_->instances.size() <= *id) impl_->instances.resize(*id + 1);
     impl_->instances[*id].is_static = true;
     impl_->changed();
@@ -331,6 +333,19 @@ Status World::remove(InstanceId id) noexcept {
     removed.is_static = impl_->instances[id].is_static;
     impl_->instances[id] = std::move(removed);
     impl_->changed();
+    return Status();
+  });
+}
+
+Status World::set_mask(InstanceId id, std::uint32_t mask) noexcept {
+  return detail::guarded("World::set_mask", [&]() -> Status {
+    if (id >= impl_->instances.size() || impl_->instances[id].removed) {
+      return detail::api_error(ErrorCode::kNotFound,
+                               "World::set_mask: instance " + std::to_string(id) + ": " +
+                                   (id < impl_->instances.size() ? "removed" : "no such instance or static mesh"));
+    }
+    // The scene patches its top level in place: no prepare is owed.
+    SINEW_RETURN_IF_ERROR_API(impl_->scene.set_mask(id, mask));
     return Status();
   });
 }

@@ -1,6 +1,7 @@
 // sinew::api::World's ray queries: single rays through rt::intersect and
-// rt::occluded (traverse/traversal.h) on the scene's frame state, prepared
-// again first when an instance changed since the last pass or query.
+// rt::occluded (traverse/traversal.h) with the ray's mask on the scene's
+// frame state, prepared again first when an instance changed since the last
+// pass or query; each hit completed with its normal, UV and material.
 #include <cmath>
 #include <string>
 
@@ -50,7 +51,11 @@ sinew::Ray to_internal(const Ray& ray) {
   return r;
 }
 
-RayHit to_api(const Hit& hit) {
+// The hit with what a host shades or filters by: the posed triangle's
+// geometric normal (its winding's side, computed in double so a thin
+// triangle keeps its direction), the mesh's UVs interpolated with the
+// barycentrics, and the triangle's material.
+RayHit to_api(const rt::Scene& scene, const Hit& hit) {
   RayHit h;
   if (!hit.valid()) return h;
   h.t = hit.t;
@@ -58,6 +63,34 @@ RayHit to_api(const Hit& hit) {
   h.v = hit.v;
   h.instance = hit.instance_id;
   h.triangle = hit.triangle_id;
+  const rt::Scene::ObjectSlot slot = scene.object_slots()[hit.instance_id];
+  const Vec3* corners[3];
+  if (slot.kind == rt::Scene::ObjectKind::kCharacter) {
+    const rt::InstanceFrame& frame = scene.instances()[slot.index];
+    const SkinnedMesh& mesh = *scene.characters()[frame.character].mesh;
+    const auto& v = mesh.triangles[hit.triangle_id];
+    for (int c = 0; c < 3; ++c) corners[c] = &frame.positions[v[static_cast<std::size_t>(c)]];
+    if (mesh.uvs.size() == mesh.positions.size()) {
+      const float w = 1.0f - hit.u - hit.v;
+      const Vec2 uv = w * mesh.uvs[v[0]] + hit.u * mesh.uvs[v[1]] + hit.v * mesh.uvs[v[2]];
+      h.uv = {uv.x, uv.y};
+    }
+    h.material = hit.triangle_id < mesh.triangle_material.size() ? mesh.triangle_material[hit.triangle_id] : 0;
+  } else {
+    const rt::StaticMeshDesc& mesh = scene.static_meshes()[slot.index].desc;
+    const auto& v = mesh.triangles[hit.triangle_id];
+    for (int c = 0; c < 3; ++c) corners[c] = &mesh.positions[v[static_cast<std::size_t>(c)]];
+    h.material = hit.triangle_id < mesh.triangle_material.size() ? mesh.triangle_material[hit.triangle_id] : 0;
+  }
+  const glm::dvec3 p0(*corners[0]);
+  const glm::dvec3 n = glm::cross(glm::dvec3(*corners[1]) - p0, glm::dvec3(*corners[2]) - p0);
+  const double length = glm::length(n);
+  // A hit has a nonzero determinant, so a nonzero cross product; zero
+  // stays zero rather than NaN all the same.
+  if (length > 0.0 && std::isfinite(length)) {
+    h.geometric_normal = {static_cast<float>(n.x / length), static_cast<float>(n.y / length),
+                          static_cast<float>(n.z / length)};
+  }
   return h;
 }
 
@@ -108,7 +141,7 @@ Status World::intersect(std::span<const Ray> rays, std::span<RayHit> hits, Trian
     }
     const rt::TriangleTest internal = to_internal(test);
     for (std::size_t i = 0; i < rays.size(); ++i) {
-      hits[i] = to_api(rt::intersect(impl_->scene, to_internal(rays[i]), internal));
+      hits[i] = to_api(impl_->scene, rt::intersect(impl_->scene, to_internal(rays[i]), rays[i].mask, internal));
     }
     return Status();
   });
@@ -130,7 +163,7 @@ Status World::occluded(std::span<const Ray> rays, std::span<std::uint8_t> blocke
     }
     const rt::TriangleTest internal = to_internal(test);
     for (std::size_t i = 0; i < rays.size(); ++i) {
-      blocked[i] = rt::occluded(impl_->scene, to_internal(rays[i]), internal) ? 1 : 0;
+      blocked[i] = rt::occluded(impl_->scene, to_internal(rays[i]), rays[i].mask, internal) ? 1 : 0;
     }
     return Status();
   });

@@ -65,7 +65,10 @@ struct RenderFlags {
                                 "its linear colour (default 1,1,1); up to 8 (default: one point\n"
                                 "light above-front of the model)")),
         threads(l.option("--threads", "N", "worker threads (default 0: all cores)")),
-        instances(l.option("--instances", "N", "copies side by side along +X, each 0.37 s later (default 1)")),
+        instances(l.option("--instances", "N", "copies of the model, copy i 0.37 s * i later (default 1)")),
+        layout(l.option("--layout", "row|grid",
+                        "row: copies side by side along +X; grid: ceil(sqrt(N)) columns along +X,\n"
+                        "rows away from the default camera (default row)")),
         frames(l.option("--frames", "N", "frames rendered at 30 fps from --time; the last is written (default 1)")),
         triangle_test(l.option("--triangle-test", "fast|watertight", "ray-triangle test (default fast)")),
         packet_rays(l.option("--packet-rays", "1|8|64|256|512",
@@ -105,6 +108,7 @@ struct RenderFlags {
   const std::vector<std::string>& light;
   const std::optional<std::string>& threads;
   const std::optional<std::string>& instances;
+  const std::optional<std::string>& layout;
   const std::optional<std::string>& frames;
   const std::optional<std::string>& triangle_test;
   const std::optional<std::string>& packet_rays;
@@ -243,6 +247,10 @@ Status parse_run(const RenderFlags& f, RenderOptions& o) {
     SINEW_ASSIGN_OR_RETURN(const int c, cli::parse_choice("--bone-trees", *text, {"kd", "bvh"}));
     o.bone_trees = c == 0 ? rt::BoneTreeKind::kKdTree : rt::BoneTreeKind::kBvh;
   }
+  if (const std::optional<std::string>& text = f.layout) {
+    SINEW_ASSIGN_OR_RETURN(const int i, cli::parse_choice("--layout", *text, {"row", "grid"}));
+    o.layout = static_cast<character::Layout>(i);
+  }
   if (const std::optional<std::string>& text = f.ground) {
     SINEW_ASSIGN_OR_RETURN(o.ground, cli::parse_on_off("--ground", *text));
   }
@@ -343,6 +351,7 @@ Expected<std::string> stats_document(const RenderOptions& options, const charact
   doc["triangles"] = model.mesh.triangle_count();
   doc["bones"] = model.skeleton.joint_count();
   doc["instances"] = options.instances;
+  doc["layout"] = character::kLayoutNames[static_cast<int>(options.layout)];
   doc["frames"] = options.frames;
   doc["size"] = {options.width, options.height};
   doc["samples"] = b.sample_count;
@@ -480,11 +489,11 @@ Expected<RenderOutputs> render_model(const RenderOptions& options) {
   for (int i = 0; i < options.instances; ++i) {
     SINEW_ASSIGN_OR_RETURN(const std::uint32_t id, scene.add_instance(character));
     instance_ids.push_back(id);
-    out.instance_placements.push_back(character::instance_placement(rest, i));
+    out.instance_placements.push_back(character::instance_placement(rest, i, options.instances, options.layout));
   }
   out.ground_instance_id = kInvalidId;
   if (options.ground) {
-    out.ground = character::ground_plane_for(rest, options.instances);
+    out.ground = character::ground_plane_for(rest, options.instances, options.layout);
     SINEW_ASSIGN_OR_RETURN(out.ground_instance_id, scene.add_static_mesh(out.ground));
   }
 

@@ -5,7 +5,7 @@
 //   sinew-editor render MODEL [--clip NAME] [--time SECONDS] [--camera ex,ey,ez,tx,ty,tz,ux,uy,uz,fovy_deg]
 //       [--size WxH] --out DIR [--pose-space arbitrary|limits|clips|clip:NAME] [--clips a,b,c]
 //       [--samples N] [--seed S] [--shadows on|off] [--light x,y,z] [--threads N] [--instances N]
-//       [--frames N] [--triangle-test fast|watertight] [--bone-boxes exact|cheap]
+//       [--layout row|grid] [--frames N] [--triangle-test fast|watertight] [--bone-boxes exact|cheap]
 //       [--fallback on|off] [--ground on|off] [--limits FILE.json]
 //
 // Writes DIR/color.png (RGBA8, sRGB), DIR/depth.exr (float32: distance along
@@ -13,8 +13,9 @@
 // 0xFFFFFFFF on a miss) and DIR/stats.json.
 //
 // The defaults follow character/framing.h (the model's own axes; nothing is
-// re-oriented): instance i plays the clip 0.37 s * i later than --time; the
-// ground is a static mesh added after the instances; the camera (no
+// re-oriented): instance i stands where --layout (row or grid) puts it and
+// plays the clip 0.37 s * i later than --time; the ground is a static mesh
+// added after the instances, under the whole layout; the camera (no
 // --camera) frames all instances' posed bounds at the first frame, and the
 // light (no --light) sits above-front-right of them.
 // * --clip: default the model's first clip; a model without clips is
@@ -31,6 +32,7 @@
 
 #include "animation/pose_space.h"
 #include "character/bake.h"
+#include "character/framing.h"
 #include "character/model.h"
 #include "editor/import/gltf_importer.h"
 #include "raytrace/camera/camera.h"
@@ -62,6 +64,7 @@ struct RenderOptions {
   std::vector<rt::Light> lights;
   int threads = 0;  // 0: all cores
   int instances = 1;
+  character::Layout layout = character::Layout::kRow;  // --layout: how the instances stand
   int frames = 1;
   rt::TriangleTest triangle_test = rt::TriangleTest::kFast;
   int packet_rays = rt::RenderSettings{}.packet_rays;  // 1, 8, 64, 256 or 512 rays traced together

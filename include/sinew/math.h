@@ -4,6 +4,11 @@
 
 namespace sinew::api {
 
+struct Float2 {
+  float x = 0.0f;
+  float y = 0.0f;
+};
+
 struct Float3 {
   float x = 0.0f;
   float y = 0.0f;

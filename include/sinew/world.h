@@ -32,25 +32,42 @@ enum class TriangleTest : std::uint8_t {
   kWatertight,  // Woop, Benthin and Wald 2013: no ray leaks between adjacent triangles
 };
 
+// Every mask bit set: the default of instances, static meshes and rays.
+inline constexpr std::uint32_t kAllMaskBits = 0xFFFFFFFFu;
+
 // A ray for World's queries: the points origin + t direction with
 // t_min <= t < t_max (the direction need not be unit length: t is in its
-// units).
+// units). The query skips every instance and static mesh whose mask shares
+// no bit with the ray's (InstanceDesc::mask, World::set_mask).
 struct Ray {
   Float3 origin;
   Float3 direction{0.0f, 0.0f, 1.0f};
   float t_min = 0.0f;
   float t_max = std::numeric_limits<float>::infinity();
+  std::uint32_t mask = kAllMaskBits;
 };
 
-// The nearest hit of a ray, or a miss (instance and triangle kNoHit, t
-// infinite). The hit point is origin + t direction = (1 - u - v) p0 + u p1
-// + v p2 on the triangle's corners (as posed, in world space).
+// The nearest hit of a ray, or a miss (instance, triangle and material
+// kNoHit, t infinite, the rest zero). The hit point is origin + t direction
+// = (1 - u - v) p0 + u p1 + v p2 on the triangle's corners (as posed, in
+// world space).
 struct RayHit {
   float t = std::numeric_limits<float>::infinity();
   float u = 0.0f;
   float v = 0.0f;
   InstanceId instance = kNoHit;
   std::uint32_t triangle = kNoHit;  // the character's (or static mesh's) triangle
+  // The posed triangle's unit normal in world space, normalize((p1 - p0) x
+  // (p2 - p0)): its front side, the one from which p0, p1, p2 run
+  // counter-clockwise, whichever side the ray came from (the ray hit the
+  // front when dot(geometric_normal, direction) < 0). Not interpolated.
+  Float3 geometric_normal;
+  // The mesh's texture coordinates at the hit, (1 - u - v) uv0 + u uv1 +
+  // v uv2 ((0, 0) when the mesh has none, as static meshes).
+  Float2 uv;
+  // The triangle's material: an index into the character's materials (0
+  // when the pack has none; a static mesh's one colour is material 0).
+  std::uint32_t material = kNoHit;
   bool hit() const noexcept { return instance != kNoHit; }
 };
 
@@ -71,6 +88,11 @@ struct InstanceDesc {
   // playback_speed * dt (cycles, fades and actions alike): 2 plays at double
   // speed, 0 holds the pose. Finite and >= 0 (kInvalidArgument otherwise).
   float playback_speed = 1.0f;
+  // Queries skip the instance when (mask & Ray::mask) == 0: give each
+  // group of instances (players, the ground, debris) a bit, and a ray the
+  // bits it may hit. World::set_mask changes it. The pass draws every
+  // instance whatever its mask.
+  std::uint32_t mask = kAllMaskBits;
 };
 
 // A static triangle mesh in world space; copied, its kd-tree built once.
@@ -78,6 +100,7 @@ struct StaticMeshDesc {
   std::span<const Float3> positions;
   std::span<const std::uint32_t> indices;  // three per triangle
   Float3 color{0.6f, 0.6f, 0.6f};          // linear RGB albedo
+  std::uint32_t mask = kAllMaskBits;       // as InstanceDesc::mask
 };
 
 class SINEW_API World {
@@ -153,6 +176,11 @@ class SINEW_API World {
   // of reaching a newer instance. Errors: kNotFound (never added, or removed
   // already).
   Status remove(InstanceId instance) noexcept;
+
+  // The mask bits of a character instance or a static mesh (InstanceDesc::
+  // mask): the next query sees them; nothing is prepared again. Errors:
+  // kNotFound (never added, or removed).
+  Status set_mask(InstanceId instance, std::uint32_t mask) noexcept;
 
   // Characters and static meshes in the world (removed ones not counted).
   std::size_t instance_count() const noexcept;

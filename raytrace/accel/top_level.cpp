@@ -36,6 +36,14 @@ Status TopLevel::build(std::vector<TopLevelObject>&& objects, const KdBuildOptio
   return {};
 }
 
+void TopLevel::set_mask(bool static_mesh, std::uint32_t index, std::uint32_t mask) {
+  for (const ObjectRun& run : runs_) {
+    const TopLevelObject& first = objects_[run.first];
+    if ((first.kind == TopLevelObject::Kind::kStatic) != static_mesh || first.index != index) continue;
+    for (std::uint32_t i = run.first; i < run.first + run.count; ++i) objects_[i].mask = mask;
+  }
+}
+
 std::vector<TopLevelObject> TopLevel::take_objects() {
   std::vector<TopLevelObject> out = std::move(objects_);
   out.clear();

@@ -14,12 +14,18 @@
 
 namespace sinew::rt {
 
+// Every mask bit set: what instances and rays have unless told otherwise.
+inline constexpr std::uint32_t kAllMaskBits = 0xFFFFFFFFu;
+
 struct TopLevelObject {
   enum class Kind : std::uint8_t { kBone, kStatic, kFallback };
   Kind kind = Kind::kBone;
   std::uint32_t index = 0;  // kBone/kFallback: instance index; kStatic: static mesh index
   std::uint32_t bone = 0;   // kBone only
   Aabb box;                 // world space
+  // The instance's or static mesh's mask: a query with ray mask m skips the
+  // object when (mask & m) == 0, before clipping the ray to its box.
+  std::uint32_t mask = kAllMaskBits;
 };
 
 // Consecutive objects of one character instance (its bones and its
@@ -45,6 +51,10 @@ class TopLevel {
   std::span<const ObjectRun> runs() const { return runs_; }
   const Aabb& bounds() const { return tree_.bounds; }
   const KdTreeStats& stats() const { return tree_.stats; }
+
+  // Sets the mask of every object of one instance (`static_mesh` false) or
+  // one static mesh, in place: a mask changes without a rebuild.
+  void set_mask(bool static_mesh, std::uint32_t index, std::uint32_t mask);
 
   // Hands back the object vector (cleared) so the next frame reuses its memory.
   std::vector<TopLevelObject> take_objects();

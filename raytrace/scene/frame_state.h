@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "raytrace/accel/kd_tree.h"
+#include "raytrace/accel/top_level.h"
 #include "raytrace/fuzzy/fuzzy_character.h"
 #include "raytrace/scene/leaf_boxes.h"
 #include "raytrace/skinning/skinning.h"
@@ -24,6 +25,8 @@ struct InstanceFrame {
   std::uint32_t character = 0;
   std::uint32_t instance_id = 0;  // scene-wide id reported in hits
   bool live = true;               // false once removed (Scene::remove): its data is freed
+  // Queries skip the instance when (mask & ray mask) == 0 (Scene::set_mask).
+  std::uint32_t mask = kAllMaskBits;
 
   std::vector<Affine3> skinning;         // per bone: bind pose -> world
   std::vector<Affine3> bone_from_world;  // per bone: the inverse (the bone frame)

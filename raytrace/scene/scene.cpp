@@ -94,6 +94,21 @@ Status Scene::remove(std::uint32_t id) {
   return {};
 }
 
+Status Scene::set_mask(std::uint32_t id, std::uint32_t mask) {
+  if (!contains(id)) {
+    return make_error(ErrorCode::kNotFound, "scene", "id", std::to_string(id),
+                      id < slots_.size() ? "removed" : "no such instance or static mesh");
+  }
+  const ObjectSlot& slot = slots_[id];
+  if (slot.kind == ObjectKind::kCharacter) {
+    instances_[slot.index].mask = mask;
+  } else {
+    statics_[slot.index].mask = mask;
+  }
+  top_level_.set_mask(slot.kind == ObjectKind::kStatic, slot.index, mask);
+  return {};
+}
+
 Status Scene::set_bones(std::uint32_t instance, std::span<const Affine3> skinning) {
   if (instance >= slots_.size() || slots_[instance].kind != ObjectKind::kCharacter) {
     return invalid_argument("instance", std::to_string(instance), "not a character instance");
@@ -162,15 +177,15 @@ Expected<FrameStats> Scene::prepare_frame(const FrameOptions& options, JobSystem
           !frame.bone_usable[b] || frame.bone_world_boxes[b].is_empty()) {
         continue;
       }
-      objects.push_back({TopLevelObject::Kind::kBone, i, b, frame.bone_world_boxes[b]});
+      objects.push_back({TopLevelObject::Kind::kBone, i, b, frame.bone_world_boxes[b], frame.mask});
     }
     if (!frame.fallback.nodes.empty()) {
-      objects.push_back({TopLevelObject::Kind::kFallback, i, 0, frame.fallback.bounds});
+      objects.push_back({TopLevelObject::Kind::kFallback, i, 0, frame.fallback.bounds, frame.mask});
     }
   }
   for (std::uint32_t s = 0; s < statics_.size(); ++s) {
     if (!statics_[s].live || statics_[s].tree.nodes.empty()) continue;
-    objects.push_back({TopLevelObject::Kind::kStatic, s, 0, statics_[s].tree.bounds});
+    objects.push_back({TopLevelObject::Kind::kStatic, s, 0, statics_[s].tree.bounds, statics_[s].mask});
   }
   SINEW_RETURN_IF_ERROR(top_level_.build(std::move(objects), within_traversal_depth(options.top_level_kd)));
   const double top_ms = ms_since(start);

@@ -100,6 +100,12 @@ class Scene {
   // Whether `id` names an instance or static mesh not removed.
   bool contains(std::uint32_t id) const;
 
+  // The mask bits of an instance or static mesh (default kAllMaskBits):
+  // queries with a ray mask skip it when (mask & ray mask) == 0
+  // (traverse/traversal.h). Takes effect at once, also on the top level
+  // already built. Errors: an id not contained.
+  Status set_mask(std::uint32_t id, std::uint32_t mask);
+
   // This frame's skinning matrices of an instance (bind pose -> world), one
   // per bone of its character. Copied. Non-finite matrices are rejected.
   Status set_bones(std::uint32_t instance, std::span<const Affine3> skinning);
@@ -122,6 +128,7 @@ class Scene {
     KdTree tree;
     std::uint32_t instance_id = 0;  // scene-wide id reported in hits
     bool live = true;               // false once removed (its mesh and tree freed)
+    std::uint32_t mask = kAllMaskBits;  // set_mask
   };
   enum class ObjectKind : std::uint8_t { kCharacter, kStatic };
   struct ObjectSlot {

@@ -150,9 +150,10 @@ bool traverse_bvh(const BvhView& tree, const Vec3& o, const Vec3& d, const Vec3&
 template <TriangleTest kTest, bool kAnyHit>
 class Query {
  public:
-  Query(const Scene& scene, const Ray& ray)
+  Query(const Scene& scene, const Ray& ray, std::uint32_t ray_mask)
       : scene_(scene),
         ray_(ray),
+        ray_mask_(ray_mask),
         inv_dir_(1.0f / ray.direction.x, 1.0f / ray.direction.y, 1.0f / ray.direction.z),
         origin_magnitude_(max_abs(ray.origin)),
         direction_magnitude_(max_abs(ray.direction)),
@@ -171,9 +172,11 @@ class Query {
     const float eps = world_eps(top.bounds, t1);
     return traverse_tree(top, ray_.origin, ray_.direction, inv_dir_, eps, t0, t1, t_limit_, counters_.node_visits,
                          [this](std::span<const std::uint32_t> objects) {
+                           const std::span<const TopLevelObject> all = scene_.top_level().objects();
                            for (const std::uint32_t object : objects) {
+                             if ((all[object].mask & ray_mask_) == 0) continue;  // masked out: never entered
                              if (already_visited(object)) continue;
-                             if (visit(scene_.top_level().objects()[object])) return true;
+                             if (visit(all[object])) return true;
                            }
                            return false;
                          });
@@ -281,6 +284,7 @@ class Query {
 
   const Scene& scene_;
   Ray ray_;
+  std::uint32_t ray_mask_;
   Vec3 inv_dir_;
   float origin_magnitude_;
   float direction_magnitude_;
@@ -295,8 +299,8 @@ class Query {
 
 
 template <TriangleTest kTest, bool kAnyHit>
-Hit run_query(const Scene& scene, const Ray& ray, TraversalCounters* counters) {
-  Query<kTest, kAnyHit> query(scene, ray);
+Hit run_query(const Scene& scene, const Ray& ray, std::uint32_t ray_mask, TraversalCounters* counters) {
+  Query<kTest, kAnyHit> query(scene, ray, ray_mask);
   query.run();
   if (counters) *counters += query.counters().for_rays(1);
   return query.hit();
@@ -304,18 +308,29 @@ Hit run_query(const Scene& scene, const Ray& ray, TraversalCounters* counters) {
 
 }  // namespace
 
-Hit intersect(const Scene& scene, const Ray& ray, TriangleTest test, TraversalCounters* counters) {
+Hit intersect(const Scene& scene, const Ray& ray, std::uint32_t ray_mask, TriangleTest test,
+              TraversalCounters* counters) {
   if (!valid_ray(ray)) return {};
-  return test == TriangleTest::kWatertight ? run_query<TriangleTest::kWatertight, false>(scene, ray, counters)
-                                           : run_query<TriangleTest::kFast, false>(scene, ray, counters);
+  return test == TriangleTest::kWatertight
+             ? run_query<TriangleTest::kWatertight, false>(scene, ray, ray_mask, counters)
+             : run_query<TriangleTest::kFast, false>(scene, ray, ray_mask, counters);
+}
+
+bool occluded(const Scene& scene, const Ray& ray, std::uint32_t ray_mask, TriangleTest test,
+              TraversalCounters* counters) {
+  if (!valid_ray(ray)) return false;
+  const Hit hit = test == TriangleTest::kWatertight
+                      ? run_query<TriangleTest::kWatertight, true>(scene, ray, ray_mask, counters)
+                      : run_query<TriangleTest::kFast, true>(scene, ray, ray_mask, counters);
+  return hit.valid();
+}
+
+Hit intersect(const Scene& scene, const Ray& ray, TriangleTest test, TraversalCounters* counters) {
+  return intersect(scene, ray, kAllMaskBits, test, counters);
 }
 
 bool occluded(const Scene& scene, const Ray& ray, TriangleTest test, TraversalCounters* counters) {
-  if (!valid_ray(ray)) return false;
-  const Hit hit = test == TriangleTest::kWatertight
-                      ? run_query<TriangleTest::kWatertight, true>(scene, ray, counters)
-                      : run_query<TriangleTest::kFast, true>(scene, ray, counters);
-  return hit.valid();
+  return occluded(scene, ray, kAllMaskBits, test, counters);
 }
 
 }  // namespace sinew::rt

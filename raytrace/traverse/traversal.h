@@ -53,4 +53,13 @@ Hit intersect(const Scene& scene, const Ray& ray, TriangleTest test,
 bool occluded(const Scene& scene, const Ray& ray, TriangleTest test,
               TraversalCounters* counters = nullptr);
 
+// The same with a ray mask: the top-level walk skips every object whose
+// instance or static mesh has (mask & ray_mask) == 0 (Scene::set_mask)
+// before it clips the ray to the object's box, so a skipped instance costs
+// one test per top-level leaf that lists it. kAllMaskBits skips nothing.
+Hit intersect(const Scene& scene, const Ray& ray, std::uint32_t ray_mask, TriangleTest test,
+              TraversalCounters* counters = nullptr);
+bool occluded(const Scene& scene, const Ray& ray, std::uint32_t ray_mask, TriangleTest test,
+              TraversalCounters* counters = nullptr);
+
 }  // namespace sinew::rt

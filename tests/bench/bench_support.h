@@ -176,7 +176,8 @@ inline Expected<std::size_t> find_walk_clip(const character::Model& model, const
 }
 
 // The staged benchmark scene: `instances` copies of one character placed in
-// a row on a ground quad, as the render command places them.
+// a row or a grid on a ground quad, as the render command places them
+// (character/framing.h).
 struct BenchStage {
   rt::Scene scene;
   std::vector<std::uint32_t> ids;
@@ -187,16 +188,17 @@ struct BenchStage {
 };
 
 inline Status stage_instances(const character::Model& model, const rt::FuzzyCharacterView& fuzzy,
-                              int instances, BenchStage& stage) {
+                              int instances, BenchStage& stage,
+                              character::Layout layout = character::Layout::kRow) {
   stage.rest = character::rest_bounds(model);
   stage.up = character::up_axis_of(stage.rest);
   SINEW_ASSIGN_OR_RETURN(const std::uint32_t character, stage.scene.add_character(model.mesh, fuzzy));
   for (int i = 0; i < instances; ++i) {
     SINEW_ASSIGN_OR_RETURN(const std::uint32_t id, stage.scene.add_instance(character));
     stage.ids.push_back(id);
-    stage.placements.push_back(character::instance_placement(stage.rest, i));
+    stage.placements.push_back(character::instance_placement(stage.rest, i, instances, layout));
   }
-  stage.ground = character::ground_plane_for(stage.rest, instances);
+  stage.ground = character::ground_plane_for(stage.rest, instances, layout);
   const auto ground = stage.scene.add_static_mesh(stage.ground);
   return ground.ok() ? Status{} : ground.status();
 }

@@ -77,6 +77,7 @@ struct Options {
   std::vector<std::string> clips{"walk"};
   std::string model = "cally";
   int instances = 1;
+  character::Layout layout = character::Layout::kRow;  // --layout
   int subdivide = 0;  // subdivision levels applied to the model (Table 2's larger meshes)
   int check_stride = 7;
   // Every (mode, width) pair is a row of its own: which width suits Embree
@@ -94,6 +95,7 @@ std::vector<BenchFlag> flags() {
       quick_flag("256x256, 30 frames, 1 thread, Embree refit at widths 1,16 only"),
       {"--model", "M", "cally (default), mannequin, or a .gltf/.glb/.cfg/.pack path"},
       {"--instances", "N", "character instances (default 1)"},
+      {"--layout", "row|grid", "how the instances stand, as sinew-editor render --layout (default row)"},
       frames_flag("frames at 30 fps through each clip (default 120)"),
       {"--clips", "LIST", "clips to animate, e.g. walk,tornado_kick (default walk)"},
       {"--clip", "NAME", "one clip to animate (instead of --clips)"},
@@ -170,6 +172,10 @@ Status read_options(const BenchArgs& parsed, Options& o) {
   }
   SINEW_RETURN_IF_ERROR(parsed.read("--model", o.model));
   SINEW_RETURN_IF_ERROR(parsed.read("--instances", 1, 256, o.instances));
+  if (const auto text = parsed.value("--layout")) {
+    SINEW_ASSIGN_OR_RETURN(const int layout, cli::parse_choice("--layout", *text, {"row", "grid"}));
+    o.layout = static_cast<character::Layout>(layout);
+  }
   SINEW_RETURN_IF_ERROR(parsed.read("--subdivide", 0, editor::kMaxSubdivisionLevels, o.subdivide));
   SINEW_RETURN_IF_ERROR(parsed.read("--check-stride", 1, 1 << 20, o.check_stride));
   if (const auto text = parsed.value("--embree-modes")) {
@@ -383,7 +389,7 @@ Expected<ConfigResult> run_configuration(const character::Model& model, const rt
                                          int threads) {
   JobSystem jobs(threads);
   BenchStage stage;
-  SINEW_RETURN_IF_ERROR(stage_instances(model, fuzzy, o.instances, stage));
+  SINEW_RETURN_IF_ERROR(stage_instances(model, fuzzy, o.instances, stage, o.layout));
 
   ConfigResult result;
   result.clip = clip_name;
@@ -681,10 +687,10 @@ int run_embree_bench(const std::vector<std::string>& args, const std::string& co
   const bool have_embree = false;
   std::printf("  Embree not found: its columns are skipped\n");
 #endif
-  std::printf("  model %s, %d instance%s, %dx%d, %d frames at 30 fps per clip, point light, shadows on,\n"
+  std::printf("  model %s, %d instance%s in a %s, %dx%d, %d frames at 30 fps per clip, point light, shadows on,\n"
               "  diffuse shading; brute-force check of every %dth pixel of the first frame\n",
-              o.model.c_str(), o.instances, o.instances == 1 ? "" : "s", o.width, o.height, o.frames,
-              o.check_stride);
+              o.model.c_str(), o.instances, o.instances == 1 ? "" : "s",
+              character::kLayoutNames[static_cast<int>(o.layout)], o.width, o.height, o.frames, o.check_stride);
   if (have_embree) {
     std::printf("  Embree modes %s at widths %s: every pair is a row\n", join_modes(o.embree_modes).c_str(),
                 join_ints(widths_of(o.embree_widths)).c_str());
@@ -695,6 +701,7 @@ int run_embree_bench(const std::vector<std::string>& args, const std::string& co
   doc.update(Json{{"model", o.model},
                   {"subdivide", o.subdivide},
                   {"instances", o.instances},
+                  {"layout", character::kLayoutNames[static_cast<int>(o.layout)]},
                   {"size", {o.width, o.height}},
                   {"frames", o.frames},
                   {"embree", have_embree},

@@ -15,6 +15,7 @@
 #include "character/framing.h"
 #include "raytrace/render/renderer.h"
 #include "runtime/jobs/job_system.h"
+#include "tests/bench/bench_support.h"
 #include "tests/bench/embree_tracer.h"
 #include "tests/support/brute_force.h"
 #include "tests/support/idle_mannequin.h"
@@ -99,6 +100,52 @@ TEST_P(EmbreeTracerTest, PrimaryHitsEqualBruteForceOverTwoFrames) {
     EXPECT_GT(same_triangle, hit_pixels / 2);
     EXPECT_GT(rendered->shadow_rays, 0u);
   }
+}
+
+// `sinew-bench embree --layout grid`: the staged crowd stands where the
+// render command's grid puts it (character/framing.h), one Embree geometry
+// per copy, and the peer's primary hits are brute force's on every pixel,
+// with every copy in view.
+TEST(EmbreeTracerGrid, ACrowdInTheGridLayoutIsTracedAsBruteForceTracesIt) {
+  const testing_support::BakedModel& m = testing_support::idle_mannequin();
+  JobSystem jobs(2);
+  constexpr int kCopies = 5;
+  BenchStage stage;
+  ASSERT_TRUE(stage_instances(m.model, m.bake.fuzzy.view(), kCopies, stage, character::Layout::kGrid).ok());
+  ASSERT_EQ(stage.placements.size(), static_cast<std::size_t>(kCopies));
+  for (int i = 0; i < kCopies; ++i) {
+    const Vec3 ours = stage.placements[static_cast<std::size_t>(i)].translation_part();
+    const Vec3 grid =
+        character::instance_placement(stage.rest, i, kCopies, character::Layout::kGrid).translation_part();
+    EXPECT_EQ(ours, grid) << "copy " << i;
+  }
+  ASSERT_TRUE(pose_instances(m.model, *m.model.find_clip("walk"), 0.2, stage).ok());
+  ASSERT_TRUE(stage.scene.prepare_frame(rt::FrameOptions{}, jobs).ok());
+  const Aabb posed = character::posed_bounds(stage.scene);
+  const auto camera =
+      rt::PinholeCamera::create(character::default_camera(posed, stage.up, kSize, kSize), kSize, kSize).value();
+  auto tracer = EmbreeTracer::create(EmbreeMode::kRefit, 2);
+  ASSERT_TRUE(tracer.ok()) << tracer.status().message();
+  ASSERT_TRUE((*tracer)->update(stage.scene).ok());
+  rt::RenderSettings settings;
+  settings.light.position = character::default_light(posed, stage.up);
+  std::vector<Hit> hits(kSize * kSize);
+  std::vector<std::uint8_t> color(4 * kSize * kSize);
+  ASSERT_TRUE((*tracer)->render(stage.scene, camera, settings, color, hits, jobs, EmbreeWidth::k8).ok());
+  const std::vector<testing_support::SoupTriangle> soup = testing_support::world_triangles(stage.scene);
+  const testing_support::ScreenBinner binner(soup, camera);
+  std::vector<int> pixels(kCopies + 1, 0);
+  for (int y = 0; y < kSize; ++y) {
+    for (int x = 0; x < kSize; ++x) {
+      const Hit& h = hits[static_cast<std::size_t>(y * kSize + x)];
+      const Ray ray = camera.ray(x, y);
+      const Hit ref = binner.nearest(soup, ray, x, y, rt::TriangleTest::kWatertight);
+      ASSERT_TRUE(testing_support::same_nearest(h, ref, soup, ray, rt::TriangleTest::kWatertight))
+          << "pixel " << x << "," << y;
+      if (h.valid()) ++pixels.at(h.instance_id);
+    }
+  }
+  for (int i = 0; i <= kCopies; ++i) EXPECT_GT(pixels[static_cast<std::size_t>(i)], 0) << "instance " << i;
 }
 
 // "RebuildLow_rtcIntersect8": the mode and the Embree call of the width.

@@ -427,6 +427,157 @@ TEST(RenderCommand, UpAxisIsTheLargerOfYAndZ) {
   for (const Vec3& p : ground.positions) EXPECT_EQ(p.z, 0.0f);  // Z-up: under the box's lowest z
 }
 
+// --- layouts -------------------------------------------------------------------
+
+// Rest bounds standing for a Z-up model (2 tall, largest extent 2) and a
+// Y-up one (1.8 tall, largest extent 1.8).
+const Aabb kZUpRest{Vec3(-0.5f, -0.25f, 0.0f), Vec3(0.5f, 0.25f, 2.0f)};
+const Aabb kYUpRest{Vec3(-0.4f, 0.0f, -0.2f), Vec3(0.4f, 1.8f, 0.2f)};
+
+struct Cell {
+  int column, row;
+};
+// By hand: the grid's (column, row) of each copy for N = 1, 2, 5, 9
+// (ceil(sqrt(N)) = 1, 2, 3, 3 columns).
+const std::vector<std::pair<int, std::vector<Cell>>> kGridCells = {
+    {1, {{0, 0}}},
+    {2, {{0, 0}, {1, 0}}},
+    {5, {{0, 0}, {1, 0}, {2, 0}, {0, 1}, {1, 1}}},
+    {9, {{0, 0}, {1, 0}, {2, 0}, {0, 1}, {1, 1}, {2, 1}, {0, 2}, {1, 2}, {2, 2}}},
+};
+
+TEST(Layouts, GridPlacementsAndTimeOffsetsAreTheIssuesByHand) {
+  struct Case {
+    const char* name;
+    Aabb rest;
+    float spacing;  // 1.2 x the largest rest extent
+    Vec3 away;      // the rows' direction, away from the default camera
+  };
+  const Case models[] = {{"Z-up", kZUpRest, 1.2f * 2.0f, Vec3(0.0f, 1.0f, 0.0f)},
+                          {"Y-up", kYUpRest, 1.2f * 1.8f, Vec3(0.0f, 0.0f, -1.0f)}};
+  for (const Case& m : models) {
+    for (const auto& [n, cells] : kGridCells) {
+      SCOPED_TRACE(std::string(m.name) + ", N = " + std::to_string(n));
+      ASSERT_EQ(cells.size(), static_cast<std::size_t>(n));
+      EXPECT_EQ(character::layout_columns(n, character::Layout::kGrid), n == 1 ? 1 : n == 2 ? 2 : 3);
+      EXPECT_EQ(character::layout_columns(n, character::Layout::kRow), n);
+      for (int i = 0; i < n; ++i) {
+        const Vec3 expected = static_cast<float>(cells[static_cast<std::size_t>(i)].column) * m.spacing *
+                                  Vec3(1.0f, 0.0f, 0.0f) +
+                              static_cast<float>(cells[static_cast<std::size_t>(i)].row) * m.spacing * m.away;
+        const Affine3 grid = character::instance_placement(m.rest, i, n, character::Layout::kGrid);
+        for (int a = 0; a < 3; ++a) EXPECT_FLOAT_EQ(grid.translation_part()[a], expected[a]) << "copy " << i;
+        // Placements move and never turn.
+        for (int r = 0; r < 3; ++r) {
+          for (int c = 0; c < 3; ++c) EXPECT_EQ(grid(r, c), r == c ? 1.0f : 0.0f);
+        }
+        // The row: copy i at i x spacing along +X, as ever.
+        const Vec3 row = character::instance_placement(m.rest, i, n, character::Layout::kRow).translation_part();
+        EXPECT_FLOAT_EQ(row.x, static_cast<float>(i) * m.spacing);
+        EXPECT_EQ(row.y, 0.0f);
+        EXPECT_EQ(row.z, 0.0f);
+        EXPECT_DOUBLE_EQ(character::instance_time_offset(i), 0.37 * i);
+      }
+    }
+  }
+  // More columns as the square grows.
+  EXPECT_EQ(character::layout_columns(10, character::Layout::kGrid), 4);
+  EXPECT_EQ(character::layout_columns(16, character::Layout::kGrid), 4);
+  EXPECT_EQ(character::layout_columns(17, character::Layout::kGrid), 5);
+  EXPECT_EQ(character::layout_columns(256, character::Layout::kGrid), 16);
+}
+
+TEST(Layouts, TheGroundCoversTheLayoutAndReachesFiftyHeightsBeyondIt) {
+  for (const Aabb& rest : {kZUpRest, kYUpRest}) {
+    const int up = character::up_axis_of(rest);
+    const int a = (up + 1) % 3, b = (up + 2) % 3;
+    const float height = rest.extent()[up];
+    for (const character::Layout layout : {character::Layout::kRow, character::Layout::kGrid}) {
+      for (const int n : {1, 2, 5, 9, 16}) {
+        SCOPED_TRACE("up " + std::to_string(up) + ", layout " + std::to_string(static_cast<int>(layout)) + ", N = " +
+                     std::to_string(n));
+        const rt::StaticMeshDesc ground = character::ground_plane_for(rest, n, layout);
+        ASSERT_EQ(ground.positions.size(), 4u);
+        ASSERT_EQ(ground.triangles.size(), 2u);
+        Aabb quad;
+        for (const Vec3& p : ground.positions) {
+          EXPECT_EQ(p[up], rest.lower[up]);  // under the feet
+          quad.extend(p);
+        }
+        // Every copy's rest box, placed, within the quad.
+        Aabb placed;
+        for (int i = 0; i < n; ++i) {
+          const Vec3 t = character::instance_placement(rest, i, n, layout).translation_part();
+          placed.extend(rest.lower + t);
+          placed.extend(rest.upper + t);
+        }
+        for (const int axis : {a, b}) {
+          EXPECT_LE(quad.lower[axis], placed.lower[axis]);
+          EXPECT_GE(quad.upper[axis], placed.upper[axis]);
+          // Centred on the layout, reaching 50 heights plus half its
+          // diagonal along the ground.
+          const float reach = 50.0f * height + 0.5f * std::hypot(placed.extent()[a], placed.extent()[b]);
+          EXPECT_NEAR(0.5f * (quad.lower[axis] + quad.upper[axis]), placed.center()[axis], 1e-4f);
+          EXPECT_NEAR(0.5f * quad.extent()[axis], reach, 1e-4f * reach);
+        }
+      }
+    }
+  }
+}
+
+// Every copy of a grid is in the picture the default camera frames, on a
+// Y-up (CesiumMan) and a Z-up (Cally) model, placed as the grid says.
+void expect_grid_shows_every_copy(const std::string& path, int n) {
+  RenderOptions o = small_options(path);
+  o.instances = n;
+  o.layout = character::Layout::kGrid;
+  o.width = 160;
+  o.height = 120;
+  const auto outputs = render_model(o);
+  ASSERT_TRUE(outputs.ok()) << outputs.status().message();
+  EXPECT_EQ(outputs->ground_instance_id, static_cast<std::uint32_t>(n));
+  std::vector<std::size_t> pixels(static_cast<std::size_t>(n) + 1, 0);
+  for (const std::uint32_t id : outputs->instance_id) {
+    if (id != kInvalidId) ++pixels.at(id);
+  }
+  for (int i = 0; i <= n; ++i) EXPECT_GT(pixels[static_cast<std::size_t>(i)], 10u) << "instance " << i;
+  // The placements, by hand from the rest bounds.
+  const auto model = import_any(path);
+  ASSERT_TRUE(model.ok()) << model.status().message();
+  const Aabb rest = character::rest_bounds(*model);
+  const Vec3 e = rest.extent();
+  const float spacing = 1.2f * std::max({e.x, e.y, e.z});
+  const bool z_up = e.z > e.y;
+  int cols = 1;
+  while (cols * cols < n) ++cols;
+  ASSERT_EQ(outputs->instance_placements.size(), static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    const float column = static_cast<float>(i % cols) * spacing;
+    const float row = static_cast<float>(i / cols) * spacing;
+    const Vec3 expected = z_up ? Vec3(column, row, 0.0f) : Vec3(column, 0.0f, -row);
+    const Vec3 t = outputs->instance_placements[static_cast<std::size_t>(i)].translation_part();
+    for (int a = 0; a < 3; ++a) EXPECT_NEAR(t[a], expected[a], 1e-5f * spacing) << "copy " << i;
+  }
+  const auto stats = nlohmann::json::parse(outputs->stats_json);
+  EXPECT_EQ(stats["layout"], "grid");
+}
+
+TEST(RenderCommand, GridLayoutShowsEveryCopyCesiumMan) { expect_grid_shows_every_copy(kCesiumMan, 5); }
+
+#if SINEW_HAVE_CAL3D
+TEST(RenderCommand, GridLayoutShowsEveryCopyCally) { expect_grid_shows_every_copy(kCally, 9); }
+#endif
+
+TEST(RenderCommand, LayoutIsRowOrGrid) {
+  EXPECT_EQ(parse_render_options({"m.glb", "--out", "o"})->layout, character::Layout::kRow);
+  EXPECT_EQ(parse_render_options({"m.glb", "--out", "o", "--layout", "grid"})->layout, character::Layout::kGrid);
+  EXPECT_EQ(parse_render_options({"m.glb", "--out", "o", "--layout=row"})->layout, character::Layout::kRow);
+  const auto bad = parse_render_options({"m.glb", "--out", "o", "--layout", "ring"});
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.status().message().find("--layout"), std::string::npos) << bad.status().message();
+  EXPECT_NE(bad.status().message().find("ring"), std::string::npos) << bad.status().message();
+}
+
 // --- errors --------------------------------------------------------------------
 
 struct RunResult {

@@ -5,10 +5,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <filesystem>
 #include <limits>
 #include <random>
 #include <vector>
 
+#include "content/mannequin/mannequin.h"
+#include "raytrace/traverse/traversal.h"
 #include "tests/embed/api_test_support.h"
 #include "tests/support/brute_force.h"
 
@@ -357,6 +361,259 @@ TEST(ApiWorld, RemovedInstancesLeaveThePassAndTheQueriesAndTheirIdsAreNotReused)
   EXPECT_EQ(refilled.triangle_id, reference.triangle_id);
   EXPECT_EQ(std::memcmp(refilled.depth.data(), reference.depth.data(), refilled.depth.size() * sizeof(float)), 0);
   EXPECT_GT(pixels_per_id(refilled, 6)[*back], 100u);
+}
+
+// The reference hit over the soup's triangles whose instance's mask shares
+// a bit with the ray's.
+std::vector<testing_support::SoupTriangle> unmasked(const std::vector<testing_support::SoupTriangle>& soup,
+                                                    const std::uint32_t* masks, std::uint32_t ray_mask) {
+  std::vector<testing_support::SoupTriangle> kept;
+  for (const auto& tri : soup) {
+    if ((masks[tri.instance_id] & ray_mask) != 0) kept.push_back(tri);
+  }
+  return kept;
+}
+
+TEST(ApiQueries, MasksSkipInstancesAsBruteForceOverTheUnmaskedOnesDoes) {
+  Scenes s;
+  std::vector<api::Ray> rays = query_rays();
+  std::mt19937 g(5);
+  std::uniform_int_distribution<std::uint32_t> bits(0, 7);
+  std::uint32_t masks[3] = {api::kAllMaskBits, api::kAllMaskBits, api::kAllMaskBits};
+  // A default ray and default masks: every object, as before.
+  EXPECT_EQ(api::Ray{}.mask, api::kAllMaskBits);
+  EXPECT_EQ(api::InstanceDesc{}.mask, api::kAllMaskBits);
+  EXPECT_EQ(api::StaticMeshDesc{}.mask, api::kAllMaskBits);
+  std::size_t skipped_hits = 0, kept_hits = 0;
+  for (int round = 0; round < 4; ++round) {
+    SCOPED_TRACE("round " + std::to_string(round));
+    // Random masks (three bits, so every overlap and none happen), set
+    // between queries: no pass or pose in between.
+    if (round > 0) {
+      for (std::uint32_t& m : masks) m = bits(g);
+      for (const api::InstanceId id : {s.walker, s.ground, s.kicker}) ASSERT_TRUE(s.world.set_mask(id, masks[id]).ok());
+    }
+    for (api::Ray& r : rays) r.mask = round == 0 ? api::kAllMaskBits : bits(g);
+    std::vector<api::RayHit> hits(rays.size());
+    std::vector<std::uint8_t> blocked(rays.size(), 7);
+    ASSERT_TRUE(s.world.intersect(rays, hits).ok());
+    ASSERT_TRUE(s.world.occluded(rays, blocked).ok());
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+      const sinew::Ray ray = to_internal(rays[i]);
+      const auto kept = unmasked(s.soup, masks, rays[i].mask);
+      const Hit ref = testing_support::nearest(kept, ray, rt::TriangleTest::kFast);
+      const Hit ours{hits[i].t, hits[i].u, hits[i].v, hits[i].triangle, hits[i].instance};
+      ASSERT_TRUE(testing_support::same_nearest(ours, ref, kept, ray, rt::TriangleTest::kFast))
+          << "ray " << i << " mask " << rays[i].mask << ": instance " << hits[i].instance << " t " << hits[i].t
+          << ", brute force: instance " << ref.instance_id << " t " << ref.t;
+      const auto single = s.world.intersect(rays[i]);
+      ASSERT_TRUE(single.ok());
+      EXPECT_EQ(single->instance, hits[i].instance);
+      EXPECT_EQ(single->t, hits[i].t);
+      const bool expected = testing_support::any_hit(kept, ray, rt::TriangleTest::kFast);
+      ASSERT_EQ(blocked[i], expected ? 1 : 0) << "ray " << i;
+      ASSERT_EQ(s.world.occluded(rays[i]).value(), expected) << "ray " << i;
+      // Whether the mask changed the answer: the nearest over every object
+      // lies on a masked one.
+      const Hit any_mask = testing_support::nearest(s.soup, ray, rt::TriangleTest::kFast);
+      if (any_mask.valid()) {
+        const bool masked_out = (masks[any_mask.instance_id] & rays[i].mask) == 0;
+        skipped_hits += masked_out;
+        kept_hits += !masked_out;
+      }
+    }
+  }
+  // The masks mattered, both ways.
+  EXPECT_GT(skipped_hits, 300u);
+  EXPECT_GT(kept_hits, 300u);
+
+  // Masks given at creation, and refused ids.
+  const api::Character character = load_mannequin();
+  api::InstanceDesc hidden;
+  hidden.mask = 0x10u;
+  api::World world = api::World::create().value();
+  const api::InstanceId id = world.add_instance(character, hidden).value();
+  const api::InstanceId floor =
+      world.add_static_mesh({kQuad, kQuadIndices, {0.5f, 0.5f, 0.5f}, 0x20u}).value();
+  api::Ray down{{0.0f, 5.0f, 2.5f}, {0.0f, -1.0f, 0.0f}};  // misses the mannequin, meets the floor
+  EXPECT_EQ(world.intersect(down).value().instance, floor);
+  down.mask = 0x10u;
+  EXPECT_FALSE(world.intersect(down).value().hit());
+  EXPECT_FALSE(world.occluded(down).value());
+  down.mask = 0x30u;
+  EXPECT_EQ(world.intersect(down).value().instance, floor);
+  EXPECT_EQ(world.set_mask(99, 1).error().code, api::ErrorCode::kNotFound);
+  ASSERT_TRUE(world.remove(id).ok());
+  const api::Status removed = world.set_mask(id, 1);
+  ASSERT_FALSE(removed.ok());
+  EXPECT_EQ(removed.error().code, api::ErrorCode::kNotFound);
+  EXPECT_NE(removed.error().message.find("removed"), std::string::npos) << removed.error().message;
+}
+
+// A masked instance costs nothing past the top level: the query enters
+// none of its objects and tests none of its triangles.
+TEST(ApiQueries, MaskedInstancesAreNeverEntered) {
+  const character::Pack pack = character::Pack::open(mannequin_pack_path()).value();
+  rt::Scene scene;
+  const std::uint32_t character = scene.add_character(pack.model().mesh, pack.fuzzy()).value();
+  const std::uint32_t a = scene.add_instance(character).value();
+  const std::uint32_t b = scene.add_instance(character).value();
+  ASSERT_TRUE(scene.set_bones(b, testing_support::clip_pose(pack.model(), "walk", 0.3,
+                                                            Scenes::translation(0.3f, 0.0f, 0.0f))).ok());
+  JobSystem jobs(1);
+  ASSERT_TRUE(scene.prepare_frame({}, jobs).ok());
+  ASSERT_TRUE(scene.set_mask(a, 1u).ok());
+  ASSERT_TRUE(scene.set_mask(b, 2u).ok());
+  const std::vector<api::Ray> rays = query_rays();
+  rt::TraversalCounters none, all;
+  std::size_t hits = 0;
+  for (const api::Ray& r : rays) {
+    EXPECT_FALSE(rt::intersect(scene, to_internal(r), 4u, rt::TriangleTest::kFast, &none).valid());
+    EXPECT_FALSE(rt::occluded(scene, to_internal(r), 4u, rt::TriangleTest::kFast, &none));
+    hits += rt::intersect(scene, to_internal(r), 3u, rt::TriangleTest::kFast, &all).valid();
+  }
+  EXPECT_EQ(none.object_visits, 0u);
+  EXPECT_EQ(none.triangle_tests, 0u);
+  EXPECT_GT(all.object_visits, 500u);
+  EXPECT_GT(hits, 200u);
+}
+
+glm::dvec3 unit_normal(const Vec3& p0, const Vec3& p1, const Vec3& p2) {
+  return glm::normalize(glm::cross(glm::dvec3(p1) - glm::dvec3(p0), glm::dvec3(p2) - glm::dvec3(p0)));
+}
+
+TEST(ApiQueries, HitsCarryTheWindingNormalOfThePosedTriangleAndItsMaterial) {
+  Scenes s;
+  const std::vector<api::Ray> rays = query_rays();
+  const character::Pack pack = character::Pack::open(mannequin_pack_path()).value();
+  const SkinnedMesh& mesh = pack.model().mesh;
+  std::vector<api::RayHit> hits(rays.size());
+  ASSERT_TRUE(s.world.intersect(rays, hits).ok());
+  std::size_t on_ground = 0, on_characters = 0, from_behind = 0;
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    const api::RayHit& h = hits[i];
+    if (!h.hit()) {
+      EXPECT_EQ(h.material, api::kNoHit);
+      continue;
+    }
+    const api::Float3 n = h.geometric_normal;
+    EXPECT_NEAR(n.x * n.x + n.y * n.y + n.z * n.z, 1.0f, 1e-5f);
+    EXPECT_EQ(h.uv.x, 0.0f);  // neither the mannequin nor the ground has UVs
+    EXPECT_EQ(h.uv.y, 0.0f);
+    if (h.instance == s.ground) {
+      // By hand: the quad's triangles (0, 2, 1) and (1, 2, 3) run
+      // counter-clockwise seen from above.
+      EXPECT_EQ(n.x, 0.0f);
+      EXPECT_EQ(n.y, 1.0f);
+      EXPECT_EQ(n.z, 0.0f);
+      EXPECT_EQ(h.material, 0u);
+      ++on_ground;
+      continue;
+    }
+    // The posed triangle of the reference's soup, by winding.
+    const auto tri = std::find_if(s.soup.begin(), s.soup.end(), [&](const testing_support::SoupTriangle& t) {
+      return t.instance_id == h.instance && t.triangle_id == h.triangle;
+    });
+    ASSERT_NE(tri, s.soup.end());
+    const glm::dvec3 expected = unit_normal(tri->p0, tri->p1, tri->p2);
+    EXPECT_NEAR(n.x, expected.x, 1e-5);
+    EXPECT_NEAR(n.y, expected.y, 1e-5);
+    EXPECT_NEAR(n.z, expected.z, 1e-5);
+    EXPECT_EQ(h.material, mesh.triangle_material[h.triangle]);
+    from_behind += n.x * rays[i].direction.x + n.y * rays[i].direction.y + n.z * rays[i].direction.z > 0.0f;
+    ++on_characters;
+  }
+  EXPECT_GT(on_ground, 100u);
+  EXPECT_GT(on_characters, 150u);
+  EXPECT_GT(from_behind, 10u);  // rays from inside a character meet back faces: the normal is not flipped
+}
+
+// The mannequin with hand-made texture coordinates, uv = (x, y) of the
+// vertex at bind pose, as a pack: a hit's UV is then the (x, y) of its
+// point carried back to bind pose.
+const std::string& uv_mannequin_pack_path() {
+  struct TemporaryPack {
+    std::string path;
+    TemporaryPack() {
+      testing_support::BakedModel baked;
+      baked.model = content::make_mannequin().value();
+      for (const Vec3& p : baked.model.mesh.positions) baked.model.mesh.uvs.push_back(Vec2(p.x, p.y));
+      character::BakeRequest request;
+      request.pose_space.mode = anim::PoseSpaceMode::kClip;
+      request.pose_space.clips = {"idle"};
+      request.pose_space.samples = 0;
+      request.pose_space.every_frame_30hz = false;
+      JobSystem jobs(2);
+      baked.bake = character::bake_in_memory(baked.model, request, jobs).value();
+      character::PackContents contents;
+      contents.model = &baked.model;
+      contents.fuzzy = &baked.bake.fuzzy;
+      contents.pose_space.desc = request.pose_space;
+      contents.provenance.source_name = "mannequin with uvs";
+      contents.provenance.tool_version = "api test";
+      path = (std::filesystem::temp_directory_path() /
+              ("sinew_api_test_uv_mannequin_" + std::to_string(::getpid()) + ".pack"))
+                 .string();
+      EXPECT_TRUE(character::write_pack(path, contents).ok());
+    }
+    ~TemporaryPack() {
+      std::error_code ignored;
+      std::filesystem::remove(path, ignored);
+    }
+  };
+  static const TemporaryPack pack;
+  return pack.path;
+}
+
+TEST(ApiQueries, HitsCarryTheirUvAndTheNormalTurnsWithTheBones) {
+  const api::Character character = api::Character::load(uv_mannequin_pack_path()).value();
+  api::World world = api::World::create().value();
+  api::InstanceDesc desc;
+  desc.driver = api::Driver::kHost;
+  const api::InstanceId id = world.add_instance(character, desc).value();
+  const character::Pack pack = character::Pack::open(uv_mannequin_pack_path()).value();
+  const SkinnedMesh& mesh = pack.model().mesh;
+  // Every bone turned a quarter about +X, (x, y, z) -> (x, -z, y), and
+  // moved by (1, 2, 3): the mannequin lies along +Z.
+  api::Matrix3x4 turn;
+  const float rows[3][4] = {{1, 0, 0, 1}, {0, 0, -1, 2}, {0, 1, 0, 3}};
+  std::memcpy(turn.m, rows, sizeof rows);
+  const std::vector<api::Matrix3x4> bones(character.bone_count(), turn);
+  ASSERT_TRUE(world.set_bone_matrices(id, bones).ok());
+  const auto posed = [&](const Vec3& p) { return Vec3(p.x + 1.0f, -p.z + 2.0f, p.y + 3.0f); };
+  const auto unposed = [&](const Vec3& q) { return Vec3(q.x - 1.0f, q.z - 3.0f, -(q.y - 2.0f)); };
+  // Rays from around each of a spread of vertices towards it.
+  std::mt19937 g(11);
+  std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+  std::size_t checked = 0;
+  for (std::size_t v = 0; v < mesh.positions.size(); v += 7) {
+    const Vec3 target = posed(mesh.positions[v]);
+    const Vec3 from = target + 3.0f * Vec3(unit(g), unit(g), unit(g));
+    const Vec3 d = target - from;
+    const auto h = world.intersect(api::Ray{{from.x, from.y, from.z}, {d.x, d.y, d.z}});
+    ASSERT_TRUE(h.ok());
+    if (!h->hit()) continue;
+    const Vec3 at = unposed(from + h->t * d);
+    EXPECT_NEAR(h->uv.x, at.x, 1e-4f) << "vertex " << v;
+    EXPECT_NEAR(h->uv.y, at.y, 1e-4f) << "vertex " << v;
+    // The bind-pose triangle's normal, turned as the bones turn it.
+    const auto& c = mesh.triangles[h->triangle];
+    const Vec3 &p0 = mesh.positions[c[0]], &p1 = mesh.positions[c[1]], &p2 = mesh.positions[c[2]];
+    const glm::dvec3 n = unit_normal(p0, p1, p2);
+    // The posed corners are skinned in float: each coordinate off by a few
+    // units in the last place of the posed magnitudes (up to about 5),
+    // which turns the normal by up to that over the triangle's height.
+    const glm::dvec3 e1 = glm::dvec3(p1) - glm::dvec3(p0), e2 = glm::dvec3(p2) - glm::dvec3(p0);
+    const double rounding = 4.0 * 0x1.0p-23 * 5.0;
+    const double tolerance =
+        1e-6 + 2.0 * rounding * (glm::length(e1) + glm::length(e2)) / glm::length(glm::cross(e1, e2));
+    EXPECT_NEAR(h->geometric_normal.x, n.x, tolerance);
+    EXPECT_NEAR(h->geometric_normal.y, -n.z, tolerance);
+    EXPECT_NEAR(h->geometric_normal.z, n.y, tolerance);
+    EXPECT_EQ(h->material, mesh.triangle_material[h->triangle]);
+    ++checked;
+  }
+  EXPECT_GT(checked, 50u);
 }
 
 }  // namespace
