@@ -75,7 +75,7 @@ RayHit to_api(const rt::Scene& scene, const Hit& hit) {
       const Vec2 uv = w * mesh.uvs[v[0]] + hit.u * mesh.uvs[v[1]] + hit.v * mesh.uvs[v[2]];
       h.uv = {uv.x, uv.y};
     }
-    h.material = hit.triangle_id < mesh.triangle_material.size() ? mesh.triangle_material[hit.triangle_id] : 0;
+    h.material = hit.triangle_id < mesh.triangle_material.size() ? mesh.triangle_material[hit.triangle_id] : kNoHit;
   } else {
     const rt::StaticMeshDesc& mesh = scene.static_meshes()[slot.index].desc;
     const auto& v = mesh.triangles[hit.triangle_id];

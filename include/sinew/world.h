@@ -65,8 +65,9 @@ struct RayHit {
   // The mesh's texture coordinates at the hit, (1 - u - v) uv0 + u uv1 +
   // v uv2 ((0, 0) when the mesh has none, as static meshes).
   Float2 uv;
-  // The triangle's material: an index into the character's materials (0
-  // when the pack has none; a static mesh's one colour is material 0).
+  // The triangle's material: an index into the character's materials
+  // (kNoHit for a character without materials; a static mesh's one colour
+  // is material 0), as the pass's material_id output gives it.
   std::uint32_t material = kNoHit;
   bool hit() const noexcept { return instance != kNoHit; }
 };
