@@ -60,6 +60,7 @@ struct RenderFlags {
         seed(l.option("--seed", "S", "seed of the random pose spaces (default 1)")),
         limits(l.option("--limits", "FILE.json", "joint limits, required by --pose-space limits")),
         shadows(l.option("--shadows", "on|off", "shadow rays (default on)")),
+        textures(l.option("--textures", "on|off", "textured materials show their textures (default on)")),
         light(l.repeated_option("--light", "X,Y,Z|point:X,Y,Z|dir:X,Y,Z[:R,G,B]",
                                 "a point light at X,Y,Z or a directional light towards X,Y,Z, with\n"
                                 "its linear colour (default 1,1,1); up to 8 (default: one point\n"
@@ -105,6 +106,7 @@ struct RenderFlags {
   const std::optional<std::string>& seed;
   const std::optional<std::string>& limits;
   const std::optional<std::string>& shadows;
+  const std::optional<std::string>& textures;
   const std::vector<std::string>& light;
   const std::optional<std::string>& threads;
   const std::optional<std::string>& instances;
@@ -229,6 +231,9 @@ Status parse_run(const RenderFlags& f, RenderOptions& o) {
   if (const std::optional<std::string>& text = f.out) o.out_dir = *text;
   if (const std::optional<std::string>& text = f.shadows) {
     SINEW_ASSIGN_OR_RETURN(o.shadows, cli::parse_on_off("--shadows", *text));
+  }
+  if (const std::optional<std::string>& text = f.textures) {
+    SINEW_ASSIGN_OR_RETURN(o.textures, cli::parse_on_off("--textures", *text));
   }
   if (const std::optional<std::string>& text = f.fallback) {
     SINEW_ASSIGN_OR_RETURN(o.fallback, cli::parse_on_off("--fallback", *text));
@@ -506,6 +511,7 @@ Expected<RenderOutputs> render_model(const RenderOptions& options) {
   settings.packet_rays = options.packet_rays;
   settings.split_fine_shadow_packets = options.split_fine_shadows;
   settings.shadows = options.shadows;
+  settings.textures = options.textures;
 
   const std::size_t pixels = static_cast<std::size_t>(options.width) * static_cast<std::size_t>(options.height);
   out.color_rgba8.assign(4 * pixels, 0);

@@ -4,7 +4,7 @@
 //
 //   sinew-editor render MODEL [--clip NAME] [--time SECONDS] [--camera ex,ey,ez,tx,ty,tz,ux,uy,uz,fovy_deg]
 //       [--size WxH] --out DIR [--pose-space arbitrary|limits|clips|clip:NAME] [--clips a,b,c]
-//       [--samples N] [--seed S] [--shadows on|off] [--light x,y,z] [--threads N] [--instances N]
+//       [--samples N] [--seed S] [--shadows on|off] [--textures on|off] [--light x,y,z] [--threads N] [--instances N]
 //       [--layout row|grid] [--frames N] [--triangle-test fast|watertight] [--bone-boxes exact|cheap]
 //       [--fallback on|off] [--ground on|off] [--limits FILE.json]
 //
@@ -59,6 +59,7 @@ struct RenderOptions {
   std::optional<anim::PoseSpaceDesc> pose_space;
   std::string limits_path;         // joint limits JSON, for pose space "limits"
   bool shadows = true;
+  bool textures = true;  // textured materials sample their textures (rt::RenderSettings::textures)
   // At most rt::kMaxLights; empty: one white point light placed
   // automatically (character::default_light).
   std::vector<rt::Light> lights;

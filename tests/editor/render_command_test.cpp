@@ -324,6 +324,35 @@ TEST(RenderCommand, GroundOffLeavesTheCharactersAlone) {
   EXPECT_EQ(seen, (std::set<std::uint32_t>{0u, kInvalidId})) << "the character and misses only";
 }
 
+// CesiumMan's one material is white with a texture: on, the character's
+// pixels take many colours; off, they are the white material shaded, whose
+// hue does not change (grey levels only).
+TEST(RenderCommand, TexturesOnShowTheMapAndOffShowTheMaterialColour) {
+  auto parsed = parse_render_options({"m.glb", "--out", "o", "--textures", "off"});
+  ASSERT_TRUE(parsed.ok()) << parsed.status().message();
+  EXPECT_FALSE(parsed->textures);
+  EXPECT_FALSE(parse_render_options({"m.glb", "--out", "o", "--textures", "maybe"}).ok());
+  const auto coloured_pixels = [](const RenderOutputs& r) {
+    int coloured = 0, on_character = 0;
+    for (std::size_t p = 0; p < r.instance_id.size(); ++p) {
+      if (r.instance_id[p] != 0u) continue;
+      ++on_character;
+      const std::uint8_t* c = &r.color_rgba8[4 * p];
+      coloured += std::max({c[0], c[1], c[2]}) - std::min({c[0], c[1], c[2]}) > 24 ? 1 : 0;
+    }
+    EXPECT_GT(on_character, 500);
+    return coloured;
+  };
+  RenderOptions o = small_options(kCesiumMan);
+  const auto on = render_model(o);
+  ASSERT_TRUE(on.ok()) << on.status().message();
+  o.textures = false;
+  const auto off = render_model(o);
+  ASSERT_TRUE(off.ok()) << off.status().message();
+  EXPECT_GT(coloured_pixels(*on), 200);
+  EXPECT_EQ(coloured_pixels(*off), 0);
+}
+
 #if SINEW_HAVE_CAL3D
 // Cally's skeleton and meshes (paths made absolute) under a .cfg of our own
 // with `scale=` first.
