@@ -24,17 +24,21 @@ namespace sinew {
 // (each level quarters the texel count), rounded to the nearest level. The
 // logarithm is the float's exponent plus its mantissa's fraction, exact at
 // powers of two and within 0.09 between: a level choice, not a value.
+// Branch-free: neighbouring pixels often straddle a level boundary, and a
+// mispredicted branch per lookup would cost more than the lookup.
 inline std::uint32_t texture_level(const Texture& texture, float uv_per_pixel2) {
-  const float texels = uv_per_pixel2 * static_cast<float>(texture.levels[0].width) *
-                       static_cast<float>(texture.levels[0].height);
-  const auto last = static_cast<std::uint32_t>(texture.levels.size() - 1);
-  if (!(texels > 1.0f)) return 0;  // magnified, or a degenerate uv triangle (NaN too)
-  if (!(texels < 3.0e38f)) return last;  // a degenerate world triangle
+  float texels = uv_per_pixel2 * static_cast<float>(texture.levels[0].width) *
+                 static_cast<float>(texture.levels[0].height);
+  // Magnified (and a degenerate uv triangle, NaN included): level 0; a
+  // degenerate world triangle (infinity): past the last level, clamped below.
+  texels = texels > 1.0f ? texels : 1.0f;
+  texels = texels < 1.0e38f ? texels : 1.0e38f;
   const auto bits = std::bit_cast<std::uint32_t>(texels);
   const float log2 = static_cast<float>(static_cast<int>(bits >> 23) - 127) +
                      static_cast<float>(bits & 0x7FFFFFu) * (1.0f / 8388608.0f);
   const auto level = static_cast<std::uint32_t>(0.5f * log2 + 0.5f);
-  return std::min(level, last);
+  const auto last = static_cast<std::uint32_t>(texture.levels.size() - 1);
+  return level < last ? level : last;
 }
 
 namespace texture_detail {
