@@ -565,6 +565,56 @@ void print_inspect(const Json& j, std::ostream& out) {
   }
 }
 
+// "38.2%" (one decimal; "0%" for none, "< 0.1%" for a few).
+std::string percent_text(double share) {
+  if (share <= 0.0) return "0%";
+  if (share < 0.001) return "< 0.1%";
+  std::ostringstream text;
+  text << std::fixed << std::setprecision(1) << 100.0 * share << "%";
+  return text.str();
+}
+
+// Whether the pose space sampled `clip` (random spaces sample no clip).
+bool pose_space_has_clip(const anim::PoseSpaceDesc& space, const std::string& clip) {
+  switch (space.mode) {
+    case anim::PoseSpaceMode::kClips:
+      return space.clips.empty() || std::find(space.clips.begin(), space.clips.end(), clip) != space.clips.end();
+    case anim::PoseSpaceMode::kClip:
+      return !space.clips.empty() && space.clips.front() == clip;
+    default:
+      return false;
+  }
+}
+
+// No silent cliffs: how much of the rest pose, and of each clip the bake
+// was not given, lies outside the pose space just baked. Those triangles
+// render exactly, through the per-frame fallback tree, at its cost.
+constexpr std::size_t kReportPosesPerClip = 30;
+
+Status report_outside(const character::Model& model, const anim::PoseSpaceDesc& space,
+                      const rt::FuzzyCharacterView& fuzzy, JobSystem& jobs, std::ostream& out) {
+  SINEW_ASSIGN_OR_RETURN(const std::vector<Affine3> rest, character::rest_skinning(model));
+  SINEW_ASSIGN_OR_RETURN(const character::OutsideShare at_rest, character::triangles_outside(model, fuzzy, rest, jobs));
+  out << "rest pose: " << percent_text(at_rest.max) << " of triangles outside the pose space"
+      << (at_rest.max > 0.0 ? " (they will render through the fallback)" : "") << "\n";
+  bool any_outside = at_rest.max > 0.0;
+  for (const anim::Clip& clip : model.clips) {
+    if (pose_space_has_clip(space, clip.name())) continue;
+    SINEW_ASSIGN_OR_RETURN(const std::vector<Affine3> poses, character::clip_poses(model, clip, kReportPosesPerClip));
+    SINEW_ASSIGN_OR_RETURN(const character::OutsideShare share,
+                           character::triangles_outside(model, fuzzy, poses, jobs));
+    out << "clip " << shown(clip.name()) << " (not baked): " << percent_text(share.mean)
+        << " of triangles outside the pose space on average, " << percent_text(share.max) << " at worst over "
+        << share.poses << (share.poses == 1 ? " pose" : " poses") << "\n";
+    any_outside |= share.max > 0.0;
+  }
+  if (any_outside) {
+    out << "poses outside the pose space render exactly but slower, through a tree built each frame: "
+           "bake the poses you will play (docs/EDITOR.md, \"Why is my character slow?\")\n";
+  }
+  return {};
+}
+
 // The process's peak resident set so far (getrusage), in KiB; 0 if unknown.
 long max_rss_kib() {
   rusage usage{};
@@ -686,6 +736,10 @@ int run_bake(const std::vector<std::string>& args, std::ostream& out, std::ostre
         << std::setprecision(3) << (st.rest_area > 0.0 ? st.cluster_fuzzy_area / st.rest_area : 0.0)
         << "x rest averaged over each bone's clusters, " << std::setprecision(0) << st.clustering_ms
         << " ms clustering and their boxes\n";
+  }
+  out << std::defaultfloat;
+  if (Status s = report_outside(*model, o.pose_space, bake->fuzzy.view(), jobs, out); !s.ok()) {
+    return fail(err, "bake", s);
   }
   if (whole) {
     SceneSavingsOptions run = o.scene_report_run;

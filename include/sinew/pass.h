@@ -124,6 +124,12 @@ struct PassStats {
   std::uint64_t primary_rays = 0;
   std::uint64_t shadow_rays = 0;
   std::size_t escaped_triangles = 0;  // triangles outside their fuzzy boxes this frame
+  // Of prepare_ms: building the per-frame tree over the escaped triangles,
+  // what poses outside the baked pose space cost (0 inside it; the rays
+  // that enter that tree are in trace_ms). A large share of the frame says
+  // the character plays poses it was not baked over: bake them
+  // (docs/EDITOR.md, "Why is my character slow?").
+  double fallback_ms = 0.0;
 };
 
 class SINEW_API RayTracePass {
