@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <regex>
 #include <atomic>
 #include <cstdlib>
 #include <cstring>
@@ -202,6 +203,95 @@ TEST_F(PackCommands, AStaticGltfBakesWithOneWarningLine) {
     EXPECT_NE(line.find("BoxTextured.glb: skins: none: a static model"), std::string::npos) << line;
   }
   EXPECT_EQ(warnings, 1u) << bake.err;
+}
+
+// Without a terminal the bake prints a line per phase and quarter. With
+// its bones in chunks (a small memory bound), sampling and assignment
+// alternate inside the bake; the lines still never go back: the percentage
+// never falls and no phase returns once another began.
+TEST_F(PackCommands, NonTerminalProgressNeverGoesBack) {
+  const std::string dir = fresh_dir("progress");
+  const CommandRun bake = run(run_bake, {kCesiumMan, "-o", dir + "/p.pack", "--max-memory-mib", "4", "--pose-clusters",
+                                         "2", "--threads", "2"});
+  ASSERT_EQ(bake.code, 0) << bake.err;
+  std::istringstream lines(bake.err);
+  std::vector<std::string> phases;
+  int last = -1, reports = 0;
+  for (std::string line; std::getline(lines, line);) {
+    if (line.rfind("bake: ", 0) != 0) continue;
+    ++reports;
+    const int percent = std::stoi(line.substr(6));
+    const auto space = line.find(' ', line.find('%'));
+    const std::string phase = line.substr(space + 1, line.find(" (") - space - 1);
+    EXPECT_GE(percent, last) << bake.err;
+    last = percent;
+    if (phases.empty() || phases.back() != phase) {
+      EXPECT_EQ(std::find(phases.begin(), phases.end(), phase), phases.end())
+          << "phase " << phase << " came back:\n" << bake.err;
+      phases.push_back(phase);
+    }
+  }
+  EXPECT_GE(reports, 5) << bake.err;
+  EXPECT_EQ(phases, (std::vector<std::string>{"sampling", "checks", "clusters", "build"})) << bake.err;
+  EXPECT_EQ(last, 100);
+}
+
+// inspect prints for people: sizes in KiB and MiB, measured numbers to 3
+// significant digits, and what each section tag holds. Each figure is
+// checked against the full-precision JSON.
+TEST_F(PackCommands, InspectPrintsHumanUnitsAndExplainsTheSections) {
+  const std::string dir = fresh_dir("inspect_units");
+  const std::string pack = dir + "/c.pack";
+  ASSERT_EQ(run(run_bake, {kCesiumMan, "-o", pack, "--threads", "2"}).code, 0);
+  const CommandRun text = run(run_inspect, {pack});
+  ASSERT_EQ(text.code, 0) << text.err;
+  const auto j = nlohmann::json::parse(run(run_inspect, {pack, "--json"}).out);
+  // A printed number equals the exact one to 3 significant digits.
+  const auto expect_3_digits = [&](const std::string& printed, double exact, const std::string& what) {
+    const double value = std::stod(printed);
+    const double unit = std::pow(10.0, std::floor(std::log10(std::abs(exact))) - 2);
+    EXPECT_LE(std::abs(value - exact), std::max(0.5, 0.5 + 1e-9) * std::max(unit, 1e-12) + 1e-9)
+        << what << ": " << printed << " for " << exact;
+    const std::string digits = std::regex_replace(printed, std::regex("[^0-9]"), "");
+    const std::string significant = std::regex_replace(digits, std::regex("^0+"), "");
+    EXPECT_LE(significant.size(), std::max<std::size_t>(3, std::to_string(static_cast<long long>(std::abs(value))).size()))
+        << what << ": " << printed;
+  };
+  std::smatch m;
+  // The file's size, then each section's: "872 KiB (892712 bytes)", "182 KiB", "28 bytes".
+  ASSERT_TRUE(std::regex_search(text.out, m, std::regex(R"(: ([0-9.]+) KiB \(([0-9]+) bytes\))"))) << text.out;
+  EXPECT_EQ(std::stoull(m[2].str()), j["bytes"].get<std::uint64_t>());
+  expect_3_digits(m[1].str(), j["bytes"].get<double>() / 1024.0, "file size");
+  for (const auto& s : j["sections"]) {
+    const std::string id = s["id"].get<std::string>();
+    const std::uint64_t bytes = s["bytes"].get<std::uint64_t>();
+    ASSERT_TRUE(std::regex_search(text.out, m, std::regex("  " + id + R"( v[0-9]+  ([0-9.]+) (bytes|KiB|MiB) +(.+)\n)")))
+        << id << "\n" << text.out;
+    if (bytes < 1024) {
+      EXPECT_EQ(m[1].str(), std::to_string(bytes)) << id;
+      EXPECT_EQ(m[2].str(), "bytes") << id;
+    } else {
+      EXPECT_EQ(m[2].str(), bytes < 1024 * 1024 ? "KiB" : "MiB") << id;
+      expect_3_digits(m[1].str(), static_cast<double>(bytes) / (bytes < 1024 * 1024 ? 1024.0 : 1024.0 * 1024.0), id);
+    }
+    EXPECT_FALSE(s["holds"].get<std::string>().empty()) << id;
+    EXPECT_EQ(m[3].str(), s["holds"].get<std::string>()) << id;
+  }
+  EXPECT_NE(text.out.find("  FRAM v1  28 bytes    framing: up axis, rest bounds\n"), std::string::npos) << text.out;
+  const auto& clip = j["model"]["clips"][0];
+  ASSERT_TRUE(std::regex_search(text.out, m, std::regex("clip " + clip["name"].get<std::string>() + R"( \(([0-9.]+) s\))")));
+  expect_3_digits(m[1].str(), clip["seconds"].get<double>(), "clip length");
+  ASSERT_TRUE(std::regex_search(text.out, m, std::regex(R"(fuzzy area ([0-9.]+)x the rest pose's, ([0-9.]+) triangles per leaf)")));
+  expect_3_digits(m[1].str(), j["fuzzy"]["fuzzy_area_ratio"].get<double>(), "fuzzy area");
+  expect_3_digits(m[2].str(), j["fuzzy"]["triangles_per_leaf"].get<double>(), "triangles per leaf");
+  ASSERT_TRUE(std::regex_search(text.out, m, std::regex(R"(boxes ([0-9.]+) ms)")));
+  expect_3_digits(m[1].str(), j["provenance"]["sampling_ms"].get<double>(), "boxes ms");
+  // CesiumMan stands along +Y as posed (docs/EMBEDDING.md, "Framing a character").
+  EXPECT_NE(text.out.find("framing: stands along +Y, rest bounds ("), std::string::npos) << text.out;
+  EXPECT_EQ(j["framing"]["up_axis"], 1);
+  EXPECT_TRUE(j["framing"]["stored"].get<bool>());
+  // No long decimals anywhere.
+  EXPECT_FALSE(std::regex_search(text.out, std::regex(R"([0-9]\.[0-9]{4,})"))) << text.out;
 }
 
 TEST_F(PackCommands, SourceDateEpochMakesBakesByteIdentical) {
