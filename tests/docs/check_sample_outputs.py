@@ -17,12 +17,14 @@ all blocks, in document order); the lines after it, up to the next `$ ` line
 or the fence, are its standard output. The blocks of a doc run in order, the
 docs in the order given. A `...` line stands for any lines (none included).
 
-Lines are compared after runs of spaces are made one, and after the numbers
-that vary from run to run are replaced on both sides (VARYING below): a
-number followed by " ms" (a timing), the process's RSS, the bake date, the
-demo's per-phase milliseconds and frame rates. Every other character, and
-every other number (sizes, counts, shares, areas), must be the same: the
-test fails as soon as a doc drifts from what the programs print.
+Numbers that vary from run to run and machine to machine are written as
+"…" in the doc (the docs carry no timings): a number followed by " ms" (a
+timing), the process's RSS, the bake date, the demo's per-phase
+milliseconds and frame rates (VARYING below). The program's output has
+those replaced by "…", runs of spaces made one, and must then equal the
+doc's line exactly: every other character and number (sizes, counts,
+shares, areas) is checked, so the test fails as soon as a doc drifts from
+what the programs print, or shows a timing.
 """
 
 import argparse
@@ -37,21 +39,26 @@ END = "<!-- end of sample output -->"
 NUMBER = r"-?[0-9]+(?:\.[0-9]+)?"
 VARYING = [
     # Timings: "41 ms", "boxes 131 ms".
-    (re.compile(NUMBER + r"(?= ms\b)"), "<ms>"),
+    (re.compile(NUMBER + r"(?= ms\b)"), "…"),
     # What the process happened to hold: "process peak RSS 129.1 MiB (127.3 MiB before the bake)".
-    (re.compile(r"RSS " + NUMBER + r" MiB \(" + NUMBER + r" MiB before"), "RSS <MiB> MiB (<MiB> MiB before"),
+    (re.compile(r"RSS " + NUMBER + r" MiB \(" + NUMBER + r" MiB before"), "RSS … MiB (… MiB before"),
     # The bake's date.
-    (re.compile(r"baked [0-9]{4}-[0-9]{2}-[0-9]{2} [0-9]{2}:[0-9]{2}:[0-9]{2} UTC"), "baked <date>"),
+    (re.compile(r"baked [0-9]{4}-[0-9]{2}-[0-9]{2} [0-9]{2}:[0-9]{2}:[0-9]{2} UTC"), "baked … UTC"),
     # The demo's per-phase table: name, samples, then median, min and max ms.
-    (re.compile(r"^([a-z][a-z ]*?) ([0-9]+) " + NUMBER + " " + NUMBER + " " + NUMBER + "$"), r"\1 \2 <ms> <ms> <ms>"),
+    (re.compile(r"^([a-z][a-z ]*?) ([0-9]+) " + NUMBER + " " + NUMBER + " " + NUMBER + "$"), r"\1 \2 … … …"),
     # Frame rates: the demo's, and the scene report's "471.4 instead of 452.2 (+4%)".
-    (re.compile(r"(phase medians\): )" + NUMBER), r"\1<fps>"),
-    (re.compile(r"(\): )" + NUMBER + " instead of " + NUMBER + r" \([+-]?[0-9]+%\)"), r"\1<fps> instead of <fps>"),
+    (re.compile(r"(phase medians\): )" + NUMBER), r"\1…"),
+    (re.compile(r"(\): )" + NUMBER + " instead of " + NUMBER + r" \([+-]?[0-9]+%\)"), r"\1… instead of … (…)"),
 ]
 
 
+def spaced(line):
+    return re.sub(r" +", " ", line.rstrip())
+
+
 def normalise(line):
-    line = re.sub(r" +", " ", line.rstrip())
+    """The program's line as the doc writes it."""
+    line = spaced(line)
     for pattern, replacement in VARYING:
         line = pattern.sub(replacement, line)
     return line
@@ -97,7 +104,7 @@ def matches(expected, actual):
         return not actual
     if expected[0] == "...":
         return any(matches(expected[1:], actual[k:]) for k in range(len(actual) + 1))
-    return bool(actual) and normalise(expected[0]) == normalise(actual[0]) and matches(expected[1:], actual[1:])
+    return bool(actual) and spaced(expected[0]) == normalise(actual[0]) and matches(expected[1:], actual[1:])
 
 
 def main():
@@ -127,8 +134,8 @@ def main():
                     print(f"{doc}:{line_number}: '$ {command}' (exit {run.returncode}) no longer prints its sample "
                           "output. The doc shows:")
                     print("\n".join("  " + line for line in expected))
-                    print("It prints (copy it into the doc if the change is right):")
-                    print("\n".join("  " + line for line in actual))
+                    print("It prints, as the doc would write it (copy it into the doc if the change is right):")
+                    print("\n".join("  " + normalise(line) for line in actual))
                     if run.stderr:
                         print("and on stderr:\n" + "\n".join("  " + line for line in run.stderr.splitlines()[-10:]))
                 else:
