@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <string>
 
 #include "animation/pose.h"
 #include "character/renderable.h"
+#include "raytrace/scene/scene.h"
 #include "runtime/jobs/job_system.h"
 #include "runtime/timing/stopwatch.h"
 
@@ -117,6 +119,50 @@ Expected<InMemoryBake> bake_in_memory(const Model& model, const BakeRequest& req
   SINEW_ASSIGN_OR_RETURN(bake.fuzzy, rt::bake_fuzzy_character(input, request.fuzzy, jobs));
   bake.memory.fuzzy_peak = bake.fuzzy.stats.peak_bytes;
   return bake;
+}
+
+Expected<OutsideShare> triangles_outside(const Model& model, const rt::FuzzyCharacterView& fuzzy,
+                                         std::span<const Affine3> poses, JobSystem& jobs) {
+  const std::size_t joints = model.skeleton.joint_count();
+  if (joints == 0 || poses.size() % joints != 0) {
+    return invalid_argument("poses", std::to_string(poses.size()) + " matrices",
+                            "not a whole number of poses of " + std::to_string(joints) + " joints");
+  }
+  OutsideShare share;
+  const std::size_t triangles = model.mesh.triangle_count();
+  if (triangles == 0 || poses.empty()) return share;
+  rt::Scene scene;
+  SINEW_ASSIGN_OR_RETURN(const std::uint32_t character, scene.add_character(model.mesh, fuzzy));
+  SINEW_ASSIGN_OR_RETURN(const std::uint32_t instance, scene.add_instance(character));
+  rt::FrameOptions options;
+  options.normals = false;  // only the escape check is wanted
+  double sum = 0.0;
+  for (std::size_t p = 0; p < poses.size(); p += joints) {
+    SINEW_RETURN_IF_ERROR(scene.set_bones(instance, poses.subspan(p, joints)));
+    SINEW_ASSIGN_OR_RETURN(const rt::FrameStats stats, scene.prepare_frame(options, jobs));
+    const double s = static_cast<double>(stats.escaped_triangles) / static_cast<double>(triangles);
+    sum += s;
+    share.max = std::max(share.max, s);
+    ++share.poses;
+  }
+  share.mean = sum / static_cast<double>(share.poses);
+  return share;
+}
+
+Expected<std::vector<Affine3>> clip_poses(const Model& model, const anim::Clip& clip, std::size_t max_poses) {
+  const double duration = std::max(0.0, static_cast<double>(clip.duration()));
+  const std::size_t every_frame = static_cast<std::size_t>(std::floor(duration * 30.0)) + 1;
+  const std::size_t count = std::max<std::size_t>(1, std::min(every_frame, max_poses));
+  std::vector<Affine3> out;
+  for (std::size_t i = 0; i < count; ++i) {
+    // Evenly over [0, duration]; clip_skinning loops, so the end is taken
+    // just before it wraps.
+    const double t = count == 1 ? 0.0 : duration * static_cast<double>(i) / static_cast<double>(count - 1);
+    SINEW_ASSIGN_OR_RETURN(const std::vector<Affine3> pose,
+                           clip_skinning(model, clip, std::min(t, std::nextafter(duration, 0.0))));
+    out.insert(out.end(), pose.begin(), pose.end());
+  }
+  return out;
 }
 
 }  // namespace sinew::character

@@ -86,4 +86,22 @@ struct InMemoryBake {
 
 Expected<InMemoryBake> bake_in_memory(const Model& model, const BakeRequest& request, JobSystem& jobs);
 
+// How far poses lie outside a baked pose space: per pose, the share of the
+// model's triangles that leave their fuzzy boxes (escape). Those render
+// exactly, through a world-space tree built for them each frame: the
+// fallback, whose cost grows with them.
+struct OutsideShare {
+  std::size_t poses = 0;
+  double mean = 0.0;  // share of the triangles (0 to 1), averaged over the poses
+  double max = 0.0;   // the largest share of one pose
+};
+// `poses`: skinning matrices sample-major, as pose_space_skinning gives
+// them. Errors: kInvalidArgument when `poses` is not a whole number of
+// poses; the scene's, for data that does not fit the mesh.
+Expected<OutsideShare> triangles_outside(const Model& model, const rt::FuzzyCharacterView& fuzzy,
+                                         std::span<const Affine3> poses, JobSystem& jobs);
+// The poses of `clip` every 1/30 s over its length (its first key time, at
+// least), at most `max_poses` of them evenly spread, as skinning matrices.
+Expected<std::vector<Affine3>> clip_poses(const Model& model, const anim::Clip& clip, std::size_t max_poses);
+
 }  // namespace sinew::character

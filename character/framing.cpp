@@ -35,9 +35,12 @@ Aabb posed_bounds(const rt::Scene& scene) {
 }
 
 rt::CameraDesc default_camera(const Aabb& box, int up, int width, int height) {
+  return default_camera(box, up, static_cast<float>(width) / static_cast<float>(height));
+}
+
+rt::CameraDesc default_camera(const Aabb& box, int up, float aspect) {
   const float radius = bounding_radius(box);
   const float half_fovy = glm::radians(0.5f * kDefaultFovyDegrees);
-  const float aspect = static_cast<float>(width) / static_cast<float>(height);
   const float half_fovx = std::atan(std::tan(half_fovy) * aspect);
   const float distance = 1.15f * radius / std::sin(std::min(half_fovy, half_fovx));
   const Vec3 view = glm::normalize(front_of(up) + 0.2f * axis_vector(up));

@@ -59,6 +59,8 @@ rt::StaticMeshDesc ground_plane_for(const Model& model, int instances = 1, Layou
 Aabb posed_bounds(const rt::Scene& scene);
 // The default camera framing `box` and the default point light.
 rt::CameraDesc default_camera(const Aabb& box, int up, int width, int height);
+// The same for an image `aspect` (width / height) times as wide as it is high.
+rt::CameraDesc default_camera(const Aabb& box, int up, float aspect);
 Vec3 default_light(const Aabb& box, int up);
 // The light a tool's --light typed (cli::parse_light).
 rt::Light light_from_option(const cli::LightOption& option);

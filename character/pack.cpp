@@ -5,6 +5,7 @@
 #include <cstring>
 #include <utility>
 
+#include "character/framing.h"
 #include "character/pack_textures.h"
 #include "character/renderable.h"
 #include "raytrace/bake/fuzzy_bake.h"
@@ -22,6 +23,8 @@ constexpr SectionId kClips = make_section_id("CLIP");
 constexpr SectionId kLimits = make_section_id("LIMT");
 constexpr SectionId kPoseSpace = make_section_id("POSE");
 constexpr SectionId kProvenance = make_section_id("PROV");
+// Optional: packs written before it compute their framing on load.
+constexpr SectionId kFraming = make_section_id("FRAM");
 constexpr SectionId kFuzzyHeader = make_section_id("FZHD");
 constexpr SectionId kTriangleBone = make_section_id("FTBN");
 constexpr SectionId kBoneTrees = make_section_id("FBTR");
@@ -176,6 +179,17 @@ std::vector<std::byte> encode_provenance(const Provenance& p) {
   e.put(p.sampling_ms);
   e.put(p.assignment_ms);
   e.put(p.build_ms);
+  return std::move(e.bytes());
+}
+
+// FRAM: u8 up axis (1 or 2), three zero bytes, the rest bounds' lower and
+// upper corners (f32[3] each): 28 bytes.
+std::vector<std::byte> encode_framing(const PackFraming& f) {
+  SectionEncoder e;
+  e.put(static_cast<std::uint8_t>(f.up_axis));
+  for (int i = 0; i < 3; ++i) e.put(std::uint8_t{0});
+  for (int a = 0; a < 3; ++a) e.put(f.rest_bounds.lower[a]);
+  for (int a = 0; a < 3; ++a) e.put(f.rest_bounds.upper[a]);
   return std::move(e.bytes());
 }
 
@@ -447,6 +461,38 @@ Expected<Provenance> decode_provenance(SectionDecoder& d) {
   return p;
 }
 
+Expected<PackFraming> decode_framing(SectionDecoder& d) {
+  PackFraming f;
+  std::uint8_t up = 0;
+  SINEW_RETURN_IF_ERROR(d.get(up, "up_axis"));
+  for (int i = 0; i < 3; ++i) {
+    std::uint8_t reserved = 0;
+    SINEW_RETURN_IF_ERROR(d.get(reserved, "reserved"));
+    if (reserved != 0) return d.error("reserved", std::to_string(reserved), "not 0");
+  }
+  Vec3 lower, upper;
+  for (int a = 0; a < 3; ++a) SINEW_RETURN_IF_ERROR(d.get(lower[a], "rest_bounds.lower"));
+  for (int a = 0; a < 3; ++a) SINEW_RETURN_IF_ERROR(d.get(upper[a], "rest_bounds.upper"));
+  SINEW_RETURN_IF_ERROR(d.finish());
+  if (up != 1 && up != 2) return d.error("up_axis", std::to_string(up), "not 1 (+Y) or 2 (+Z)");
+  static const char* const kAxis[3] = {"x", "y", "z"};
+  for (int a = 0; a < 3; ++a) {
+    for (const auto& [v, name] : {std::pair{lower[a], "lower"}, std::pair{upper[a], "upper"}}) {
+      if (!std::isfinite(v) || static_cast<double>(std::abs(v)) > kMaxCoordinate) {
+        return d.error(std::string("rest_bounds.") + name + "." + kAxis[a], std::to_string(v),
+                       "not finite or beyond the largest coordinate a pack holds (1e9)");
+      }
+    }
+    if (lower[a] > upper[a]) {
+      return d.error(std::string("rest_bounds.lower.") + kAxis[a], std::to_string(lower[a]),
+                     "above the upper bound " + std::to_string(upper[a]));
+    }
+  }
+  f.up_axis = up;
+  f.rest_bounds = Aabb{lower, upper};
+  return f;
+}
+
 // A section viewed in place as T; a missing section is an error naming it.
 template <typename T>
 Expected<std::span<const T>> view_section(const PackReader& reader, SectionId id) {
@@ -476,6 +522,17 @@ SectionDecoder decoder(const PackReader& reader, SectionId id) {
 
 }  // namespace
 
+Expected<PackFraming> framing_of(const Model& model) {
+  PackFraming f;
+  f.rest_bounds = rest_bounds(model);
+  if (f.rest_bounds.is_empty()) {
+    return make_error(ErrorCode::kInvalidData, model.source, "rest_bounds", "empty",
+                      "the rest pose cannot be computed or skins no vertex");
+  }
+  f.up_axis = up_axis_of(f.rest_bounds);
+  return f;
+}
+
 bool is_pack_path(const std::string& path) {
   return path.size() >= 5 && path.compare(path.size() - 5, 5, ".pack") == 0;
 }
@@ -500,6 +557,13 @@ Expected<PackWriter> character_pack_writer(const PackContents& c) {
   }
   SINEW_RETURN_IF_ERROR(w.add_section(kPoseSpace, kSectionVersion, encode_pose_space(c.pose_space)));
   SINEW_RETURN_IF_ERROR(w.add_section(kProvenance, kSectionVersion, encode_provenance(c.provenance)));
+  PackFraming framing;
+  if (c.framing) {
+    framing = *c.framing;
+  } else {
+    SINEW_ASSIGN_OR_RETURN(framing, framing_of(*c.model));
+  }
+  SINEW_RETURN_IF_ERROR(w.add_section(kFraming, kSectionVersion, encode_framing(framing)));
   if (c.fuzzy != nullptr) {
     const rt::FuzzyCharacterData& f = *c.fuzzy;
     FuzzyHeader h{};
@@ -627,6 +691,16 @@ Expected<Pack> Pack::load(PackReader reader) {
   {
     SectionDecoder d = decoder(r, kProvenance);
     SINEW_ASSIGN_OR_RETURN(pack.provenance_, decode_provenance(d));
+  }
+  if (r.contains(kFraming)) {
+    SINEW_RETURN_IF_ERROR(check_version(r, kFraming));
+    SectionDecoder d = decoder(r, kFraming);
+    SINEW_ASSIGN_OR_RETURN(pack.framing_, decode_framing(d));
+    pack.framing_stored_ = true;
+  } else {
+    auto computed = framing_of(pack.model_);
+    if (!computed.ok()) return make_error(computed.status().code(), r.name(), "FRAM", "", computed.status().detail());
+    pack.framing_ = *computed;
   }
   // Cluster sections refine the fuzzy data: without its header, or without
   // the fuzzy data itself, they mean nothing, and ignoring them would hide a

@@ -27,6 +27,7 @@
 #include "character/model.h"
 #include "raytrace/fuzzy/fuzzy_character.h"
 #include "runtime/core/expected.h"
+#include "runtime/math/aabb.h"
 #include "runtime/pack/pack_reader.h"
 
 namespace sinew::character {
@@ -49,6 +50,19 @@ struct Provenance {
   double build_ms = 0.0;
 };
 
+// How a character stands (the FRAM section): the axis it stands along and
+// its bounds at the skeleton's rest pose, skinned, in model space: the
+// convention the mixer poses it in. Not the mesh as stored (its bind pose),
+// which an importer may keep in another orientation (CesiumMan's mesh is
+// Z-up, its posed skeleton Y-up).
+struct PackFraming {
+  Aabb rest_bounds;  // never empty in a pack that loads
+  int up_axis = 1;   // 1 (+Y) or 2 (+Z)
+};
+// The framing computed from the model (character/framing.h: rest_bounds,
+// up_axis_of). Errors: a rest pose that cannot be computed or bounds nothing.
+Expected<PackFraming> framing_of(const Model& model);
+
 // What goes into a pack. `fuzzy` null: a model-only pack.
 struct PackContents {
   const Model* model = nullptr;
@@ -56,6 +70,8 @@ struct PackContents {
   const rt::FuzzyCharacterData* fuzzy = nullptr;
   PoseSpaceRecord pose_space;
   Provenance provenance;
+  // Written as FRAM; empty: framing_of(*model).
+  std::optional<PackFraming> framing;
 };
 
 // The pack's bytes: the same contents give the same bytes.
@@ -85,6 +101,10 @@ class Pack {
   const rt::FuzzyBakeStats& fuzzy_stats() const { return stats_; }
   const PoseSpaceRecord& pose_space() const { return pose_space_; }
   const Provenance& provenance() const { return provenance_; }
+  // FRAM's framing, or, in a pack written before the section, framing_of
+  // the loaded model (framing_stored() false).
+  const PackFraming& framing() const { return framing_; }
+  bool framing_stored() const { return framing_stored_; }
   const PackReader& reader() const { return reader_; }
 
   Pack(Pack&&) noexcept = default;
@@ -102,6 +122,8 @@ class Pack {
   rt::FuzzyBakeStats stats_;
   PoseSpaceRecord pose_space_;
   Provenance provenance_;
+  PackFraming framing_;
+  bool framing_stored_ = false;
 };
 
 // True when `path` names a content pack by its extension (".pack").

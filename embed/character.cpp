@@ -1,7 +1,9 @@
 // sinew::api::Character over character::Pack.
+#include <cmath>
 #include <string>
 
 #include "animation/pose_space.h"
+#include "character/framing.h"
 #include "embed/api_errors.h"
 #include "embed/character_impl.h"
 #include "embed/convert.h"
@@ -87,6 +89,24 @@ Character::Bounds Character::bind_bounds() const noexcept {
   Aabb box;
   for (const Vec3& p : positions) box.extend(p);
   return {detail::to_api(box.lower), detail::to_api(box.upper)};
+}
+
+Character::Framing Character::framing(float aspect) const noexcept {
+  const character::PackFraming& stored = impl_->pack.framing();
+  const Aabb& box = stored.rest_bounds;
+  // A degenerate aspect (not finite or not positive) is taken as square.
+  if (!(aspect > 0.0f) || !std::isfinite(aspect)) aspect = 1.0f;
+  Framing f;
+  f.up_axis = stored.up_axis;
+  f.rest_bounds = {detail::to_api(box.lower), detail::to_api(box.upper)};
+  const rt::CameraDesc camera = character::default_camera(box, stored.up_axis, aspect);
+  f.camera.eye = detail::to_api(camera.eye);
+  f.camera.target = detail::to_api(camera.target);
+  f.camera.up = detail::to_api(camera.up);
+  f.camera.fovy_degrees = camera.fovy_degrees;
+  f.light.kind = Light::Kind::kPoint;
+  f.light.position = detail::to_api(character::default_light(box, stored.up_axis));
+  return f;
 }
 
 std::size_t Character::vertex_count() const noexcept { return impl_->model().mesh.vertex_count(); }

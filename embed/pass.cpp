@@ -248,6 +248,7 @@ Result<PassStats> RayTracePass::execute(World& world, const PassInputs& inputs, 
     PassStats stats;
     stats.prepare_ms = ms_since(start);
     stats.escaped_triangles = prepared->escaped_triangles;
+    stats.fallback_ms = prepared->fallback_ms;
     const auto rendered = impl_->renderer.render(scene, *camera, settings, buffers, jobs);
     if (!rendered.ok()) return bad(rendered.status().message());
     stats.trace_ms = rendered->trace_primary_ms + rendered->trace_shadow_ms;

@@ -18,8 +18,13 @@ bool draw_hud(const HudFrame& frame, const BakeInfo& bake, HudControls& controls
     ImGui::Text("%.1f fps   %dx%d", frame.fps, frame.width, frame.height);
     const double mrays = frame.trace_ms > 0.0 ? static_cast<double>(frame.rays) / (frame.trace_ms * 1e3) : 0.0;
     ImGui::Text("%.2f M rays/s traced (%.2f M rays)", mrays, static_cast<double>(frame.rays) * 1e-6);
-    ImGui::Text("characters %d (you: %d)   escaped triangles %zu", frame.characters, frame.player + 1,
-                frame.escaped_triangles);
+    ImGui::Text("characters %d (you: %d)", frame.characters, frame.player + 1);
+    ImGui::Text("escaped triangles %zu, fallback %.2f ms", frame.escaped_triangles, frame.fallback_ms);
+    if (frame.escaped_triangles > 0) {
+      // Poses outside the baked pose space: exact, through the fallback, at
+      // its cost (docs/EDITOR.md, "Why is my character slow?").
+      ImGui::TextColored(ImVec4(1.0f, 0.8f, 0.3f, 1.0f), "poses outside the bake: bake what you play");
+    }
     if (ImGui::CollapsingHeader("phases (ms, last frame)", ImGuiTreeNodeFlags_DefaultOpen)) {
       double total = 0.0;
       for (const auto& [name, ms] : frame.phases_ms) {

@@ -21,6 +21,7 @@ struct HudFrame {
   int characters = 0;
   int player = 0;
   std::size_t escaped_triangles = 0;  // in the last frame
+  double fallback_ms = 0.0;           // building their fallback trees, the last frame
   int width = 0;
   int height = 0;
 };

@@ -64,6 +64,7 @@ HudFrame hud_frame(const DemoSession& session, const FrameReport& report, const 
   h.characters = session.world().character_count();
   h.player = session.world().player();
   h.escaped_triangles = report.scene.escaped_triangles;
+  h.fallback_ms = report.scene.fallback_ms;
   h.width = session.width();
   h.height = session.height();
   return h;

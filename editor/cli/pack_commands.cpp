@@ -6,6 +6,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
@@ -322,7 +323,9 @@ class ScopedInterruptHandler {
 };
 
 // A bar with percent, phase and ETA on a terminal; plain lines otherwise
-// (one per phase and per 25%), so logs stay readable.
+// (one per phase and per 25%), so logs stay readable. The bake's fraction
+// never falls and its phases come in order, each once
+// (FuzzyBakeOptions::progress); the percentage printed never falls either.
 class ProgressReporter {
  public:
   explicit ProgressReporter(std::ostream& err)
@@ -331,7 +334,8 @@ class ProgressReporter {
   bool update(std::string_view phase, double fraction) {
     if (g_interrupted.load()) return false;
     const double seconds = std::chrono::duration<double>(Clock::now() - start_).count();
-    const int percent = static_cast<int>(fraction * 100.0);
+    const int percent = std::max(static_cast<int>(fraction * 100.0), last_percent_);
+    last_percent_ = percent;
     if (terminal_) {
       constexpr int kWidth = 30;
       const int filled = static_cast<int>(fraction * kWidth);
@@ -358,6 +362,7 @@ class ProgressReporter {
   Clock::time_point start_;
   std::string last_phase_;
   int next_percent_ = 0;
+  int last_percent_ = 0;
 };
 
 // SOURCE_DATE_EPOCH (reproducible-builds.org): a fixed bake date, and no
@@ -458,11 +463,81 @@ Json shown_all(const std::vector<std::string>& texts) {
   return out;
 }
 
+// A measured number for people: 3 significant digits, never an exponent
+// ("1.94", "23.2", "566", "0.0667", "131"; "1235" stays whole). With
+// `scale`, as many decimals as 3 significant digits of `scale` take (the
+// corners of a box to its size: 0.00 rather than -0.000000231).
+std::string number_text(double value, double scale = 0.0) {
+  if (!std::isfinite(value)) return value > 0 ? "inf" : value < 0 ? "-inf" : "nan";
+  if (value == 0.0 && scale == 0.0) return "0";
+  const double magnitude = scale > 0.0 ? scale : std::abs(value);
+  std::ostringstream text;
+  if (magnitude >= 100.0) {
+    text << std::fixed << std::setprecision(0) << value;
+  } else {
+    const int decimals = 2 - static_cast<int>(std::floor(std::log10(magnitude)));
+    text << std::fixed << std::setprecision(std::min(decimals, 12)) << value;
+  }
+  std::string t = text.str();
+  if (t[0] == '-' && t.find_first_of("123456789") == std::string::npos) t.erase(0, 1);  // no "-0.00"
+  return t;
+}
+
+// What each section holds, in a few words (docs/PACK_FORMAT.md has the
+// layouts); "" for a tag this build does not know.
+std::string_view section_meaning(std::string_view id) {
+  static constexpr std::pair<std::string_view, std::string_view> kMeanings[] = {
+      {"SKEL", "skeleton"},
+      {"MESH", "skinned mesh"},
+      {"CLIP", "animation clips"},
+      {"LIMT", "joint limits"},
+      {"POSE", "pose space baked over"},
+      {"PROV", "provenance"},
+      {"FRAM", "framing: up axis, rest bounds"},
+      {"FZHD", "fuzzy header"},
+      {"FTBN", "each triangle's bone"},
+      {"FBTR", "bone trees"},
+      {"FNOD", "kd-tree nodes"},
+      {"FBVN", "BVH nodes"},
+      {"FITM", "leaf items"},
+      {"FVCB", "escape checks per vertex"},
+      {"FVCK", "escape checks"},
+      {"FTCK", "triangle corners' checks"},
+      {"FCHD", "pose-cluster header"},
+      {"FCLB", "clusters per bone"},
+      {"FCLS", "pose clusters"},
+      {"FCKR", "check ranks"},
+      {"FCLX", "cluster boxes"},
+      {"FFBB", "feature bones per bone"},
+      {"FFBN", "feature bones"},
+      {"FCCN", "cluster centres"},
+  };
+  for (const auto& [tag, meaning] : kMeanings) {
+    if (tag == id) return meaning;
+  }
+  return "";
+}
+
+// A byte count for people: "83 bytes", "4.0 KiB", "872 KiB", "1.23 MiB".
+std::string size_text(std::uint64_t bytes) {
+  if (bytes < 1024) return std::to_string(bytes) + (bytes == 1 ? " byte" : " bytes");
+  const char* const units[] = {"KiB", "MiB", "GiB", "TiB"};
+  double value = static_cast<double>(bytes) / 1024.0;
+  int unit = 0;
+  while (value >= 1024.0 && unit < 3) {
+    value /= 1024.0;
+    ++unit;
+  }
+  return number_text(value) + " " + units[unit];
+}
+
 Json inspect_json(const character::Pack& pack) {
   const character::Model& m = pack.model();
   Json sections = Json::array();
   for (const SectionInfo& s : pack.reader().sections()) {
-    sections.push_back({{"id", shown(section_id_name(s.id))}, {"version", s.version}, {"bytes", s.size}});
+    const std::string id = section_id_name(s.id);
+    sections.push_back({{"id", shown(id)}, {"version", s.version}, {"bytes", s.size},
+                        {"holds", std::string(section_meaning(id))}});
   }
   Json clips = Json::array();
   for (const anim::Clip& c : m.clips) clips.push_back({{"name", shown(c.name())}, {"seconds", c.duration()}});
@@ -481,6 +556,12 @@ Json inspect_json(const character::Pack& pack) {
                       {"samples_requested", ps.desc.samples}, {"every_frame_30hz", ps.desc.every_frame_30hz},
                       {"seed", ps.desc.seed}, {"padding", ps.padding},
                       {"candidates", ps.candidates == rt::CandidateBones::kAll ? "all" : "influencing"}}},
+      {"framing", {{"up_axis", pack.framing().up_axis},
+                   {"rest_bounds", {{"min", {pack.framing().rest_bounds.lower.x, pack.framing().rest_bounds.lower.y,
+                                             pack.framing().rest_bounds.lower.z}},
+                                    {"max", {pack.framing().rest_bounds.upper.x, pack.framing().rest_bounds.upper.y,
+                                             pack.framing().rest_bounds.upper.z}}}},
+                   {"stored", pack.framing_stored()}}},
       {"provenance", {{"source", shown(p.source_name)}, {"source_xxh3", p.source_hash}, {"tool", shown(p.tool_version)},
                       {"bake_date", utc_text(p.bake_unix_time)}, {"bake_unix_time", p.bake_unix_time},
                       {"pose_sampling_ms", p.pose_sampling_ms}, {"sampling_ms", p.sampling_ms},
@@ -525,44 +606,113 @@ Json inspect_json(const character::Pack& pack) {
 }
 
 void print_inspect(const Json& j, std::ostream& out) {
-  out << j["file"].get<std::string>() << ": " << j["bytes"] << " bytes, pack format " << j["format_version"].get<std::string>()
-      << ", " << j["sections"].size() << " sections\n";
+  const auto num = [](const Json& v) { return number_text(v.get<double>()); };
+  out << j["file"].get<std::string>() << ": " << size_text(j["bytes"].get<std::uint64_t>()) << " ("
+      << j["bytes"] << " bytes), pack format " << j["format_version"].get<std::string>() << ", "
+      << j["sections"].size() << " sections\n";
   for (const Json& s : j["sections"]) {
-    out << "  " << s["id"].get<std::string>() << " v" << s["version"] << "  " << s["bytes"] << " bytes\n";
+    const std::string id = s["id"].get<std::string>();
+    const std::string_view meaning = section_meaning(id);
+    out << "  " << id << " v" << s["version"] << "  " << std::left << std::setw(10)
+        << size_text(s["bytes"].get<std::uint64_t>()) << std::right
+        << (meaning.empty() ? std::string() : "  " + std::string(meaning)) << "\n";
   }
   const Json& m = j["model"];
   out << "model: " << m["joints"] << " joints, " << m["vertices"] << " vertices, " << m["triangles"] << " triangles, "
       << m["materials"] << " materials, " << m["clips"].size() << " clips"
       << (m["joint_limits"].get<bool>() ? ", joint limits" : "") << "\n";
-  for (const Json& c : m["clips"]) out << "  clip " << c["name"].get<std::string>() << " (" << c["seconds"] << " s)\n";
+  for (const Json& c : m["clips"]) out << "  clip " << c["name"].get<std::string>() << " (" << num(c["seconds"]) << " s)\n";
+  const Json& fr = j["framing"];
+  double scale = 0.0;  // the box's largest coordinate: its corners to 3 significant digits of it
+  for (const char* c : {"min", "max"}) {
+    for (int a = 0; a < 3; ++a) scale = std::max(scale, std::abs(fr["rest_bounds"][c][a].get<double>()));
+  }
+  const auto corner = [&](const Json& v) {
+    const auto n = [&](int a) { return number_text(v[a].get<double>(), scale); };
+    return "(" + n(0) + ", " + n(1) + ", " + n(2) + ")";
+  };
+  out << "framing: stands along +" << (fr["up_axis"].get<int>() == 1 ? "Y" : "Z") << ", rest bounds "
+      << corner(fr["rest_bounds"]["min"]) << " to " << corner(fr["rest_bounds"]["max"])
+      << (fr["stored"].get<bool>() ? "" : " (computed: the pack predates FRAM)") << "\n";
   const Json& ps = j["pose_space"];
   std::string clip_names;
   for (const Json& c : ps["clips"]) clip_names += (clip_names.empty() ? " (" : ", ") + c.get<std::string>();
   if (!clip_names.empty()) clip_names += ")";
   out << "pose space: " << ps["mode"].get<std::string>() << clip_names << ", samples requested " << ps["samples_requested"]
-      << ", seed " << ps["seed"] << ", padding " << ps["padding"] << ", candidates "
+      << ", seed " << ps["seed"] << ", padding " << num(ps["padding"]) << ", candidates "
       << ps["candidates"].get<std::string>() << "\n";
   const Json& p = j["provenance"];
   out << "provenance: " << p["source"].get<std::string>() << " (xxh3 " << std::hex << p["source_xxh3"].get<std::uint64_t>()
       << std::dec << "), " << p["tool"].get<std::string>() << ", baked " << p["bake_date"].get<std::string>() << "\n"
-      << "bake times: pose sampling " << p["pose_sampling_ms"] << " ms, boxes " << p["sampling_ms"]
-      << " ms, assignment " << p["assignment_ms"] << " ms, trees " << p["build_ms"] << " ms\n";
+      << "bake times: pose sampling " << num(p["pose_sampling_ms"]) << " ms, boxes " << num(p["sampling_ms"])
+      << " ms, assignment " << num(p["assignment_ms"]) << " ms, trees " << num(p["build_ms"]) << " ms\n";
   if (j["fuzzy"].is_null()) {
     out << "fuzzy trees: none (a model-only pack)\n";
     return;
   }
   const Json& f = j["fuzzy"];
-  out << "fuzzy trees: " << f["pose_samples"] << " pose samples, fuzzy area " << f["fuzzy_area_ratio"]
-      << "x the rest pose's, " << f["triangles_per_leaf"] << " triangles per leaf, " << f["nodes"] << " nodes, depth "
-      << f["max_depth"] << " max / " << f["mean_leaf_depth"] << " mean leaf; "
+  out << "fuzzy trees: " << f["pose_samples"] << " pose samples, fuzzy area " << num(f["fuzzy_area_ratio"])
+      << "x the rest pose's, " << num(f["triangles_per_leaf"]) << " triangles per leaf, " << f["nodes"]
+      << " nodes, depth " << f["max_depth"] << " max / " << num(f["mean_leaf_depth"]) << " mean leaf; "
       << (f["merge_rigid_bones"].get<bool>() ? std::to_string(f["merged_bones"].get<std::uint32_t>()) +
                                                    " bones merged into their parents' trees"
                                              : std::string("rigid bones kept"))
       << "\n";
   if (f["clusters"].get<std::size_t>() > 0) {
     out << "pose-space clusters: " << f["clusters"] << " (up to " << f["clusters_per_bone"]
-        << " a bone), fuzzy area " << f["cluster_fuzzy_area_ratio"] << "x the rest pose's averaged over each bone's clusters\n";
+        << " a bone), fuzzy area " << num(f["cluster_fuzzy_area_ratio"])
+        << "x the rest pose's averaged over each bone's clusters\n";
   }
+}
+
+// "38.2%" (one decimal; "0%" for none, "< 0.1%" for a few).
+std::string percent_text(double share) {
+  if (share <= 0.0) return "0%";
+  if (share < 0.001) return "< 0.1%";
+  std::ostringstream text;
+  text << std::fixed << std::setprecision(1) << 100.0 * share << "%";
+  return text.str();
+}
+
+// Whether the pose space sampled `clip` (random spaces sample no clip).
+bool pose_space_has_clip(const anim::PoseSpaceDesc& space, const std::string& clip) {
+  switch (space.mode) {
+    case anim::PoseSpaceMode::kClips:
+      return space.clips.empty() || std::find(space.clips.begin(), space.clips.end(), clip) != space.clips.end();
+    case anim::PoseSpaceMode::kClip:
+      return !space.clips.empty() && space.clips.front() == clip;
+    default:
+      return false;
+  }
+}
+
+// No silent cliffs: how much of the rest pose, and of each clip the bake
+// was not given, lies outside the pose space just baked. Those triangles
+// render exactly, through the per-frame fallback tree, at its cost.
+constexpr std::size_t kReportPosesPerClip = 30;
+
+Status report_outside(const character::Model& model, const anim::PoseSpaceDesc& space,
+                      const rt::FuzzyCharacterView& fuzzy, JobSystem& jobs, std::ostream& out) {
+  SINEW_ASSIGN_OR_RETURN(const std::vector<Affine3> rest, character::rest_skinning(model));
+  SINEW_ASSIGN_OR_RETURN(const character::OutsideShare at_rest, character::triangles_outside(model, fuzzy, rest, jobs));
+  out << "rest pose: " << percent_text(at_rest.max) << " of triangles outside the pose space"
+      << (at_rest.max > 0.0 ? " (they will render through the fallback)" : "") << "\n";
+  bool any_outside = at_rest.max > 0.0;
+  for (const anim::Clip& clip : model.clips) {
+    if (pose_space_has_clip(space, clip.name())) continue;
+    SINEW_ASSIGN_OR_RETURN(const std::vector<Affine3> poses, character::clip_poses(model, clip, kReportPosesPerClip));
+    SINEW_ASSIGN_OR_RETURN(const character::OutsideShare share,
+                           character::triangles_outside(model, fuzzy, poses, jobs));
+    out << "clip " << shown(clip.name()) << " (not baked): " << percent_text(share.mean)
+        << " of triangles outside the pose space on average, " << percent_text(share.max) << " at worst over "
+        << share.poses << (share.poses == 1 ? " pose" : " poses") << "\n";
+    any_outside |= share.max > 0.0;
+  }
+  if (any_outside) {
+    out << "poses outside the pose space render exactly but slower, through a tree built each frame: "
+           "bake the poses you will play (docs/EDITOR.md, \"Why is my character slow?\")\n";
+  }
+  return {};
 }
 
 // The process's peak resident set so far (getrusage), in KiB; 0 if unknown.
@@ -686,6 +836,10 @@ int run_bake(const std::vector<std::string>& args, std::ostream& out, std::ostre
         << std::setprecision(3) << (st.rest_area > 0.0 ? st.cluster_fuzzy_area / st.rest_area : 0.0)
         << "x rest averaged over each bone's clusters, " << std::setprecision(0) << st.clustering_ms
         << " ms clustering and their boxes\n";
+  }
+  out << std::defaultfloat;
+  if (Status s = report_outside(*model, o.pose_space, bake->fuzzy.view(), jobs, out); !s.ok()) {
+    return fail(err, "bake", s);
   }
   if (whole) {
     SceneSavingsOptions run = o.scene_report_run;

@@ -116,6 +116,28 @@ Expected<character::Model> convert(const Ctx& c, const gltf_detail::ImageBytes& 
   gltf_detail::import_textures(c, images, out.material_names, out.mesh, out.warnings);
 
   SINEW_ASSIGN_OR_RETURN(out.clips, build_clips(c, plan, out.skeleton, raw_to_sorted));
+  // What bakes, but not as the file means it: one clear line each.
+  if (c.model.skins.empty()) {
+    out.warnings.push_back(c.file + ": skins: none: a static model; it bakes as rigid parts (" +
+                           std::to_string(out.skeleton.joint_count()) +
+                           (out.skeleton.joint_count() == 1 ? " bone" : " bones") +
+                           "), where a host's static mesh (World::add_static_mesh) needs no bake");
+  }
+  std::size_t morph_targets = 0;
+  std::string first_morph;
+  for (std::size_t m = 0; m < c.model.meshes.size(); ++m) {
+    const auto& prims = c.model.meshes[m].primitives;
+    for (std::size_t p = 0; p < prims.size(); ++p) {
+      if (prims[p].targets.empty()) continue;
+      if (first_morph.empty()) first_morph = idx(idx("meshes", m) + ".primitives", p) + ".targets";
+      morph_targets += prims[p].targets.size();
+    }
+  }
+  if (morph_targets > 0) {
+    out.warnings.push_back(c.file + ": " + first_morph + ": " + std::to_string(morph_targets) +
+                           " morph targets (all meshes), ignored with their weights' animation: Sinew deforms "
+                           "by bones only, so the meshes bake and render in their base shape");
+  }
   // Weights that do not sum to 1 are renormalised here, with a warning when
   // they were off by more than rounding (the rule all importers share).
   SINEW_RETURN_IF_ERROR(character::normalize_skin_weights(out));

@@ -25,9 +25,11 @@ int main(int argc, char** argv) {
   std::vector<unsigned char> rgba(kSize * kSize * 4);
   api::PassOutputs out;
   out.color_rgba8 = {rgba.data(), kSize * 4};  // the row pitch in bytes
-  const api::Light light;  // a white point light above and in front
-  api::PassInputs inputs;  // the default camera looks at a Y-up figure from +Z
-  inputs.lights = {&light, 1};
+  // The pack's framing: upright and in view whichever axis the model stands along.
+  const api::Character::Framing framing = character->framing(1.0f);  // a square image
+  api::PassInputs inputs;
+  inputs.camera = framing.camera;
+  inputs.lights = {&framing.light, 1};
   auto stats = pass->execute(*world, inputs, out);
   if (!stats) return fail(stats.error());
   std::ofstream ppm(argv[2], std::ios::binary);

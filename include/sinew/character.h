@@ -15,6 +15,7 @@
 #include "sinew/export.h"
 #include "sinew/math.h"
 #include "sinew/result.h"
+#include "sinew/view.h"
 
 namespace sinew::api {
 
@@ -51,6 +52,24 @@ class SINEW_API Character {
     Float3 max;
   };
   Bounds bind_bounds() const noexcept;
+
+  // How the character stands and how to look at it, in the convention the
+  // mixer poses it in (World::play_cycle and friends; model space, before
+  // the instance's placement). Unlike bind_bounds, which is the mesh as
+  // stored and may lie in another orientation (CesiumMan's mesh is Z-up
+  // while its posed skeleton is Y-up), these are the character skinned at
+  // its skeleton's rest pose. The pack records them (its FRAM section);
+  // packs baked before it get them computed on load.
+  struct Framing {
+    int up_axis = 1;     // 1: it stands along +Y; 2: along +Z (Cal3D characters usually); camera.up is that axis
+    Bounds rest_bounds;  // the rest pose's bounds
+    // Looks at the rest bounds' centre from the front, a little above,
+    // from far enough that their bounding sphere fits an image `aspect`
+    // (width / height) times as wide as high, with the up axis up; fovy 40.
+    Camera camera;
+    Light light;  // a white point light above, in front of and right of the character
+  };
+  Framing framing(float aspect = 1.0f) const noexcept;
 
   std::size_t vertex_count() const noexcept;
   std::size_t triangle_count() const noexcept;

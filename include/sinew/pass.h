@@ -25,6 +25,7 @@
 #include "sinew/math.h"
 #include "sinew/result.h"
 #include "sinew/tasks.h"
+#include "sinew/view.h"
 #include "sinew/world.h"
 
 namespace sinew::api {
@@ -80,20 +81,7 @@ struct PassDesc {
   int threads = 0;
 };
 
-struct Camera {  // a pinhole camera; y = 0 is the image's top row
-  Float3 eye{0.0f, 1.0f, 4.0f};
-  Float3 target{0.0f, 1.0f, 0.0f};
-  Float3 up{0.0f, 1.0f, 0.0f};
-  float fovy_degrees = 45.0f;
-};
-
-struct Light {
-  enum class Kind : std::uint8_t { kPoint, kDirectional };
-  Kind kind = Kind::kPoint;
-  Float3 position{4.0f, 8.0f, 6.0f};   // kPoint
-  Float3 direction{0.4f, 1.0f, 0.6f};  // kDirectional: towards the light
-  Float3 color{1.0f, 1.0f, 1.0f};      // linear RGB, no distance falloff
-};
+// Camera and Light: sinew/view.h (Character::framing suggests both).
 inline constexpr std::size_t kMaxLights = 8;
 
 struct PassInputs {
@@ -142,6 +130,12 @@ struct PassStats {
   std::uint64_t primary_rays = 0;
   std::uint64_t shadow_rays = 0;
   std::size_t escaped_triangles = 0;  // triangles outside their fuzzy boxes this frame
+  // Of prepare_ms: building the per-frame tree over the escaped triangles,
+  // what poses outside the baked pose space cost (0 inside it; the rays
+  // that enter that tree are in trace_ms). A large share of the frame says
+  // the character plays poses it was not baked over: bake them
+  // (docs/EDITOR.md, "Why is my character slow?").
+  double fallback_ms = 0.0;
 };
 
 class SINEW_API RayTracePass {

@@ -9,4 +9,5 @@
 #include "sinew/result.h"
 #include "sinew/tasks.h"
 #include "sinew/version.h"
+#include "sinew/view.h"
 #include "sinew/world.h"

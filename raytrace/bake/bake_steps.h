@@ -106,8 +106,9 @@ struct Samples {
 };
 
 // Calls grow(vertices, first_sample, last_sample) over all vertices for
-// batches of samples, reporting progress between batches (sweeps.cpp).
-Status sweep_samples(const Samples& samples, JobSystem& jobs, Progress& progress,
+// batches of samples, reporting progress as `phase` between batches
+// (sweeps.cpp).
+Status sweep_samples(const Samples& samples, JobSystem& jobs, Progress& progress, std::string_view phase,
                      const std::function<void(Range, std::size_t, std::size_t)>& grow);
 
 // ---------------------------------------------------------------------------

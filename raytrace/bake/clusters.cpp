@@ -83,7 +83,7 @@ ClusterMembers plan_clusters(const Samples& samples, std::uint32_t clusters_per_
 // cluster's samples, in the bone's frame (grow_check_boxes over a subset).
 Status grow_cluster_boxes(const Samples& samples, const ClusterMembers& members, float pad, JobSystem& jobs,
                           Progress& progress, FuzzyCharacterData& out) {
-  SINEW_RETURN_IF_ERROR(sweep_samples(samples, jobs, progress, [&](Range r, std::size_t s0, std::size_t s1) {
+  SINEW_RETURN_IF_ERROR(sweep_samples(samples, jobs, progress, "clusters", [&](Range r, std::size_t s0, std::size_t s1) {
     for (std::size_t v = r.begin; v < r.end; ++v) {
       const std::uint32_t first = out.vertex_check_begin[v], last = out.vertex_check_begin[v + 1];
       bool clustered = false;

@@ -194,7 +194,9 @@ Status assign_in_chunks(const Samples& samples, const BoneLists& candidates, con
     const auto assignment_start = Clock::now();
     assign_chunk(samples.mesh, candidates, chunk, best, jobs);
     stats.assignment_ms += ms_since(assignment_start);
-    SINEW_RETURN_IF_ERROR(progress.advance("assignment", 0.0));
+    // The assignment is part of the sampling phase: with bones in several
+    // chunks the two alternate, and the phases a user sees never go back.
+    SINEW_RETURN_IF_ERROR(progress.advance("sampling", 0.0));
   }
   memory.release(bytes_of(chunk.boxes));
   return {};

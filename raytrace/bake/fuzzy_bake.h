@@ -102,8 +102,11 @@ struct FuzzyBakeOptions {
   // Clear it for none at every size.
   bool fine_mesh_clusters = true;
   std::size_t memory_budget_bytes = std::size_t{256} << 20;
-  // Called from the calling thread with a phase name ("sampling",
-  // "assignment", "build") and the fraction of the whole bake done, in [0, 1].
+  // Called from the calling thread with a phase name and the fraction of
+  // the whole bake done, in [0, 1], never falling. The phases come in this
+  // order, each once: "sampling" (every candidate bone's boxes, and the
+  // choice of each triangle's bone), "checks" (the chosen bones' boxes, the
+  // escape checks), "clusters" (only when clustering), "build" (the trees).
   // Returning false cancels the bake (kCancelled).
   std::function<bool(std::string_view phase, double fraction)> progress;
 };

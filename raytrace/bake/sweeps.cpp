@@ -20,14 +20,14 @@ std::span<const std::uint16_t> within(std::span<const std::uint16_t> list, std::
 
 }  // namespace
 
-Status sweep_samples(const Samples& samples, JobSystem& jobs, Progress& progress,
+Status sweep_samples(const Samples& samples, JobSystem& jobs, Progress& progress, std::string_view phase,
                      const std::function<void(Range, std::size_t, std::size_t)>& grow) {
   const std::size_t count = samples.count();
   const std::size_t vertex_count = samples.mesh.vertex_count();
   for (std::size_t s0 = 0; s0 < count; s0 += kSamplesPerBatch) {
     const std::size_t s1 = std::min(count, s0 + kSamplesPerBatch);
     jobs.parallel_for(0, vertex_count, kVertexGrain, [&](Range r) { grow(r, s0, s1); });
-    SINEW_RETURN_IF_ERROR(progress.advance("sampling", static_cast<double>(s1 - s0)));
+    SINEW_RETURN_IF_ERROR(progress.advance(phase, static_cast<double>(s1 - s0)));
   }
   return {};
 }
@@ -35,7 +35,7 @@ Status sweep_samples(const Samples& samples, JobSystem& jobs, Progress& progress
 Status grow_chunk_boxes(const Samples& samples, const BoneLists& needs, BoxChunk& chunk, float pad,
                         JobSystem& jobs, Progress& progress) {
   std::fill(chunk.boxes.begin(), chunk.boxes.end(), Aabb::empty());
-  SINEW_RETURN_IF_ERROR(sweep_samples(samples, jobs, progress, [&](Range r, std::size_t s0, std::size_t s1) {
+  SINEW_RETURN_IF_ERROR(sweep_samples(samples, jobs, progress, "sampling", [&](Range r, std::size_t s0, std::size_t s1) {
     for (std::size_t v = r.begin; v < r.end; ++v) {
       const auto bones = within(needs.of(v), chunk.first, chunk.last);
       if (bones.empty()) continue;

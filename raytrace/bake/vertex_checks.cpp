@@ -25,7 +25,7 @@ void make_vertex_checks(const VertexTriangles& adj, std::span<const std::uint16_
 
 Status grow_check_boxes(const Samples& samples, float pad, JobSystem& jobs, Progress& progress,
                         FuzzyCharacterData& out) {
-  SINEW_RETURN_IF_ERROR(sweep_samples(samples, jobs, progress, [&](Range r, std::size_t s0, std::size_t s1) {
+  SINEW_RETURN_IF_ERROR(sweep_samples(samples, jobs, progress, "checks", [&](Range r, std::size_t s0, std::size_t s1) {
     for (std::size_t v = r.begin; v < r.end; ++v) {
       VertexCheck* first = out.vertex_checks.data() + out.vertex_check_begin[v];
       VertexCheck* last = out.vertex_checks.data() + out.vertex_check_begin[v + 1];

@@ -191,6 +191,7 @@ Expected<FrameStats> Scene::prepare_frame(const FrameOptions& options, JobSystem
   const double top_ms = ms_since(start);
   stats.top_level_objects = static_cast<std::uint32_t>(top_level_.objects().size());
   stats.top_level_nodes = top_level_.stats().node_count;
+  stats.fallback_ms = stats.escaped_triangles > 0 ? fallback_ms : 0.0;  // nothing escaped: no tree built
 
   if (timers) {
     timers->record("skinning", skinning_ms);

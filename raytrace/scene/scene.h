@@ -62,6 +62,11 @@ struct FrameStats {
   std::size_t cluster_misses = 0;     // bones whose cluster a vertex left: back on their full tree
   std::uint32_t top_level_objects = 0;
   std::uint32_t top_level_nodes = 0;
+  // Building the fallback trees over the escaped triangles (also the
+  // "fallback" phase of the timers): what poses outside the baked pose
+  // space cost before tracing (rays entering those trees are in the trace).
+  // 0 when nothing escaped.
+  double fallback_ms = 0.0;
 };
 
 // A static triangle mesh in world space (the arena's ground, obstacles).

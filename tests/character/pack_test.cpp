@@ -379,6 +379,53 @@ TEST_F(CorruptPack, TheRigidBoneFieldsRoundTripAndAreValidated) {
   expect_rejected(repack(header, [](auto& p) { overwrite(p, 29, std::uint8_t{1}); }), "FZHD.reserved");
 }
 
+// FRAM: byte 0 the up axis, 1-3 reserved, 4-15 the rest bounds' lower
+// corner, 16-27 the upper (docs/PACK_FORMAT.md).
+TEST_F(CorruptPack, TheFramingSectionRoundTripsAndIsValidated) {
+  const SectionId fram = make_section_id("FRAM");
+  auto pack = character::Pack::from_bytes(*bytes_, "pristine.pack");
+  ASSERT_TRUE(pack.ok()) << pack.status().message();
+  ASSERT_TRUE(pack->framing_stored());
+  // What the writer computed: the rest pose skinned vertex by vertex.
+  const auto skin = character::rest_skinning(baked_->model).value();
+  Aabb rest;
+  for (std::size_t v = 0; v < baked_->model.mesh.vertex_count(); ++v) {
+    Vec3 p(0.0f);
+    for (int k = 0; k < kMaxInfluences; ++k) {
+      p += baked_->model.mesh.weights[v][k] *
+           skin[baked_->model.mesh.joints[v][k]].transform_point(baked_->model.mesh.positions[v]);
+    }
+    rest.extend(p);
+  }
+  const float tolerance = 1e-5f * glm::length(rest.extent());
+  for (int a = 0; a < 3; ++a) {
+    EXPECT_NEAR(pack->framing().rest_bounds.lower[a], rest.lower[a], tolerance);
+    EXPECT_NEAR(pack->framing().rest_bounds.upper[a], rest.upper[a], tolerance);
+  }
+  EXPECT_EQ(pack->framing().up_axis, 1);  // the mannequin stands along +Y
+  // A framing the writer is given is stored as given.
+  character::PackContents given = contents_of(*baked_);
+  given.framing = character::PackFraming{Aabb{Vec3(-1.0f, -2.0f, -3.0f), Vec3(4.0f, 5.0f, 6.0f)}, 2};
+  auto given_bytes = character::serialize_pack(given);
+  ASSERT_TRUE(given_bytes.ok());
+  auto given_pack = character::Pack::from_bytes(*given_bytes, "given.pack");
+  ASSERT_TRUE(given_pack.ok()) << given_pack.status().message();
+  EXPECT_EQ(given_pack->framing().up_axis, 2);
+  EXPECT_EQ(given_pack->framing().rest_bounds.lower, Vec3(-1.0f, -2.0f, -3.0f));
+  EXPECT_EQ(given_pack->framing().rest_bounds.upper, Vec3(4.0f, 5.0f, 6.0f));
+
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  expect_rejected(repack(fram, [](auto& p) { overwrite(p, 0, std::uint8_t{0}); }), "FRAM.up_axis");
+  expect_rejected(repack(fram, [](auto& p) { overwrite(p, 0, std::uint8_t{3}); }), "FRAM.up_axis");
+  expect_rejected(repack(fram, [](auto& p) { overwrite(p, 2, std::uint8_t{1}); }), "FRAM.reserved");
+  expect_rejected(repack(fram, [&](auto& p) { overwrite(p, 1, nan); }), "FRAM.rest_bounds.lower.x");
+  expect_rejected(repack(fram, [](auto& p) { overwrite(p, 6, 2e9f); }), "FRAM.rest_bounds.upper.z");
+  expect_rejected(repack(fram, [](auto& p) { overwrite(p, 2, 1e6f); }), "FRAM.rest_bounds.lower.y");  // above upper.y
+  expect_rejected(repack(fram, [](auto& p) { p.pop_back(); }), "FRAM");
+  expect_rejected(repack(fram, [](auto& p) { p.push_back(std::byte{0}); }), "FRAM");
+  expect_rejected(testing_support::repack_section(*bytes_, fram, [](auto&) {}, 2u), "FRAM.version");
+}
+
 TEST_F(CorruptPack, KdNodeLinksOutsideTheTreeAreRefused) {
   // An inner node whose above child points past the bone's slice.
   std::size_t inner = 0;

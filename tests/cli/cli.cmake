@@ -23,6 +23,7 @@ endif()
 sinew_cli_convention_test(demo $<TARGET_FILE:sinew-demo> "" --frames nope "--frames = nope: expected an integer")
 sinew_cli_convention_test(image_diff $<TARGET_FILE:sinew-image-diff> "a.png b.png" --max-channel-diff 300
   "--max-channel-diff = 300: expected an integer from 0 to 255")
+sinew_cli_convention_test(frame_check $<TARGET_FILE:sinew-frame-check> "a.png" --turn 45 "--turn = 45")
 set(bench $<TARGET_FILE:sinew-bench>)
 foreach(benchmark animation bake demo embree paper raytrace report structures tradeoff)
   if(benchmark STREQUAL "report")

@@ -391,6 +391,10 @@ TEST(GltfImport, StaticModelImportsWithOneRootJoint) {
   EXPECT_EQ(m->skeleton.joint_count(), 1u);
   EXPECT_EQ(m->skeleton.names()[0], "<static>");
   EXPECT_EQ(m->mesh.triangle_count(), 12u);
+  // Never silently: one line says it is static, naming the file.
+  ASSERT_EQ(m->warnings.size(), 1u);
+  EXPECT_NE(m->warnings[0].find("BoxTextured.glb: skins: none: a static model"), std::string::npos) << m->warnings[0];
+  EXPECT_EQ(m->warnings[0].find('\n'), std::string::npos);
   EXPECT_EQ(m->mesh.uvs.size(), m->mesh.vertex_count());
   const auto skinned = pose_and_skin(*m, nullptr, 0.0f);
   for (std::size_t v = 0; v < skinned.size(); ++v) {
@@ -674,6 +678,25 @@ TEST_F(GltfSynthetic, ValidModelImportsRemapsJointsAndAnimates) {
   EXPECT_NEAR(p[1].x, -2.0f, 1e-5f);
   EXPECT_NEAR(p[1].y, 1.0f, 1e-5f);
   EXPECT_EQ(m->mesh.material_colors.size(), 1u);  // the default material
+  EXPECT_TRUE(m->warnings.empty()) << m->warnings.front();  // skinned, no morph targets
+}
+
+// Morph targets are not Sinew's (it deforms by bones): the import goes on
+// in the base shape, and says so in one line naming the first primitive.
+TEST_F(GltfSynthetic, MorphTargetsAreWarnedAboutInOneLine) {
+  Synthetic s = synthetic();
+  replace(s.json, "\"attributes\": {\"POSITION\": 0, \"JOINTS_0\": 1, \"WEIGHTS_0\": 2}",
+          "\"attributes\": {\"POSITION\": 0, \"JOINTS_0\": 1, \"WEIGHTS_0\": 2}, "
+          "\"targets\": [{\"POSITION\": 0}, {\"POSITION\": 0}]");
+  const std::string path = write(s);
+  const auto m = import_gltf(path);
+  ASSERT_TRUE(m.ok()) << m.status().message();
+  ASSERT_EQ(m->warnings.size(), 1u);
+  EXPECT_EQ(m->warnings[0], path + ": meshes[0].primitives[0].targets: 2 morph targets (all meshes), ignored with "
+                                   "their weights' animation: Sinew deforms by bones only, so the meshes bake and "
+                                   "render in their base shape");
+  // The base shape: the positions as stored.
+  EXPECT_EQ(m->mesh.positions[1], Vec3(1.0f, 2.0f, 0.0f));
 }
 
 TEST_F(GltfSynthetic, EightInfluencesSmallComponentsAndStride) {

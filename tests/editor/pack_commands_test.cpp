@@ -12,10 +12,13 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
+#include <regex>
 #include <atomic>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <functional>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -30,6 +33,7 @@
 #include "editor/import/model_loader.h"
 #include "runtime/io/mapped_file.h"
 #include "runtime/pack/checksum.h"
+#include "sinew/sinew.h"
 
 namespace sinew::editor {
 namespace {
@@ -108,6 +112,186 @@ TEST_F(PackCommands, BakeWritesAPackThatValidatesAndInspects) {
   EXPECT_NE(text.out.find("pose space: arbitrary"), std::string::npos) << text.out;
   EXPECT_NE(text.out.find("FBVN"), std::string::npos) << "the default bone trees are BVHs";
   EXPECT_EQ(text.out.find("FNOD"), std::string::npos);
+}
+
+// The share of triangles outside the pack's pose space in the poses a
+// world is given, measured through the public API (a mixer-driven instance
+// and the pass's escape count): independent of the bake's own report.
+double api_outside_share(const std::string& pack, const std::function<void(api::World&, api::InstanceId)>& pose) {
+  auto character = api::Character::load(pack);
+  EXPECT_TRUE(character.ok());
+  auto world = api::World::create();
+  auto instance = world->add_instance(*character);
+  pose(*world, *instance);
+  auto pass = api::RayTracePass::create({.width = 8, .height = 8, .outputs = api::Output::kDepth, .threads = 2});
+  std::vector<float> depth(64);
+  api::PassOutputs out;
+  out.depth = {depth.data(), 0};
+  const auto stats = pass->execute(*world, {}, out);
+  EXPECT_TRUE(stats.ok()) << stats.error().message;
+  return static_cast<double>(stats->escaped_triangles) / static_cast<double>(character->triangle_count());
+}
+
+// "NN.N%" after `prefix` in `text`, as a share (0 to 1); -1 when absent.
+double printed_share(const std::string& text, const std::string& prefix) {
+  const auto at = text.find(prefix);
+  if (at == std::string::npos) return -1.0;
+  const std::string value = text.substr(at + prefix.size());
+  if (value.rfind("< 0.1%", 0) == 0) return 0.0005;  // a few triangles
+  return std::stod(value) / 100.0;
+}
+
+// No silent cliffs: a bake of CesiumMan's one clip says how much of the
+// rest pose (where a host's idle instance stands) lies outside its pose
+// space; a bake of random poses says it for the clip it was not given too.
+TEST_F(PackCommands, TheBakeSaysHowMuchOfTheRestPoseAndOfEachClipNotGivenLiesOutside) {
+  const std::string dir = fresh_dir("outside");
+  const std::string pack = dir + "/cesium.pack";
+  const CommandRun bake = run(run_bake, {kCesiumMan, "-o", pack, "--threads", "2"});
+  ASSERT_EQ(bake.code, 0) << bake.err;
+  const double rest = printed_share(bake.out, "rest pose: ");
+  ASSERT_GE(rest, 0.0) << bake.out;
+  EXPECT_NE(bake.out.find("of triangles outside the pose space (they will render through the fallback)"),
+            std::string::npos) << bake.out;
+  const double rest_api = api_outside_share(pack, [](api::World&, api::InstanceId) {});  // at rest
+  EXPECT_GT(rest_api, 0.05) << "CesiumMan's rest pose (arms out) lies outside its walk";
+  EXPECT_NEAR(rest, rest_api, 0.0005 + 1e-9) << bake.out;
+  EXPECT_EQ(bake.out.find("(not baked)"), std::string::npos) << "its one clip was baked";
+  EXPECT_NE(bake.out.find("bake the poses you will play"), std::string::npos) << bake.out;
+
+  // 20 random poses: the clip was not given. Its poses every 1/30 s over
+  // its 2 s, at most 30 evenly spread: the report's mean and worst.
+  const std::string random_pack = dir + "/random.pack";
+  const CommandRun random = run(run_bake, {kCesiumMan, "-o", random_pack, "--pose-space", "arbitrary", "--samples",
+                                           "20", "--threads", "2"});
+  ASSERT_EQ(random.code, 0) << random.err;
+  auto character = api::Character::load(random_pack);
+  ASSERT_TRUE(character.ok());
+  ASSERT_EQ(character->clip_count(), 1u);
+  const std::string clip(character->clip_name(0));
+  const double duration = character->clip_duration(0);
+  const int poses = std::min(30, static_cast<int>(std::floor(duration * 30.0)) + 1);
+  double sum = 0.0, worst = 0.0;
+  for (int i = 0; i < poses; ++i) {
+    const double t = std::min(duration * i / (poses - 1), std::nextafter(duration, 0.0));
+    const double share = api_outside_share(random_pack, [&](api::World& w, api::InstanceId id) {
+      ASSERT_TRUE(w.pose_at(id, clip, t).ok());
+    });
+    sum += share;
+    worst = std::max(worst, share);
+  }
+  const std::string line = "clip " + clip + " (not baked): ";
+  const auto at = random.out.find(line);
+  ASSERT_NE(at, std::string::npos) << random.out;
+  EXPECT_NEAR(printed_share(random.out, line), sum / poses, 0.0005 + 1e-9) << random.out;
+  EXPECT_NEAR(printed_share(random.out.substr(at), "on average, "), worst, 0.0005 + 1e-9) << random.out;
+  EXPECT_NE(random.out.find("at worst over " + std::to_string(poses) + " poses"), std::string::npos) << random.out;
+}
+
+// A static glTF (no skin) bakes, with one warning line naming the file.
+TEST_F(PackCommands, AStaticGltfBakesWithOneWarningLine) {
+  const std::string box = "/usr/share/assimp/models/glTF2/BoxTextured-glTF-Binary/BoxTextured.glb";
+  if (!std::filesystem::exists(box)) GTEST_SKIP() << box << " not found (Debian's assimp test models)";
+  const std::string dir = fresh_dir("static");
+  const CommandRun bake = run(run_bake, {box, "-o", dir + "/box.pack", "--threads", "2"});
+  ASSERT_EQ(bake.code, 0) << bake.err;
+  std::size_t warnings = 0;
+  std::istringstream lines(bake.err);
+  for (std::string line; std::getline(lines, line);) {
+    if (line.rfind("sinew-editor bake: warning: ", 0) != 0) continue;
+    ++warnings;
+    EXPECT_NE(line.find("BoxTextured.glb: skins: none: a static model"), std::string::npos) << line;
+  }
+  EXPECT_EQ(warnings, 1u) << bake.err;
+}
+
+// Without a terminal the bake prints a line per phase and quarter. With
+// its bones in chunks (a small memory bound), sampling and assignment
+// alternate inside the bake; the lines still never go back: the percentage
+// never falls and no phase returns once another began.
+TEST_F(PackCommands, NonTerminalProgressNeverGoesBack) {
+  const std::string dir = fresh_dir("progress");
+  const CommandRun bake = run(run_bake, {kCesiumMan, "-o", dir + "/p.pack", "--max-memory-mib", "4", "--pose-clusters",
+                                         "2", "--threads", "2"});
+  ASSERT_EQ(bake.code, 0) << bake.err;
+  std::istringstream lines(bake.err);
+  std::vector<std::string> phases;
+  int last = -1, reports = 0;
+  for (std::string line; std::getline(lines, line);) {
+    if (line.rfind("bake: ", 0) != 0) continue;
+    ++reports;
+    const int percent = std::stoi(line.substr(6));
+    const auto space = line.find(' ', line.find('%'));
+    const std::string phase = line.substr(space + 1, line.find(" (") - space - 1);
+    EXPECT_GE(percent, last) << bake.err;
+    last = percent;
+    if (phases.empty() || phases.back() != phase) {
+      EXPECT_EQ(std::find(phases.begin(), phases.end(), phase), phases.end())
+          << "phase " << phase << " came back:\n" << bake.err;
+      phases.push_back(phase);
+    }
+  }
+  EXPECT_GE(reports, 5) << bake.err;
+  EXPECT_EQ(phases, (std::vector<std::string>{"sampling", "checks", "clusters", "build"})) << bake.err;
+  EXPECT_EQ(last, 100);
+}
+
+// inspect prints for people: sizes in KiB and MiB, measured numbers to 3
+// significant digits, and what each section tag holds. Each figure is
+// checked against the full-precision JSON.
+TEST_F(PackCommands, InspectPrintsHumanUnitsAndExplainsTheSections) {
+  const std::string dir = fresh_dir("inspect_units");
+  const std::string pack = dir + "/c.pack";
+  ASSERT_EQ(run(run_bake, {kCesiumMan, "-o", pack, "--threads", "2"}).code, 0);
+  const CommandRun text = run(run_inspect, {pack});
+  ASSERT_EQ(text.code, 0) << text.err;
+  const auto j = nlohmann::json::parse(run(run_inspect, {pack, "--json"}).out);
+  // A printed number equals the exact one to 3 significant digits.
+  const auto expect_3_digits = [&](const std::string& printed, double exact, const std::string& what) {
+    const double value = std::stod(printed);
+    const double unit = std::pow(10.0, std::floor(std::log10(std::abs(exact))) - 2);
+    EXPECT_LE(std::abs(value - exact), std::max(0.5, 0.5 + 1e-9) * std::max(unit, 1e-12) + 1e-9)
+        << what << ": " << printed << " for " << exact;
+    const std::string digits = std::regex_replace(printed, std::regex("[^0-9]"), "");
+    const std::string significant = std::regex_replace(digits, std::regex("^0+"), "");
+    EXPECT_LE(significant.size(), std::max<std::size_t>(3, std::to_string(static_cast<long long>(std::abs(value))).size()))
+        << what << ": " << printed;
+  };
+  std::smatch m;
+  // The file's size, then each section's: "872 KiB (892712 bytes)", "182 KiB", "28 bytes".
+  ASSERT_TRUE(std::regex_search(text.out, m, std::regex(R"(: ([0-9.]+) KiB \(([0-9]+) bytes\))"))) << text.out;
+  EXPECT_EQ(std::stoull(m[2].str()), j["bytes"].get<std::uint64_t>());
+  expect_3_digits(m[1].str(), j["bytes"].get<double>() / 1024.0, "file size");
+  for (const auto& s : j["sections"]) {
+    const std::string id = s["id"].get<std::string>();
+    const std::uint64_t bytes = s["bytes"].get<std::uint64_t>();
+    ASSERT_TRUE(std::regex_search(text.out, m, std::regex("  " + id + R"( v[0-9]+  ([0-9.]+) (bytes|KiB|MiB) +(.+)\n)")))
+        << id << "\n" << text.out;
+    if (bytes < 1024) {
+      EXPECT_EQ(m[1].str(), std::to_string(bytes)) << id;
+      EXPECT_EQ(m[2].str(), "bytes") << id;
+    } else {
+      EXPECT_EQ(m[2].str(), bytes < 1024 * 1024 ? "KiB" : "MiB") << id;
+      expect_3_digits(m[1].str(), static_cast<double>(bytes) / (bytes < 1024 * 1024 ? 1024.0 : 1024.0 * 1024.0), id);
+    }
+    EXPECT_FALSE(s["holds"].get<std::string>().empty()) << id;
+    EXPECT_EQ(m[3].str(), s["holds"].get<std::string>()) << id;
+  }
+  EXPECT_NE(text.out.find("  FRAM v1  28 bytes    framing: up axis, rest bounds\n"), std::string::npos) << text.out;
+  const auto& clip = j["model"]["clips"][0];
+  ASSERT_TRUE(std::regex_search(text.out, m, std::regex("clip " + clip["name"].get<std::string>() + R"( \(([0-9.]+) s\))")));
+  expect_3_digits(m[1].str(), clip["seconds"].get<double>(), "clip length");
+  ASSERT_TRUE(std::regex_search(text.out, m, std::regex(R"(fuzzy area ([0-9.]+)x the rest pose's, ([0-9.]+) triangles per leaf)")));
+  expect_3_digits(m[1].str(), j["fuzzy"]["fuzzy_area_ratio"].get<double>(), "fuzzy area");
+  expect_3_digits(m[2].str(), j["fuzzy"]["triangles_per_leaf"].get<double>(), "triangles per leaf");
+  ASSERT_TRUE(std::regex_search(text.out, m, std::regex(R"(boxes ([0-9.]+) ms)")));
+  expect_3_digits(m[1].str(), j["provenance"]["sampling_ms"].get<double>(), "boxes ms");
+  // CesiumMan stands along +Y as posed (docs/EMBEDDING.md, "Framing a character").
+  EXPECT_NE(text.out.find("framing: stands along +Y, rest bounds ("), std::string::npos) << text.out;
+  EXPECT_EQ(j["framing"]["up_axis"], 1);
+  EXPECT_TRUE(j["framing"]["stored"].get<bool>());
+  // No long decimals anywhere.
+  EXPECT_FALSE(std::regex_search(text.out, std::regex(R"([0-9]\.[0-9]{4,})"))) << text.out;
 }
 
 TEST_F(PackCommands, SourceDateEpochMakesBakesByteIdentical) {

@@ -150,8 +150,18 @@ TEST(ApiPass, PoseAtRendersWhatTheRendererRendersForThatClipPose) {
   EXPECT_GT(hit_pixels(ours), 300u);
   EXPECT_EQ(stats->primary_rays, static_cast<std::uint64_t>(kW * kH));
   EXPECT_GT(stats->shadow_rays, 0u);
-  // The idle-baked pack does not cover a walk: its escapes are reported.
+  // The idle-baked pack does not cover a walk: its escapes are reported,
+  // with the time their fallback tree took, a part of the prepare.
   EXPECT_GT(stats->escaped_triangles, 0u);
+  EXPECT_GT(stats->fallback_ms, 0.0);
+  EXPECT_LE(stats->fallback_ms, stats->prepare_ms);
+  // Inside the pose space (the idle clip it was baked over, at a key) nothing
+  // escapes and the fallback costs nothing.
+  ASSERT_TRUE(world->pose_at(*id, "idle", 0.0).ok());
+  const auto idle = pass.execute(*world, inputs_with(light), ours.outputs());
+  ASSERT_TRUE(idle.ok()) << idle.error().message;
+  EXPECT_EQ(idle->escaped_triangles, 0u);
+  EXPECT_EQ(idle->fallback_ms, 0.0);
 }
 
 TEST(ApiPass, TheMixerDrivesInstancesLikeTheAnimationSystem) {
