@@ -494,6 +494,7 @@ std::string_view section_meaning(std::string_view id) {
       {"POSE", "pose space baked over"},
       {"PROV", "provenance"},
       {"FRAM", "framing: up axis, rest bounds"},
+      {"TEXR", "material textures, their mip chains"},
       {"FZHD", "fuzzy header"},
       {"FTBN", "each triangle's bone"},
       {"FBTR", "bone trees"},

@@ -258,10 +258,11 @@ TEST_F(PackCommands, InspectPrintsHumanUnitsAndExplainsTheSections) {
         << what << ": " << printed;
   };
   std::smatch m;
-  // The file's size, then each section's: "872 KiB (892712 bytes)", "182 KiB", "28 bytes".
-  ASSERT_TRUE(std::regex_search(text.out, m, std::regex(R"(: ([0-9.]+) KiB \(([0-9]+) bytes\))"))) << text.out;
-  EXPECT_EQ(std::stoull(m[2].str()), j["bytes"].get<std::uint64_t>());
-  expect_3_digits(m[1].str(), j["bytes"].get<double>() / 1024.0, "file size");
+  // The file's size, then each section's: "11.2 MiB (11785856 bytes)", "182 KiB", "28 bytes".
+  ASSERT_TRUE(std::regex_search(text.out, m, std::regex(R"(: ([0-9.]+) (KiB|MiB) \(([0-9]+) bytes\))"))) << text.out;
+  EXPECT_EQ(std::stoull(m[3].str()), j["bytes"].get<std::uint64_t>());
+  expect_3_digits(m[1].str(), j["bytes"].get<double>() / (m[2].str() == "KiB" ? 1024.0 : 1024.0 * 1024.0),
+                  "file size");
   for (const auto& s : j["sections"]) {
     const std::string id = s["id"].get<std::string>();
     const std::uint64_t bytes = s["bytes"].get<std::uint64_t>();
