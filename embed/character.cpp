@@ -78,6 +78,18 @@ std::string_view Character::clip_name(std::size_t clip) const noexcept {
   return clip < clips.size() ? std::string_view(clips[clip].name()) : std::string_view();
 }
 
+std::size_t Character::material_count() const noexcept { return impl_->model().mesh.material_colors.size(); }
+
+std::string_view Character::material_name(std::size_t material) const noexcept {
+  const auto& names = impl_->model().material_names;
+  return material < names.size() ? std::string_view(names[material]) : std::string_view();
+}
+
+bool Character::material_has_texture(std::size_t material) const noexcept {
+  const auto& textured = impl_->model().mesh.material_texture;
+  return material < textured.size() && textured[material] != kNoTexture;
+}
+
 float Character::clip_duration(std::size_t clip) const noexcept {
   const auto& clips = impl_->model().clips;
   return clip < clips.size() ? clips[clip].duration() : 0.0f;

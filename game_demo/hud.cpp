@@ -46,6 +46,7 @@ bool draw_hud(const HudFrame& frame, const BakeInfo& bake, HudControls& controls
     if (ImGui::CollapsingHeader("settings", ImGuiTreeNodeFlags_DefaultOpen)) {
       changed |= ImGui::SliderInt("threads", &controls.threads, 1, controls.max_threads);
       changed |= ImGui::Checkbox("shadows", &controls.shadows);
+      changed |= ImGui::Checkbox("textures", &controls.textures);
       changed |= ImGui::Checkbox("watertight triangle test", &controls.watertight);
     }
   }

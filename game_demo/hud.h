@@ -31,6 +31,7 @@ struct HudControls {
   int threads = 1;
   int max_threads = 1;
   bool shadows = true;
+  bool textures = true;     // textured materials show their textures
   bool watertight = false;  // the watertight triangle test instead of the fast one
 };
 

@@ -83,6 +83,7 @@ Expected<WindowRunResult> run_window(DemoSession& session, std::unique_ptr<JobSy
   controls.threads = jobs->thread_count();
   controls.max_threads = std::max<int>(jobs->thread_count(), static_cast<int>(std::thread::hardware_concurrency()));
   controls.shadows = session.render_settings().shadows;
+  controls.textures = session.render_settings().textures;
   controls.watertight = session.render_settings().triangle_test == rt::TriangleTest::kWatertight;
   bool hud = options.hud;
   KeySnapshot previous_keys;
@@ -117,6 +118,7 @@ Expected<WindowRunResult> run_window(DemoSession& session, std::unique_ptr<JobSy
       imgui->begin_frame();
       if (hud && draw_hud(hud_frame(session, report, session.timers(), meter.fps()), session.bake_info(), controls)) {
         session.render_settings().shadows = controls.shadows;
+        session.render_settings().textures = controls.textures;
         session.render_settings().triangle_test =
             controls.watertight ? rt::TriangleTest::kWatertight : rt::TriangleTest::kFast;
         if (controls.threads != jobs->thread_count()) jobs = std::make_unique<JobSystem>(controls.threads);

@@ -45,6 +45,12 @@ class SINEW_API Character {
   std::string_view clip_name(std::size_t clip) const noexcept;  // "" past the end
   float clip_duration(std::size_t clip) const noexcept;         // seconds; 0 past the end
 
+  // Materials in the pack's order: the pass's material_id output and
+  // RayHit::material index them.
+  std::size_t material_count() const noexcept;
+  std::string_view material_name(std::size_t material) const noexcept;  // "" past the end or unnamed
+  bool material_has_texture(std::size_t material) const noexcept;        // false past the end
+
   // The mesh as stored (its bind pose), in model space: for framing a
   // camera, culling, or putting a ground under it.
   struct Bounds {

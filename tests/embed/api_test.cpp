@@ -13,6 +13,7 @@
 #include "animation/blend.h"
 #include "animation/mixer.h"
 #include "animation/pose.h"
+#include "runtime/image/texture.h"
 #include "runtime/pack/pack_format.h"
 #include "tests/embed/api_test_support.h"
 #include "tests/support/temp_dir.h"
@@ -90,6 +91,83 @@ TEST(ApiVersion, MatchesTheHeadersAndThePackFormat) {
   EXPECT_EQ(v.patch, SINEW_VERSION_PATCH);
   EXPECT_EQ(api::pack_format_version().major, kPackVersionMajor);
   EXPECT_EQ(api::pack_format_version().minor, kPackVersionMinor);
+}
+
+// The mannequin with uvs and its shirt (material 1) textured by a 4x4
+// checkerboard of red and blue, as a pack in memory. Each texel spans a
+// third of a metre or so: magnified in the test's view, so level 0.
+std::vector<std::byte> textured_mannequin_pack() {
+  testing_support::BakedModel m = testing_support::idle_mannequin();
+  SkinnedMesh& mesh = m.model.mesh;
+  for (const Vec3& p : mesh.positions) mesh.uvs.emplace_back(0.6f * p.x, 0.6f * p.y);
+  std::vector<float> checker;
+  for (int i = 0; i < 16; ++i) {
+    const bool red = (i % 4 + i / 4) % 2 == 0;
+    checker.insert(checker.end(), {red ? 1.0f : 0.0f, 0.0f, red ? 0.0f : 1.0f, 1.0f});
+  }
+  mesh.textures = {make_texture("checker", 4, 4, checker, TextureWrap::kRepeat, TextureWrap::kRepeat).value()};
+  mesh.material_texture.assign(mesh.material_colors.size(), kNoTexture);
+  mesh.material_texture[1] = 0;
+  character::PackContents contents;
+  contents.model = &m.model;
+  contents.fuzzy = &m.bake.fuzzy;
+  return character::serialize_pack(contents).value();
+}
+
+TEST(ApiCharacter, MaterialsAreNamedAndTexturedMaterialsShadeWithTheirTexture) {
+  const std::vector<std::byte> bytes = textured_mannequin_pack();
+  const auto c = api::Character::from_memory(bytes, "textured.pack");
+  ASSERT_TRUE(c.ok()) << c.error().message;
+  const character::Pack pack = open_mannequin_pack();
+  ASSERT_EQ(c->material_count(), pack.model().mesh.material_colors.size());
+  for (std::size_t m = 0; m < c->material_count(); ++m) {
+    EXPECT_EQ(c->material_name(m), m < pack.model().material_names.size() ? pack.model().material_names[m] : "");
+    EXPECT_EQ(c->material_has_texture(m), m == 1);
+  }
+  EXPECT_EQ(c->material_name(c->material_count()), "");
+  EXPECT_FALSE(c->material_has_texture(c->material_count()));
+
+  // Through the pass: the shirt's pixels blend the checker's red and blue
+  // at their uv (ambient light only: the colour is the albedo times 0.5).
+  auto world = api::World::create();
+  ASSERT_TRUE(world.ok());
+  ASSERT_TRUE(world->add_instance(*c).ok());
+  auto pass = api::RayTracePass::create(
+      {.width = kW, .height = kH, .outputs = api::Output::kColorRgba32f | api::Output::kUv | api::Output::kMaterialId});
+  ASSERT_TRUE(pass.ok());
+  Frame f(kW, kH);
+  api::PassInputs inputs;
+  inputs.camera = testing_support::test_camera();
+  inputs.ambient = {0.5f, 0.5f, 0.5f};
+  ASSERT_TRUE(pass->execute(*world, inputs, f.outputs()).ok());
+  int shirt = 0, checked = 0, reds = 0;  // reds: pixels mostly red
+  for (std::size_t p = 0; p < f.material_id.size(); ++p) {
+    if (f.material_id[p] != 1u) continue;
+    ++shirt;
+    // The bilinear blend of the checker at the pixel's uv, from the
+    // definition: texel centres at (i + 0.5) / 4, repeating.
+    const float x = f.uv[p].x * 4.0f - 0.5f, y = f.uv[p].y * 4.0f - 0.5f;
+    const float x0 = std::floor(x), y0 = std::floor(y);
+    float red_share = 0.0f;
+    for (int dy = 0; dy < 2; ++dy) {
+      for (int dx = 0; dx < 2; ++dx) {
+        const int tx = static_cast<int>(x0) + dx, ty = static_cast<int>(y0) + dy;
+        const bool red = (((tx % 4) + 4) % 4 + ((ty % 4) + 4) % 4) % 2 == 0;
+        const float w = (dx ? x - x0 : 1.0f - (x - x0)) * (dy ? y - y0 : 1.0f - (y - y0));
+        red_share += red ? w : 0.0f;
+      }
+    }
+    const Vec3 colour = pack.model().mesh.material_colors[1];
+    EXPECT_NEAR(f.rgba32f[4 * p], 0.5f * colour.x * red_share, 1e-3f) << "pixel " << p;
+    EXPECT_NEAR(f.rgba32f[4 * p + 2], 0.5f * colour.z * (1.0f - red_share), 1e-3f) << "pixel " << p;
+    ++checked;
+    const bool red = red_share > 0.5f;
+    reds += red ? 1 : 0;
+  }
+  EXPECT_GT(shirt, 200);
+  EXPECT_EQ(checked, shirt);
+  EXPECT_GT(reds, 10);
+  EXPECT_GT(checked - reds, 10);
 }
 
 TEST(ApiCharacter, DescribesThePack) {
