@@ -145,42 +145,23 @@ Result<PassStats> RayTracePass::execute(World& world, const PassInputs& inputs, 
     rt::FrameBuffers buffers;
     buffers.width = w;
     buffers.height = h;
-    if (wanted(Output::kColorRgba8)) {
-      buffers.color_rgba8 = host_span<std::uint8_t>(outputs.color_rgba8, 4, w, h);
-      buffers.row_pitch.color_rgba8 = outputs.color_rgba8.row_pitch;
-    }
-    if (wanted(Output::kColorRgba32f)) {
-      buffers.color_rgba32f = host_span<float>(outputs.color_rgba32f, 4, w, h);
-      buffers.row_pitch.color_rgba32f = outputs.color_rgba32f.row_pitch;
-    }
-    if (wanted(Output::kDepth)) {
-      buffers.depth = host_span<float>(outputs.depth, 1, w, h);
-      buffers.row_pitch.depth = outputs.depth.row_pitch;
-    }
-    if (wanted(Output::kNormal)) {
-      buffers.normal = host_span<Vec3>(outputs.normal, 1, w, h);
-      buffers.row_pitch.normal = outputs.normal.row_pitch;
-    }
-    if (wanted(Output::kInstanceId)) {
-      buffers.instance_id = host_span<std::uint32_t>(outputs.instance_id, 1, w, h);
-      buffers.row_pitch.instance_id = outputs.instance_id.row_pitch;
-    }
-    if (wanted(Output::kTriangleId)) {
-      buffers.triangle_id = host_span<std::uint32_t>(outputs.triangle_id, 1, w, h);
-      buffers.row_pitch.triangle_id = outputs.triangle_id.row_pitch;
-    }
-    if (wanted(Output::kUv)) {
-      buffers.uv = host_span<Vec2>(outputs.uv, 1, w, h);
-      buffers.row_pitch.uv = outputs.uv.row_pitch;
-    }
-    if (wanted(Output::kBarycentrics)) {
-      buffers.barycentric = host_span<Vec2>(outputs.barycentrics, 1, w, h);
-      buffers.row_pitch.barycentric = outputs.barycentrics.row_pitch;
-    }
-    if (wanted(Output::kMaterialId)) {
-      buffers.material_id = host_span<std::uint32_t>(outputs.material_id, 1, w, h);
-      buffers.row_pitch.material_id = outputs.material_id.row_pitch;
-    }
+    // Each requested output's span over the host's buffer, and its pitch.
+    const auto bind = [&]<class T>(Output o, const OutputBuffer& buffer, std::size_t channels, std::span<T>& span,
+                                   std::size_t& pitch) {
+      if (!wanted(o)) return;
+      span = host_span<T>(buffer, channels, w, h);
+      pitch = buffer.row_pitch;
+    };
+    rt::FrameBuffers::RowPitches& pitch = buffers.row_pitch;
+    bind(Output::kColorRgba8, outputs.color_rgba8, 4, buffers.color_rgba8, pitch.color_rgba8);
+    bind(Output::kColorRgba32f, outputs.color_rgba32f, 4, buffers.color_rgba32f, pitch.color_rgba32f);
+    bind(Output::kDepth, outputs.depth, 1, buffers.depth, pitch.depth);
+    bind(Output::kNormal, outputs.normal, 1, buffers.normal, pitch.normal);
+    bind(Output::kInstanceId, outputs.instance_id, 1, buffers.instance_id, pitch.instance_id);
+    bind(Output::kTriangleId, outputs.triangle_id, 1, buffers.triangle_id, pitch.triangle_id);
+    bind(Output::kUv, outputs.uv, 1, buffers.uv, pitch.uv);
+    bind(Output::kBarycentrics, outputs.barycentrics, 1, buffers.barycentric, pitch.barycentric);
+    bind(Output::kMaterialId, outputs.material_id, 1, buffers.material_id, pitch.material_id);
 
     // Inputs.
     const rt::CameraDesc camera_desc{detail::to_internal(inputs.camera.eye), detail::to_internal(inputs.camera.target),

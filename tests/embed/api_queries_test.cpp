@@ -532,37 +532,13 @@ TEST(ApiQueries, HitsCarryTheWindingNormalOfThePosedTriangleAndItsMaterial) {
 // vertex at bind pose, as a pack: a hit's UV is then the (x, y) of its
 // point carried back to bind pose.
 const std::string& uv_mannequin_pack_path() {
-  struct TemporaryPack {
-    std::string path;
-    TemporaryPack() {
-      testing_support::BakedModel baked;
-      baked.model = content::make_mannequin().value();
-      for (const Vec3& p : baked.model.mesh.positions) baked.model.mesh.uvs.push_back(Vec2(p.x, p.y));
-      character::BakeRequest request;
-      request.pose_space.mode = anim::PoseSpaceMode::kClip;
-      request.pose_space.clips = {"idle"};
-      request.pose_space.samples = 0;
-      request.pose_space.every_frame_30hz = false;
-      JobSystem jobs(2);
-      baked.bake = character::bake_in_memory(baked.model, request, jobs).value();
-      character::PackContents contents;
-      contents.model = &baked.model;
-      contents.fuzzy = &baked.bake.fuzzy;
-      contents.pose_space.desc = request.pose_space;
-      contents.provenance.source_name = "mannequin with uvs";
-      contents.provenance.tool_version = "api test";
-      path = (std::filesystem::temp_directory_path() /
-              ("sinew_api_test_uv_mannequin_" + std::to_string(::getpid()) + ".pack"))
-                 .string();
-      EXPECT_TRUE(character::write_pack(path, contents).ok());
-    }
-    ~TemporaryPack() {
-      std::error_code ignored;
-      std::filesystem::remove(path, ignored);
-    }
-  };
-  static const TemporaryPack pack;
-  return pack.path;
+  static const testing_support::BakedModel baked = [] {
+    character::Model model = content::make_mannequin().value();
+    for (const Vec3& p : model.mesh.positions) model.mesh.uvs.push_back(Vec2(p.x, p.y));
+    return testing_support::bake_over_idle(std::move(model));
+  }();
+  static const testing_support::TemporaryPackFile pack(baked, "uv_mannequin");
+  return pack.path();
 }
 
 TEST(ApiQueries, HitsCarryTheirUvAndTheNormalTurnsWithTheBones) {

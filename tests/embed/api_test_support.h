@@ -20,34 +20,41 @@
 
 namespace sinew::testing_support {
 
-// The idle-baked mannequin as a pack file: written once per test process
-// into the temporary folder, and removed when the process exits (ctest runs
-// each test in a process of its own, so a file left behind per process
-// filled the folder).
+// A baked model as a pack file in the temporary folder, removed when the
+// object is (a static one: when the process exits; ctest runs each test in
+// a process of its own, so a file left behind per process filled the
+// folder).
+class TemporaryPackFile {
+ public:
+  TemporaryPackFile(const BakedModel& baked, const std::string& stem) {
+    character::PackContents contents;
+    contents.model = &baked.model;
+    contents.fuzzy = &baked.bake.fuzzy;
+    contents.pose_space.desc.mode = anim::PoseSpaceMode::kClip;
+    contents.pose_space.desc.clips = {"idle"};
+    contents.provenance.source_name = stem;
+    contents.provenance.tool_version = "api test";
+    path_ = (std::filesystem::temp_directory_path() /
+             ("sinew_api_test_" + stem + "_" + std::to_string(::getpid()) + ".pack"))
+                .string();
+    EXPECT_TRUE(character::write_pack(path_, contents).ok());
+  }
+  ~TemporaryPackFile() {
+    std::error_code ignored;
+    std::filesystem::remove(path_, ignored);
+  }
+  TemporaryPackFile(const TemporaryPackFile&) = delete;
+  TemporaryPackFile& operator=(const TemporaryPackFile&) = delete;
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+};
+
+// The idle-baked mannequin as a pack file, written once per test process.
 inline const std::string& mannequin_pack_path() {
-  struct TemporaryPack {
-    std::string path;
-    TemporaryPack() {
-      const BakedModel& baked = idle_mannequin();
-      character::PackContents contents;
-      contents.model = &baked.model;
-      contents.fuzzy = &baked.bake.fuzzy;
-      contents.pose_space.desc.mode = anim::PoseSpaceMode::kClip;
-      contents.pose_space.desc.clips = {"idle"};
-      contents.provenance.source_name = "mannequin";
-      contents.provenance.tool_version = "api test";
-      path = (std::filesystem::temp_directory_path() /
-              ("sinew_api_test_mannequin_" + std::to_string(::getpid()) + ".pack"))
-                 .string();
-      EXPECT_TRUE(character::write_pack(path, contents).ok());
-    }
-    ~TemporaryPack() {
-      std::error_code ignored;
-      std::filesystem::remove(path, ignored);
-    }
-  };
-  static const TemporaryPack pack;
-  return pack.path;
+  static const TemporaryPackFile pack(idle_mannequin(), "mannequin");
+  return pack.path();
 }
 
 // The mannequin pack through the public API.

@@ -64,26 +64,18 @@ struct Image {
 // The mannequin with one white material textured by `image`, its uvs a
 // planar projection of its bind pose along z, baked over its idle clip.
 testing_support::BakedModel textured_mannequin(const Image& image) {
-  testing_support::BakedModel out;
-  out.model = content::make_mannequin().value();
-  SkinnedMesh& mesh = out.model.mesh;
+  character::Model model = content::make_mannequin().value();
+  SkinnedMesh& mesh = model.mesh;
   mesh.uvs.clear();
   for (const Vec3& p : mesh.positions) mesh.uvs.emplace_back(1.3f * p.x + 0.5f, 1.0f - 0.9f * p.y);
   mesh.triangle_material.assign(mesh.triangle_count(), 0);
   mesh.material_colors = {Vec3(1.0f)};
-  out.model.material_names = {"textured"};
+  model.material_names = {"textured"};
   mesh.material_texture = {0};
   mesh.textures = {make_texture("image", image.side, image.side, image.rgba(), TextureWrap::kRepeat,
                                 TextureWrap::kRepeat)
                        .value()};
-  character::BakeRequest request;
-  request.pose_space.mode = anim::PoseSpaceMode::kClip;
-  request.pose_space.clips = {"idle"};
-  request.pose_space.samples = 0;
-  request.pose_space.every_frame_30hz = false;
-  JobSystem jobs(2);
-  out.bake = character::bake_in_memory(out.model, request, jobs).value();
-  return out;
+  return testing_support::bake_over_idle(std::move(model));
 }
 
 struct Frame {

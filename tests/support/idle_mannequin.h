@@ -5,6 +5,7 @@
 #pragma once
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "animation/pose_space.h"
@@ -19,9 +20,10 @@ struct BakedModel {
   character::InMemoryBake bake;
 };
 
-inline BakedModel bake_idle_mannequin(rt::BoneTreeKind trees) {
+// `model` (the mannequin, or one made from it) baked over its idle clip's keys.
+inline BakedModel bake_over_idle(character::Model model, rt::BoneTreeKind trees = rt::BoneTreeKind::kKdTree) {
   BakedModel out;
-  out.model = content::make_mannequin().value();
+  out.model = std::move(model);
   character::BakeRequest request;
   request.pose_space.mode = anim::PoseSpaceMode::kClip;
   request.pose_space.clips = {"idle"};
@@ -33,6 +35,10 @@ inline BakedModel bake_idle_mannequin(rt::BoneTreeKind trees) {
   JobSystem jobs(2);
   out.bake = character::bake_in_memory(out.model, request, jobs).value();
   return out;
+}
+
+inline BakedModel bake_idle_mannequin(rt::BoneTreeKind trees) {
+  return bake_over_idle(content::make_mannequin().value(), trees);
 }
 
 // With the default kd-trees, or with BVH bone trees.
