@@ -142,6 +142,10 @@ struct PassStats {
   std::uint64_t primary_rays = 0;
   std::uint64_t shadow_rays = 0;
   std::size_t escaped_triangles = 0;  // triangles outside their fuzzy boxes this frame
+  // Instances skinned for the frame, and those left out because none of its
+  // camera or shadow rays can reach them (their poses still advance).
+  std::size_t skinned_instances = 0;
+  std::size_t culled_instances = 0;
 };
 
 class SINEW_API RayTracePass {

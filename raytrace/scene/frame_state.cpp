@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "raytrace/fuzzy/pose_clusters.h"
 #include "runtime/jobs/job_system.h"
@@ -46,6 +47,59 @@ EscapeCheckInput escape_input(InstanceFrame& frame, const FuzzyCharacterView& fu
 }
 
 }  // namespace
+
+InfluenceBounds influence_bounds(const SkinnedMesh& mesh, std::size_t bone_count) {
+  InfluenceBounds out;
+  out.bone_rest_boxes.assign(bone_count, Aabb::empty());
+  const std::size_t vertices = std::min({mesh.positions.size(), mesh.joints.size(), mesh.weights.size()});
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (std::size_t v = 0; v < vertices; ++v) {
+    double sum = 0.0;
+    for (std::size_t k = 0; k < static_cast<std::size_t>(kMaxInfluences); ++k) {
+      const float w = mesh.weights[v][k];
+      // The kernels skip a slot whose weight compares equal to zero.
+      if (w == 0.0f) continue;
+      sum += static_cast<double>(w);
+      const std::size_t bone = mesh.joints[v][k];
+      if (bone < bone_count) out.bone_rest_boxes[bone].extend(mesh.positions[v]);
+    }
+    lo = std::min(lo, sum);
+    hi = std::max(hi, sum);
+  }
+  if (vertices > 0) {
+    // Outward to float.
+    out.weight_sum_lo = std::nextafter(static_cast<float>(lo), -std::numeric_limits<float>::infinity());
+    out.weight_sum_hi = std::nextafter(static_cast<float>(hi), std::numeric_limits<float>::infinity());
+    out.weight_sum_lo = std::max(out.weight_sum_lo, 0.0f);
+  }
+  return out;
+}
+
+Aabb instance_bounds(std::span<const Affine3> skinning, const InfluenceBounds& bounds) {
+  Aabb carried = Aabb::empty();
+  const std::size_t bones = std::min(skinning.size(), bounds.bone_rest_boxes.size());
+  for (std::size_t b = 0; b < bones; ++b) {
+    if (!bounds.bone_rest_boxes[b].is_empty()) carried.extend(transform(skinning[b], bounds.bone_rest_boxes[b]));
+  }
+  Aabb out = Aabb::empty();
+  if (!carried.is_empty()) {
+    // Weight sums in [lo, hi] scale the carried box per axis: the interval
+    // product's ends.
+    for (int a = 0; a < 3; ++a) {
+      const float ends[4] = {bounds.weight_sum_lo * carried.lower[a], bounds.weight_sum_lo * carried.upper[a],
+                             bounds.weight_sum_hi * carried.lower[a], bounds.weight_sum_hi * carried.upper[a]};
+      out.lower[a] = std::min({ends[0], ends[1], ends[2], ends[3]});
+      out.upper[a] = std::max({ends[0], ends[1], ends[2], ends[3]});
+    }
+    // Skinning sums a few weighted products per coordinate: its rounding is
+    // a few units of 2^-24 of the largest, far inside this.
+    out = grown(out, 64.0f * kFrameRelativeSlack * std::max(bounds.weight_sum_hi, 1.0f) * max_abs(carried) +
+                         std::numeric_limits<float>::min());
+  }
+  // A vertex without weights skins to the origin.
+  if (bounds.weight_sum_lo == 0.0f) out.extend(Vec3(0.0f));
+  return out;
+}
 
 void update_bone_frames(InstanceFrame& frame, const FuzzyCharacterView& fuzzy) {
   const std::size_t bones = frame.skinning.size();

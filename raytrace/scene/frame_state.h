@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "raytrace/accel/kd_tree.h"
@@ -27,6 +28,13 @@ struct InstanceFrame {
   bool live = true;               // false once removed (Scene::remove): its data is freed
   // Queries skip the instance when (mask & ray mask) == 0 (Scene::set_mask).
   std::uint32_t mask = kAllMaskBits;
+  // Culled this frame (FrameOptions::visibility): no ray of the frame can
+  // reach it, so nothing below but `skinning` and `bounds` is current and
+  // the top level leaves it out.
+  bool culled = false;
+  // This frame's conservative world bounds (instance_bounds), computed when
+  // the frame is culled by visibility; empty otherwise.
+  Aabb bounds;
 
   std::vector<Affine3> skinning;         // per bone: bind pose -> world
   std::vector<Affine3> bone_from_world;  // per bone: the inverse (the bone frame)
@@ -74,6 +82,23 @@ struct InstanceFrame {
   std::size_t escaped_checks = 0;
   std::size_t singular_bones = 0;
 };
+
+// What bounds a character's skinned vertices in any pose: per bone, the box
+// of the rest positions of the vertices it weights, and the range of the
+// vertices' weight sums (1 for normalised weights).
+struct InfluenceBounds {
+  std::vector<Aabb> bone_rest_boxes;
+  float weight_sum_lo = 1.0f;
+  float weight_sum_hi = 1.0f;
+};
+InfluenceBounds influence_bounds(const SkinnedMesh& mesh, std::size_t bone_count);
+
+// A box holding every vertex of the instance skinned by `skinning`, in any
+// pose, escaped or not: a skinned vertex is sum_j w_j S_j p with weights >= 0,
+// so it lies in its weight sum times the box of the S_j-carried rest boxes
+// of the bones weighting it; grown for the rounding of skinning. One box
+// transform per bone, no vertex read.
+Aabb instance_bounds(std::span<const Affine3> skinning, const InfluenceBounds& bounds);
 
 // Relative slack for float rounding in bone-frame computations: a few units
 // in the last place of the magnitudes involved.

@@ -1,6 +1,8 @@
 #include "raytrace/scene/scene.h"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <string>
 #include <utility>
 
@@ -22,6 +24,12 @@ KdBuildOptions within_traversal_depth(KdBuildOptions options) {
 }
 
 
+float max_abs(const Aabb& box) {
+  if (box.is_empty()) return 0.0f;
+  return std::max({std::fabs(box.lower.x), std::fabs(box.lower.y), std::fabs(box.lower.z), std::fabs(box.upper.x),
+                   std::fabs(box.upper.y), std::fabs(box.upper.z)});
+}
+
 }  // namespace
 
 Scene::Scene() = default;
@@ -34,7 +42,7 @@ Expected<std::uint32_t> Scene::add_character(const SkinnedMesh& mesh, const Fuzz
   PackedInfluences influences = pack_influences(mesh);
   std::vector<std::uint16_t> rigid =
       find_rigid_check_blocks(mesh, influences, fuzzy.vertex_check_begin, fuzzy.vertex_checks, fuzzy.check_rank);
-  characters_.push_back({&mesh, fuzzy, std::move(influences), std::move(rigid)});
+  characters_.push_back({&mesh, fuzzy, std::move(influences), std::move(rigid), influence_bounds(mesh, fuzzy.bone_count)});
   return static_cast<std::uint32_t>(characters_.size() - 1);
 }
 
@@ -128,16 +136,67 @@ Status Scene::set_bones(std::uint32_t instance, std::span<const Affine3> skinnin
   return {};
 }
 
+void Scene::cull_instances(const FrameOptions& options) {
+  bool usable = false;
+  if (options.visibility) {
+    float magnitude = 0.0f;
+    for (InstanceFrame& frame : instances_) {
+      if (!frame.live) continue;
+      frame.bounds = instance_bounds(frame.skinning, characters_[frame.character].influence_bounds);
+      magnitude = std::max(magnitude, max_abs(frame.bounds));
+    }
+    for (const StaticMesh& mesh : statics_) {
+      if (mesh.live && !mesh.tree.nodes.empty()) magnitude = std::max(magnitude, max_abs(mesh.tree.bounds));
+    }
+    usable = cull_.begin(*options.visibility, magnitude);
+  }
+  if (!usable) {
+    for (InstanceFrame& frame : instances_) {
+      frame.culled = false;
+      if (!options.visibility) frame.bounds = Aabb::empty();
+    }
+    return;
+  }
+  // Camera rays first; then shadow rays, which start on what the camera
+  // sees: the static meshes and the instances in view.
+  Aabb in_view = Aabb::empty();
+  for (InstanceFrame& frame : instances_) {
+    if (!frame.live) continue;
+    frame.culled = !cull_.in_view(frame.bounds);
+    if (!frame.culled) in_view.extend(frame.bounds);
+  }
+  cull_.add_receivers(in_view);
+  for (const StaticMesh& mesh : statics_) {
+    if (mesh.live && !mesh.tree.nodes.empty()) cull_.add_receivers(mesh.tree.bounds);
+  }
+  cull_.finish_receivers();
+  for (InstanceFrame& frame : instances_) {
+    if (frame.live && frame.culled) frame.culled = !cull_.casts_into_view(frame.bounds);
+  }
+}
+
 Expected<FrameStats> Scene::prepare_frame(const FrameOptions& options, JobSystem& jobs,
                                           PhaseTimers* timers) {
   FrameStats stats;
   double skinning_ms = 0.0;
   double boxes_ms = 0.0;
   double fallback_ms = 0.0;
+  auto start = std::chrono::steady_clock::now();
+  cull_instances(options);  // timed as skinning's, the step it skips
+  skinning_ms += ms_since(start);
   for (InstanceFrame& frame : instances_) {
     if (!frame.live) continue;
+    if (frame.culled) {
+      ++stats.culled_instances;
+      frame.bone_world_boxes.assign(frame.skinning.size(), Aabb::empty());
+      frame.escaped_triangles.clear();
+      frame.fallback = KdTree{};
+      frame.escaped_checks = frame.singular_bones = frame.cluster_bones = frame.cluster_misses = 0;
+      continue;
+    }
+    ++stats.skinned_instances;
     const Character& character = characters_[frame.character];
-    auto start = std::chrono::steady_clock::now();
+    start = std::chrono::steady_clock::now();
     update_bone_frames(frame, character.fuzzy);
     choose_bone_clusters(frame, character.fuzzy, options.pose_clusters);
     skin_instance(frame, *character.mesh, character.influences, character.fuzzy, character.rigid_blocks,
@@ -166,11 +225,11 @@ Expected<FrameStats> Scene::prepare_frame(const FrameOptions& options, JobSystem
     stats.cluster_misses += frame.cluster_misses;
   }
 
-  const auto start = std::chrono::steady_clock::now();
+  start = std::chrono::steady_clock::now();
   std::vector<TopLevelObject> objects = top_level_.take_objects();
   for (std::uint32_t i = 0; i < instances_.size(); ++i) {
     const InstanceFrame& frame = instances_[i];
-    if (!frame.live) continue;
+    if (!frame.live || frame.culled) continue;
     const FuzzyCharacterView& fuzzy = characters_[frame.character].fuzzy;
     for (std::uint32_t b = 0; b < fuzzy.bone_count; ++b) {
       if (fuzzy.bone_trees[b].triangle_count == 0 || fuzzy.bone_trees[b].node_count == 0 ||
