@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <string>
 #include <utility>
 
@@ -136,43 +137,66 @@ Status Scene::set_bones(std::uint32_t instance, std::span<const Affine3> skinnin
   return {};
 }
 
-void Scene::cull_instances(const FrameOptions& options) {
-  bool usable = false;
-  if (options.visibility) {
-    float magnitude = 0.0f;
-    for (InstanceFrame& frame : instances_) {
-      if (!frame.live) continue;
-      frame.bounds = instance_bounds(frame.skinning, characters_[frame.character].influence_bounds);
-      magnitude = std::max(magnitude, max_abs(frame.bounds));
-    }
-    for (const StaticMesh& mesh : statics_) {
-      if (mesh.live && !mesh.tree.nodes.empty()) magnitude = std::max(magnitude, max_abs(mesh.tree.bounds));
-    }
-    usable = cull_.begin(*options.visibility, magnitude);
-  }
-  if (!usable) {
+Status Scene::cull_instances(const FrameOptions& options) {
+  const bool by_rays = !options.rays.empty();
+  if (!options.visibility && !by_rays) {
     for (InstanceFrame& frame : instances_) {
       frame.culled = false;
-      if (!options.visibility) frame.bounds = Aabb::empty();
+      frame.bounds = Aabb::empty();
     }
-    return;
+    return {};
   }
-  // Camera rays first; then shadow rays, which start on what the camera
-  // sees: the static meshes and the instances in view.
-  Aabb in_view = Aabb::empty();
+  float magnitude = 0.0f;
   for (InstanceFrame& frame : instances_) {
+    frame.culled = false;
     if (!frame.live) continue;
-    frame.culled = !cull_.in_view(frame.bounds);
-    if (!frame.culled) in_view.extend(frame.bounds);
+    frame.bounds = instance_bounds(frame.skinning, characters_[frame.character].influence_bounds);
+    magnitude = std::max(magnitude, max_abs(frame.bounds));
   }
-  cull_.add_receivers(in_view);
   for (const StaticMesh& mesh : statics_) {
-    if (mesh.live && !mesh.tree.nodes.empty()) cull_.add_receivers(mesh.tree.bounds);
+    if (mesh.live && !mesh.tree.nodes.empty()) magnitude = std::max(magnitude, max_abs(mesh.tree.bounds));
   }
-  cull_.finish_receivers();
-  for (InstanceFrame& frame : instances_) {
-    if (frame.live && frame.culled) frame.culled = !cull_.casts_into_view(frame.bounds);
+  if (options.visibility && !cull_.begin(*options.visibility, magnitude)) return {};  // nothing culled
+  // From here an instance is culled unless some ray can reach it.
+  for (InstanceFrame& frame : instances_) frame.culled = frame.live;
+  if (options.visibility) {
+    // Camera rays first; then shadow rays, which start on what the camera
+    // sees: the static meshes and the instances in view.
+    Aabb in_view = Aabb::empty();
+    for (InstanceFrame& frame : instances_) {
+      if (!frame.live || !cull_.in_view(frame.bounds)) continue;
+      frame.culled = false;
+      in_view.extend(frame.bounds);
+    }
+    cull_.add_receivers(in_view);
+    for (const StaticMesh& mesh : statics_) {
+      if (mesh.live && !mesh.tree.nodes.empty()) cull_.add_receivers(mesh.tree.bounds);
+    }
+    cull_.finish_receivers();
+    for (InstanceFrame& frame : instances_) {
+      if (frame.culled && cull_.casts_into_view(frame.bounds)) frame.culled = false;
+    }
   }
+  if (by_rays) {
+    // A hit rounds relative to the ray's origin and the triangle, which
+    // lies in its instance's bounds.
+    float scale = magnitude;
+    for (const Ray& ray : options.rays) {
+      const float origin = std::max({std::fabs(ray.origin.x), std::fabs(ray.origin.y), std::fabs(ray.origin.z)});
+      if (std::isfinite(origin)) scale = std::max(scale, origin);
+    }
+    const double margin = FrameCull::kRelativeMargin * static_cast<double>(scale) +
+                          static_cast<double>(std::numeric_limits<float>::min());
+    reach_boxes_.resize(instances_.size());
+    for (std::size_t i = 0; i < instances_.size(); ++i) {
+      reach_boxes_[i] = instances_[i].culled ? instances_[i].bounds : Aabb::empty();
+    }
+    SINEW_RETURN_IF_ERROR(reach_.mark(options.rays, reach_boxes_, margin, reached_));
+    for (std::size_t i = 0; i < instances_.size(); ++i) {
+      if (reached_[i]) instances_[i].culled = false;
+    }
+  }
+  return {};
 }
 
 Expected<FrameStats> Scene::prepare_frame(const FrameOptions& options, JobSystem& jobs,
@@ -182,7 +206,7 @@ Expected<FrameStats> Scene::prepare_frame(const FrameOptions& options, JobSystem
   double boxes_ms = 0.0;
   double fallback_ms = 0.0;
   auto start = std::chrono::steady_clock::now();
-  cull_instances(options);  // timed as skinning's, the step it skips
+  SINEW_RETURN_IF_ERROR(cull_instances(options));  // timed as skinning's, the step it skips
   skinning_ms += ms_since(start);
   for (InstanceFrame& frame : instances_) {
     if (!frame.live) continue;

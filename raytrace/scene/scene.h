@@ -19,6 +19,7 @@
 #include "raytrace/accel/top_level.h"
 #include "raytrace/fuzzy/fuzzy_character.h"
 #include "raytrace/scene/frame_state.h"
+#include "raytrace/scene/ray_reach.h"
 #include "raytrace/scene/visibility.h"
 #include "raytrace/skinning/skinning.h"
 #include "runtime/core/expected.h"
@@ -60,6 +61,12 @@ struct FrameOptions {
   // only their conservative bounds are computed (InstanceFrame::culled).
   // Unset: every instance is prepared, as queries from anywhere need.
   std::optional<FrameVisibility> visibility;
+  // The rays a batch of queries will trace (the API's World::intersect and
+  // occluded over a span), kept by the caller for the call: with them, only
+  // the instances some ray's segment reaches are prepared, lazy skinning
+  // (with a visibility as well, those either one reaches). Traversals of
+  // other rays may then miss culled instances.
+  std::span<const Ray> rays;
 };
 
 struct FrameStats {
@@ -69,7 +76,7 @@ struct FrameStats {
   std::size_t cluster_bones = 0;      // bones traversed with a pose-space cluster's tree
   std::size_t cluster_misses = 0;     // bones whose cluster a vertex left: back on their full tree
   std::uint32_t skinned_instances = 0;  // instances skinned and checked this frame
-  std::uint32_t culled_instances = 0;   // instances no ray of FrameOptions::visibility can reach
+  std::uint32_t culled_instances = 0;   // instances no ray of FrameOptions::visibility or rays can reach
   std::uint32_t top_level_objects = 0;
   std::uint32_t top_level_nodes = 0;
 };
@@ -160,11 +167,14 @@ class Scene {
   std::vector<InstanceFrame> instances_;
   std::vector<StaticMesh> statics_;
   std::vector<ObjectSlot> slots_;
-  // Marks each live instance culled or not (FrameOptions::visibility).
-  void cull_instances(const FrameOptions& options);
+  // Marks each live instance culled or not (FrameOptions::visibility, rays).
+  Status cull_instances(const FrameOptions& options);
 
   TopLevel top_level_;
   FrameCull cull_;
+  RayReach reach_;
+  std::vector<Aabb> reach_boxes_;       // per instance: its bounds (empty when removed)
+  std::vector<std::uint8_t> reached_;  // per instance: a query ray reaches it
 };
 
 }  // namespace sinew::rt
