@@ -43,7 +43,8 @@ Expected<std::uint32_t> Scene::add_character(const SkinnedMesh& mesh, const Fuzz
   PackedInfluences influences = pack_influences(mesh);
   std::vector<std::uint16_t> rigid =
       find_rigid_check_blocks(mesh, influences, fuzzy.vertex_check_begin, fuzzy.vertex_checks, fuzzy.check_rank);
-  characters_.push_back({&mesh, fuzzy, std::move(influences), std::move(rigid), influence_bounds(mesh, fuzzy.bone_count)});
+  characters_.push_back(
+      {&mesh, fuzzy, std::move(influences), std::move(rigid), influence_bounds(mesh, fuzzy.bone_count)});
   return static_cast<std::uint32_t>(characters_.size() - 1);
 }
 
@@ -223,19 +224,19 @@ Expected<FrameStats> Scene::prepare_frame(const FrameOptions& options, JobSystem
     start = std::chrono::steady_clock::now();
     update_bone_frames(frame, character.fuzzy);
     choose_bone_clusters(frame, character.fuzzy, options.pose_clusters);
-    skin_instance(frame, *character.mesh, character.influences, character.fuzzy, character.rigid_blocks,
+    skin_instance(frame, scratch_, *character.mesh, character.influences, character.fuzzy, character.rigid_blocks,
                   options.normals, options.bone_boxes == BoneBoxMode::kExact, options.skinning, jobs);
-    settle_bone_clusters(frame, character.fuzzy, character.rigid_blocks, jobs);
+    settle_bone_clusters(frame, scratch_, character.fuzzy, character.rigid_blocks, jobs);
     frame.leaf_boxes.prepare(character.fuzzy);
     skinning_ms += ms_since(start);
 
     start = std::chrono::steady_clock::now();
-    compute_bone_boxes(frame, character.fuzzy, options.bone_boxes == BoneBoxMode::kExact);
+    compute_bone_boxes(frame, scratch_, character.fuzzy, options.bone_boxes == BoneBoxMode::kExact);
     boxes_ms += ms_since(start);
 
     start = std::chrono::steady_clock::now();
     if (options.fallback) {
-      SINEW_RETURN_IF_ERROR(build_fallback(frame, *character.mesh, character.fuzzy,
+      SINEW_RETURN_IF_ERROR(build_fallback(frame, scratch_, *character.mesh, character.fuzzy,
                                            within_traversal_depth(options.fallback_kd)));
     } else {
       frame.escaped_triangles.clear();

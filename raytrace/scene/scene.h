@@ -172,6 +172,7 @@ class Scene {
 
   TopLevel top_level_;
   FrameCull cull_;
+  FrameScratch scratch_;  // one instance's escape flags and chunk boxes at a time
   RayReach reach_;
   std::vector<Aabb> reach_boxes_;       // per instance: its bounds (empty when removed)
   std::vector<std::uint8_t> reached_;  // per instance: a query ray reaches it

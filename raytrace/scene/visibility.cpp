@@ -98,7 +98,8 @@ void FrameCull::add_receivers(const Aabb& box) {
   }
   if (inside) {
     for (int c = 0; c < 8; ++c) {
-      receivers_.push_back({(c & 1) ? upper[0] : lower[0], (c & 2) ? upper[1] : lower[1], (c & 4) ? upper[2] : lower[2]});
+      receivers_.push_back(
+          {(c & 1) ? upper[0] : lower[0], (c & 2) ? upper[1] : lower[1], (c & 4) ? upper[2] : lower[2]});
     }
     return;
   }

@@ -77,7 +77,8 @@ TEST(FrameCull, BoxesOnCameraAndShadowRaysAreKept) {
     for (const Aabb& box : receivers) cull.add_receivers(box);
     cull.finish_receivers();
     for (int ray = 0; ray < 100; ++ray) {
-      const float a = uniform(g, -base.half_width, base.half_width), b = uniform(g, -base.half_height, base.half_height);
+      const float a = uniform(g, -base.half_width, base.half_width);
+      const float b = uniform(g, -base.half_height, base.half_height);
       const Vec3 d = glm::normalize(base.forward + a * base.right + b * base.up);
       // A box anywhere along the camera ray is in view.
       const Vec3 on_ray = eye + uniform(g, 0.0f, 50.0f) * d;
