@@ -10,6 +10,7 @@
 #include "embed/convert.h"
 #include "embed/world_impl.h"
 #include "raytrace/camera/camera.h"
+#include "raytrace/render/frame_visibility.h"
 #include "raytrace/render/renderer.h"
 #include "runtime/jobs/executor.h"
 #include "runtime/jobs/job_system.h"
@@ -218,6 +219,7 @@ Result<PassStats> RayTracePass::execute(World& world, const PassInputs& inputs, 
     frame.bone_boxes = desc.exact_bone_boxes ? rt::BoneBoxMode::kExact : rt::BoneBoxMode::kCheap;
     frame.fallback = desc.fallback;
     frame.normals = wanted(Output::kColorRgba8) || wanted(Output::kColorRgba32f) || wanted(Output::kNormal);
+    frame.visibility = rt::frame_visibility(*camera, settings);  // skin only what the rays can reach
     rt::Scene& scene = world.impl().scene;
     const auto start = std::chrono::steady_clock::now();
     World::Impl& state = world.impl();
@@ -225,11 +227,14 @@ Result<PassStats> RayTracePass::execute(World& world, const PassInputs& inputs, 
     const auto prepared = scene.prepare_frame(frame, jobs);
     if (!prepared.ok()) return detail::to_api_error(prepared.status());
     state.prepared_changes = state.changes;
-    state.prepared_exact = desc.fallback;
+    // Queries need every instance: a frame that culled some is prepared again.
+    state.prepared_exact = desc.fallback && prepared->culled_instances == 0;
     PassStats stats;
     stats.prepare_ms = ms_since(start);
     stats.escaped_triangles = prepared->escaped_triangles;
     stats.fallback_ms = prepared->fallback_ms;
+    stats.skinned_instances = prepared->skinned_instances;
+    stats.culled_instances = prepared->culled_instances;
     const auto rendered = impl_->renderer.render(scene, *camera, settings, buffers, jobs);
     if (!rendered.ok()) return bad(rendered.status().message());
     stats.trace_ms = rendered->trace_primary_ms + rendered->trace_shadow_ms;

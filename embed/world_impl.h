@@ -47,7 +47,11 @@ struct World::Impl {
   // the fallback).
   std::uint64_t changes = 1;           // bumped by every change to an instance
   std::uint64_t prepared_changes = 0;  // `changes` at the last prepare
-  bool prepared_exact = false;         // that prepare routed escaped triangles
+  bool prepared_exact = false;
+  // A batch of queries skins only the instances its rays reach (lazy
+  // skinning); these are its rays, kept for the next batch's allocation.
+  bool lazy_query_skinning = true;
+  std::vector<sinew::Ray> query_rays;         // that prepare routed escaped triangles
   std::unique_ptr<JobSystem> query_jobs;  // one thread, made by the first query that prepares
   void changed() { ++changes; }
 };

@@ -95,18 +95,25 @@ RayHit to_api(const rt::Scene& scene, const Hit& hit) {
 }
 
 // The scene's frame state for the world as posed now, escaped triangles
-// routed: prepared again unless the last pass or query left exactly that.
-Status prepare_for_queries(World::Impl& world) {
+// routed: prepared again unless the last pass or query left exactly that. A
+// batch prepares only the instances its rays can reach (lazy skinning), a
+// single ray every instance, which the queries after it reuse.
+Status prepare_for_queries(World::Impl& world, std::span<const Ray> rays) {
   if (world.prepared_changes == world.changes && world.prepared_exact) return Status();
   if (!world.query_jobs) world.query_jobs = std::make_unique<JobSystem>(1);
   rt::FrameOptions options;
   options.normals = false;  // queries read positions only; a pass prepares its own frame
   options.fallback = true;
+  world.query_rays.clear();
+  if (rays.size() > 1 && world.lazy_query_skinning) {
+    for (const Ray& ray : rays) world.query_rays.push_back(to_internal(ray));
+    options.rays = world.query_rays;
+  }
   world.prepared_changes = 0;
   const auto prepared = world.scene.prepare_frame(options, *world.query_jobs);
   if (!prepared.ok()) return detail::to_api_error(prepared.status());
   world.prepared_changes = world.changes;
-  world.prepared_exact = true;
+  world.prepared_exact = prepared->culled_instances == 0;
   return Status();
 }
 
@@ -120,7 +127,7 @@ Status ready_for(World::Impl& world, const char* call, std::span<const Ray> rays
                                                               std::to_string(rays.size()) + " rays");
   }
   if (Status status = check_rays(call, rays); !status.ok()) return status;
-  return prepare_for_queries(world);
+  return prepare_for_queries(world, rays);
 }
 
 }  // namespace

@@ -21,6 +21,7 @@
 #include "character/pack.h"
 #include "editor/cli/import_limit_flags.h"
 #include "editor/import/model_loader.h"
+#include "raytrace/render/frame_visibility.h"
 #include "raytrace/render/renderer.h"
 #include "raytrace/skinning/skinning.h"
 #include "runtime/cli/command_line.h"
@@ -545,6 +546,9 @@ Expected<RenderOutputs> render_model(const RenderOptions& options) {
         SINEW_RETURN_IF_ERROR(scene.set_bones(instance_ids[i], bones[i]));
       }
     }
+    // The first frame frames the view on every posed instance; later frames
+    // skin only the instances the camera's and the lights' rays can reach.
+    if (camera) frame_options.visibility = rt::frame_visibility(*camera, settings);
     SINEW_ASSIGN_OR_RETURN(const rt::FrameStats frame, scene.prepare_frame(frame_options, jobs, &frame_timers));
     if (!camera) {
       // Framed once, on the first frame's pose, so every frame shares one view.

@@ -136,6 +136,10 @@ struct PassStats {
   // the character plays poses it was not baked over: bake them
   // (docs/EDITOR.md, "Why is my character slow?").
   double fallback_ms = 0.0;
+  // Instances skinned for the frame, and those left out because none of its
+  // camera or shadow rays can reach them (their poses still advance).
+  std::size_t skinned_instances = 0;
+  std::size_t culled_instances = 0;
 };
 
 class SINEW_API RayTracePass {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "raytrace/fuzzy/pose_clusters.h"
 #include "runtime/jobs/job_system.h"
@@ -32,20 +33,73 @@ Aabb grown(const Aabb& box, float by) {
 
 // The escape check of the frame's bones, each held to its cluster's boxes
 // where it has one.
-EscapeCheckInput escape_input(InstanceFrame& frame, const FuzzyCharacterView& fuzzy,
+EscapeCheckInput escape_input(const InstanceFrame& frame, FrameScratch& scratch, const FuzzyCharacterView& fuzzy,
                               std::span<const std::uint16_t> rigid_blocks) {
   const bool clustered = frame.cluster_bones > 0 && frame.bone_check_boxes.size() == frame.bone_from_world.size();
   return {fuzzy.vertex_check_begin,
           fuzzy.vertex_checks,
           frame.bone_from_world,
           frame.tolerance,
-          frame.chunk_bone_boxes,
+          scratch.chunk_bone_boxes,
           clustered ? std::span<const Aabb* const>(frame.bone_check_boxes) : std::span<const Aabb* const>{},
           clustered ? fuzzy.check_rank : std::span<const std::uint32_t>{},
           rigid_blocks};
 }
 
 }  // namespace
+
+InfluenceBounds influence_bounds(const SkinnedMesh& mesh, std::size_t bone_count) {
+  InfluenceBounds out;
+  out.bone_rest_boxes.assign(bone_count, Aabb::empty());
+  const std::size_t vertices = std::min({mesh.positions.size(), mesh.joints.size(), mesh.weights.size()});
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (std::size_t v = 0; v < vertices; ++v) {
+    double sum = 0.0;
+    for (std::size_t k = 0; k < static_cast<std::size_t>(kMaxInfluences); ++k) {
+      const float w = mesh.weights[v][k];
+      // The kernels skip a slot whose weight compares equal to zero.
+      if (w == 0.0f) continue;
+      sum += static_cast<double>(w);
+      const std::size_t bone = mesh.joints[v][k];
+      if (bone < bone_count) out.bone_rest_boxes[bone].extend(mesh.positions[v]);
+    }
+    lo = std::min(lo, sum);
+    hi = std::max(hi, sum);
+  }
+  if (vertices > 0) {
+    // Outward to float.
+    out.weight_sum_lo = std::nextafter(static_cast<float>(lo), -std::numeric_limits<float>::infinity());
+    out.weight_sum_hi = std::nextafter(static_cast<float>(hi), std::numeric_limits<float>::infinity());
+    out.weight_sum_lo = std::max(out.weight_sum_lo, 0.0f);
+  }
+  return out;
+}
+
+Aabb instance_bounds(std::span<const Affine3> skinning, const InfluenceBounds& bounds) {
+  Aabb carried = Aabb::empty();
+  const std::size_t bones = std::min(skinning.size(), bounds.bone_rest_boxes.size());
+  for (std::size_t b = 0; b < bones; ++b) {
+    if (!bounds.bone_rest_boxes[b].is_empty()) carried.extend(transform(skinning[b], bounds.bone_rest_boxes[b]));
+  }
+  Aabb out = Aabb::empty();
+  if (!carried.is_empty()) {
+    // Weight sums in [lo, hi] scale the carried box per axis: the interval
+    // product's ends.
+    for (int a = 0; a < 3; ++a) {
+      const float ends[4] = {bounds.weight_sum_lo * carried.lower[a], bounds.weight_sum_lo * carried.upper[a],
+                             bounds.weight_sum_hi * carried.lower[a], bounds.weight_sum_hi * carried.upper[a]};
+      out.lower[a] = std::min({ends[0], ends[1], ends[2], ends[3]});
+      out.upper[a] = std::max({ends[0], ends[1], ends[2], ends[3]});
+    }
+    // Skinning sums a few weighted products per coordinate: its rounding is
+    // a few units of 2^-24 of the largest, far inside this.
+    out = grown(out, 64.0f * kFrameRelativeSlack * std::max(bounds.weight_sum_hi, 1.0f) * max_abs(carried) +
+                         std::numeric_limits<float>::min());
+  }
+  // A vertex without weights skins to the origin.
+  if (bounds.weight_sum_lo == 0.0f) out.extend(Vec3(0.0f));
+  return out;
+}
 
 void update_bone_frames(InstanceFrame& frame, const FuzzyCharacterView& fuzzy) {
   const std::size_t bones = frame.skinning.size();
@@ -102,27 +156,28 @@ void choose_bone_clusters(InstanceFrame& frame, const FuzzyCharacterView& fuzzy,
   }
 }
 
-void skin_instance(InstanceFrame& frame, const SkinnedMesh& mesh, const PackedInfluences& influences,
-                   const FuzzyCharacterView& fuzzy, std::span<const std::uint16_t> rigid_blocks, bool normals,
-                   bool exact_boxes, SkinningPath path, JobSystem& jobs) {
+void skin_instance(InstanceFrame& frame, FrameScratch& scratch, const SkinnedMesh& mesh,
+                   const PackedInfluences& influences, const FuzzyCharacterView& fuzzy,
+                   std::span<const std::uint16_t> rigid_blocks, bool normals, bool exact_boxes, SkinningPath path,
+                   JobSystem& jobs) {
   frame.positions.resize(mesh.vertex_count());
   frame.normals.resize(normals && !mesh.normals.empty() ? mesh.vertex_count() : 0);
-  frame.escaped.resize(fuzzy.vertex_checks.size());
-  frame.chunk_bone_boxes.resize(exact_boxes ? skinning_chunk_count(mesh.vertex_count()) * frame.bone_from_world.size()
+  scratch.escaped.resize(fuzzy.vertex_checks.size());
+  scratch.chunk_bone_boxes.resize(exact_boxes ? skinning_chunk_count(mesh.vertex_count()) * frame.bone_from_world.size()
                                             : 0);
-  const EscapeCheckInput escape = escape_input(frame, fuzzy, rigid_blocks);
-  const SkinningTargets targets{frame.positions, frame.normals, frame.escaped};
+  const EscapeCheckInput escape = escape_input(frame, scratch, fuzzy, rigid_blocks);
+  const SkinningTargets targets{frame.positions, frame.normals, scratch.escaped};
   const SkinningResult result = skin_vertices(mesh, influences, frame.skinning, targets, &escape, &jobs, path);
   frame.escaped_checks = result.escaped_checks;
 }
 
-void settle_bone_clusters(InstanceFrame& frame, const FuzzyCharacterView& fuzzy,
+void settle_bone_clusters(InstanceFrame& frame, FrameScratch& scratch, const FuzzyCharacterView& fuzzy,
                           std::span<const std::uint16_t> rigid_blocks, JobSystem& jobs) {
   if (frame.cluster_bones == 0 || frame.escaped_checks == 0) return;
   bool missed = false;
-  const std::size_t checks = std::min(frame.escaped.size(), fuzzy.vertex_checks.size());
+  const std::size_t checks = std::min(scratch.escaped.size(), fuzzy.vertex_checks.size());
   for (std::size_t c = 0; c < checks; ++c) {
-    if (!frame.escaped[c]) continue;
+    if (!scratch.escaped[c]) continue;
     const std::uint32_t b = fuzzy.vertex_checks[c].bone;
     if (b >= frame.bone_cluster.size() || frame.bone_cluster[b] < 0) continue;
     frame.bone_cluster[b] = -1;
@@ -132,10 +187,12 @@ void settle_bone_clusters(InstanceFrame& frame, const FuzzyCharacterView& fuzzy,
     missed = true;
   }
   if (!missed) return;
-  frame.escaped_checks = check_escapes(escape_input(frame, fuzzy, rigid_blocks), frame.positions, frame.escaped, &jobs);
+  frame.escaped_checks =
+      check_escapes(escape_input(frame, scratch, fuzzy, rigid_blocks), frame.positions, scratch.escaped, &jobs);
 }
 
-void compute_bone_boxes(InstanceFrame& frame, const FuzzyCharacterView& fuzzy, bool exact) {
+void compute_bone_boxes(InstanceFrame& frame, const FrameScratch& scratch, const FuzzyCharacterView& fuzzy,
+                        bool exact) {
   const std::size_t bones = frame.skinning.size();
   frame.bone_world_boxes.assign(bones, Aabb::empty());
   if (!exact) {
@@ -151,10 +208,10 @@ void compute_bone_boxes(InstanceFrame& frame, const FuzzyCharacterView& fuzzy, b
   // chunk by the skinning (skin_instance), give every bone the bounds of its
   // skinned triangles, merged here in chunk order.
   const std::size_t stride = frame.bone_from_world.size();
-  const std::size_t rows = stride > 0 ? frame.chunk_bone_boxes.size() / stride : 0;
+  const std::size_t rows = stride > 0 ? scratch.chunk_bone_boxes.size() / stride : 0;
   for (std::size_t row = 0; row < rows; ++row) {
     for (std::size_t b = 0; b < std::min(bones, stride); ++b) {
-      frame.bone_world_boxes[b].extend(frame.chunk_bone_boxes[row * stride + b]);
+      frame.bone_world_boxes[b].extend(scratch.chunk_bone_boxes[row * stride + b]);
     }
   }
   for (std::size_t b = 0; b < bones; ++b) {
@@ -162,8 +219,8 @@ void compute_bone_boxes(InstanceFrame& frame, const FuzzyCharacterView& fuzzy, b
   }
 }
 
-Status build_fallback(InstanceFrame& frame, const SkinnedMesh& mesh, const FuzzyCharacterView& fuzzy,
-                      const KdBuildOptions& kd) {
+Status build_fallback(InstanceFrame& frame, const FrameScratch& scratch, const SkinnedMesh& mesh,
+                      const FuzzyCharacterView& fuzzy, const KdBuildOptions& kd) {
   frame.escaped_triangles.clear();
   if (frame.escaped_checks == 0 && frame.singular_bones == 0) {
     frame.fallback = KdTree{};
@@ -171,8 +228,8 @@ Status build_fallback(InstanceFrame& frame, const SkinnedMesh& mesh, const Fuzzy
   }
   for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
     const auto& corners = fuzzy.triangle_checks[t];
-    const bool escaped = !frame.bone_usable[fuzzy.triangle_bone[t]] || frame.escaped[corners[0]] ||
-                         frame.escaped[corners[1]] || frame.escaped[corners[2]];
+    const bool escaped = !frame.bone_usable[fuzzy.triangle_bone[t]] || scratch.escaped[corners[0]] ||
+                         scratch.escaped[corners[1]] || scratch.escaped[corners[2]];
     if (escaped) frame.escaped_triangles.push_back(static_cast<std::uint32_t>(t));
   }
   std::vector<Aabb> boxes;

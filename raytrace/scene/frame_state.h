@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "raytrace/accel/kd_tree.h"
@@ -27,6 +28,13 @@ struct InstanceFrame {
   bool live = true;               // false once removed (Scene::remove): its data is freed
   // Queries skip the instance when (mask & ray mask) == 0 (Scene::set_mask).
   std::uint32_t mask = kAllMaskBits;
+  // Culled this frame (FrameOptions::visibility): no ray of the frame can
+  // reach it, so nothing below but `skinning` and `bounds` is current and
+  // the top level leaves it out.
+  bool culled = false;
+  // This frame's conservative world bounds (instance_bounds), computed when
+  // the frame is culled by visibility; empty otherwise.
+  Aabb bounds;
 
   std::vector<Affine3> skinning;         // per bone: bind pose -> world
   std::vector<Affine3> bone_from_world;  // per bone: the inverse (the bone frame)
@@ -44,10 +52,6 @@ struct InstanceFrame {
 
   std::vector<Vec3> positions;  // skinned, world space
   std::vector<Vec3> normals;    // skinned, world space, not unit length (empty when not asked)
-  std::vector<std::uint8_t> escaped;  // per vertex check: 1 = outside its fuzzy box
-  // Exact bone boxes: per skinning chunk and bone, the box of its checked
-  // vertices (EscapeCheckInput::chunk_bone_boxes), merged by compute_bone_boxes.
-  std::vector<Aabb> chunk_bone_boxes;
 
   // Pose-space clusters (FuzzyCharacterView::clusters): per bone the
   // cluster whose tree and boxes it uses this frame (an index into
@@ -75,6 +79,33 @@ struct InstanceFrame {
   std::size_t singular_bones = 0;
 };
 
+// What the per-frame steps need only while one instance is prepared:
+// Scene::prepare_frame prepares one instance at a time and keeps one of
+// these, so its size follows the largest character, not the crowd.
+struct FrameScratch {
+  std::vector<std::uint8_t> escaped;  // per vertex check: 1 = outside its fuzzy box
+  // Exact bone boxes: per skinning chunk and bone, the box of its checked
+  // vertices (EscapeCheckInput::chunk_bone_boxes), merged by compute_bone_boxes.
+  std::vector<Aabb> chunk_bone_boxes;
+};
+
+// What bounds a character's skinned vertices in any pose: per bone, the box
+// of the rest positions of the vertices it weights, and the range of the
+// vertices' weight sums (1 for normalised weights).
+struct InfluenceBounds {
+  std::vector<Aabb> bone_rest_boxes;
+  float weight_sum_lo = 1.0f;
+  float weight_sum_hi = 1.0f;
+};
+InfluenceBounds influence_bounds(const SkinnedMesh& mesh, std::size_t bone_count);
+
+// A box holding every vertex of the instance skinned by `skinning`, in any
+// pose, escaped or not: a skinned vertex is sum_j w_j S_j p with weights >= 0,
+// so it lies in its weight sum times the box of the S_j-carried rest boxes
+// of the bones weighting it; grown for the rounding of skinning. One box
+// transform per bone, no vertex read.
+Aabb instance_bounds(std::span<const Affine3> skinning, const InfluenceBounds& bounds);
+
 // Relative slack for float rounding in bone-frame computations: a few units
 // in the last place of the magnitudes involved.
 inline constexpr float kFrameRelativeSlack = 8.0f * 0x1.0p-24f;
@@ -91,24 +122,26 @@ void choose_bone_clusters(InstanceFrame& frame, const FuzzyCharacterView& fuzzy,
 // `exact_boxes`, it also gathers the bone boxes compute_bone_boxes merges.
 // `influences` is pack_influences(mesh), `rigid_blocks` the character's
 // find_rigid_check_blocks (rigid_checks.h; empty: every check computed).
-void skin_instance(InstanceFrame& frame, const SkinnedMesh& mesh, const PackedInfluences& influences,
-                   const FuzzyCharacterView& fuzzy, std::span<const std::uint16_t> rigid_blocks, bool normals,
-                   bool exact_boxes, SkinningPath path, JobSystem& jobs);
+void skin_instance(InstanceFrame& frame, FrameScratch& scratch, const SkinnedMesh& mesh,
+                   const PackedInfluences& influences, const FuzzyCharacterView& fuzzy,
+                   std::span<const std::uint16_t> rigid_blocks, bool normals, bool exact_boxes, SkinningPath path,
+                   JobSystem& jobs);
 
 // After skin_instance: a bone whose cluster a vertex left goes back to its
 // full tree, and the escape check runs again (positions as they are)
 // against the full boxes of those bones.
-void settle_bone_clusters(InstanceFrame& frame, const FuzzyCharacterView& fuzzy,
+void settle_bone_clusters(InstanceFrame& frame, FrameScratch& scratch, const FuzzyCharacterView& fuzzy,
                           std::span<const std::uint16_t> rigid_blocks, JobSystem& jobs);
 
 // Per bone world boxes: exact (union of the bone's skinned vertices, from
 // the boxes skin_instance gathered with exact_boxes) or cheap (the fuzzy
 // root box, grown by the tolerance, carried by the bone matrix).
-void compute_bone_boxes(InstanceFrame& frame, const FuzzyCharacterView& fuzzy, bool exact);
+void compute_bone_boxes(InstanceFrame& frame, const FrameScratch& scratch, const FuzzyCharacterView& fuzzy,
+                        bool exact);
 
 // Collects triangles with an escaped corner (or on a singular bone) and
 // builds the world-space fallback tree over them.
-Status build_fallback(InstanceFrame& frame, const SkinnedMesh& mesh, const FuzzyCharacterView& fuzzy,
-                      const KdBuildOptions& kd);
+Status build_fallback(InstanceFrame& frame, const FrameScratch& scratch, const SkinnedMesh& mesh,
+                      const FuzzyCharacterView& fuzzy, const KdBuildOptions& kd);
 
 }  // namespace sinew::rt

@@ -1,6 +1,9 @@
 #include "raytrace/scene/scene.h"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <limits>
 #include <string>
 #include <utility>
 
@@ -22,6 +25,12 @@ KdBuildOptions within_traversal_depth(KdBuildOptions options) {
 }
 
 
+float max_abs(const Aabb& box) {
+  if (box.is_empty()) return 0.0f;
+  return std::max({std::fabs(box.lower.x), std::fabs(box.lower.y), std::fabs(box.lower.z), std::fabs(box.upper.x),
+                   std::fabs(box.upper.y), std::fabs(box.upper.z)});
+}
+
 }  // namespace
 
 Scene::Scene() = default;
@@ -34,7 +43,8 @@ Expected<std::uint32_t> Scene::add_character(const SkinnedMesh& mesh, const Fuzz
   PackedInfluences influences = pack_influences(mesh);
   std::vector<std::uint16_t> rigid =
       find_rigid_check_blocks(mesh, influences, fuzzy.vertex_check_begin, fuzzy.vertex_checks, fuzzy.check_rank);
-  characters_.push_back({&mesh, fuzzy, std::move(influences), std::move(rigid)});
+  characters_.push_back(
+      {&mesh, fuzzy, std::move(influences), std::move(rigid), influence_bounds(mesh, fuzzy.bone_count)});
   return static_cast<std::uint32_t>(characters_.size() - 1);
 }
 
@@ -128,31 +138,105 @@ Status Scene::set_bones(std::uint32_t instance, std::span<const Affine3> skinnin
   return {};
 }
 
+Status Scene::cull_instances(const FrameOptions& options) {
+  const bool by_rays = !options.rays.empty();
+  if (!options.visibility && !by_rays) {
+    for (InstanceFrame& frame : instances_) {
+      frame.culled = false;
+      frame.bounds = Aabb::empty();
+    }
+    return {};
+  }
+  float magnitude = 0.0f;
+  for (InstanceFrame& frame : instances_) {
+    frame.culled = false;
+    if (!frame.live) continue;
+    frame.bounds = instance_bounds(frame.skinning, characters_[frame.character].influence_bounds);
+    magnitude = std::max(magnitude, max_abs(frame.bounds));
+  }
+  for (const StaticMesh& mesh : statics_) {
+    if (mesh.live && !mesh.tree.nodes.empty()) magnitude = std::max(magnitude, max_abs(mesh.tree.bounds));
+  }
+  if (options.visibility && !cull_.begin(*options.visibility, magnitude)) return {};  // nothing culled
+  // From here an instance is culled unless some ray can reach it.
+  for (InstanceFrame& frame : instances_) frame.culled = frame.live;
+  if (options.visibility) {
+    // Camera rays first; then shadow rays, which start on what the camera
+    // sees: the static meshes and the instances in view.
+    Aabb in_view = Aabb::empty();
+    for (InstanceFrame& frame : instances_) {
+      if (!frame.live || !cull_.in_view(frame.bounds)) continue;
+      frame.culled = false;
+      in_view.extend(frame.bounds);
+    }
+    cull_.add_receivers(in_view);
+    for (const StaticMesh& mesh : statics_) {
+      if (mesh.live && !mesh.tree.nodes.empty()) cull_.add_receivers(mesh.tree.bounds);
+    }
+    cull_.finish_receivers();
+    for (InstanceFrame& frame : instances_) {
+      if (frame.culled && cull_.casts_into_view(frame.bounds)) frame.culled = false;
+    }
+  }
+  if (by_rays) {
+    // A hit rounds relative to the ray's origin and the triangle, which
+    // lies in its instance's bounds.
+    float scale = magnitude;
+    for (const Ray& ray : options.rays) {
+      const float origin = std::max({std::fabs(ray.origin.x), std::fabs(ray.origin.y), std::fabs(ray.origin.z)});
+      if (std::isfinite(origin)) scale = std::max(scale, origin);
+    }
+    const double margin = FrameCull::kRelativeMargin * static_cast<double>(scale) +
+                          static_cast<double>(std::numeric_limits<float>::min());
+    reach_boxes_.resize(instances_.size());
+    for (std::size_t i = 0; i < instances_.size(); ++i) {
+      reach_boxes_[i] = instances_[i].culled ? instances_[i].bounds : Aabb::empty();
+    }
+    SINEW_RETURN_IF_ERROR(reach_.mark(options.rays, reach_boxes_, margin, reached_));
+    for (std::size_t i = 0; i < instances_.size(); ++i) {
+      if (reached_[i]) instances_[i].culled = false;
+    }
+  }
+  return {};
+}
+
 Expected<FrameStats> Scene::prepare_frame(const FrameOptions& options, JobSystem& jobs,
                                           PhaseTimers* timers) {
   FrameStats stats;
   double skinning_ms = 0.0;
   double boxes_ms = 0.0;
   double fallback_ms = 0.0;
+  auto start = std::chrono::steady_clock::now();
+  SINEW_RETURN_IF_ERROR(cull_instances(options));  // timed as skinning's, the step it skips
+  skinning_ms += ms_since(start);
   for (InstanceFrame& frame : instances_) {
     if (!frame.live) continue;
+    if (frame.culled) {
+      ++stats.culled_instances;
+      frame.bone_world_boxes.assign(frame.skinning.size(), Aabb::empty());
+      frame.escaped_triangles.clear();
+      frame.fallback = KdTree{};
+      frame.escaped_checks = frame.singular_bones = frame.cluster_bones = frame.cluster_misses = 0;
+      continue;
+    }
+    ++stats.skinned_instances;
     const Character& character = characters_[frame.character];
-    auto start = std::chrono::steady_clock::now();
+    start = std::chrono::steady_clock::now();
     update_bone_frames(frame, character.fuzzy);
     choose_bone_clusters(frame, character.fuzzy, options.pose_clusters);
-    skin_instance(frame, *character.mesh, character.influences, character.fuzzy, character.rigid_blocks,
+    skin_instance(frame, scratch_, *character.mesh, character.influences, character.fuzzy, character.rigid_blocks,
                   options.normals, options.bone_boxes == BoneBoxMode::kExact, options.skinning, jobs);
-    settle_bone_clusters(frame, character.fuzzy, character.rigid_blocks, jobs);
+    settle_bone_clusters(frame, scratch_, character.fuzzy, character.rigid_blocks, jobs);
     frame.leaf_boxes.prepare(character.fuzzy);
     skinning_ms += ms_since(start);
 
     start = std::chrono::steady_clock::now();
-    compute_bone_boxes(frame, character.fuzzy, options.bone_boxes == BoneBoxMode::kExact);
+    compute_bone_boxes(frame, scratch_, character.fuzzy, options.bone_boxes == BoneBoxMode::kExact);
     boxes_ms += ms_since(start);
 
     start = std::chrono::steady_clock::now();
     if (options.fallback) {
-      SINEW_RETURN_IF_ERROR(build_fallback(frame, *character.mesh, character.fuzzy,
+      SINEW_RETURN_IF_ERROR(build_fallback(frame, scratch_, *character.mesh, character.fuzzy,
                                            within_traversal_depth(options.fallback_kd)));
     } else {
       frame.escaped_triangles.clear();
@@ -166,11 +250,11 @@ Expected<FrameStats> Scene::prepare_frame(const FrameOptions& options, JobSystem
     stats.cluster_misses += frame.cluster_misses;
   }
 
-  const auto start = std::chrono::steady_clock::now();
+  start = std::chrono::steady_clock::now();
   std::vector<TopLevelObject> objects = top_level_.take_objects();
   for (std::uint32_t i = 0; i < instances_.size(); ++i) {
     const InstanceFrame& frame = instances_[i];
-    if (!frame.live) continue;
+    if (!frame.live || frame.culled) continue;
     const FuzzyCharacterView& fuzzy = characters_[frame.character].fuzzy;
     for (std::uint32_t b = 0; b < fuzzy.bone_count; ++b) {
       if (fuzzy.bone_trees[b].triangle_count == 0 || fuzzy.bone_trees[b].node_count == 0 ||

@@ -11,6 +11,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -18,6 +19,8 @@
 #include "raytrace/accel/top_level.h"
 #include "raytrace/fuzzy/fuzzy_character.h"
 #include "raytrace/scene/frame_state.h"
+#include "raytrace/scene/ray_reach.h"
+#include "raytrace/scene/visibility.h"
 #include "raytrace/skinning/skinning.h"
 #include "runtime/core/expected.h"
 #include "runtime/math/affine.h"
@@ -52,6 +55,18 @@ struct FrameOptions {
   KdBuildOptions top_level_kd{.traversal_cost = 1.0f, .intersection_cost = 4.0f,
                               .empty_bonus = 0.2f, .max_leaf_items = 1, .max_depth = 0};
   KdBuildOptions fallback_kd{};
+  // The frame's camera and lights (render/frame_visibility.h makes them from
+  // a renderer's camera and settings): instances no camera or shadow ray can
+  // reach are culled, neither skinned nor checked nor in the top level, and
+  // only their conservative bounds are computed (InstanceFrame::culled).
+  // Unset: every instance is prepared, as queries from anywhere need.
+  std::optional<FrameVisibility> visibility;
+  // The rays a batch of queries will trace (the API's World::intersect and
+  // occluded over a span), kept by the caller for the call: with them, only
+  // the instances some ray's segment reaches are prepared, lazy skinning
+  // (with a visibility as well, those either one reaches). Traversals of
+  // other rays may then miss culled instances.
+  std::span<const Ray> rays;
 };
 
 struct FrameStats {
@@ -60,6 +75,8 @@ struct FrameStats {
   std::size_t singular_bones = 0;     // bones without a finite inverse (zero scale)
   std::size_t cluster_bones = 0;      // bones traversed with a pose-space cluster's tree
   std::size_t cluster_misses = 0;     // bones whose cluster a vertex left: back on their full tree
+  std::uint32_t skinned_instances = 0;  // instances skinned and checked this frame
+  std::uint32_t culled_instances = 0;   // instances no ray of FrameOptions::visibility or rays can reach
   std::uint32_t top_level_objects = 0;
   std::uint32_t top_level_nodes = 0;
   // Building the fallback trees over the escaped triangles (also the
@@ -115,7 +132,8 @@ class Scene {
   // per bone of its character. Copied. Non-finite matrices are rejected.
   Status set_bones(std::uint32_t instance, std::span<const Affine3> skinning);
 
-  // Skinning, escape check, bone boxes, fallback and top level. Phases are
+  // Skinning, escape check, bone boxes, fallback and top level, for the
+  // instances FrameOptions::visibility does not cull. Phases are
   // recorded into `timers` when given: "skinning", "boxes", "fallback",
   // "top level".
   Expected<FrameStats> prepare_frame(const FrameOptions& options, JobSystem& jobs,
@@ -127,6 +145,7 @@ class Scene {
     FuzzyCharacterView fuzzy;
     PackedInfluences influences;  // the mesh's, packed once for the skinning
     std::vector<std::uint16_t> rigid_blocks;  // find_rigid_check_blocks, once for the escape check
+    InfluenceBounds influence_bounds;  // once, for the instances' conservative bounds
   };
   struct StaticMesh {
     StaticMeshDesc desc;
@@ -153,7 +172,15 @@ class Scene {
   std::vector<InstanceFrame> instances_;
   std::vector<StaticMesh> statics_;
   std::vector<ObjectSlot> slots_;
+  // Marks each live instance culled or not (FrameOptions::visibility, rays).
+  Status cull_instances(const FrameOptions& options);
+
   TopLevel top_level_;
+  FrameCull cull_;
+  FrameScratch scratch_;  // one instance's escape flags and chunk boxes at a time
+  RayReach reach_;
+  std::vector<Aabb> reach_boxes_;       // per instance: its bounds (empty when removed)
+  std::vector<std::uint8_t> reached_;  // per instance: a query ray reaches it
 };
 
 }  // namespace sinew::rt

@@ -66,13 +66,13 @@ struct WalkMeasure {
   double phase_ms(std::string_view phase) const { return phase_median(timers, phase); }
 };
 
-// The memory an instance's frame holds: skinned vertices, escape flags,
-// bone frames and boxes, cluster choices, escaped triangles, leaf boxes.
+// The memory an instance's frame holds: skinned vertices, bone frames and
+// boxes, cluster choices, escaped triangles, leaf boxes.
 inline std::size_t instance_frame_bytes(const rt::InstanceFrame& f) {
   const auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
   return bytes(f.skinning) + bytes(f.bone_from_world) + bytes(f.bone_usable) + bytes(f.tolerance) +
-         bytes(f.bone_carry) + bytes(f.bone_world_boxes) + bytes(f.positions) + bytes(f.normals) + bytes(f.escaped) +
-         bytes(f.chunk_bone_boxes) + bytes(f.bone_cluster) + bytes(f.bone_check_boxes) + bytes(f.escaped_triangles) +
+         bytes(f.bone_carry) + bytes(f.bone_world_boxes) + bytes(f.positions) + bytes(f.normals) +
+         bytes(f.bone_cluster) + bytes(f.bone_check_boxes) + bytes(f.escaped_triangles) +
          f.leaf_boxes.bytes();
 }
 

@@ -156,6 +156,36 @@ TEST(ApiQueries, NearestHitsMatchBruteForceOverThePosedTriangles) {
   }
 }
 
+// A batch skins only the instances its rays reach (lazy skinning): after a
+// batch that reaches no character, single rays and batches aimed at them
+// still see every posed triangle.
+TEST(ApiQueries, AfterABatchThatReachesNoCharacterEveryQuerySeesThemAll) {
+  Scenes s;
+  const std::vector<api::Ray> away = {{{-2.5f, 1.0f, 2.5f}, {0.0f, 1.0f, 0.0f}, 0.0f, 1.0f},
+                                      {{2.5f, 1.0f, 2.5f}, {0.0f, 1.0f, 0.0f}, 0.0f, 1.0f}};
+  std::vector<api::RayHit> none(away.size());
+  ASSERT_TRUE(s.world.intersect(away, none).ok());
+  for (const api::RayHit& h : none) EXPECT_FALSE(h.hit());
+  const api::Ray at_kicker{{0.8f, 1.0f, 3.0f}, {0.0f, 0.0f, -1.0f}};
+  const api::Ray at_walker{{0.0f, 1.0f, 3.0f}, {0.0f, 0.0f, -1.0f}};
+  const auto single = s.world.intersect(at_kicker);
+  ASSERT_TRUE(single.ok());
+  EXPECT_EQ(single->instance, s.kicker);
+  ASSERT_TRUE(s.world.intersect(away, none).ok());
+  const std::vector<api::Ray> both = {at_walker, at_kicker};
+  std::vector<api::RayHit> hits(both.size());
+  ASSERT_TRUE(s.world.intersect(both, hits).ok());
+  for (std::size_t i = 0; i < both.size(); ++i) {
+    const sinew::Ray ray = to_internal(both[i]);
+    const Hit ref = testing_support::nearest(s.soup, ray, rt::TriangleTest::kFast);
+    ASSERT_TRUE(ref.valid());
+    const Hit ours{hits[i].t, hits[i].u, hits[i].v, hits[i].triangle, hits[i].instance};
+    EXPECT_TRUE(testing_support::same_nearest(ours, ref, s.soup, ray, rt::TriangleTest::kFast)) << i;
+  }
+  EXPECT_EQ(hits[0].instance, s.walker);
+  EXPECT_EQ(hits[1].instance, s.kicker);
+}
+
 TEST(ApiQueries, AnyHitIsWhetherTheNearestHitLiesOnTheRay) {
   Scenes s;
   std::vector<api::Ray> rays = query_rays();
