@@ -9,6 +9,7 @@
 #include "character/bake.h"
 #include "character/framing.h"
 #include "content/mannequin/mannequin.h"
+#include "raytrace/render/frame_visibility.h"
 #include "runtime/timing/stopwatch.h"
 
 namespace sinew::demo {
@@ -150,11 +151,15 @@ Expected<FrameReport> DemoSession::frame(float dt, PlayerInput input, const Foll
     }
   }
   FrameReport report;
-  SINEW_ASSIGN_OR_RETURN(report.scene, scene_.prepare_frame(rt::FrameOptions{}, jobs, &timers_));
   const Vec3 target = world_.character(world_.player()).position;
   SINEW_ASSIGN_OR_RETURN(rt::PinholeCamera cam,
                          rt::PinholeCamera::create(follow_camera_desc(camera, target), options_.width, options_.height));
   camera_ = cam;
+  // Characters no camera or shadow ray of this frame can reach are not
+  // skinned (docs/RAYTRACE.md, "Culling whole characters").
+  rt::FrameOptions frame;
+  frame.visibility = rt::frame_visibility(*camera_, settings_);
+  SINEW_ASSIGN_OR_RETURN(report.scene, scene_.prepare_frame(frame, jobs, &timers_));
   rt::FrameBuffers buffers;
   buffers.width = options_.width;
   buffers.height = options_.height;
