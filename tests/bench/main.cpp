@@ -41,7 +41,7 @@ int main(int argc, char** argv) {
   line.command("embree", "Sinew vs Embree 3 (rebuild LOW/MEDIUM, refit) vs exact kd");
   line.command("paper", "the paper's Tables 1 and 2 on Cally");
   line.command("raytrace", "ray tracer frame phases, and fuzzy vs exact kd-tree trace time");
-  line.command("report", "every issue-7 benchmark; writes docs/BENCHMARKS.md");
+  line.command("report", "every benchmark section; writes docs/BENCHMARKS.md");
   line.command("structures", "the paper's one tree a bone against pose-space clusters, per model and mesh size");
   line.command("tradeoff",
                "speed against accuracy: samples, pose spaces, padding, held-out escapes and holes,\n"

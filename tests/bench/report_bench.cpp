@@ -57,7 +57,7 @@ std::vector<BenchFlag> bench_flags() {
   };
 }
 
-const char* const kDescription = "every issue-7 benchmark; writes docs/BENCHMARKS.md\n";
+const char* const kDescription = "every benchmark section; writes docs/BENCHMARKS.md\n";
 
 Status read_options(const BenchArgs& parsed, Options& o) {
   namespace cli = sinew::cli;
