@@ -29,7 +29,7 @@ struct MeshRefs {
   std::span<const Texture> textures;
   bool is_static = false;
 
-  // The texture of triangle `tri`'s material `m`, or null.
+  // Material `m`'s texture, or null.
   const Texture* texture_of(std::uint32_t m) const {
     if (m >= material_texture.size() || material_texture[m] == kNoTexture) return nullptr;
     return &textures[material_texture[m]];
