@@ -179,6 +179,8 @@ Result<PassStats> RayTracePass::execute(World& world, const PassInputs& inputs, 
         desc.triangle_test == TriangleTest::kWatertight ? rt::TriangleTest::kWatertight : rt::TriangleTest::kFast;
     settings.ambient = detail::to_internal(inputs.ambient);
     settings.background = detail::to_internal(inputs.background);
+    settings.camera_mask = inputs.camera_ray_mask;
+    settings.shadow_mask = inputs.shadow_ray_mask;
     std::vector<rt::Light> lights;
     for (std::size_t i = 0; i < inputs.lights.size(); ++i) {
       const Light& in = inputs.lights[i];

@@ -89,6 +89,12 @@ struct PassInputs {
   std::span<const Light> lights;  // 0 to kMaxLights; none: ambient only
   Float3 ambient{0.18f, 0.18f, 0.18f};
   Float3 background{0.32f, 0.36f, 0.42f};  // linear RGB of a miss
+  // Camera rays see, and shadow rays are blocked by, only the instances and
+  // static meshes whose mask (InstanceDesc::mask, World::set_mask) shares a
+  // bit with these: a first-person body that shadows the floor but is not
+  // drawn, a ground that receives shadows but casts none.
+  std::uint32_t camera_ray_mask = 0xFFFFFFFFu;
+  std::uint32_t shadow_ray_mask = 0xFFFFFFFFu;
 };
 
 // A host buffer: `data` holds `height` rows, `row_pitch` bytes apart (0:

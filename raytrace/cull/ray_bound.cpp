@@ -185,7 +185,8 @@ IntervalBound RayBound::test() const {
   return IntervalBound(r);
 }
 
-void cull_objects(const Scene& scene, const RayBound& bound, std::vector<std::uint32_t>& out, float extra_grow) {
+void cull_objects(const Scene& scene, const RayBound& bound, std::vector<std::uint32_t>& out, float extra_grow,
+                  std::uint32_t ray_mask) {
   const TopLevel& top = scene.top_level();
   const KdTreeView tree = top.view();
   if (tree.empty() || bound.empty()) return;
@@ -207,7 +208,7 @@ void cull_objects(const Scene& scene, const RayBound& bound, std::vector<std::ui
     for (const ObjectRun& run : runs) {
       if (run.count > 1 && !test.may_enter(run.box, grow)) continue;
       for (std::uint32_t object = run.first; object < run.first + run.count; ++object) {
-        if (test.may_enter(objects[object].box, grow)) out.push_back(object);
+        if ((objects[object].mask & ray_mask) != 0 && test.may_enter(objects[object].box, grow)) out.push_back(object);
       }
     }
     return;
@@ -226,7 +227,7 @@ void cull_objects(const Scene& scene, const RayBound& bound, std::vector<std::ui
     for (const std::uint32_t object : items) {
       if (stamp[object] == stamp_value) continue;
       stamp[object] = stamp_value;
-      if (test.may_enter(objects[object].box, grow)) out.push_back(object);
+      if ((objects[object].mask & ray_mask) != 0 && test.may_enter(objects[object].box, grow)) out.push_back(object);
     }
     return true;
   });

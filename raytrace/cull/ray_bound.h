@@ -106,8 +106,9 @@ inline constexpr std::size_t kFlatCullObjects = 64;
 
 // The top-level objects (indices into scene.top_level().objects(), in
 // ascending order) that some ray of `bound` may enter, every box grown by
-// extra_grow beyond the bound's own slack bound. Appends to `out`.
+// extra_grow beyond the bound's own slack bound, leaving out those whose
+// mask shares no bit with `ray_mask` (accel/top_level.h). Appends to `out`.
 void cull_objects(const Scene& scene, const RayBound& bound, std::vector<std::uint32_t>& out,
-                  float extra_grow = 0.0f);
+                  float extra_grow = 0.0f, std::uint32_t ray_mask = kAllMaskBits);
 
 }  // namespace sinew::rt

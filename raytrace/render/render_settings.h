@@ -30,6 +30,11 @@ struct RenderSettings {
   // Textured materials sample their texture (docs/RAYTRACE.md, "Textures");
   // off, every material shows its colour alone.
   bool textures = true;
+  // Per-instance mask bits (Scene::set_mask): camera rays see, and shadow
+  // rays are blocked by, only the objects whose mask shares a bit with
+  // these (a first-person body that casts a shadow but is not drawn).
+  std::uint32_t camera_mask = 0xFFFFFFFFu;
+  std::uint32_t shadow_mask = 0xFFFFFFFFu;
   Light light;
   // When non-empty, these lights (1 to kMaxLights; kept by the caller for
   // the render's duration) replace `light`.

@@ -69,6 +69,8 @@ TracePlan plan_for_packet_rays(int packet_rays) {
 
 TracePlan make_trace_plan(const Scene& scene, const PinholeCamera& camera, const RenderSettings& settings) {
   TracePlan plan = plan_for_packet_rays(settings.packet_rays);
+  plan.camera_mask = settings.camera_mask;
+  plan.shadow_mask = settings.shadow_mask;
   plan.split_fine_shadows = settings.split_fine_shadow_packets;
   const bool characters_fine = characters_look_fine(scene, camera);
   const bool fine = settings.shadows && settings.split_fine_shadow_packets && characters_fine;

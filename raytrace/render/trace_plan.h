@@ -5,6 +5,8 @@
 // plan", gives the measurement behind each; docs/BENCHMARKS.md the numbers.
 #pragma once
 
+#include <cstdint>
+
 namespace sinew::rt {
 
 class PinholeCamera;
@@ -30,6 +32,10 @@ struct TracePlan {
   // Where some character looks fine: camera and shadow packets clip their
   // lanes to each leaf's current box (LargePacketRays::clip_leaf_lanes).
   bool clip_leaf_lanes = false;
+  // Objects whose mask shares no bit with these are left out of the camera
+  // rays or the shadow rays (RenderSettings::camera_mask, shadow_mask).
+  std::uint32_t camera_mask = 0xFFFFFFFFu;
+  std::uint32_t shadow_mask = 0xFFFFFFFFu;
 };
 
 // Whether `packet_rays` is one RenderSettings::packet_rays accepts, and the

@@ -310,6 +310,41 @@ TEST(ApiPass, HostMatricesRenderTheSameAsTheMixerAtThatPose) {
   EXPECT_GT(hit_pixels(a), 300u);
 }
 
+// PassInputs' ray masks reach the renderer: an instance whose mask shares
+// no bit with camera_ray_mask is not drawn, and the rest of the image is
+// the same as with that instance removed from camera rays alone (its
+// shadow stays: shadow_ray_mask still takes it).
+TEST(ApiPass, CameraRayMaskLeavesAnInstanceUndrawnButShadowing) {
+  const api::Character character = load_mannequin();
+  auto world = api::World::create();
+  ASSERT_TRUE(world.ok());
+  api::InstanceDesc left, right;
+  left.transform = api::Matrix3x4::translation(-0.45f, 0.0f, 0.0f);
+  right.transform = api::Matrix3x4::translation(0.45f, 0.0f, 0.0f);
+  right.mask = 2u;
+  const auto a = world->add_instance(character, left);
+  const auto b = world->add_instance(character, right);
+  ASSERT_TRUE(a.ok() && b.ok());
+  const api::Float3 quad[] = {{-3, 0, -3}, {3, 0, -3}, {-3, 0, 3}, {3, 0, 3}};
+  const std::uint32_t indices[] = {0, 2, 1, 1, 2, 3};
+  ASSERT_TRUE(world->add_static_mesh({quad, indices, {0.5f, 0.5f, 0.5f}}).ok());
+  const api::Light light = testing_support::test_light();
+  api::RayTracePass pass = make_pass(api::Output::kColorRgba32f | api::Output::kInstanceId);
+  Frame all(kW, kH), masked(kW, kH), masked_everywhere(kW, kH);
+  api::PassInputs inputs = inputs_with(light);
+  ASSERT_TRUE(pass.execute(*world, inputs, all.outputs()).ok());
+  inputs.camera_ray_mask = ~2u;
+  ASSERT_TRUE(pass.execute(*world, inputs, masked.outputs()).ok());
+  inputs.shadow_ray_mask = ~2u;
+  ASSERT_TRUE(pass.execute(*world, inputs, masked_everywhere.outputs()).ok());
+  const auto count = [](const Frame& f, std::uint32_t id) { return std::count(f.instance_id.begin(), f.instance_id.end(), id); };
+  EXPECT_GT(count(all, *b), 100);
+  EXPECT_EQ(count(masked, *b), 0);
+  EXPECT_GT(count(masked, *a), 100);
+  // Its shadow on the ground stays until shadow rays leave it out too.
+  EXPECT_NE(masked.rgba32f, masked_everywhere.rgba32f);
+}
+
 TEST(ApiPass, InstancesShareTheirCharacterAndStaticMeshesJoinTheNumbering) {
   const api::Character character = load_mannequin();
   auto world = api::World::create();

@@ -456,5 +456,96 @@ TEST(Renderer, EachLightsContributionIsItsBruteForceVisibilityTimesNdotL) {
   }
 }
 
+// Masks (Scene::set_mask, RenderSettings::camera_mask and shadow_mask):
+// the image is what brute force over the unmasked objects gives. Camera
+// rays see only objects sharing a bit with camera_mask, shadow rays are
+// blocked only by those sharing a bit with shadow_mask.
+TEST(Renderer, MasksLeaveObjectsOutOfCameraRaysOrShadowRaysAsBruteForceOverTheRestDoes) {
+  std::unique_ptr<rt::Scene> sc = testing_support::make_scene();  // mannequins 0 and 1, the ground 2
+  const std::uint32_t masks[3] = {1u, 2u, 4u};
+  for (std::uint32_t id = 0; id < 3; ++id) ASSERT_TRUE(sc->set_mask(id, masks[id]).ok());
+  JobSystem jobs(2);
+  const int w = 80, h = 60;
+  const auto camera =
+      rt::PinholeCamera::create({Vec3(0.5f, 1.8f, 3.5f), Vec3(0.0f, 0.6f, 0.0f), Vec3(0, 1, 0), 50.0f}, w, h).value();
+  rt::Light light[1];
+  light[0].position = Vec3(-2.0f, 5.0f, 3.0f);
+  const std::vector<testing_support::SoupTriangle> soup = testing_support::world_triangles(*sc);
+  struct Round {
+    std::uint32_t camera_mask, shadow_mask;
+  };
+  // Mannequin 1 casts shadows but is not drawn; mannequin 0 is drawn but
+  // casts none. Then the ground and mannequin 0 drawn, only mannequin 1
+  // casting.
+  for (const Round round : {Round{~2u, ~1u}, Round{5u, 2u}}) {
+    SCOPED_TRACE(round.camera_mask);
+    rt::RenderSettings settings;
+    settings.lights = light;
+    settings.ambient = Vec3(0.0f);
+    settings.camera_mask = round.camera_mask;
+    settings.shadow_mask = round.shadow_mask;
+    std::vector<float> color(static_cast<std::size_t>(4 * w * h));
+    std::vector<std::uint32_t> triangle(static_cast<std::size_t>(w * h)), instance(static_cast<std::size_t>(w * h));
+    std::vector<Vec3> normal(static_cast<std::size_t>(w * h));
+    rt::FrameBuffers buffers;
+    buffers.width = w;
+    buffers.height = h;
+    buffers.color_rgba32f = color;
+    buffers.normal = normal;
+    buffers.triangle_id = triangle;
+    buffers.instance_id = instance;
+    rt::Renderer renderer;
+    ASSERT_TRUE(renderer.render(*sc, camera, settings, buffers, jobs).ok());
+    std::vector<testing_support::SoupTriangle> seen, casting;
+    for (const testing_support::SoupTriangle& t : soup) {
+      if ((masks[t.instance_id] & round.camera_mask) != 0) seen.push_back(t);
+      if ((masks[t.instance_id] & round.shadow_mask) != 0) casting.push_back(t);
+    }
+    int same = 0, lit = 0, shadowed = 0;
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) {
+        const std::size_t p = static_cast<std::size_t>(y * w + x);
+        if (instance[p] != kInvalidId) {
+          ASSERT_NE(masks[instance[p]] & round.camera_mask, 0u) << "a masked object drawn";
+        }
+        const Ray eye = camera.ray(x, y);
+        const Hit hit = testing_support::nearest(seen, eye, TriangleTest::kFast);
+        if (!hit.valid()) {
+          EXPECT_EQ(instance[p], kInvalidId) << x << "," << y;
+          continue;
+        }
+        if (hit.instance_id != instance[p] || hit.triangle_id != triangle[p]) continue;  // an edge
+        ++same;
+        const auto tri = std::find_if(seen.begin(), seen.end(), [&](const testing_support::SoupTriangle& t) {
+          return t.triangle_id == hit.triangle_id && t.instance_id == hit.instance_id;
+        });
+        Vec3 g = glm::normalize(glm::cross(tri->p1 - tri->p0, tri->p2 - tri->p0));
+        if (glm::dot(g, eye.direction) > 0.0f) g = -g;
+        const Vec3 point = eye.origin + hit.t * eye.direction;
+        const Vec3 to_light = light[0].position - point;
+        // Facing away or at the terminator, by either normal (the shading
+        // normal's N.L is the colour's factor).
+        if (glm::dot(g, glm::normalize(to_light)) < 1e-3f || glm::dot(normal[p], glm::normalize(to_light)) < 1e-3f) {
+          continue;
+        }
+        const auto blocked_from = [&](const Vec3& from) {
+          Ray ray;
+          ray.origin = from;
+          ray.direction = light[0].position - from;
+          ray.t_max = 1.0f;
+          return testing_support::nearest(casting, ray, TriangleTest::kWatertight).valid();
+        };
+        const bool near = blocked_from(point + 1e-4f * g), far = blocked_from(point + 1e-3f * g);
+        if (near != far) continue;  // an occluder within the offsets: the test's own rounding decides
+        EXPECT_EQ(color[4 * p] > 0.0f, !near) << "pixel " << x << "," << y << " instance " << instance[p];
+        (near ? shadowed : lit) += 1;
+      }
+    }
+    EXPECT_GT(same, w * h / 3);
+    EXPECT_GT(lit, 200);
+    EXPECT_GT(shadowed, 20) << "some shadow in view";
+  }
+}
+
 }  // namespace
 }  // namespace sinew

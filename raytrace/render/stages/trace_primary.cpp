@@ -109,7 +109,7 @@ void trace_primary(const Scene& scene, const PinholeCamera& camera, TriangleTest
         Ray ray;
         ray.origin = eye;
         ray.direction = Vec3(s.dir_x[k], s.dir_y[k], s.dir_z[k]);
-        const Hit hit = intersect(scene, ray, test, &counters);
+        const Hit hit = intersect(scene, ray, s.plan.camera_mask, test, &counters);
         s.t[k] = hit.t;
         s.u[k] = hit.u;
         s.v[k] = hit.v;
@@ -128,7 +128,7 @@ void trace_primary(const Scene& scene, const PinholeCamera& camera, TriangleTest
   RayBound tile_bound;
   const float* const dirs[3] = {s.dir_x.data(), s.dir_y.data(), s.dir_z.data()};
   tile_bound.add_groups(eye, dirs, 0.0f, kInf, std::span<const std::uint8_t>(s.block_pixels.data(), blocks));
-  cull_objects(scene, tile_bound, lists.tile);
+  cull_objects(scene, tile_bound, lists.tile, 0.0f, s.plan.camera_mask);
   thread_local StaticTile statics;
   if (gather_static_tile(scene, test, tile_bound, 0.0f, lists.tile, statics, camera_tile_cone(camera, s.tile))) {
     for (std::size_t b = 0; b < blocks; ++b) counters.rays += static_cast<std::uint64_t>(std::popcount(s.block_pixels[b]));

@@ -90,7 +90,7 @@ std::uint64_t trace_shadow_rays(const Scene& scene, TriangleTest test, int l, Ti
     offset_shadow_rays(s);
     compact_shadow_rays(s);
     for (std::size_t i = 0; i < s.shadow_count; ++i) {
-      if (occluded(scene, s.shadow_ray(i), test, &counters)) block(i);
+      if (occluded(scene, s.shadow_ray(i), s.plan.shadow_mask, test, &counters)) block(i);
     }
     return blocked_count;
   }
@@ -142,7 +142,7 @@ std::uint64_t trace_shadow_rays(const Scene& scene, TriangleTest test, int l, Ti
   }
   // A tile whose rays can reach nothing (a ground in the open, mostly)
   // places and compacts none.
-  cull_objects(scene, tile_bound, lists.tile);
+  cull_objects(scene, tile_bound, lists.tile, 0.0f, s.plan.shadow_mask);
   if (lists.tile.empty()) {
     counters.rays += s.shadow_placed;
     return 0;
