@@ -24,6 +24,7 @@
 #include "runtime/jobs/job_system.h"
 #include "runtime/memory/line_aligned.h"
 #include "tests/raytrace/render_test_support.h"
+#include "tests/support/aov_frame.h"
 #include "tests/support/brute_force.h"
 #include "tests/support/idle_mannequin.h"
 
@@ -484,18 +485,13 @@ TEST(Renderer, MasksLeaveObjectsOutOfCameraRaysOrShadowRaysAsBruteForceOverTheRe
     settings.ambient = Vec3(0.0f);
     settings.camera_mask = round.camera_mask;
     settings.shadow_mask = round.shadow_mask;
-    std::vector<float> color(static_cast<std::size_t>(4 * w * h));
-    std::vector<std::uint32_t> triangle(static_cast<std::size_t>(w * h)), instance(static_cast<std::size_t>(w * h));
-    std::vector<Vec3> normal(static_cast<std::size_t>(w * h));
-    rt::FrameBuffers buffers;
-    buffers.width = w;
-    buffers.height = h;
-    buffers.color_rgba32f = color;
-    buffers.normal = normal;
-    buffers.triangle_id = triangle;
-    buffers.instance_id = instance;
+    testing_support::AovFrame frame(w, h);
     rt::Renderer renderer;
-    ASSERT_TRUE(renderer.render(*sc, camera, settings, buffers, jobs).ok());
+    ASSERT_TRUE(renderer.render(*sc, camera, settings, frame.buffers(), jobs).ok());
+    const std::vector<float>& color = frame.rgba32f;
+    const std::vector<Vec3>& normal = frame.normal;
+    const std::vector<std::uint32_t>& triangle = frame.triangle_id;
+    const std::vector<std::uint32_t>& instance = frame.instance_id;
     std::vector<testing_support::SoupTriangle> seen, casting;
     for (const testing_support::SoupTriangle& t : soup) {
       if ((masks[t.instance_id] & round.camera_mask) != 0) seen.push_back(t);
