@@ -91,8 +91,9 @@ struct InstanceDesc {
   float playback_speed = 1.0f;
   // Queries skip the instance when (mask & Ray::mask) == 0: give each
   // group of instances (players, the ground, debris) a bit, and a ray the
-  // bits it may hit. World::set_mask changes it. The pass draws every
-  // instance whatever its mask.
+  // bits it may hit. World::set_mask changes it. The pass's camera and
+  // shadow rays test it against PassInputs::camera_ray_mask and
+  // shadow_ray_mask.
   std::uint32_t mask = kAllMaskBits;
 };
 

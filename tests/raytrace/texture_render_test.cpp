@@ -17,6 +17,7 @@
 #include "raytrace/render/renderer.h"
 #include "runtime/image/texture.h"
 #include "runtime/jobs/job_system.h"
+#include "tests/support/aov_frame.h"
 #include "tests/support/brute_force.h"
 #include "tests/support/idle_mannequin.h"
 
@@ -78,27 +79,11 @@ testing_support::BakedModel textured_mannequin(const Image& image) {
   return testing_support::bake_over_idle(std::move(model));
 }
 
-struct Frame {
-  int w, h;
-  std::vector<float> color;
-  std::vector<std::uint32_t> triangle, instance;
-  rt::FrameBuffers buffers;
-  Frame(int width, int height)
-      : w(width), h(height), color(static_cast<std::size_t>(4 * w * h)),
-        triangle(static_cast<std::size_t>(w * h)), instance(static_cast<std::size_t>(w * h)) {
-    buffers.width = w;
-    buffers.height = h;
-    buffers.color_rgba32f = color;
-    buffers.triangle_id = triangle;
-    buffers.instance_id = instance;
-  }
-};
-
 // Renders the model's albedo (ambient 1, no light) from `eye`.
 struct Rendered {
   std::unique_ptr<rt::Scene> scene;
   rt::PinholeCamera camera;
-  Frame frame;
+  testing_support::AovFrame frame;
 };
 Rendered render_albedo(const testing_support::BakedModel& m, const Vec3& eye, int size) {
   auto scene = std::make_unique<rt::Scene>();
@@ -108,7 +93,7 @@ Rendered render_albedo(const testing_support::BakedModel& m, const Vec3& eye, in
   JobSystem jobs(2);
   EXPECT_TRUE(scene->prepare_frame(rt::FrameOptions{}, jobs).ok());
   const auto camera = rt::PinholeCamera::create({eye, Vec3(0.0f, 0.9f, 0.0f), Vec3(0, 1, 0), 40.0f}, size, size).value();
-  Frame frame(size, size);
+  testing_support::AovFrame frame(size, size);
   rt::RenderSettings settings;
   settings.ambient = Vec3(1.0f);
   settings.shadows = false;
@@ -117,7 +102,7 @@ Rendered render_albedo(const testing_support::BakedModel& m, const Vec3& eye, in
   dark[0].color = Vec3(0.0f);
   settings.lights = dark;
   rt::Renderer renderer;
-  EXPECT_TRUE(renderer.render(*scene, camera, settings, frame.buffers, jobs).ok());
+  EXPECT_TRUE(renderer.render(*scene, camera, settings, frame.buffers(), jobs).ok());
   return {std::move(scene), camera, std::move(frame)};
 }
 
@@ -129,14 +114,14 @@ TEST(TexturedRender, MagnifiedTexelsMatchABilinearLookupOfTheSourceImageAtTheBru
   const SkinnedMesh& mesh = m.model.mesh;
   int checked = 0;
   float lo = 1.0f, hi = 0.0f;
-  for (int y = 0; y < r.frame.h; ++y) {
-    for (int x = 0; x < r.frame.w; ++x) {
-      const std::size_t p = static_cast<std::size_t>(y * r.frame.w + x);
-      if (r.frame.instance[p] == kInvalidId) continue;
+  for (int y = 0; y < r.frame.height; ++y) {
+    for (int x = 0; x < r.frame.width; ++x) {
+      const std::size_t p = static_cast<std::size_t>(y * r.frame.width + x);
+      if (r.frame.instance_id[p] == kInvalidId) continue;
       const Ray ray = r.camera.ray(x, y);
       const Hit hit = testing_support::nearest(soup, ray, rt::TriangleTest::kFast);
       ASSERT_TRUE(hit.valid());
-      if (hit.triangle_id != r.frame.triangle[p]) continue;  // an edge: the tests' rounding differs
+      if (hit.triangle_id != r.frame.triangle_id[p]) continue;  // an edge: the tests' rounding differs
       const auto& v = mesh.triangles[hit.triangle_id];
       const auto& tri = soup[hit.triangle_id];
       const Vec3 g = glm::normalize(glm::cross(tri.p1 - tri.p0, tri.p2 - tri.p0));
@@ -150,7 +135,7 @@ TEST(TexturedRender, MagnifiedTexelsMatchABilinearLookupOfTheSourceImageAtTheBru
       };
       const double u = interpolate(0), vv = interpolate(1);
       for (int c = 0; c < 3; ++c) {
-        const float got = r.frame.color[4 * p + static_cast<std::size_t>(c)];
+        const float got = r.frame.rgba32f[4 * p + static_cast<std::size_t>(c)];
         ASSERT_NEAR(got, image.sample(u, vv, c), 1.0 / 255.0) << "pixel " << x << "," << y << " channel " << c << " uv " << u << " " << vv << " t " << hit.t << " tri " << hit.triangle_id;
         lo = std::min(lo, got);
         hi = std::max(hi, got);
@@ -168,18 +153,18 @@ TEST(TexturedRender, AOneTexelCheckerboardSeenFromFarAwayAveragesToGreyThroughTh
   const Rendered r = render_albedo(m, Vec3(0.0f, 1.0f, 11.0f), 192);
   const std::vector<testing_support::SoupTriangle> soup = testing_support::world_triangles(*r.scene);
   int checked = 0;
-  for (int y = 0; y < r.frame.h; ++y) {
-    for (int x = 0; x < r.frame.w; ++x) {
-      const std::size_t p = static_cast<std::size_t>(y * r.frame.w + x);
-      if (r.frame.instance[p] == kInvalidId) continue;
-      const auto& tri = soup[r.frame.triangle[p]];
+  for (int y = 0; y < r.frame.height; ++y) {
+    for (int x = 0; x < r.frame.width; ++x) {
+      const std::size_t p = static_cast<std::size_t>(y * r.frame.width + x);
+      if (r.frame.instance_id[p] == kInvalidId) continue;
+      const auto& tri = soup[r.frame.triangle_id[p]];
       const Vec3 g = glm::normalize(glm::cross(tri.p1 - tri.p0, tri.p2 - tri.p0));
       // Where the planar projection squeezes the uvs (sides facing x or y),
       // a pixel covers few texels and level 0 is right: only the faces
       // toward the projection are asked to average.
       if (std::fabs(g.z) < 0.7f) continue;
       for (int c = 0; c < 3; ++c) {
-        EXPECT_NEAR(r.frame.color[4 * p + static_cast<std::size_t>(c)], 0.5f, 0.01f) << "pixel " << x << "," << y;
+        EXPECT_NEAR(r.frame.rgba32f[4 * p + static_cast<std::size_t>(c)], 0.5f, 0.01f) << "pixel " << x << "," << y;
       }
       ++checked;
     }
@@ -194,12 +179,12 @@ TEST(TexturedRender, WithoutTheTextureTheSameRenderIsTheMaterialColour) {
   m.model.mesh.material_colors = {Vec3(0.25f, 0.5f, 0.75f)};
   const Rendered r = render_albedo(m, Vec3(0.3f, 1.1f, 2.6f), 48);
   int hits = 0;
-  for (std::size_t p = 0; p < r.frame.instance.size(); ++p) {
-    if (r.frame.instance[p] == kInvalidId) continue;
+  for (std::size_t p = 0; p < r.frame.instance_id.size(); ++p) {
+    if (r.frame.instance_id[p] == kInvalidId) continue;
     ++hits;
-    EXPECT_EQ(r.frame.color[4 * p], 0.25f);
-    EXPECT_EQ(r.frame.color[4 * p + 1], 0.5f);
-    EXPECT_EQ(r.frame.color[4 * p + 2], 0.75f);
+    EXPECT_EQ(r.frame.rgba32f[4 * p], 0.25f);
+    EXPECT_EQ(r.frame.rgba32f[4 * p + 1], 0.5f);
+    EXPECT_EQ(r.frame.rgba32f[4 * p + 2], 0.75f);
   }
   EXPECT_GT(hits, 100);
 }
