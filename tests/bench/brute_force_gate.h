@@ -3,17 +3,14 @@
 // contender's primary hits with brute force (tests/support/brute_force.h)
 // on every `stride`-th pixel of the image.
 //
-// Tolerances: t relative 1e-4. A different triangle at the same t passes
-// when the ray really hits it there (a shared edge or vertex). A hit
-// against a miss, or a nearer hit on one side only, passes when the nearer
-// triangle is only grazed (its smallest barycentric within 1e-5 of 0 in
-// double precision): two float triangle tests may decide such a ray either
-// way. Grazes are counted and reported.
+// Tolerances: those of compare_nearest_hits (hit_comparison.h).
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <unordered_map>
 #include <vector>
@@ -23,6 +20,7 @@
 #include "raytrace/scene/scene.h"
 #include "runtime/core/expected.h"
 #include "runtime/jobs/job_system.h"
+#include "tests/bench/hit_comparison.h"
 #include "tests/support/brute_force.h"
 
 namespace sinew::bench {
@@ -58,82 +56,28 @@ class BruteForceGate {
       const Ray ray = camera_.ray(static_cast<int>(p % static_cast<std::size_t>(w)),
                                   static_cast<int>(p / static_cast<std::size_t>(w)));
       ++r.checked;
-      switch (compare(hits[p], reference_[sample++], ray)) {
-        case Verdict::kSame: break;
-        case Verdict::kGraze: ++r.grazes; break;
-        case Verdict::kDifferent: ++r.mismatched; break;
+      const auto corners_of = [this](std::uint32_t instance, std::uint32_t triangle) {
+        return this->corners_of(instance, triangle);
+      };
+      switch (compare_nearest_hits(hits[p], reference_[sample++], ray, corners_of)) {
+        case HitVerdict::kSame: break;
+        case HitVerdict::kGraze: ++r.grazes; break;
+        case HitVerdict::kDifferent: ++r.mismatched; break;
       }
     }
     return r;
   }
 
  private:
-  enum class Verdict { kSame, kGraze, kDifferent };
-  static constexpr double kTolerance = 1e-4;
-  static constexpr double kGrazeBarycentric = 1e-5;
-
   static std::uint64_t key(std::uint32_t instance, std::uint32_t triangle) {
     return (static_cast<std::uint64_t>(instance) << 32) | triangle;
   }
 
-  // The ray against the hit's triangle in double precision: its t and its
-  // smallest barycentric (negative: outside). False for an unknown id or a
-  // ray parallel to the plane.
-  bool exact_hit(const Hit& hit, const Ray& ray, double& t, double& min_bary) const {
-    const auto it = index_.find(key(hit.instance_id, hit.triangle_id));
-    if (it == index_.end()) return false;
+  std::optional<std::array<Vec3, 3>> corners_of(std::uint32_t instance, std::uint32_t triangle) const {
+    const auto it = index_.find(key(instance, triangle));
+    if (it == index_.end()) return std::nullopt;
     const testing_support::SoupTriangle& tri = soup_[it->second];
-    const auto d = [](const Vec3& v) { return std::array<double, 3>{v.x, v.y, v.z}; };
-    const auto sub = [](const std::array<double, 3>& a, const std::array<double, 3>& b) {
-      return std::array<double, 3>{a[0] - b[0], a[1] - b[1], a[2] - b[2]};
-    };
-    const auto cross = [](const std::array<double, 3>& a, const std::array<double, 3>& b) {
-      return std::array<double, 3>{a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-    };
-    const auto dot = [](const std::array<double, 3>& a, const std::array<double, 3>& b) {
-      return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-    };
-    const auto p0 = d(tri.p0), e1 = sub(d(tri.p1), p0), e2 = sub(d(tri.p2), p0);
-    const auto dir = d(ray.direction);
-    const auto pv = cross(dir, e2);
-    const double det = dot(e1, pv);
-    if (det == 0.0) return false;
-    const auto tv = sub(d(ray.origin), p0);
-    const double u = dot(tv, pv) / det;
-    const auto qv = cross(tv, e1);
-    const double v = dot(dir, qv) / det;
-    t = dot(e2, qv) / det;
-    min_bary = std::min({u, v, 1.0 - u - v});
-    return true;
-  }
-
-  bool grazed(const Hit& hit, const Ray& ray) const {
-    double t = 0.0, min_bary = 0.0;
-    return exact_hit(hit, ray, t, min_bary) && std::fabs(min_bary) <= kGrazeBarycentric;
-  }
-
-  Verdict compare(const Hit& ours, const Hit& ref, const Ray& ray) const {
-    if (!ours.valid() && !ref.valid()) return Verdict::kSame;
-    if (ours.valid() && ref.valid()) {
-      const double tol = kTolerance * std::max(static_cast<double>(std::fabs(ref.t)), 1e-30);
-      if (std::fabs(static_cast<double>(ours.t) - static_cast<double>(ref.t)) <= tol) {
-        if (ours.triangle_id == ref.triangle_id && ours.instance_id == ref.instance_id) return Verdict::kSame;
-        double t = 0.0, min_bary = 0.0;  // another triangle at the same t: does the ray really hit it there?
-        const bool real = exact_hit(ours, ray, t, min_bary) && min_bary >= -kGrazeBarycentric &&
-                          std::fabs(t - static_cast<double>(ref.t)) <= tol;
-        if (real) return Verdict::kSame;
-        // The reference's own hit on an edge: the ray passes through the
-        // edge, and the triangle across it at the same t is a tie that the
-        // float test may settle either way (its barycentrics are those of
-        // another triangle, so its distance past the edge is on another
-        // scale).
-        return grazed(ref, ray) ? Verdict::kGraze : Verdict::kDifferent;
-      }
-      // Different depths: the nearer one must be a graze the other missed.
-      const Hit& nearer = ours.t < ref.t ? ours : ref;
-      return grazed(nearer, ray) ? Verdict::kGraze : Verdict::kDifferent;
-    }
-    return grazed(ours.valid() ? ours : ref, ray) ? Verdict::kGraze : Verdict::kDifferent;
+    return std::array<Vec3, 3>{tri.p0, tri.p1, tri.p2};
   }
 
   rt::PinholeCamera camera_;
