@@ -64,6 +64,7 @@ struct EmbreeTracer::State {
   // Embree-owned vertex buffer the new positions are copied into.
   std::vector<RTCGeometry> instance_geometries;
   std::vector<float*> instance_vertices;
+  std::vector<std::size_t> instance_vertex_counts;  // the caller's meshes only (their refresh checks them)
   // Embree geometry id -> the Sinew scene's instance id reported in hits.
   std::vector<std::uint32_t> sinew_id_of_geometry;
 
@@ -140,6 +141,38 @@ struct EmbreeTracer::State {
     return {};
   }
 
+  Status first_build(std::span<const EmbreeMesh> meshes) {
+    for (const EmbreeMesh& mesh : meshes) {
+      RTCGeometry g = nullptr;
+      SINEW_ASSIGN_OR_RETURN(float* vertex,
+                             add_geometry(mesh.triangles, mesh.positions.size(), mesh.id, geometry_quality(), g));
+      instance_geometries.push_back(g);
+      instance_vertices.push_back(vertex);
+      instance_vertex_counts.push_back(mesh.positions.size());
+      copy_positions(mesh.positions, vertex);
+      rtcCommitGeometry(g);
+    }
+    built = true;
+    return {};
+  }
+
+  Status refresh(std::span<const EmbreeMesh> meshes) {
+    if (meshes.size() != instance_geometries.size()) {
+      return invalid_argument("meshes", std::to_string(meshes.size()), "changed in number since the first update");
+    }
+    for (std::size_t i = 0; i < meshes.size(); ++i) {
+      if (meshes[i].positions.size() != instance_vertex_counts[i]) {
+        return invalid_argument("meshes[" + std::to_string(i) + "].positions",
+                                std::to_string(meshes[i].positions.size()),
+                                "vertex count changed since the first update");
+      }
+      copy_positions(meshes[i].positions, instance_vertices[i]);
+      rtcUpdateGeometryBuffer(instance_geometries[i], RTC_BUFFER_TYPE_VERTEX, 0);
+      rtcCommitGeometry(instance_geometries[i]);
+    }
+    return {};
+  }
+
   Status refresh(const rt::Scene& s) {
     if (s.instances().size() != instance_geometries.size()) {
       return invalid_argument("scene.instances", std::to_string(s.instances().size()),
@@ -185,6 +218,43 @@ Expected<double> EmbreeTracer::update(const rt::Scene& scene) {
   const double ms = ms_between(start, Clock::now());
   if (rtcGetDeviceError(s.device) != RTC_ERROR_NONE) return embree_error(s.device, "rtcCommitScene");
   return ms;
+}
+
+Expected<double> EmbreeTracer::update(std::span<const EmbreeMesh> meshes) {
+  State& s = *state_;
+  const Clock::time_point start = Clock::now();
+  if (!s.built) {
+    SINEW_RETURN_IF_ERROR(s.first_build(meshes));
+  } else {
+    SINEW_RETURN_IF_ERROR(s.refresh(meshes));
+  }
+  rtcCommitScene(s.scene);
+  const double ms = ms_between(start, Clock::now());
+  if (rtcGetDeviceError(s.device) != RTC_ERROR_NONE) return embree_error(s.device, "rtcCommitScene");
+  return ms;
+}
+
+Hit EmbreeTracer::intersect1(const Ray& ray) const {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  RTCRayHit rh;
+  rh.ray.org_x = ray.origin.x;
+  rh.ray.org_y = ray.origin.y;
+  rh.ray.org_z = ray.origin.z;
+  rh.ray.dir_x = ray.direction.x;
+  rh.ray.dir_y = ray.direction.y;
+  rh.ray.dir_z = ray.direction.z;
+  rh.ray.tnear = ray.t_min;
+  rh.ray.tfar = ray.t_max;
+  rh.ray.time = 0.0f;
+  rh.ray.mask = 0xFFFFFFFFu;
+  rh.ray.id = 0;
+  rh.ray.flags = 0;
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  rtcIntersect1(state_->scene, &context, &rh);
+  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return {};
+  return Hit{rh.ray.tfar, rh.hit.u, rh.hit.v, rh.hit.primID, state_->sinew_id_of_geometry[rh.hit.geomID]};
 }
 
 namespace {

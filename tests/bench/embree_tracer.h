@@ -15,6 +15,7 @@
 //   part of the build / refit.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -58,6 +59,15 @@ struct EmbreeRenderStats {
   double shade_ms = 0.0;
 };
 
+// One skinned mesh the caller keeps (the query benchmark's path, which has
+// no rt::Scene): its triangles, this tick's world positions, and the id its
+// hits report. The spans need only live through the update.
+struct EmbreeMesh {
+  std::span<const std::array<std::uint32_t, 3>> triangles;
+  std::span<const Vec3> positions;
+  std::uint32_t id = 0;
+};
+
 class EmbreeTracer {
  public:
   // `threads`: the Embree device's build threads (the JobSystem's count, so
@@ -74,6 +84,16 @@ class EmbreeTracer {
   // positions and rebuild or refit by the mode. The scene's set of instances
   // and static meshes must not change between calls. Returns milliseconds.
   Expected<double> update(const rt::Scene& scene);
+  // The same for meshes skinned by the caller: the first call creates one
+  // geometry per mesh and builds, later calls upload the new positions and
+  // rebuild or refit by the mode. The meshes (their number, triangles and
+  // vertex counts) must not change between calls, and a tracer serves
+  // either this overload or the scene's, not both.
+  Expected<double> update(std::span<const EmbreeMesh> meshes);
+
+  // The nearest hit of one ray through rtcIntersect1 (after an update), in
+  // Sinew's ids: the triangle index within its mesh and the mesh's id.
+  Hit intersect1(const Ray& ray) const;
 
   // Renders like rt::Renderer::render with `settings` (one light, its
   // shadows, diffuse shading) into `color_rgba8` (width x height x 4, may be
