@@ -12,6 +12,7 @@
 #include "tests/bench/demo_bench.h"
 #include "tests/bench/embree_bench.h"
 #include "tests/bench/paper_bench.h"
+#include "tests/bench/query_bench.h"
 #include "tests/bench/raytrace_bench.h"
 #include "tests/bench/report_bench.h"
 #include "tests/bench/structures_bench.h"
@@ -40,6 +41,7 @@ int main(int argc, char** argv) {
   line.command("demo", "the game demo's fps and phases");
   line.command("embree", "Sinew vs Embree 3 (rebuild LOW/MEDIUM, refit) vs exact kd");
   line.command("paper", "the paper's Tables 1 and 2 on Cally");
+  line.command("queries", "gameplay queries in a crowd: World::intersect against Embree refit and rebuild");
   line.command("raytrace", "ray tracer frame phases, and fuzzy vs exact kd-tree trace time");
   line.command("report", "every benchmark section; writes docs/BENCHMARKS.md");
   line.command("structures", "the paper's one tree a bone against pose-space clusters, per model and mesh size");
@@ -67,6 +69,7 @@ int main(int argc, char** argv) {
   if (what == "demo") return sinew::bench::run_demo_bench(args, command_line(argc, argv));
   if (what == "embree") return sinew::bench::run_embree_bench(args, command_line(argc, argv));
   if (what == "paper") return sinew::bench::run_paper_bench(args, command_line(argc, argv));
+  if (what == "queries") return sinew::bench::run_query_bench(args, command_line(argc, argv));
   if (what == "raytrace") return sinew::bench::run_raytrace_bench(args, command_line(argc, argv));
   if (what == "report") return sinew::bench::run_report_bench(args, command_line(argc, argv));
   if (what == "structures") return sinew::bench::run_structures_bench(args, command_line(argc, argv));
