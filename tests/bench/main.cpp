@@ -11,6 +11,7 @@
 #include "tests/bench/bake_bench.h"
 #include "tests/bench/demo_bench.h"
 #include "tests/bench/embree_bench.h"
+#include "tests/bench/memory_bench.h"
 #include "tests/bench/paper_bench.h"
 #include "tests/bench/query_bench.h"
 #include "tests/bench/raytrace_bench.h"
@@ -40,6 +41,7 @@ int main(int argc, char** argv) {
   line.command("bake", "fuzzy bake cost per candidate-bone mode, its trace effect, and its memory bound");
   line.command("demo", "the game demo's fps and phases");
   line.command("embree", "Sinew vs Embree 3 (rebuild LOW/MEDIUM, refit) vs exact kd");
+  line.command("memory", "resident memory per added character instance against its skinned vertices");
   line.command("paper", "the paper's Tables 1 and 2 on Cally");
   line.command("queries", "gameplay queries in a crowd: World::intersect against Embree refit and rebuild");
   line.command("raytrace", "ray tracer frame phases, and fuzzy vs exact kd-tree trace time");
@@ -68,6 +70,7 @@ int main(int argc, char** argv) {
   if (what == "bake") return sinew::bench::run_bake_bench(args, command_line(argc, argv));
   if (what == "demo") return sinew::bench::run_demo_bench(args, command_line(argc, argv));
   if (what == "embree") return sinew::bench::run_embree_bench(args, command_line(argc, argv));
+  if (what == "memory") return sinew::bench::run_memory_bench(args, command_line(argc, argv));
   if (what == "paper") return sinew::bench::run_paper_bench(args, command_line(argc, argv));
   if (what == "queries") return sinew::bench::run_query_bench(args, command_line(argc, argv));
   if (what == "raytrace") return sinew::bench::run_raytrace_bench(args, command_line(argc, argv));
