@@ -36,8 +36,12 @@ constexpr float kActionFadeOut = 0.3f;  // s
 constexpr float kMaxSubstep = 1.0f / 30.0f;
 // A hitch longer than this is simulated as this long.
 constexpr float kMaxStep = 1.0f;
-// Spacing of the start positions (centre, then rings).
+// Spacing of the start positions (centre, then rings). A crowd that does
+// not fit at that spacing starts closer, down to kMinStartSpacing (two body
+// radii and a little room), tried in kStartSpacingStep steps.
 constexpr float kStartSpacing = 1.5f;
+constexpr float kMinStartSpacing = 0.9f;
+constexpr float kStartSpacingStep = 0.15f;
 
 // NPC behaviour.
 constexpr float kArriveDistance = 0.4f;  // m
@@ -227,6 +231,7 @@ struct World::Impl {
   }
 
   Status place_characters();
+  std::vector<Vec3> start_spots(float spacing) const;
   void start_action(Character& c, int clip);
   void enter_pause(Character& c, bool allow_action);
   bool pick_target(Character& c);
@@ -237,29 +242,42 @@ struct World::Impl {
   void pose(Character& c);
 };
 
-Status World::Impl::place_characters() {
-  // Candidates: the centre, then rings spaced kStartSpacing apart with about
-  // kStartSpacing between neighbours, each ring turned a little so the rings
-  // do not line up. Spots in a box, outside the arena or too close to an
-  // earlier character are skipped.
+std::vector<Vec3> World::Impl::start_spots(float spacing) const {
+  // Candidates: the centre, then rings `spacing` apart with about `spacing`
+  // between neighbours, each ring turned a little so the rings do not line
+  // up. Spots in a box, outside the arena or too close to an earlier
+  // character are skipped; at most options.characters are returned.
   const float limit = options.arena_half_size - kBodyRadius;
-  const int rings = static_cast<int>(std::ceil(limit * std::numbers::sqrt2_v<float> / kStartSpacing)) + 1;
+  const int rings = static_cast<int>(std::ceil(limit * std::numbers::sqrt2_v<float> / spacing)) + 1;
   std::vector<Vec3> spots;
   auto try_spot = [&](const Vec3& p) {
     if (std::abs(p.x) > limit || std::abs(p.z) > limit || blocked(p)) return;
     for (const Vec3& q : spots) {
-      if (glm::length(p - q) < 0.9f * kStartSpacing) return;
+      if (glm::length(p - q) < 0.9f * spacing) return;
     }
     spots.push_back(p);
   };
   try_spot(Vec3(0.0f));
   for (int ring = 1; ring <= rings && static_cast<int>(spots.size()) < options.characters; ++ring) {
-    const float radius = kStartSpacing * static_cast<float>(ring);
+    const float radius = spacing * static_cast<float>(ring);
     const int n = static_cast<int>(std::floor(kTwoPi * static_cast<float>(ring)));
     for (int k = 0; k < n && static_cast<int>(spots.size()) < options.characters; ++k) {
       const float a = 0.5f * static_cast<float>(ring) + kTwoPi * static_cast<float>(k) / static_cast<float>(n);
       try_spot(Vec3(radius * std::sin(a), 0.0f, radius * std::cos(a)));
     }
+  }
+  return spots;
+}
+
+Status World::Impl::place_characters() {
+  // The widest spacing the crowd fits at: a small crowd starts where it
+  // always did, a large one closer together.
+  std::vector<Vec3> spots;
+  for (int step = 0;; ++step) {
+    const float spacing = kStartSpacing - kStartSpacingStep * static_cast<float>(step);
+    if (spacing < kMinStartSpacing - 1e-3f) break;
+    spots = start_spots(spacing);
+    if (static_cast<int>(spots.size()) >= options.characters) break;
   }
   if (static_cast<int>(spots.size()) < options.characters) {
     return invalid_argument("characters", std::to_string(options.characters),

@@ -69,6 +69,20 @@ TEST(DemoSession, CharactersMoveAndAnimate) {
   EXPECT_EQ(session->world().character_count(), 6);
 }
 
+TEST(DemoSession, ACrowdOf256FitsTheArenaAndRenders) {
+  // --characters takes up to 256: a crowd too large for the usual start
+  // spacing starts closer together, between the arena's obstacles.
+  JobSystem jobs(2);
+  SessionOptions options;
+  options.width = 32;
+  options.height = 32;
+  options.characters = 256;
+  auto session = DemoSession::create(options, jobs);
+  ASSERT_TRUE(session.ok()) << session.status().message();
+  EXPECT_EQ((*session)->world().character_count(), 256);
+  run_frames(**session, jobs, 0, 2);
+}
+
 TEST(DemoSession, CharactersCastShadowsOnTheGround) {
   JobSystem jobs(2);
   auto session = make_session(jobs);

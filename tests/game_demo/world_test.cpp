@@ -190,6 +190,36 @@ TEST(WorldCreate, RejectsModelsWithoutAWalkAndBadOptions) {
   EXPECT_EQ(code_for([](WorldOptions& o) { o.obstacles = {Aabb::empty()}; }), ErrorCode::kOk);
 }
 
+TEST(WorldPlacement, ALargeCrowdStartsCloserTogetherButApart) {
+  // Six characters start 1.5 m apart as ever; 256 do not fit so, and start
+  // closer, yet never within two body radii of each other, inside the
+  // arena and outside the boxes.
+  WorldOptions o;
+  o.obstacles = some_obstacles();
+  o.characters = 256;
+  const World crowd = make_world(o);
+  ASSERT_EQ(crowd.character_count(), 256);
+  float closest = INFINITY;
+  for (int i = 0; i < 256; ++i) {
+    const Vec3 p = crowd.character(i).position;
+    EXPECT_LE(std::max(std::abs(p.x), std::abs(p.z)), o.arena_half_size) << i;
+    for (const Aabb& b : o.obstacles) {
+      const bool inside = p.x >= b.lower.x && p.x <= b.upper.x && p.z >= b.lower.z && p.z <= b.upper.z;
+      EXPECT_FALSE(inside) << i;
+    }
+    for (int j = 0; j < i; ++j) closest = std::min(closest, glm::length(p - crowd.character(j).position));
+  }
+  EXPECT_GE(closest, 0.8f);
+  EXPECT_LT(closest, 1.5f * 0.9f);  // closer than a small crowd's spacing allows
+  o.characters = 6;
+  const World few = make_world(o);
+  for (int i = 0; i < 6; ++i) {
+    for (int j = 0; j < i; ++j) {
+      EXPECT_GE(glm::length(few.character(i).position - few.character(j).position), 1.5f * 0.9f) << i << " " << j;
+    }
+  }
+}
+
 TEST(WorldDeterminism, SameInputsGiveBitIdenticalWorlds) {
   WorldOptions o;
   o.characters = 6;
