@@ -19,6 +19,8 @@ bool draw_hud(const HudFrame& frame, const BakeInfo& bake, HudControls& controls
     const double mrays = frame.trace_ms > 0.0 ? static_cast<double>(frame.rays) / (frame.trace_ms * 1e3) : 0.0;
     ImGui::Text("%.2f M rays/s traced (%.2f M rays)", mrays, static_cast<double>(frame.rays) * 1e-6);
     ImGui::Text("characters %d (you: %d)", frame.characters, frame.player + 1);
+    ImGui::Text("per character: update %.3f ms, trace %.3f ms", frame.per_character.update_ms,
+                frame.per_character.trace_ms);
     ImGui::Text("escaped triangles %zu, fallback %.2f ms", frame.escaped_triangles, frame.fallback_ms);
     if (frame.escaped_triangles > 0) {
       // Poses outside the baked pose space: exact, through the fallback, at

@@ -8,6 +8,7 @@
 #include <utility>
 #include <vector>
 
+#include "game_demo/character_cost.h"
 #include "game_demo/demo_session.h"
 
 namespace sinew::demo {
@@ -20,6 +21,7 @@ struct HudFrame {
   double trace_ms = 0.0;         // their trace time
   int characters = 0;
   int player = 0;
+  CharacterCost per_character;  // the last frame's update and trace, per character
   std::size_t escaped_triangles = 0;  // in the last frame
   double fallback_ms = 0.0;           // building their fallback trees, the last frame
   int width = 0;

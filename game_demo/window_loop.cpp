@@ -63,6 +63,7 @@ HudFrame hud_frame(const DemoSession& session, const FrameReport& report, const 
   h.trace_ms = report.render.trace_primary_ms + report.render.trace_shadow_ms;
   h.characters = session.world().character_count();
   h.player = session.world().player();
+  h.per_character = per_character_cost(h.phases_ms, h.characters);
   h.escaped_triangles = report.scene.escaped_triangles;
   h.fallback_ms = report.scene.fallback_ms;
   h.width = session.width();

@@ -8,6 +8,7 @@
 
 #include "character/pack.h"
 #include "editor/import/model_loader.h"
+#include "game_demo/character_cost.h"
 #include "game_demo/demo_session.h"
 #include "game_demo/world.h"
 #include "runtime/cli/option_values.h"
@@ -70,6 +71,7 @@ struct CountResult {
   int characters = 0;
   std::vector<PhaseSummary> phases;
   double frame_ms = 0.0;  // sum of the phase medians
+  demo::CharacterCost per_character;  // from the phase medians
   double rays_per_frame = 0.0;
   std::uint64_t escaped_triangles = 0;
   std::size_t triangles = 0;
@@ -123,6 +125,9 @@ Expected<CountResult> measure(const DemoBenchOptions& o, int characters, JobSyst
   }
   r.phases = session->timers().summarize();
   r.frame_ms = session->timers().median_total_ms();
+  std::vector<std::pair<std::string, double>> medians;
+  for (const PhaseSummary& p : r.phases) medians.emplace_back(p.name, p.median_ms);
+  r.per_character = demo::per_character_cost(medians, characters);
   r.rays_per_frame = static_cast<double>(rays) / o.frames;
   const auto median = [](std::vector<double> v) {
     if (v.empty()) return 0.0;
@@ -138,13 +143,14 @@ void print_table(const DemoBenchOptions& o, const std::vector<CountResult>& resu
   if (results.empty()) return;
   std::printf("\n| characters | fps |");
   for (const PhaseSummary& p : results.front().phases) std::printf(" %s |", p.name.c_str());
-  std::printf(" frame ms | M rays/s | escaped tris/frame |\n|---:|---:|");
+  std::printf(" frame ms | update ms/character | trace ms/character | M rays/s | escaped tris/frame |\n|---:|---:|");
   for (std::size_t i = 0; i < results.front().phases.size(); ++i) std::printf("---:|");
-  std::printf("---:|---:|---:|\n");
+  std::printf("---:|---:|---:|---:|---:|\n");
   for (const CountResult& r : results) {
     std::printf("| %d | %.1f |", r.characters, r.frame_ms > 0.0 ? 1000.0 / r.frame_ms : 0.0);
     for (const PhaseSummary& p : r.phases) std::printf(" %.2f |", p.median_ms);
-    std::printf(" %.1f | %.1f | %.1f |\n", r.frame_ms, r.frame_ms > 0.0 ? r.rays_per_frame / (r.frame_ms * 1e3) : 0.0,
+    std::printf(" %.1f | %.3f | %.3f | %.1f | %.1f |\n", r.frame_ms, r.per_character.update_ms,
+                r.per_character.trace_ms, r.frame_ms > 0.0 ? r.rays_per_frame / (r.frame_ms * 1e3) : 0.0,
                 static_cast<double>(r.escaped_triangles) / o.frames);
   }
   std::printf("\n| characters | primary: node visits | objects | triangle tests | shadow: node visits | objects |"
@@ -164,7 +170,9 @@ void print_table(const DemoBenchOptions& o, const std::vector<CountResult>& resu
     }
   }
   std::printf("\nPhase columns are per-frame medians in ms over %d frames after %d warm-up frames; fps = 1000 /"
-              " their sum. M rays/s counts primary and shadow rays over the whole frame time. The second table is the"
+              " their sum. Per character: the update phases (animation, skinning, boxes, fallback, top level) and the"
+              " trace phases (primary, shadow) over the character count. M rays/s counts primary and shadow rays over"
+              " the whole frame time. The second table is the"
               " tracers' work per ray (render/renderer.h TraversalCounters) over the same frames.\n",
               o.frames, o.warmup);
 }
@@ -202,6 +210,8 @@ int run_demo_bench(const std::vector<std::string>& args, const std::string& comm
     for (const PhaseSummary& p : r.phases) phases[p.name] = p.median_ms;
     doc["counts"].push_back({{"characters", r.characters}, {"fps", r.frame_ms > 0.0 ? 1000.0 / r.frame_ms : 0.0},
                              {"frame_ms", r.frame_ms}, {"phases_ms", phases},
+                             {"per_character_ms", {{"update", r.per_character.update_ms},
+                                                   {"trace", r.per_character.trace_ms}}},
                              {"rays_per_frame", r.rays_per_frame}});
     if (o.textures == "both") {
       doc["counts"].back()["shade_ms_textures_off"] = r.shade_off_ms;
