@@ -150,6 +150,7 @@ Vec3 aim_point(std::uint64_t draw, const CrowdReference& reference, const std::v
 // One contender's answers and checks over the run.
 struct Contender {
   std::string name;
+  std::string key;  // the JSON's: "sinew", "embree_refit", "embree_rebuild_low"
   PhaseTimers timers;  // Sinew: "bones", "query", "total"; Embree: "skin", "build", "trace", "total"
   std::vector<Hit> hits;  // this tick's
   std::uint64_t checked = 0, mismatched = 0, grazes = 0;
@@ -268,7 +269,7 @@ void print_table(const Options& o, const std::vector<Contender>& contenders, con
   for (std::size_t i = 1; i < contenders.size(); ++i) {
     const Contender& c = contenders[i];
     std::printf("  %s: skin %.3f ms + %s %.3f ms, trace %.3f ms\n", c.name.c_str(), median_of(c.timers, "skin"),
-                c.name.find("refit") != std::string::npos ? "refit" : "rebuild", median_of(c.timers, "build"),
+                c.key == "embree_refit" ? "refit" : "rebuild", median_of(c.timers, "build"),
                 median_of(c.timers, "trace"));
   }
   if (s.best_embree > 0) {
@@ -287,6 +288,7 @@ void print_table(const Options& o, const std::vector<Contender>& contenders, con
 
 Json contender_json(const Options& o, const Contender& c, bool best) {
   Json entry = {{"name", c.name},
+                {"key", c.key},
                 {"brute_force",
                  {{"passed", c.mismatched == 0}, {"checked", c.checked}, {"mismatched", c.mismatched},
                   {"edge_grazes", c.grazes}}},
@@ -328,15 +330,19 @@ Status run(const Options& o, const character::Model& model, BenchRecord& record)
   }
 
   std::vector<Contender> contenders;
-  contenders.emplace_back().name = "sinew World::intersect";
+  contenders.emplace_back();
+  contenders.back().name = "sinew World::intersect";
+  contenders.back().key = "sinew";
 #ifdef SINEW_HAVE_EMBREE
   std::vector<std::unique_ptr<EmbreeCrowd>> embree;
   for (const EmbreeMode mode : {EmbreeMode::kRefit, EmbreeMode::kRebuildLow}) {
     SINEW_ASSIGN_OR_RETURN(std::unique_ptr<EmbreeCrowd> crowd,
                            EmbreeCrowd::create(mode, jobs.thread_count(), model.mesh, ids));
     embree.push_back(std::move(crowd));
-    contenders.emplace_back().name =
-        mode == EmbreeMode::kRefit ? "embree refit + rtcIntersect1" : "embree LOW rebuild + rtcIntersect1";
+    const bool refit = mode == EmbreeMode::kRefit;
+    contenders.emplace_back();
+    contenders.back().name = refit ? "embree refit + rtcIntersect1" : "embree LOW rebuild + rtcIntersect1";
+    contenders.back().key = refit ? "embree_refit" : "embree_rebuild_low";
   }
 #else
   record.note("Embree not found: its rows are skipped");
@@ -408,6 +414,7 @@ Status run(const Options& o, const character::Model& model, BenchRecord& record)
   }
   if (summary.best_embree > 0) {
     const double best = median_of(contenders[summary.best_embree].timers, "total");
+    doc["best_embree"] = contenders[summary.best_embree].key;
     doc["sinew_over_best_embree"] = best > 0.0 ? median_of(contenders[0].timers, "total") / best : 0.0;
   }
   return {};
