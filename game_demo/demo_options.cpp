@@ -22,6 +22,9 @@ struct DemoFlags {
         size(l.option("--size", "WxH", "frame size (default 1024x1024; 16 to 8192 each)")),
         seed(l.option("--seed", "S", "seed of the arena and the characters' wandering (default 1)")),
         characters(l.option("--characters", "N", "characters in the arena, one of them yours (default 6)")),
+        pace_spread(l.option("--pace-spread", "S",
+                             "each character but yours walks, runs and plays its cycles at its own\n"
+                             "pace, drawn from [1 - S, 1 + S]; 0 to 0.5 (default 0: all alike)")),
         model(l.option("--model", "PATH",
                        "the character: a content pack (sinew-editor bake MODEL -o PATH);\n"
                        "default the procedural mannequin")),
@@ -42,6 +45,7 @@ struct DemoFlags {
   const std::optional<std::string>& size;
   const std::optional<std::string>& seed;
   const std::optional<std::string>& characters;
+  const std::optional<std::string>& pace_spread;
   const std::optional<std::string>& model;
   const std::optional<std::string>& script;
   const std::optional<std::string>& screenshot;
@@ -84,6 +88,10 @@ Expected<DemoOptions> parse_demo_options(const std::vector<std::string>& args) {
   SINEW_RETURN_IF_ERROR(int_option("--frames", f.frames, 1, 1000000, o.frames));
   SINEW_RETURN_IF_ERROR(int_option("--seed", f.seed, 0, std::numeric_limits<std::uint32_t>::max(), o.seed));
   SINEW_RETURN_IF_ERROR(int_option("--characters", f.characters, 1, 256, o.characters));
+  if (f.pace_spread) {
+    SINEW_ASSIGN_OR_RETURN(const double spread, cli::parse_double("--pace-spread", *f.pace_spread, 0.0, 0.5));
+    o.pace_spread = static_cast<float>(spread);
+  }
   if (f.threads) {
     SINEW_ASSIGN_OR_RETURN(o.threads, cli::parse_threads("--threads", *f.threads));
   }

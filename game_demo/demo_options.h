@@ -21,6 +21,7 @@ struct DemoOptions {
   int height = 1024;
   std::uint32_t seed = 1;
   int characters = 6;
+  float pace_spread = 0.0f;  // each character's own pace in [1 - s, 1 + s] (WorldOptions::pace_spread)
   std::string model_path;  // empty: the procedural mannequin
   std::string script_path;      // keys from this input script (input_script.h), fixed 1/30 s steps
   std::string screenshot_path;  // windowed: the last frame as shown, HUD included, as PNG

@@ -93,6 +93,7 @@ Expected<std::unique_ptr<DemoSession>> DemoSession::create(const SessionOptions&
   WorldOptions world_options;
   world_options.characters = options.characters;
   world_options.seed = options.seed;
+  world_options.pace_spread = options.pace_spread;
   world_options.arena_half_size = arena.walk_half_size;
   world_options.obstacles = arena.obstacles;
   world_options.model_to_world = model_to_world(model);

@@ -36,6 +36,7 @@ struct SessionOptions {
   std::string model_path;  // a content pack (.pack); empty: the procedural mannequin
   int characters = 6;
   std::uint32_t seed = 1;
+  float pace_spread = 0.0f;  // WorldOptions::pace_spread
   int width = 1024;
   int height = 1024;
   bool shadows = true;

@@ -165,6 +165,7 @@ int run(const std::vector<std::string>& args) {
   so.model_path = opt.model_path;
   so.characters = opt.characters;
   so.seed = opt.seed;
+  so.pace_spread = opt.pace_spread;
   so.width = opt.width;
   so.height = opt.height;
   so.lights = opt.lights;

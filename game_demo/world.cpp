@@ -18,6 +18,7 @@ namespace sinew::demo {
 namespace {
 
 constexpr int kMaxCharacters = 256;
+constexpr float kMaxPaceSpread = 0.5f;
 constexpr float kPi = std::numbers::pi_v<float>;
 constexpr float kTwoPi = 2.0f * std::numbers::pi_v<float>;
 
@@ -143,6 +144,9 @@ Status validate(const WorldOptions& o) {
   if (!std::isfinite(o.run_speed) || o.run_speed <= o.walk_speed || o.run_speed > 100.0f) {
     return invalid_argument("run_speed", std::to_string(o.run_speed),
                             "must be finite, above walk_speed and at most 100 m/s");
+  }
+  if (!(o.pace_spread >= 0.0f && o.pace_spread <= kMaxPaceSpread)) {
+    return invalid_argument("pace_spread", std::to_string(o.pace_spread), "must be in [0, 0.5]");
   }
   if (!is_finite(o.model_to_world)) {
     return invalid_argument("model_to_world", "non-finite", "must be a finite transform");
@@ -344,7 +348,7 @@ Intent World::Impl::player_intent(const Character& c, const PlayerInput& input) 
   }
   intent.has_direction = true;
   intent.heading = std::atan2(wish.x, wish.z);
-  intent.speed = amount * (input.run ? options.run_speed : options.walk_speed);
+  intent.speed = c.state.pace * amount * (input.run ? options.run_speed : options.walk_speed);
   return intent;
 }
 
@@ -365,7 +369,7 @@ Intent World::Impl::npc_intent(Character& c, float dt) {
   }
   intent.has_direction = true;
   intent.heading = std::atan2(to_target.x, to_target.z);
-  intent.speed = npc.run ? options.run_speed : options.walk_speed;
+  intent.speed = c.state.pace * (npc.run ? options.run_speed : options.walk_speed);
   return intent;
 }
 
@@ -410,7 +414,7 @@ void World::Impl::set_cycle_weights(Character& c) {
   // rest pose (Cal3D normalises cycle weights, so a lone walk fading out
   // still poses fully until it is gone).
   const float v = c.state.speed;
-  const float walk_v = options.walk_speed, run_v = options.run_speed;
+  const float walk_v = c.state.pace * options.walk_speed, run_v = c.state.pace * options.run_speed;
   std::array<float, 3> w{0.0f, 0.0f, 0.0f};  // idle, walk, run
   if (v < walk_v) {
     w[1] = v / walk_v;
@@ -479,6 +483,12 @@ Expected<World> World::create(const character::Model& model, const WorldOptions&
     if (i > 0) {
       c.npc.state = NpcState::kPause;
       c.npc.timer = in_range(c.rng, 0.5f, 2.0f);
+    }
+    if (i > 0 && options.pace_spread > 0.0f) {
+      // A generator of its own, so the pace leaves the wandering as it was.
+      std::mt19937 pace_rng(options.seed ^ (0x9E3779B9u * static_cast<std::uint32_t>(i)));
+      c.state.pace = 1.0f + options.pace_spread * (2.0f * unit_float(pace_rng) - 1.0f);
+      (void)c.mixer.set_time_factor(c.state.pace);  // finite: cannot fail
     }
     // Start in the settled rest-speed blend rather than fading in from T-pose.
     impl->set_cycle_weights(c);

@@ -46,6 +46,14 @@ struct WorldOptions {
   Affine3 model_to_world = Affine3::identity();
   float walk_speed = 1.4f;  // m/s at full walk weight
   float run_speed = 3.6f;   // m/s at full run weight
+  // Each character's own pace, so a crowd does not walk in step: for every
+  // character but the first (the player's at the start) a factor drawn
+  // from [1 - s, 1 + s] (a generator of its own, from the seed) that
+  // scales its walk and run speeds and the clock of its cycles alike
+  // (Mixer::set_time_factor), so its stride still matches its speed; it
+  // keeps its pace when the player takes it over. In [0, 0.5]; 0: everybody
+  // at the same pace.
+  float pace_spread = 0.0f;
 };
 
 // The clips the controllers use, found by name in the model (case-insensitive
@@ -63,12 +71,14 @@ struct CharacterState {
   Vec3 position{0.0f};    // on the floor
   float heading = 0.0f;   // radians about +Y; 0 faces +Z
   float speed = 0.0f;     // m/s, current (smoothed)
+  float pace = 1.0f;      // its speeds and cycle clock over the options' (WorldOptions::pace_spread)
   bool player = false;
 };
 
 class World {
  public:
-  // Errors: kInvalidArgument (characters < 1 or > 256, bad speeds or arena),
+  // Errors: kInvalidArgument (characters < 1 or > 256, bad speeds, pace
+  // spread or arena),
   // kNotFound when the model has no clip usable as a walk.
   static Expected<World> create(const character::Model& model, const WorldOptions& options);
 

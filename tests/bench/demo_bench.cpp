@@ -23,6 +23,7 @@ namespace {
 
 struct DemoBenchOptions {
   std::vector<int> characters{1, 6, 12};
+  float pace_spread = 0.0f;  // each character's own pace (sinew-demo --pace-spread)
   int width = 1024;
   int height = 1024;
   int threads = 2;
@@ -38,6 +39,8 @@ struct DemoBenchOptions {
 std::vector<BenchFlag> demo_flags() {
   return {
       {"--characters", "LIST", "character counts to measure (default 1,6,12)"},
+      {"--pace-spread", "S", "each character but the player at its own pace in [1 - S, 1 + S], as sinew-demo\n"
+                             "--pace-spread (0 to 0.5, default 0)"},
       size_flag("1024x1024"),
       threads_flag("2"),
       frames_flag("measured frames per count (default 30), after"),
@@ -53,6 +56,10 @@ const char* const kDescription = "the game demo's fps and phases\n";
 
 Status read_options(const BenchArgs& parsed, DemoBenchOptions& o) {
   SINEW_RETURN_IF_ERROR(parsed.read("--characters", 1, 256, o.characters));
+  if (const auto text = parsed.value("--pace-spread")) {
+    SINEW_ASSIGN_OR_RETURN(const double spread, cli::parse_double("--pace-spread", *text, 0.0, 0.5));
+    o.pace_spread = static_cast<float>(spread);
+  }
   SINEW_RETURN_IF_ERROR(parsed.read_size(8192, o.width, o.height));
   SINEW_RETURN_IF_ERROR(parsed.read_threads(o.threads));
   SINEW_RETURN_IF_ERROR(parsed.read("--frames", 1, 100000, o.frames));
@@ -90,6 +97,7 @@ Expected<CountResult> measure(const DemoBenchOptions& o, int characters, JobSyst
   demo::SessionOptions so;
   so.model_path = o.model_path;
   so.characters = characters;
+  so.pace_spread = o.pace_spread;
   so.width = o.width;
   so.height = o.height;
   so.shadows = o.shadows;
@@ -186,11 +194,13 @@ int run_demo_bench(const std::vector<std::string>& args, const std::string& comm
   const DemoBenchOptions& o = *parsed;
   JobSystem jobs(o.threads);
   BenchRecord record("demo", command_line, jobs.thread_count());
-  std::printf("  %dx%d, shadows %s\n", o.width, o.height, o.shadows ? "on" : "off");
+  std::printf("  %dx%d, shadows %s, pace spread %.2f\n", o.width, o.height, o.shadows ? "on" : "off",
+              static_cast<double>(o.pace_spread));
   Json& doc = record.doc();
   doc["size"] = {o.width, o.height};
   doc["shadows"] = o.shadows;
   doc["textures"] = o.textures;
+  doc["pace_spread"] = o.pace_spread;
   doc["counts"] = Json::array();
   std::vector<CountResult> results;
   for (int characters : o.characters) {

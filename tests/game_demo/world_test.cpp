@@ -174,6 +174,10 @@ TEST(WorldCreate, RejectsModelsWithoutAWalkAndBadOptions) {
   EXPECT_EQ(code_for([](WorldOptions& o) { o.walk_speed = NAN; }), ErrorCode::kInvalidArgument);
   EXPECT_EQ(code_for([](WorldOptions& o) { o.run_speed = 1.0f; }), ErrorCode::kInvalidArgument);
   EXPECT_EQ(code_for([](WorldOptions& o) { o.run_speed = INFINITY; }), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(code_for([](WorldOptions& o) { o.pace_spread = -0.1f; }), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(code_for([](WorldOptions& o) { o.pace_spread = 0.6f; }), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(code_for([](WorldOptions& o) { o.pace_spread = NAN; }), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(code_for([](WorldOptions& o) { o.pace_spread = 0.5f; }), ErrorCode::kOk);
   EXPECT_EQ(code_for([](WorldOptions& o) { o.arena_half_size = 0.0f; }), ErrorCode::kInvalidArgument);
   EXPECT_EQ(code_for([](WorldOptions& o) { o.arena_half_size = NAN; }), ErrorCode::kInvalidArgument);
   EXPECT_EQ(code_for([](WorldOptions& o) { o.obstacles = {Aabb{Vec3(0.0f), Vec3(NAN)}}; }),
@@ -216,6 +220,39 @@ TEST(WorldPlacement, ALargeCrowdStartsCloserTogetherButApart) {
   for (int i = 0; i < 6; ++i) {
     for (int j = 0; j < i; ++j) {
       EXPECT_GE(glm::length(few.character(i).position - few.character(j).position), 1.5f * 0.9f) << i << " " << j;
+    }
+  }
+}
+
+TEST(WorldPace, EachCharacterButTheFirstWalksAtItsOwnPace) {
+  WorldOptions o;
+  o.characters = 24;
+  o.seed = 3;
+  const World alike = make_world(o);
+  o.pace_spread = 0.3f;
+  World paced = make_world(o);
+  EXPECT_EQ(paced.character(0).pace, 1.0f);  // the player's
+  float lo = INFINITY, hi = -INFINITY;
+  for (int i = 0; i < o.characters; ++i) {
+    EXPECT_EQ(alike.character(i).pace, 1.0f) << i;
+    const float pace = paced.character(i).pace;
+    EXPECT_GE(pace, 0.7f) << i;
+    EXPECT_LE(pace, 1.3f) << i;
+    // The pace has a generator of its own: everybody starts where they
+    // would at one pace.
+    EXPECT_EQ(paced.character(i).position, alike.character(i).position) << i;
+    if (i > 0) {
+      lo = std::min(lo, pace);
+      hi = std::max(hi, pace);
+    }
+  }
+  EXPECT_GT(hi - lo, 0.2f);  // spread out, not one pace for all
+  // Its cycles' clock runs at its pace, and it never outruns its own run.
+  for (int i = 0; i < o.characters; ++i) EXPECT_EQ(paced.mixer(i).time_factor(), paced.character(i).pace) << i;
+  for (int step = 0; step < 150; ++step) {
+    paced.step(kDt, PlayerInput{});
+    for (int i = 1; i < o.characters; ++i) {
+      EXPECT_LE(paced.character(i).speed, paced.character(i).pace * o.run_speed + 1e-4f) << i;
     }
   }
 }
