@@ -31,8 +31,11 @@ struct TileRecord {
   TraversalCounters shadow;
   std::uint64_t hits = 0;
   std::uint64_t shadowed = 0;
+  TraversalCounters ao;
+  std::uint64_t ao_occluded = 0;
   double primary_ns = 0.0;
   double shadow_ns = 0.0;
+  double ao_ns = 0.0;
   double shade_ns = 0.0;
 };
 
@@ -59,9 +62,69 @@ Expected<OutputPlanes> output_planes(const FrameBuffers& buffers) {
   return out;
 }
 
+bool finite(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+// The sample counts, the ambient occlusion radius and every light's shape.
+Status check_sampling(const RenderSettings& settings, std::span<const Light> lights) {
+  if (settings.shadow_samples < 1 || settings.shadow_samples > kMaxSamples) {
+    return invalid_argument("settings.shadow_samples", std::to_string(settings.shadow_samples),
+                            "must be 1 to " + std::to_string(kMaxSamples));
+  }
+  if (settings.ao_rays < 0 || settings.ao_rays > kMaxSamples) {
+    return invalid_argument("settings.ao_rays", std::to_string(settings.ao_rays),
+                            "must be 0 to " + std::to_string(kMaxSamples));
+  }
+  if (settings.ao_rays > 0 && !(std::isfinite(settings.ao_radius) && settings.ao_radius > 0.0f)) {
+    return invalid_argument("settings.ao_radius", std::to_string(settings.ao_radius), "must be finite and above 0");
+  }
+  for (std::size_t l = 0; l < lights.size(); ++l) {
+    const Light& light = lights[l];
+    const std::string name = "settings.lights[" + std::to_string(l) + "]";
+    if (!finite(light.position) || !finite(light.direction) || !finite(light.color)) {
+      return invalid_argument(name, "a non-finite position, direction or color", "must be finite");
+    }
+    if (!(std::isfinite(light.radius) && light.radius >= 0.0f)) {
+      return invalid_argument(name + ".radius", std::to_string(light.radius), "must be finite and at least 0");
+    }
+    if (!(light.angular_radius >= 0.0f && light.angular_radius < 1.5f)) {
+      return invalid_argument(name + ".angular_radius", std::to_string(light.angular_radius),
+                              "must be at least 0 and below 1.5 radians");
+    }
+    if (light.kind == Light::Kind::kDirectional && !(glm::length(light.direction) > 0.0f)) {
+      return invalid_argument(name + ".direction", "0", "a directional light needs a direction");
+    }
+    if (light.kind == Light::Kind::kRect &&
+        !(finite(light.edge_u) && finite(light.edge_v) && glm::length(glm::cross(light.edge_u, light.edge_v)) > 0.0f)) {
+      return invalid_argument(name + ".edge_u, edge_v", "parallel, zero or non-finite edges",
+                              "a rectangle light needs two finite edges spanning an area");
+    }
+  }
+  return Status{};
+}
+
 }  // namespace
 
 namespace {
+
+// `n` rounds of stochastic rays (render/stages/tile_stages.h): round j's
+// rays, placed by place(j), are traced on bit `bit` of s.lit, and each hit's
+// open fraction is left in fraction[0, s.lanes). Returns the blocked rays.
+template <class Place>
+std::uint64_t trace_rounds(const Scene& scene, TriangleTest test, int n, std::uint32_t stream,
+                           const RenderSettings& settings, float* fraction, TileScratch& s,
+                           TraversalCounters& counters, Place&& place, int bit = 0) {
+  shift_pixels(settings.sample_seed, stream, s);
+  std::fill_n(fraction, s.lanes, 0.0f);
+  const float weight = 1.0f / static_cast<float>(n);
+  std::uint64_t blocked = 0;
+  for (int j = 0; j < n; ++j) {
+    set_lit_bit(bit, s);
+    place(j);
+    blocked += trace_shadow_rays(scene, test, bit, s, counters);
+    count_unblocked(bit, weight, fraction, s);
+  }
+  return blocked;
+}
 
 // One tile, stage by stage (render/stages/tile_stages.h), timing each phase.
 void render_tile(const Scene& scene, const PinholeCamera& camera, const RenderSettings& settings,
@@ -79,13 +142,31 @@ void render_tile(const Scene& scene, const PinholeCamera& camera, const RenderSe
   std::fill(s.lit.begin(), s.lit.begin() + static_cast<std::ptrdiff_t>(s.lanes),
             static_cast<std::uint8_t>((1u << lights.size()) - 1u));
   if (out.want_surface()) reconstruct_surfaces(scene, surface_settings(settings, camera, out), s);
-  double shadow_ns = 0.0;
+  double shadow_ns = 0.0, ao_ns = 0.0;
+  if (out.want_color() && settings.ao_rays > 0 && record.hits > 0) {
+    // Borrows light 0's bit of s.lit, which is set again after.
+    const auto ao_start = Clock::now();
+    record.ao_occluded += trace_rounds(scene, settings.triangle_test, settings.ao_rays, kAmbientOcclusionStream,
+                                       settings, s.ao_open.data(), s, record.ao,
+                                       [&](int j) { place_ao_rays(settings.ao_radius, 0, j, settings.ao_rays, s); });
+    std::fill(s.lit.begin(), s.lit.begin() + static_cast<std::ptrdiff_t>(s.lanes),
+              static_cast<std::uint8_t>((1u << lights.size()) - 1u));
+    ao_ns = nanoseconds(ao_start, Clock::now());
+  }
   if (out.want_color() && settings.shadows) {
     const auto shadow_start = Clock::now();
     for (std::size_t l = 0; l < lights.size(); ++l) {
-      aim_shadow_rays(lights[l], static_cast<int>(l), s);
-      record.shadowed +=
-          trace_shadow_rays(scene, settings.triangle_test, static_cast<int>(l), s, record.shadow);
+      const int bit = static_cast<int>(l);
+      if (lights[l].is_area()) {
+        if (record.hits == 0) continue;
+        record.shadowed += trace_rounds(
+            scene, settings.triangle_test, settings.shadow_samples, static_cast<std::uint32_t>(l), settings,
+            &s.light_fraction[l * s.lanes], s, record.shadow,
+            [&](int j) { place_light_samples(lights[l], bit, j, settings.shadow_samples, s); }, bit);
+        continue;
+      }
+      aim_shadow_rays(lights[l], bit, s);
+      record.shadowed += trace_shadow_rays(scene, settings.triangle_test, bit, s, record.shadow);
     }
     shadow_ns = nanoseconds(shadow_start, Clock::now());
   }
@@ -93,7 +174,8 @@ void render_tile(const Scene& scene, const PinholeCamera& camera, const RenderSe
   const auto t3 = Clock::now();
   record.primary_ns = nanoseconds(t0, t1);
   record.shadow_ns = shadow_ns;
-  record.shade_ns = nanoseconds(t1, t3) - shadow_ns;
+  record.ao_ns = ao_ns;
+  record.shade_ns = nanoseconds(t1, t3) - shadow_ns - ao_ns;
 }
 
 }  // namespace
@@ -118,6 +200,7 @@ Expected<RenderStats> Renderer::render(const Scene& scene, const PinholeCamera& 
     return invalid_argument("settings.lights", std::to_string(lights.size()),
                             "at most " + std::to_string(kMaxLights) + " lights");
   }
+  SINEW_RETURN_IF_ERROR(check_sampling(settings, lights));
   SINEW_ASSIGN_OR_RETURN(const OutputPlanes out, output_planes(buffers));
   const int tile = settings.tile_size;
   const int tiles_x = (buffers.width + tile - 1) / tile;
@@ -133,24 +216,29 @@ Expected<RenderStats> Renderer::render(const Scene& scene, const PinholeCamera& 
 
   // Tile order keeps the sums deterministic.
   RenderStats stats;
-  double primary_ns = 0.0, shadow_ns = 0.0, shade_ns = 0.0;
+  double primary_ns = 0.0, shadow_ns = 0.0, ao_ns = 0.0, shade_ns = 0.0;
   for (const TileRecord& r : records) {
     stats.primary += r.primary;
     stats.shadow += r.shadow;
+    stats.ao += r.ao;
     stats.primary_hits += r.hits;
     stats.shadowed += r.shadowed;
+    stats.ao_occluded += r.ao_occluded;
     primary_ns += r.primary_ns;
     shadow_ns += r.shadow_ns;
+    ao_ns += r.ao_ns;
     shade_ns += r.shade_ns;
   }
   stats.primary_rays = static_cast<std::uint64_t>(buffers.width) * static_cast<std::uint64_t>(buffers.height);
   stats.shadow_rays = stats.shadow.rays;
+  stats.ao_rays = stats.ao.rays;
   // The phases interleave within each tile: the wall time of the whole
   // render is split in proportion to the time the tiles spent in each.
-  const double busy_ns = primary_ns + shadow_ns + shade_ns;
+  const double busy_ns = primary_ns + shadow_ns + ao_ns + shade_ns;
   if (busy_ns > 0.0) {
     stats.trace_primary_ms = wall_ms * primary_ns / busy_ns;
     stats.trace_shadow_ms = wall_ms * shadow_ns / busy_ns;
+    stats.trace_ao_ms = wall_ms * ao_ns / busy_ns;
     stats.shade_ms = wall_ms * shade_ns / busy_ns;
   } else {
     stats.shade_ms = wall_ms;
@@ -159,6 +247,7 @@ Expected<RenderStats> Renderer::render(const Scene& scene, const PinholeCamera& 
   if (timers) {
     timers->record("trace primary", stats.trace_primary_ms);
     timers->record("trace shadow", stats.trace_shadow_ms);
+    if (settings.ao_rays > 0) timers->record("trace ao", stats.trace_ao_ms);
     timers->record("shade", stats.shade_ms);
   }
   return stats;

@@ -18,17 +18,12 @@ using namespace stages;
 
 namespace {
 
-// Bit i: bit l of lit[i], for eight bytes (each lane's bit gathered into
-// the top byte by one multiply: no two partial products overlap).
-std::uint32_t lane_bits(const std::uint8_t* lit, int l) {
-  std::uint64_t word;
-  std::memcpy(&word, lit, sizeof word);
-  return static_cast<std::uint32_t>((((word >> l) & 0x0101010101010101ull) * 0x0102040810204080ull) >> 56);
-}
-
 // A light's terms for the shading, eight lanes wide, made once per tile.
 struct LightTerms {
-  bool point;
+  bool point;  // a point, sphere or rectangle light: towards `at` from the hit
+  // Its shadow is the fraction of its samples that reach the hit
+  // (s.light_fraction), not a bit of s.lit.
+  bool soft;
   Vec3x8 at;  // the position (point) or the direction (directional)
   Vec3x8 color;
 };
@@ -37,33 +32,40 @@ struct LightTerms {
 struct ShadingLights {
   std::array<LightTerms, kMaxLights> terms;
   std::size_t count = 0;
-  explicit ShadingLights(std::span<const Light> lights) : count(std::min(lights.size(), kMaxLights)) {
+  bool ambient_occlusion = false;  // the ambient term is scaled by s.ao_open
+  ShadingLights(const RenderSettings& settings, std::span<const Light> lights)
+      : count(std::min(lights.size(), kMaxLights)), ambient_occlusion(settings.ao_rays > 0) {
     for (std::size_t l = 0; l < count; ++l) {
       const Light& light = lights[l];
-      const bool point = light.kind == Light::Kind::kPoint;
+      const bool point = light.kind != Light::Kind::kDirectional;
       const Vec3 at = point ? light.position : light.direction;
-      terms[l] = {point, {Float8(at.x), Float8(at.y), Float8(at.z)},
+      terms[l] = {point, settings.shadows && light.is_area(), {Float8(at.x), Float8(at.y), Float8(at.z)},
                   {Float8(light.color.x), Float8(light.color.y), Float8(light.color.z)}};
     }
   }
   std::span<const LightTerms> span() const { return {terms.data(), count}; }
 };
 
-// The linear colour of block b's hits: ambient plus each light's N·L where
-// it is unblocked, times the albedo.
-Vec3x8 block_color(const RenderSettings& settings, std::span<const LightTerms> lights, const TileScratch& s,
+// The linear colour of block b's hits: ambient (times the open fraction of
+// the ambient occlusion rays) plus each light's N·L to its centre, times
+// the fraction of it that reaches the hit (0 or 1 for a hard light), times
+// the albedo.
+Vec3x8 block_color(const RenderSettings& settings, const ShadingLights& shading, const TileScratch& s,
                    std::size_t b, std::uint32_t hits) {
   const std::size_t k0 = b * kBlockLanes;
   const Vec3x8 position = load3(s.px, s.py, s.pz, k0);
   const Vec3x8 n = load3(s.nx, s.ny, s.nz, k0);
   Vec3x8 radiance{Float8(settings.ambient.x), Float8(settings.ambient.y), Float8(settings.ambient.z)};
+  if (shading.ambient_occlusion) radiance = Float8::load(&s.ao_open[k0]) * radiance;
+  const std::span<const LightTerms> lights = shading.span();
   for (std::size_t l = 0; l < lights.size(); ++l) {
-    const std::uint32_t lit_bits = lane_bits(&s.lit[k0], static_cast<int>(l)) & hits;
-    if (lit_bits == 0) continue;
     const LightTerms& light = lights[l];
+    const std::uint32_t lit_bits = light.soft ? hits : lane_bits(&s.lit[k0], static_cast<int>(l)) & hits;
+    if (lit_bits == 0) continue;
     const Vec3x8 to_light = light.point ? light.at - position : light.at;
-    const Float8 cosine = select(Mask8::from_bits(lit_bits),
-                                 max(dot(n, to_light) / sqrt(dot(to_light, to_light)), Float8(0.0f)), Float8(0.0f));
+    Float8 cosine = select(Mask8::from_bits(lit_bits),
+                           max(dot(n, to_light) / sqrt(dot(to_light, to_light)), Float8(0.0f)), Float8(0.0f));
+    if (light.soft) cosine = cosine * Float8::load(&s.light_fraction[l * s.lanes + k0]);
     radiance = radiance + Vec3x8{light.color.x * cosine, light.color.y * cosine, light.color.z * cosine};
   }
   return {Float8::load(&s.ar[k0]) * radiance.x, Float8::load(&s.ag[k0]) * radiance.y,
@@ -78,8 +80,7 @@ Vec3x8 block_color(const RenderSettings& settings, std::span<const LightTerms> l
 // store.
 void shade_rgba8_only(const RenderSettings& settings, std::span<const Light> lights,
                       const OutputPlane<std::uint8_t>& plane, TileScratch& s) {
-  const ShadingLights terms(lights);
-  const std::span<const LightTerms> shading_lights = terms.span();
+  const ShadingLights shading_lights(settings, lights);
   std::byte* const base = plane.base;
   const std::size_t pitch = plane.pitch;
   const int x0 = plane.x0, y0 = plane.y0;
@@ -151,7 +152,7 @@ void shade_and_write(const RenderSettings& settings, std::span<const Light> ligh
   }
   const std::size_t blocks = s.lanes / kBlockLanes;
   const bool want_color = out.want_color();
-  const ShadingLights shading_lights(lights);
+  const ShadingLights shading_lights(settings, lights);
   const std::array<std::uint8_t, 4> background_bytes = {srgb_byte(settings.background.x),
                                                          srgb_byte(settings.background.y),
                                                          srgb_byte(settings.background.z), 255};
@@ -174,7 +175,7 @@ void shade_and_write(const RenderSettings& settings, std::span<const Light> ligh
         (Float8::load(&s.t[k0]) * sqrt(dot(dir, dir))).store(depth);
       }
       if (want_color) {
-        const Vec3x8 color = block_color(settings, shading_lights.span(), s, b, hits);
+        const Vec3x8 color = block_color(settings, shading_lights, s, b, hits);
         color.x.store(linear[0]);
         color.y.store(linear[1]);
         color.z.store(linear[2]);

@@ -112,6 +112,30 @@ std::uint64_t trace_shadow_rays(const Scene& scene, TriangleTest test, int l, Ti
 // counts object visits and triangle tests, not rays.
 std::uint64_t occluded_static_tile(const StaticTile& tile, int l, TileScratch& s, TraversalCounters& counters);
 
+// The stochastic rays (docs/RAYTRACE.md, "Soft shadows and ambient
+// occlusion"), a round at a time: each round places one sample per hit as
+// segments (s.shadows_per_lane) that trace_shadow_rays traces like any
+// shadow rays, clearing bit l of s.lit where blocked; count_unblocked then
+// adds the round's open rays to a per-hit fraction.
+//
+// shift_pixels: each hit pixel's shift of stream `stream`'s pattern
+// (render/sampling/sample_pattern.h), for the rounds that follow.
+void shift_pixels(std::uint32_t seed, std::uint32_t stream, TileScratch& s);
+// Sample j of n of an area light (Light::is_area) per hit: from a point on
+// the sphere's disk facing the hit, or on the rectangle, to the hit pushed
+// off as a point light's rays end (t in [0, 1)); or, for the sun, from the
+// hit pushed off along a direction within its angular radius (t unbounded).
+// Hits whose surface faces away from their sample lose bit l of s.lit.
+void place_light_samples(const Light& light, int l, int j, int n, TileScratch& s);
+// Ambient occlusion ray j of n per hit: cosine distributed about the
+// camera-facing geometric normal, `radius` long (t in [0, 1) along radius
+// times the unit direction), from the hit pushed off.
+void place_ao_rays(float radius, int l, int j, int n, TileScratch& s);
+// Sets bit l of s.lit on every lane (a round's start).
+void set_lit_bit(int l, TileScratch& s);
+// fraction[k] += weight for each hit k whose bit l of s.lit is set.
+void count_unblocked(int l, float weight, float* fraction, const TileScratch& s);
+
 // Diffuse shading (ambient + each unblocked light's N.L) and the requested
 // outputs of the tile's pixels, through s.staging: line-aligned planes get
 // whole lines by streaming stores, the others are written in place.
