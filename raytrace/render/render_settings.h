@@ -109,6 +109,13 @@ struct FrameBuffers {
   std::span<Vec2> uv;
   std::span<Vec2> barycentric;
   std::span<std::uint32_t> material_id;
+  // Visibility masks, 1 where nothing blocks and on a miss: per pixel, one
+  // float per light (the render's lights, in order): 0 or 1 for a hard
+  // light, the fraction of its samples that reach the hit for an area
+  // light (1 with shadows off); and the fraction of the ambient occlusion
+  // rays that escape (1 without them).
+  std::span<float> shadow;
+  std::span<float> ambient_occlusion;
 
   // Bytes from the start of one row to the next, per output (a host's
   // texture or staging buffer with padded rows); 0: rows packed. A pitch
@@ -127,6 +134,8 @@ struct FrameBuffers {
     std::size_t uv = 0;
     std::size_t barycentric = 0;
     std::size_t material_id = 0;
+    std::size_t shadow = 0;
+    std::size_t ambient_occlusion = 0;
   };
   RowPitches row_pitch;
 };

@@ -39,7 +39,7 @@ struct TileRecord {
   double shade_ns = 0.0;
 };
 
-Expected<OutputPlanes> output_planes(const FrameBuffers& buffers) {
+Expected<OutputPlanes> output_planes(const FrameBuffers& buffers, std::size_t lights) {
   const int w = buffers.width;
   const int h = buffers.height;
   const FrameBuffers::RowPitches& pitch = buffers.row_pitch;
@@ -59,6 +59,9 @@ Expected<OutputPlanes> output_planes(const FrameBuffers& buffers) {
                          output_plane(buffers.barycentric, pitch.barycentric, 1, w, h, "buffers.barycentric"));
   SINEW_ASSIGN_OR_RETURN(out.material,
                          output_plane(buffers.material_id, pitch.material_id, 1, w, h, "buffers.material_id"));
+  SINEW_ASSIGN_OR_RETURN(out.shadow, output_plane(buffers.shadow, pitch.shadow, lights, w, h, "buffers.shadow"));
+  SINEW_ASSIGN_OR_RETURN(out.ambient_occlusion, output_plane(buffers.ambient_occlusion, pitch.ambient_occlusion, 1,
+                                                             w, h, "buffers.ambient_occlusion"));
   return out;
 }
 
@@ -106,26 +109,6 @@ Status check_sampling(const RenderSettings& settings, std::span<const Light> lig
 
 namespace {
 
-// `n` rounds of stochastic rays (render/stages/tile_stages.h): round j's
-// rays, placed by place(j), are traced on bit `bit` of s.lit, and each hit's
-// open fraction is left in fraction[0, s.lanes). Returns the blocked rays.
-template <class Place>
-std::uint64_t trace_rounds(const Scene& scene, TriangleTest test, int n, std::uint32_t stream,
-                           const RenderSettings& settings, float* fraction, TileScratch& s,
-                           TraversalCounters& counters, Place&& place, int bit = 0) {
-  shift_pixels(settings.sample_seed, stream, s);
-  std::fill_n(fraction, s.lanes, 0.0f);
-  const float weight = 1.0f / static_cast<float>(n);
-  std::uint64_t blocked = 0;
-  for (int j = 0; j < n; ++j) {
-    set_lit_bit(bit, s);
-    place(j);
-    blocked += trace_shadow_rays(scene, test, bit, s, counters);
-    count_unblocked(bit, weight, fraction, s);
-  }
-  return blocked;
-}
-
 // One tile, stage by stage (render/stages/tile_stages.h), timing each phase.
 void render_tile(const Scene& scene, const PinholeCamera& camera, const RenderSettings& settings,
                  std::span<const Light> lights, const TracePlan& plan, const OutputPlanes& out, const Tile& tile,
@@ -139,43 +122,19 @@ void render_tile(const Scene& scene, const PinholeCamera& camera, const RenderSe
   for (std::size_t b = 0; b < s.lanes / kBlockLanes; ++b) {
     record.hits += static_cast<std::uint64_t>(std::popcount(static_cast<unsigned>(s.block_hits[b])));
   }
-  std::fill(s.lit.begin(), s.lit.begin() + static_cast<std::ptrdiff_t>(s.lanes),
-            static_cast<std::uint8_t>((1u << lights.size()) - 1u));
   if (out.want_surface()) reconstruct_surfaces(scene, surface_settings(settings, camera, out), s);
-  double shadow_ns = 0.0, ao_ns = 0.0;
-  if (out.want_color() && settings.ao_rays > 0 && record.hits > 0) {
-    // Borrows light 0's bit of s.lit, which is set again after.
-    const auto ao_start = Clock::now();
-    record.ao_occluded += trace_rounds(scene, settings.triangle_test, settings.ao_rays, kAmbientOcclusionStream,
-                                       settings, s.ao_open.data(), s, record.ao,
-                                       [&](int j) { place_ao_rays(settings.ao_radius, 0, j, settings.ao_rays, s); });
-    std::fill(s.lit.begin(), s.lit.begin() + static_cast<std::ptrdiff_t>(s.lanes),
-              static_cast<std::uint8_t>((1u << lights.size()) - 1u));
-    ao_ns = nanoseconds(ao_start, Clock::now());
-  }
-  if (out.want_color() && settings.shadows) {
-    const auto shadow_start = Clock::now();
-    for (std::size_t l = 0; l < lights.size(); ++l) {
-      const int bit = static_cast<int>(l);
-      if (lights[l].is_area()) {
-        if (record.hits == 0) continue;
-        record.shadowed += trace_rounds(
-            scene, settings.triangle_test, settings.shadow_samples, static_cast<std::uint32_t>(l), settings,
-            &s.light_fraction[l * s.lanes], s, record.shadow,
-            [&](int j) { place_light_samples(lights[l], bit, j, settings.shadow_samples, s); }, bit);
-        continue;
-      }
-      aim_shadow_rays(lights[l], bit, s);
-      record.shadowed += trace_shadow_rays(scene, settings.triangle_test, bit, s, record.shadow);
-    }
-    shadow_ns = nanoseconds(shadow_start, Clock::now());
-  }
+  LightRayWork light_work;
+  if (out.want_light_rays()) trace_light_rays(scene, settings, lights, s, light_work);
   shade_and_write(settings, lights, out, s);
   const auto t3 = Clock::now();
   record.primary_ns = nanoseconds(t0, t1);
-  record.shadow_ns = shadow_ns;
-  record.ao_ns = ao_ns;
-  record.shade_ns = nanoseconds(t1, t3) - shadow_ns - ao_ns;
+  record.shadow = light_work.shadow;
+  record.ao = light_work.ao;
+  record.shadowed = light_work.shadowed;
+  record.ao_occluded = light_work.ao_occluded;
+  record.shadow_ns = light_work.shadow_ns;
+  record.ao_ns = light_work.ao_ns;
+  record.shade_ns = nanoseconds(t1, t3) - light_work.shadow_ns - light_work.ao_ns;
 }
 
 }  // namespace
@@ -201,7 +160,7 @@ Expected<RenderStats> Renderer::render(const Scene& scene, const PinholeCamera& 
                             "at most " + std::to_string(kMaxLights) + " lights");
   }
   SINEW_RETURN_IF_ERROR(check_sampling(settings, lights));
-  SINEW_ASSIGN_OR_RETURN(const OutputPlanes out, output_planes(buffers));
+  SINEW_ASSIGN_OR_RETURN(const OutputPlanes out, output_planes(buffers, lights.size()));
   const int tile = settings.tile_size;
   const int tiles_x = (buffers.width + tile - 1) / tile;
   const int tiles_y = (buffers.height + tile - 1) / tile;

@@ -126,7 +126,7 @@ Image render(rt::Scene& scene, bool cull, Lighting lighting, int threads, bool s
   image.depth.resize(n);
   image.instance.resize(n);
   rt::FrameBuffers buffers{camera.width(), camera.height(), image.color, {}, image.depth, {}, {}, image.instance,
-                           {}, {}, {}, {}};
+                           {}, {}, {}, {}, {}, {}};
   EXPECT_TRUE(rt::Renderer().render(scene, camera, settings, buffers, jobs).ok());
   return image;
 }

@@ -31,13 +31,24 @@ rt::PinholeCamera test_camera() {
       .value();
 }
 
-std::vector<float> render_linear(const rt::Scene& sc, const rt::RenderSettings& settings, int threads = 2) {
+struct Masks {
+  std::vector<float> shadow, ambient_occlusion;
+};
+
+std::vector<float> render_linear(const rt::Scene& sc, const rt::RenderSettings& settings, int threads = 2,
+                                 Masks* masks = nullptr) {
   JobSystem jobs(threads);
   std::vector<float> rgba(4 * static_cast<std::size_t>(kWidth * kHeight));
   rt::FrameBuffers buffers;
   buffers.width = kWidth;
   buffers.height = kHeight;
   buffers.color_rgba32f = rgba;
+  if (masks) {
+    masks->shadow.assign(static_cast<std::size_t>(kWidth * kHeight), -1.0f);
+    masks->ambient_occlusion.assign(static_cast<std::size_t>(kWidth * kHeight), -1.0f);
+    buffers.shadow = masks->shadow;
+    buffers.ambient_occlusion = masks->ambient_occlusion;
+  }
   const auto stats = rt::Renderer().render(sc, test_camera(), settings, buffers, jobs);
   EXPECT_TRUE(stats.ok()) << stats.status().message();
   return rgba;
@@ -56,7 +67,8 @@ TEST(SoftShadows, APixelsLightIsItsUnshadowedLightTimesTheFractionOfSamplesThatR
   const rt::Scene& sc = scene();
   for (const int samples : {4, 16}) {
     rt::RenderSettings settings = sphere_light(samples);
-    const std::vector<float> soft = render_linear(sc, settings);
+    Masks masks;
+    const std::vector<float> soft = render_linear(sc, settings, 2, &masks);
     settings.shadows = false;
     const std::vector<float> open = render_linear(sc, settings);
     std::set<int> fractions;
@@ -68,6 +80,10 @@ TEST(SoftShadows, APixelsLightIsItsUnshadowedLightTimesTheFractionOfSamplesThatR
       ASSERT_GE(k, 0.0f);
       ASSERT_LE(k, static_cast<float>(samples));
       for (int c = 1; c < 3; ++c) ASSERT_NEAR(soft[p + c], fraction * open[p + c], 1e-5f);
+      // The shadow mask holds the fraction; without ambient occlusion rays
+      // the ambient occlusion mask is 1.
+      ASSERT_EQ(masks.shadow[p / 4], k / static_cast<float>(samples)) << "pixel " << p / 4;
+      ASSERT_EQ(masks.ambient_occlusion[p / 4], 1.0f);
       fractions.insert(static_cast<int>(k));
     }
     // Umbra, penumbra and open light all appear.
@@ -119,13 +135,15 @@ TEST(SoftShadows, AmbientOcclusionDarkensOnlyTheAmbientTermNearOccluders) {
   const std::vector<float> open = render_linear(sc, settings);
   settings.ao_rays = 8;
   settings.ao_radius = 0.4f;
-  const std::vector<float> occluded = render_linear(sc, settings);
+  Masks masks;
+  const std::vector<float> occluded = render_linear(sc, settings, 2, &masks);
   std::size_t darker = 0, same = 0;
   for (std::size_t p = 0; p < open.size(); p += 4) {
     if (open[p] < 1e-3f) continue;
     const float fraction = occluded[p] / open[p];
     const float k = std::round(fraction * 8.0f);
     ASSERT_NEAR(fraction, k / 8.0f, 1e-4f);
+    ASSERT_EQ(masks.ambient_occlusion[p / 4], k / 8.0f);
     (k < 8.0f ? darker : same) += 1;
   }
   EXPECT_GT(darker, 50u);  // the mannequins' creases and the ground at their feet

@@ -159,6 +159,19 @@ void shade_and_write(const RenderSettings& settings, std::span<const Light> ligh
   // A row of a block that missed, whole.
   std::uint32_t background_row[kBlockWidth];
   for (std::uint32_t& pixel : background_row) std::memcpy(&pixel, background_bytes.data(), 4);
+  // The visibility masks of pixel (x, y), lane k: 1 on a miss.
+  const bool ambient_occlusion = settings.ao_rays > 0;
+  const auto write_masks = [&](int x, int y, std::size_t k, bool hit) {
+    if (out.shadow.wanted()) {
+      float* mask = out.shadow.at(x, y);
+      for (std::size_t l = 0; l < out.shadow.channels; ++l) {
+        const bool soft = shading_lights.terms[l].soft;
+        mask[l] = !hit ? 1.0f : soft ? s.light_fraction[l * s.lanes + k] : static_cast<float>(s.lit[k] >> l & 1u);
+      }
+    }
+    if (out.ambient_occlusion.wanted()) *out.ambient_occlusion.at(x, y) = hit && ambient_occlusion ? s.ao_open[k] : 1.0f;
+  };
+  const bool want_masks = out.shadow.wanted() || out.ambient_occlusion.wanted();
   static constexpr float kMissDepths[kBlockWidth] = {kInf, kInf, kInf, kInf};
   static constexpr std::uint32_t kMissIds[kBlockWidth] = {kInvalidId, kInvalidId, kInvalidId, kInvalidId};
   for (std::size_t b = 0; b < blocks; ++b) {
@@ -190,6 +203,9 @@ void shade_and_write(const RenderSettings& settings, std::span<const Light> ligh
       for (int row = 0; row < kBlockHeight; ++row) {
         const std::size_t k = k0 + static_cast<std::size_t>(row * kBlockWidth);
         const int y = by + row;
+        if (want_masks) {
+          for (int i = 0; i < kBlockWidth; ++i) write_masks(bx + i, y, k + static_cast<std::size_t>(i), hits != 0u);
+        }
         if (out.triangle.wanted()) std::memcpy(out.triangle.at(bx, y), &s.triangle[k], 4 * sizeof(std::uint32_t));
         if (out.instance.wanted()) std::memcpy(out.instance.at(bx, y), &s.instance[k], 4 * sizeof(std::uint32_t));
         if (hits == 0u) {
@@ -234,6 +250,7 @@ void shade_and_write(const RenderSettings& settings, std::span<const Light> ligh
       const std::size_t k = k0 + static_cast<std::size_t>(lane);
       const int x = bx + lane % kBlockWidth;
       const int y = by + lane / kBlockWidth;
+      if (want_masks) write_masks(x, y, k, (hits >> lane & 1u) != 0);
       if (out.triangle.wanted()) *out.triangle.at(x, y) = s.triangle[k];
       if (out.instance.wanted()) *out.instance.at(x, y) = s.instance[k];
       if (!(hits >> lane & 1u)) {

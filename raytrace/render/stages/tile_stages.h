@@ -136,6 +136,22 @@ void set_lit_bit(int l, TileScratch& s);
 // fraction[k] += weight for each hit k whose bit l of s.lit is set.
 void count_unblocked(int l, float weight, float* fraction, const TileScratch& s);
 
+// What trace_light_rays traced, and the time it took.
+struct LightRayWork {
+  TraversalCounters shadow, ao;
+  std::uint64_t shadowed = 0, ao_occluded = 0;  // blocked rays
+  double shadow_ns = 0.0, ao_ns = 0.0;
+};
+
+// The rays the shading and the visibility masks need from the tile's hits
+// (their surfaces reconstructed): with settings.ao_rays, the ambient
+// occlusion rounds (into s.ao_open); with settings.shadows, each hard
+// light's shadow rays (into its bit of s.lit, which this sets for every
+// light first) and each area light's sample rounds (into its span of
+// s.light_fraction).
+void trace_light_rays(const Scene& scene, const RenderSettings& settings, std::span<const Light> lights,
+                      TileScratch& s, LightRayWork& work);
+
 // Diffuse shading (ambient + each unblocked light's N.L) and the requested
 // outputs of the tile's pixels, through s.staging: line-aligned planes get
 // whole lines by streaming stores, the others are written in place.
