@@ -25,8 +25,8 @@ void set_every_light(std::size_t lights, TileScratch& s) {
 // by place(j), are traced on bit `bit` of s.lit, and each hit's open
 // fraction is left in fraction[0, s.lanes). Returns the blocked rays.
 template <class Place>
-std::uint64_t trace_rounds(const Scene& scene, const RenderSettings& settings, int n, std::uint32_t stream, int bit,
-                           float* fraction, TileScratch& s, TraversalCounters& counters, Place&& place) {
+std::uint64_t trace_rounds(const ShadowTracer& trace, const RenderSettings& settings, int n, std::uint32_t stream,
+                           int bit, float* fraction, TileScratch& s, TraversalCounters& counters, Place&& place) {
   shift_pixels(settings.sample_seed, stream, s);
   std::fill_n(fraction, s.lanes, 0.0f);
   const float weight = 1.0f / static_cast<float>(n);
@@ -34,7 +34,7 @@ std::uint64_t trace_rounds(const Scene& scene, const RenderSettings& settings, i
   for (int j = 0; j < n; ++j) {
     set_lit_bit(bit, s);
     place(j);
-    blocked += trace_shadow_rays(scene, settings.triangle_test, bit, s, counters);
+    blocked += trace(bit, s, counters);
     count_unblocked(bit, weight, fraction, s);
   }
   return blocked;
@@ -44,13 +44,20 @@ std::uint64_t trace_rounds(const Scene& scene, const RenderSettings& settings, i
 
 void trace_light_rays(const Scene& scene, const RenderSettings& settings, std::span<const Light> lights,
                       TileScratch& s, LightRayWork& work) {
+  trace_light_rays(settings, lights, s, work, [&](int l, TileScratch& rays, TraversalCounters& counters) {
+    return trace_shadow_rays(scene, settings.triangle_test, l, rays, counters);
+  });
+}
+
+void trace_light_rays(const RenderSettings& settings, std::span<const Light> lights, TileScratch& s,
+                      LightRayWork& work, const ShadowTracer& trace) {
   bool any_hit = false;
   for (std::size_t b = 0; b < s.blocks() && !any_hit; ++b) any_hit = s.block_hits[b] != 0;
   if (any_hit && settings.ao_rays > 0) {
     // Borrows light 0's bit of s.lit, set again below.
     const auto start = Clock::now();
     const int n = settings.ao_rays;
-    work.ao_occluded += trace_rounds(scene, settings, n, kAmbientOcclusionStream, 0, s.ao_open.data(), s, work.ao,
+    work.ao_occluded += trace_rounds(trace, settings, n, kAmbientOcclusionStream, 0, s.ao_open.data(), s, work.ao,
                                      [&](int j) { place_ao_rays(settings.ao_radius, 0, j, n, s); });
     work.ao_ns += nanoseconds_since(start);
   }
@@ -62,13 +69,13 @@ void trace_light_rays(const Scene& scene, const RenderSettings& settings, std::s
     const int bit = static_cast<int>(l);
     if (light.is_area()) {
       const int n = settings.shadow_samples;
-      work.shadowed += trace_rounds(scene, settings, n, static_cast<std::uint32_t>(l), bit,
+      work.shadowed += trace_rounds(trace, settings, n, static_cast<std::uint32_t>(l), bit,
                                     &s.light_fraction[l * s.lanes], s, work.shadow,
                                     [&](int j) { place_light_samples(light, bit, j, n, s); });
       continue;
     }
     aim_shadow_rays(light, bit, s);
-    work.shadowed += trace_shadow_rays(scene, settings.triangle_test, bit, s, work.shadow);
+    work.shadowed += trace(bit, s, work.shadow);
   }
   work.shadow_ns += nanoseconds_since(start);
 }

@@ -11,6 +11,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <span>
 
 #include "raytrace/camera/camera.h"
@@ -151,6 +152,15 @@ struct LightRayWork {
 // s.light_fraction).
 void trace_light_rays(const Scene& scene, const RenderSettings& settings, std::span<const Light> lights,
                       TileScratch& s, LightRayWork& work);
+
+// The same with another tracer of the shadow rays (the Embree peer of the
+// benchmarks), so that both trace the same rays: trace(l, s, counters)
+// traces the rays aimed or placed for bit l (offset_shadow_rays and
+// compact_shadow_rays make them ready), clears bit l of s.lit for each
+// blocked one and returns how many were.
+using ShadowTracer = std::function<std::uint64_t(int l, TileScratch& s, TraversalCounters& counters)>;
+void trace_light_rays(const RenderSettings& settings, std::span<const Light> lights, TileScratch& s,
+                      LightRayWork& work, const ShadowTracer& trace);
 
 // Diffuse shading (ambient + each unblocked light's N.L) and the requested
 // outputs of the tile's pixels, through s.staging: line-aligned planes get
