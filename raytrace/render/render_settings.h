@@ -8,17 +8,35 @@
 #include <span>
 
 #include "raytrace/geometry/triangle_intersect.h"
+#include "raytrace/render/sampling/sample_pattern.h"
 #include "raytrace/traverse/traversal.h"
 #include "runtime/math/types.h"
 
 namespace sinew::rt {
 
 struct Light {
-  enum class Kind : std::uint8_t { kPoint, kDirectional };
+  enum class Kind : std::uint8_t { kPoint, kDirectional, kRect };
   Kind kind = Kind::kPoint;
-  Vec3 position{4.0f, 8.0f, 6.0f};   // kPoint
+  Vec3 position{4.0f, 8.0f, 6.0f};   // kPoint, kRect: the centre
   Vec3 direction{0.4f, 1.0f, 0.6f};  // kDirectional: towards the light (any length)
   Vec3 color{1.0f};                  // linear RGB radiance scale (no distance falloff)
+  // The light's size; a light of size 0 is hard (one shadow ray per hit).
+  // An area light takes RenderSettings::shadow_samples rays per hit to
+  // stratified points on it (docs/RAYTRACE.md, "Soft shadows").
+  float radius = 0.0f;          // kPoint: a sphere light's radius (scene units)
+  float angular_radius = 0.0f;  // kDirectional: the sun's half angle (radians, below pi/2)
+  // kRect: the rectangle's two full edges (it spans position +- edge / 2);
+  // it lights both of its sides.
+  Vec3 edge_u{0.0f}, edge_v{0.0f};
+
+  bool is_area() const {
+    switch (kind) {
+      case Kind::kPoint: return radius > 0.0f;
+      case Kind::kDirectional: return angular_radius > 0.0f;
+      case Kind::kRect: return true;
+    }
+    return false;
+  }
 };
 
 // Lights one render shades with, each with its own shadow ray.
@@ -27,6 +45,17 @@ inline constexpr std::size_t kMaxLights = 8;
 struct RenderSettings {
   TriangleTest triangle_test = TriangleTest::kFast;
   bool shadows = true;
+  // Shadow rays per hit towards each area light (Light::is_area), 1 to
+  // kMaxSamples; hard lights take one.
+  int shadow_samples = 4;
+  // Ambient occlusion: rays per hit (0: off, up to kMaxSamples), cosine
+  // distributed about the surface, each ao_radius long (scene units); the
+  // ambient term is scaled by the fraction that escape.
+  int ao_rays = 0;
+  float ao_radius = 1.0f;
+  // The stochastic rays' pattern (render/sampling/sample_pattern.h): a
+  // function of this seed, the pixel and the sample.
+  std::uint32_t sample_seed = 0;
   // Textured materials sample their texture (docs/RAYTRACE.md, "Textures");
   // off, every material shows its colour alone.
   bool textures = true;
@@ -80,6 +109,13 @@ struct FrameBuffers {
   std::span<Vec2> uv;
   std::span<Vec2> barycentric;
   std::span<std::uint32_t> material_id;
+  // Visibility masks, 1 where nothing blocks and on a miss: per pixel, one
+  // float per light (the render's lights, in order): 0 or 1 for a hard
+  // light, the fraction of its samples that reach the hit for an area
+  // light (1 with shadows off); and the fraction of the ambient occlusion
+  // rays that escape (1 without them).
+  std::span<float> shadow;
+  std::span<float> ambient_occlusion;
 
   // Bytes from the start of one row to the next, per output (a host's
   // texture or staging buffer with padded rows); 0: rows packed. A pitch
@@ -98,6 +134,8 @@ struct FrameBuffers {
     std::size_t uv = 0;
     std::size_t barycentric = 0;
     std::size_t material_id = 0;
+    std::size_t shadow = 0;
+    std::size_t ambient_occlusion = 0;
   };
   RowPitches row_pitch;
 };
@@ -107,10 +145,14 @@ struct RenderStats {
   std::uint64_t primary_hits = 0;
   std::uint64_t shadow_rays = 0;
   std::uint64_t shadowed = 0;
+  std::uint64_t ao_rays = 0;
+  std::uint64_t ao_occluded = 0;
   TraversalCounters primary;
-  TraversalCounters shadow;
+  TraversalCounters shadow;  // hard and area lights' shadow rays
+  TraversalCounters ao;
   double trace_primary_ms = 0.0;
   double trace_shadow_ms = 0.0;
+  double trace_ao_ms = 0.0;
   double shade_ms = 0.0;
 };
 

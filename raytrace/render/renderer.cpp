@@ -31,12 +31,15 @@ struct TileRecord {
   TraversalCounters shadow;
   std::uint64_t hits = 0;
   std::uint64_t shadowed = 0;
+  TraversalCounters ao;
+  std::uint64_t ao_occluded = 0;
   double primary_ns = 0.0;
   double shadow_ns = 0.0;
+  double ao_ns = 0.0;
   double shade_ns = 0.0;
 };
 
-Expected<OutputPlanes> output_planes(const FrameBuffers& buffers) {
+Expected<OutputPlanes> output_planes(const FrameBuffers& buffers, std::size_t lights) {
   const int w = buffers.width;
   const int h = buffers.height;
   const FrameBuffers::RowPitches& pitch = buffers.row_pitch;
@@ -56,7 +59,50 @@ Expected<OutputPlanes> output_planes(const FrameBuffers& buffers) {
                          output_plane(buffers.barycentric, pitch.barycentric, 1, w, h, "buffers.barycentric"));
   SINEW_ASSIGN_OR_RETURN(out.material,
                          output_plane(buffers.material_id, pitch.material_id, 1, w, h, "buffers.material_id"));
+  SINEW_ASSIGN_OR_RETURN(out.shadow, output_plane(buffers.shadow, pitch.shadow, lights, w, h, "buffers.shadow"));
+  SINEW_ASSIGN_OR_RETURN(out.ambient_occlusion, output_plane(buffers.ambient_occlusion, pitch.ambient_occlusion, 1,
+                                                             w, h, "buffers.ambient_occlusion"));
   return out;
+}
+
+bool finite(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+// The sample counts, the ambient occlusion radius and every light's shape.
+Status check_sampling(const RenderSettings& settings, std::span<const Light> lights) {
+  if (settings.shadow_samples < 1 || settings.shadow_samples > kMaxSamples) {
+    return invalid_argument("settings.shadow_samples", std::to_string(settings.shadow_samples),
+                            "must be 1 to " + std::to_string(kMaxSamples));
+  }
+  if (settings.ao_rays < 0 || settings.ao_rays > kMaxSamples) {
+    return invalid_argument("settings.ao_rays", std::to_string(settings.ao_rays),
+                            "must be 0 to " + std::to_string(kMaxSamples));
+  }
+  if (settings.ao_rays > 0 && !(std::isfinite(settings.ao_radius) && settings.ao_radius > 0.0f)) {
+    return invalid_argument("settings.ao_radius", std::to_string(settings.ao_radius), "must be finite and above 0");
+  }
+  for (std::size_t l = 0; l < lights.size(); ++l) {
+    const Light& light = lights[l];
+    const std::string name = "settings.lights[" + std::to_string(l) + "]";
+    if (!finite(light.position) || !finite(light.direction) || !finite(light.color)) {
+      return invalid_argument(name, "a non-finite position, direction or color", "must be finite");
+    }
+    if (!(std::isfinite(light.radius) && light.radius >= 0.0f)) {
+      return invalid_argument(name + ".radius", std::to_string(light.radius), "must be finite and at least 0");
+    }
+    if (!(light.angular_radius >= 0.0f && light.angular_radius < 1.5f)) {
+      return invalid_argument(name + ".angular_radius", std::to_string(light.angular_radius),
+                              "must be at least 0 and below 1.5 radians");
+    }
+    if (light.kind == Light::Kind::kDirectional && !(glm::length(light.direction) > 0.0f)) {
+      return invalid_argument(name + ".direction", "0", "a directional light needs a direction");
+    }
+    if (light.kind == Light::Kind::kRect &&
+        !(finite(light.edge_u) && finite(light.edge_v) && glm::length(glm::cross(light.edge_u, light.edge_v)) > 0.0f)) {
+      return invalid_argument(name + ".edge_u, edge_v", "parallel, zero or non-finite edges",
+                              "a rectangle light needs two finite edges spanning an area");
+    }
+  }
+  return Status{};
 }
 
 }  // namespace
@@ -76,24 +122,19 @@ void render_tile(const Scene& scene, const PinholeCamera& camera, const RenderSe
   for (std::size_t b = 0; b < s.lanes / kBlockLanes; ++b) {
     record.hits += static_cast<std::uint64_t>(std::popcount(static_cast<unsigned>(s.block_hits[b])));
   }
-  std::fill(s.lit.begin(), s.lit.begin() + static_cast<std::ptrdiff_t>(s.lanes),
-            static_cast<std::uint8_t>((1u << lights.size()) - 1u));
   if (out.want_surface()) reconstruct_surfaces(scene, surface_settings(settings, camera, out), s);
-  double shadow_ns = 0.0;
-  if (out.want_color() && settings.shadows) {
-    const auto shadow_start = Clock::now();
-    for (std::size_t l = 0; l < lights.size(); ++l) {
-      aim_shadow_rays(lights[l], static_cast<int>(l), s);
-      record.shadowed +=
-          trace_shadow_rays(scene, settings.triangle_test, static_cast<int>(l), s, record.shadow);
-    }
-    shadow_ns = nanoseconds(shadow_start, Clock::now());
-  }
+  LightRayWork light_work;
+  if (out.want_light_rays()) trace_light_rays(scene, settings, lights, s, light_work);
   shade_and_write(settings, lights, out, s);
   const auto t3 = Clock::now();
   record.primary_ns = nanoseconds(t0, t1);
-  record.shadow_ns = shadow_ns;
-  record.shade_ns = nanoseconds(t1, t3) - shadow_ns;
+  record.shadow = light_work.shadow;
+  record.ao = light_work.ao;
+  record.shadowed = light_work.shadowed;
+  record.ao_occluded = light_work.ao_occluded;
+  record.shadow_ns = light_work.shadow_ns;
+  record.ao_ns = light_work.ao_ns;
+  record.shade_ns = nanoseconds(t1, t3) - light_work.shadow_ns - light_work.ao_ns;
 }
 
 }  // namespace
@@ -118,7 +159,8 @@ Expected<RenderStats> Renderer::render(const Scene& scene, const PinholeCamera& 
     return invalid_argument("settings.lights", std::to_string(lights.size()),
                             "at most " + std::to_string(kMaxLights) + " lights");
   }
-  SINEW_ASSIGN_OR_RETURN(const OutputPlanes out, output_planes(buffers));
+  SINEW_RETURN_IF_ERROR(check_sampling(settings, lights));
+  SINEW_ASSIGN_OR_RETURN(const OutputPlanes out, output_planes(buffers, lights.size()));
   const int tile = settings.tile_size;
   const int tiles_x = (buffers.width + tile - 1) / tile;
   const int tiles_y = (buffers.height + tile - 1) / tile;
@@ -133,24 +175,29 @@ Expected<RenderStats> Renderer::render(const Scene& scene, const PinholeCamera& 
 
   // Tile order keeps the sums deterministic.
   RenderStats stats;
-  double primary_ns = 0.0, shadow_ns = 0.0, shade_ns = 0.0;
+  double primary_ns = 0.0, shadow_ns = 0.0, ao_ns = 0.0, shade_ns = 0.0;
   for (const TileRecord& r : records) {
     stats.primary += r.primary;
     stats.shadow += r.shadow;
+    stats.ao += r.ao;
     stats.primary_hits += r.hits;
     stats.shadowed += r.shadowed;
+    stats.ao_occluded += r.ao_occluded;
     primary_ns += r.primary_ns;
     shadow_ns += r.shadow_ns;
+    ao_ns += r.ao_ns;
     shade_ns += r.shade_ns;
   }
   stats.primary_rays = static_cast<std::uint64_t>(buffers.width) * static_cast<std::uint64_t>(buffers.height);
   stats.shadow_rays = stats.shadow.rays;
+  stats.ao_rays = stats.ao.rays;
   // The phases interleave within each tile: the wall time of the whole
   // render is split in proportion to the time the tiles spent in each.
-  const double busy_ns = primary_ns + shadow_ns + shade_ns;
+  const double busy_ns = primary_ns + shadow_ns + ao_ns + shade_ns;
   if (busy_ns > 0.0) {
     stats.trace_primary_ms = wall_ms * primary_ns / busy_ns;
     stats.trace_shadow_ms = wall_ms * shadow_ns / busy_ns;
+    stats.trace_ao_ms = wall_ms * ao_ns / busy_ns;
     stats.shade_ms = wall_ms * shade_ns / busy_ns;
   } else {
     stats.shade_ms = wall_ms;
@@ -159,6 +206,7 @@ Expected<RenderStats> Renderer::render(const Scene& scene, const PinholeCamera& 
   if (timers) {
     timers->record("trace primary", stats.trace_primary_ms);
     timers->record("trace shadow", stats.trace_shadow_ms);
+    if (settings.ao_rays > 0) timers->record("trace ao", stats.trace_ao_ms);
     timers->record("shade", stats.shade_ms);
   }
   return stats;

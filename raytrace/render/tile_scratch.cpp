@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "raytrace/render/output/srgb_encode.h"
+#include "raytrace/render/render_settings.h"
 
 namespace sinew::rt {
 
@@ -14,6 +15,7 @@ void TileScratch::prepare(const Tile& area, const TracePlan& frame_plan) {
   shadow_count = 0;
   shadow_region_begin.clear();
   shadows_from_point = false;
+  shadows_per_lane = false;
   shadows_aimed_only = false;
   const int width = area.x1 - area.x0, height = area.y1 - area.y0;
   const int rx = std::max(1, plan.region_blocks_x), ry = std::max(1, plan.region_blocks_y);
@@ -47,9 +49,12 @@ void TileScratch::prepare(const Tile& area, const TracePlan& frame_plan) {
     for (std::vector<float>* a : {&dir_x, &dir_y, &dir_z, &t, &u, &v, &px, &py, &pz, &gx, &gy, &gz, &nx, &ny,
                                   &nz, &ar, &ag, &ab, &error, &so_x, &so_y, &so_z, &sd_x, &sd_y, &sd_z, &s_tmax,
                                   &shadow_lane_x, &shadow_lane_y, &shadow_lane_z, &shadow_push_x,
-                                  &shadow_push_y, &shadow_push_z, &lr, &lg, &lb, &uv_x, &uv_y}) {
+                                  &shadow_push_y, &shadow_push_z, &lr, &lg, &lb, &uv_x, &uv_y, &shadow_from_x,
+                                  &shadow_from_y, &shadow_from_z, &shift_xi, &shift_eta, &shift_cos, &shift_sin,
+                                  &ao_open}) {
       a->resize(arrays);
     }
+    light_fraction.resize(arrays * kMaxLights);
     triangle.resize(arrays);
     instance.resize(arrays);
     material.resize(arrays);

@@ -88,6 +88,20 @@ struct TileScratch {
   // point light's: render/surface.h shadow_ray_from_light).
   bool shadows_from_point = false;
   Vec3 shadow_origin{0.0f};
+  // Whether the rays are segments, each from its own origin
+  // (shadow_from_*) along its own direction (shadow_lane_*) with t in
+  // [0, shadow_tmax): an area light's samples and ambient occlusion rays
+  // (render/stages/tile_stages.h place_light_samples, place_ao_rays).
+  bool shadows_per_lane = false;
+  float shadow_tmax = 1.0f;
+  std::vector<float> shadow_from_x, shadow_from_y, shadow_from_z;
+  // Each pixel's shift of one stream's sample pattern (shift_pixels).
+  std::vector<float> shift_xi, shift_eta, shift_cos, shift_sin;
+  // Per area light l, lanes [l * lanes, (l + 1) * lanes): the fraction of
+  // its samples that reach the hit; and per hit the fraction of ambient
+  // occlusion rays that escape.
+  std::vector<float> light_fraction;
+  std::vector<float> ao_open;
   // Shadow run r: rays [shadow_region_begin[r], shadow_region_begin[r + 1])
   // come from one region's pixels, those on characters or those on static
   // meshes (runs without a ray have no entry), split finer where the plan

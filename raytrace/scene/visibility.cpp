@@ -50,13 +50,17 @@ bool FrameCull::begin(const FrameVisibility& view, float magnitude) {
   double scale = std::max(static_cast<double>(magnitude), static_cast<double>(max_abs(view.eye)));
   for (std::uint32_t l = 0; l < view.light_count; ++l) {
     const ViewLight& light = view.lights[l];
-    if (!finite(light.position) || !finite(light.direction)) return false;
+    if (!finite(light.position) || !finite(light.direction) || !std::isfinite(light.radius) ||
+        !(light.radius >= 0.0f) || !(light.angular_radius >= 0.0f && light.angular_radius < 1.5f)) {
+      return false;
+    }
     if (light.kind == ViewLight::Kind::kPoint) {
-      scale = std::max(scale, static_cast<double>(max_abs(light.position)));
+      scale = std::max(scale, static_cast<double>(max_abs(light.position)) + static_cast<double>(light.radius));
     } else if (!(norm(to_d(light.direction)) > 0.0)) {
       return false;  // no direction: its shadow rays are not bounded here
     }
   }
+  if (!(std::isfinite(view.ao_reach) && view.ao_reach >= 0.0f)) return false;
   margin_ = kRelativeMargin * scale + static_cast<double>(std::numeric_limits<float>::min());
 
   // Camera rays: forward + a right + b up with |a| <= half_width. The side
@@ -169,7 +173,10 @@ void FrameCull::finish_receivers() {
   auto add_plane = [&](const D3& n, const ViewLight& light) {
     double offset = -std::numeric_limits<double>::infinity();
     for (const D3& p : receivers_) offset = std::max(offset, dot(n, p));
-    if (light.kind == ViewLight::Kind::kPoint) offset = std::max(offset, dot(n, to_d(light.position)));
+    if (light.kind == ViewLight::Kind::kPoint) {
+      // The light's farthest point along n: its centre plus its radius.
+      offset = std::max(offset, dot(n, to_d(light.position)) + static_cast<double>(light.radius) * norm(n));
+    }
     if (std::isfinite(offset)) planes_.push_back({{n[0], n[1], n[2]}, offset});
   };
   // Normals around an axis `a` (unit): four sides and four diagonals.
@@ -190,6 +197,8 @@ void FrameCull::finish_receivers() {
     if (light.kind == ViewLight::Kind::kPoint) {
       const D3 lp = to_d(light.position);
       for (std::size_t i = 0; i < 12; ++i) add_plane(fixed[i], light);
+      // An area light's volume has no single apex: the fixed planes hold it.
+      if (light.radius > 0.0f) continue;
       // A pyramid from the light around the receivers: for each side w, the
       // steepest slope (p - L) . w / (p - L) . a of a receiver, when every
       // receiver lies ahead of the light along a.
@@ -218,10 +227,15 @@ void FrameCull::finish_receivers() {
       d = add_scaled({0.0, 0.0, 0.0}, 1.0 / norm(d), d);
       add_plane({-d[0], -d[1], -d[2]}, light);
       around(d, &fixed[12]);
+      // The sun's rays arrive within its angular radius of d: a plane holds
+      // them when its normal leans that far and more past perpendicular.
+      const double lean = std::tan(static_cast<double>(light.angular_radius) * (1.0 + 0x1.0p-10));
       for (const D3& n : fixed) {
-        // Against the light: n . d = -2^-16 |n| after the projection.
+        // Against the light: n . d = -2^-16 |n| after the projection (and
+        // for the sun, its lean of the rest of n more).
         const double size = norm(n);
-        const D3 projected = add_scaled(n, -dot(n, d) - 0x1.0p-16 * size, d);
+        const D3 across = add_scaled(n, -dot(n, d), d);
+        const D3 projected = add_scaled(n, -dot(n, d) - 0x1.0p-16 * size - lean * norm(across), d);
         if (!(norm(projected) > 1e-3 * size)) continue;
         if (!(dot(projected, d) < 0.0)) continue;
         add_plane(projected, light);
@@ -232,9 +246,23 @@ void FrameCull::finish_receivers() {
 }
 
 bool FrameCull::casts_into_view(const Aabb& box) const {
-  if (!shadows_ || box.is_empty()) return false;
+  if (box.is_empty()) return false;
   double lower[3], upper[3];
   grown(box, lower, upper);
+  if (view_.ao_reach > 0.0f) {
+    // An ambient occlusion ray starts on a point in view and ends within
+    // ao_reach of it: the box grown by that much meets the frustum.
+    const double reach = static_cast<double>(view_.ao_reach) * (1.0 + 0x1.0p-10);
+    double far_lower[3], far_upper[3];
+    for (int a = 0; a < 3; ++a) {
+      far_lower[a] = lower[a] - reach;
+      far_upper[a] = upper[a] + reach;
+    }
+    bool outside = false;
+    for (const Plane& plane : frustum_) outside = outside || box_outside(plane, far_lower, far_upper);
+    if (!outside) return true;
+  }
+  if (!shadows_) return false;
   for (std::uint32_t l = 0; l < view_.light_count; ++l) {
     bool outside = false;
     for (std::uint32_t i = light_begin_[l]; i < light_begin_[l + 1] && !outside; ++i) {

@@ -31,6 +31,12 @@ struct ViewLight {
   Kind kind = Kind::kPoint;
   Vec3 position{0.0f};               // kPoint
   Vec3 direction{0.0f, 1.0f, 0.0f};  // kDirectional: towards the light (any length)
+  // An area light's extent: kPoint, every point of the light lies within
+  // `radius` of `position` (a sphere or rectangle light); kDirectional,
+  // its rays arrive within `angular_radius` radians of `direction` (the
+  // sun).
+  float radius = 0.0f;
+  float angular_radius = 0.0f;
 };
 
 inline constexpr std::size_t kMaxViewLights = 8;
@@ -49,6 +55,9 @@ struct FrameVisibility {
   bool shadows = true;
   std::array<ViewLight, kMaxViewLights> lights{};
   std::uint32_t light_count = 0;
+  // Ambient occlusion rays: up to this long, from a point a camera ray
+  // hits (0: none).
+  float ao_reach = 0.0f;
 };
 
 // The cull of one frame. Use: begin(), in_view() per box, add_receivers()
@@ -73,7 +82,8 @@ class FrameCull {
   // Bounds each light's caster volume from the receivers added.
   void finish_receivers();
 
-  // Whether a shadow ray may reach `box` (after finish_receivers).
+  // Whether a shadow ray or an ambient occlusion ray may reach `box`
+  // (after finish_receivers).
   bool casts_into_view(const Aabb& box) const;
 
   // The relative margin every box is grown by: far above the rounding of

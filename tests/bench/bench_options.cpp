@@ -59,6 +59,14 @@ Status BenchArgs::read(std::string_view name, std::int64_t lo, std::int64_t hi, 
   return {};
 }
 
+Status BenchArgs::read(std::string_view name, double lo, double hi, float& out) const {
+  if (const auto text = value(name)) {
+    SINEW_ASSIGN_OR_RETURN(const double x, cli::parse_double(name, *text, lo, hi));
+    out = static_cast<float>(x);
+  }
+  return {};
+}
+
 Status BenchArgs::read(std::string_view name, int lo, int hi, std::vector<int>& out) const {
   if (const auto text = value(name)) {
     SINEW_ASSIGN_OR_RETURN(out, cli::parse_int_list(name, *text, lo, hi));

@@ -51,6 +51,7 @@ class BenchArgs {
   Status read(std::string_view name, std::int64_t lo, std::int64_t hi, int& out) const;  // an integer
   Status read(std::string_view name, int lo, int hi, std::vector<int>& out) const;       // "1,4,16"
   Status read(std::string_view name, bool& out) const;                                 // on|off
+  Status read(std::string_view name, double lo, double hi, float& out) const;          // a number
   Status read(std::string_view name, std::string& out) const;                          // text
   Status read_size(int max_side, int& width, int& height) const;                       // --size WxH
   Status read_threads(int& out) const;                                                 // --threads N

@@ -85,6 +85,15 @@ struct Options {
   // and Sinew is compared with the best.
   std::vector<EmbreeMode> embree_modes{EmbreeMode::kRebuildLow, EmbreeMode::kRefit, EmbreeMode::kRebuildMedium};
   std::vector<EmbreeWidth> embree_widths{std::begin(kEmbreeWidths), std::end(kEmbreeWidths)};
+  // Soft shadows and ambient occlusion, sized by the character's height
+  // (its posed extent along its up axis).
+  float light_radius = 0.0f;  // the point light's sphere radius, in heights
+  int shadow_samples = 4;
+  int ao_rays = 0;
+  float ao_length = 0.5f;  // in heights
+  // The Embree flag of the area-light and ambient occlusion rays: each is a
+  // row of its own when both are asked for.
+  std::vector<bool> secondary_coherent{true, false};
   std::string shared = SINEW_SHARED_DIR;
   std::string json_path;
   bool help = false;
@@ -107,6 +116,12 @@ std::vector<BenchFlag> flags() {
        "rays per Embree call: 1 (rtcIntersect1/rtcOccluded1) or 4, 8, 16\n"
        "(coherent packets); every mode runs at every width (default 1,4,8,16)"},
       {"--subdivide", "L", "subdivide the model L times first (each level: 4x the triangles)"},
+      {"--light-radius", "H", "the point light is a sphere of radius H x the character's height (default 0)"},
+      {"--shadow-samples", "S", "shadow rays per hit towards an area light (default 4)"},
+      {"--ao-rays", "A", "ambient occlusion rays per hit (default 0: none)"},
+      {"--ao-length", "H", "their length, x the character's height (default 0.5)"},
+      {"--embree-secondary", "coherent|incoherent|both",
+       "Embree's flag for area-light and ambient occlusion rays;\nboth: a row each (default both)"},
       {"--check-stride", "N", "brute-force check every Nth pixel of the first frame (default 7)"},
       shared_flag(),
       json_flag(),
@@ -178,6 +193,16 @@ Status read_options(const BenchArgs& parsed, Options& o) {
   }
   SINEW_RETURN_IF_ERROR(parsed.read("--subdivide", 0, editor::kMaxSubdivisionLevels, o.subdivide));
   SINEW_RETURN_IF_ERROR(parsed.read("--check-stride", 1, 1 << 20, o.check_stride));
+  SINEW_RETURN_IF_ERROR(parsed.read("--light-radius", 0.0, 10.0, o.light_radius));
+  SINEW_RETURN_IF_ERROR(parsed.read("--shadow-samples", 1, rt::kMaxSamples, o.shadow_samples));
+  SINEW_RETURN_IF_ERROR(parsed.read("--ao-rays", 0, rt::kMaxSamples, o.ao_rays));
+  SINEW_RETURN_IF_ERROR(parsed.read("--ao-length", 0.001, 10.0, o.ao_length));
+  if (const auto text = parsed.value("--embree-secondary")) {
+    SINEW_ASSIGN_OR_RETURN(const int which,
+                           cli::parse_choice("--embree-secondary", *text, {"coherent", "incoherent", "both"}));
+    o.secondary_coherent = which == 0 ? std::vector<bool>{true} : which == 1 ? std::vector<bool>{false}
+                                                                             : std::vector<bool>{true, false};
+  }
   if (const auto text = parsed.value("--embree-modes")) {
     SINEW_ASSIGN_OR_RETURN(o.embree_modes, parse_modes(*text));
   }
@@ -199,6 +224,8 @@ struct Contender {
   Kind kind = Kind::kSinew;
   EmbreeMode mode = EmbreeMode::kRefit;  // kEmbree only
   EmbreeWidth width = EmbreeWidth::k1;   // kEmbree only
+  bool secondary_coherent = true;        // kEmbree only: its area-light and ambient occlusion rays' flag
+  bool secondary = false;                // whether the frame has such rays (the label says the flag)
 };
 
 // "rtcIntersect8": the Embree call the width uses (its name lives in the
@@ -214,7 +241,8 @@ std::string width_label(EmbreeWidth width) {
 // "LOW rebuild rtcIntersect8": the mode and the width, as the summary names
 // the best Embree row.
 std::string embree_label(const Contender& c) {
-  return std::string(mode_spec(c.mode).label) + " " + width_label(c.width);
+  return std::string(mode_spec(c.mode).label) + " " + width_label(c.width) +
+         (c.secondary ? (c.secondary_coherent ? " coherent" : " incoherent") : "");
 }
 
 std::string contender_name(const Contender& c) {
@@ -232,6 +260,7 @@ struct ContenderResult {
   GateResult gate;
   std::uint64_t primary_hits = 0;  // last frame
   std::uint64_t shadow_rays = 0;   // last frame
+  std::uint64_t ao_rays = 0;       // last frame
 };
 
 struct ConfigResult {
@@ -246,20 +275,24 @@ struct FrameSample {
   double build_ms = 0.0;
   double primary_ms = 0.0;
   double shadow_ms = 0.0;
+  double ao_ms = 0.0;
   double shade_ms = 0.0;
   std::uint64_t primary_hits = 0;
   std::uint64_t shadow_rays = 0;
+  std::uint64_t ao_rays = 0;
 };
 
 void record(ContenderResult& r, const FrameSample& s, double skinning_ms) {
   r.timers.record("build", s.build_ms);
   r.timers.record("trace primary", s.primary_ms);
   r.timers.record("trace shadow", s.shadow_ms);
-  r.timers.record("trace", s.primary_ms + s.shadow_ms);
+  r.timers.record("trace ao", s.ao_ms);
+  r.timers.record("trace", s.primary_ms + s.shadow_ms + s.ao_ms);
   r.timers.record("shade", s.shade_ms);
-  r.timers.record("total", skinning_ms + s.build_ms + s.primary_ms + s.shadow_ms + s.shade_ms);
+  r.timers.record("total", skinning_ms + s.build_ms + s.primary_ms + s.shadow_ms + s.ao_ms + s.shade_ms);
   r.primary_hits = s.primary_hits;
   r.shadow_rays = s.shadow_rays;
+  r.ao_rays = s.ao_rays;
 }
 
 double phase(const PhaseTimers& timers, std::string_view name) {
@@ -304,9 +337,11 @@ FrameSample sinew_sample(const PhaseTimers& prepare, const rt::RenderStats& stat
   s.build_ms = phase(prepare, "boxes") + phase(prepare, "fallback") + phase(prepare, "top level");
   s.primary_ms = stats.trace_primary_ms;
   s.shadow_ms = stats.trace_shadow_ms;
+  s.ao_ms = stats.trace_ao_ms;
   s.shade_ms = stats.shade_ms;
   s.primary_hits = stats.primary_hits;
   s.shadow_rays = stats.shadow_rays;
+  s.ao_rays = stats.ao_rays;
   return s;
 }
 
@@ -335,9 +370,11 @@ Expected<FrameSample> run_exact(const FrameContext& c, rt::Renderer& renderer, c
   SINEW_ASSIGN_OR_RETURN(const rt::RenderStats stats, renderer.render(exact, c.camera, c.settings, c.color, *c.jobs));
   s.primary_ms = stats.trace_primary_ms;
   s.shadow_ms = stats.trace_shadow_ms;
+  s.ao_ms = stats.trace_ao_ms;
   s.shade_ms = stats.shade_ms;
   s.primary_hits = stats.primary_hits;
   s.shadow_rays = stats.shadow_rays;
+  s.ao_rays = stats.ao_rays;
   if (gate) {
     SINEW_ASSIGN_OR_RETURN(std::vector<Hit> hits, render_primary_hits(exact, c.camera, c.settings, *c.jobs));
     map_exact_ids(c.stage->scene, c.model->mesh.triangles.size(), hits);
@@ -349,17 +386,20 @@ Expected<FrameSample> run_exact(const FrameContext& c, rt::Renderer& renderer, c
 #ifdef SINEW_HAVE_EMBREE
 // One Embree row's frame: the BVH brought up to date and the frame rendered
 // at the row's width; on the gated frame, the hits of the same width.
-Expected<FrameSample> run_embree(const FrameContext& c, EmbreeTracer& tracer, EmbreeWidth width,
+Expected<FrameSample> run_embree(const FrameContext& c, EmbreeTracer& tracer, const Contender& row,
                                  std::span<std::uint8_t> color, const BruteForceGate* gate, GateResult* gate_out) {
   FrameSample s;
+  const EmbreeWidth width = row.width;
   SINEW_ASSIGN_OR_RETURN(s.build_ms, tracer.update(c.stage->scene));
-  SINEW_ASSIGN_OR_RETURN(const EmbreeRenderStats stats,
-                         tracer.render(c.stage->scene, c.camera, c.settings, color, {}, *c.jobs, width));
+  SINEW_ASSIGN_OR_RETURN(const EmbreeRenderStats stats, tracer.render(c.stage->scene, c.camera, c.settings, color, {},
+                                                                      *c.jobs, width, row.secondary_coherent));
   s.primary_ms = stats.trace_primary_ms;
   s.shadow_ms = stats.trace_shadow_ms;
+  s.ao_ms = stats.trace_ao_ms;
   s.shade_ms = stats.shade_ms;
   s.primary_hits = stats.primary_hits;
   s.shadow_rays = stats.shadow_rays;
+  s.ao_rays = stats.ao_rays;
   if (gate) {
     std::vector<Hit> hits(static_cast<std::size_t>(c.camera.width()) * static_cast<std::size_t>(c.camera.height()));
     SINEW_RETURN_IF_ERROR(status_of(tracer.render(c.stage->scene, c.camera, c.settings, {}, hits, *c.jobs, width)));
@@ -374,8 +414,15 @@ Expected<FrameSample> run_embree(const FrameContext& c, EmbreeTracer& tracer, Em
 std::vector<Contender> contenders(const Options& o) {
   std::vector<Contender> order{{Kind::kSinew}};
 #ifdef SINEW_HAVE_EMBREE
+  const bool secondary = o.light_radius > 0.0f || o.ao_rays > 0;
   for (const EmbreeMode mode : o.embree_modes) {
-    for (const EmbreeWidth width : o.embree_widths) order.push_back({Kind::kEmbree, mode, width});
+    for (const EmbreeWidth width : o.embree_widths) {
+      if (!secondary) {
+        order.push_back({Kind::kEmbree, mode, width});
+        continue;
+      }
+      for (const bool coherent : o.secondary_coherent) order.push_back({Kind::kEmbree, mode, width, coherent, true});
+    }
   }
 #else
   (void)o;
@@ -395,7 +442,7 @@ Expected<ConfigResult> run_configuration(const character::Model& model, const rt
   result.clip = clip_name;
   result.threads = threads;
   const std::vector<Contender> order = contenders(o);
-  for (const Contender& c : order) result.contenders.push_back(ContenderResult{c, {}, {}, 0, 0});
+  for (const Contender& c : order) result.contenders.push_back(ContenderResult{c, {}, {}, 0, 0, 0});
 
 #ifdef SINEW_HAVE_EMBREE
   // One tracer (one Embree device and scene) per mode, shared by its widths:
@@ -416,6 +463,8 @@ Expected<ConfigResult> run_configuration(const character::Model& model, const rt
   ctx.jobs = &jobs;
   ctx.settings.shadows = true;
   ctx.settings.light.kind = rt::Light::Kind::kPoint;
+  ctx.settings.shadow_samples = o.shadow_samples;
+  ctx.settings.ao_rays = o.ao_rays;
   ctx.color.width = o.width;
   ctx.color.height = o.height;
   ctx.color.color_rgba8 = color;
@@ -436,6 +485,9 @@ Expected<ConfigResult> run_configuration(const character::Model& model, const rt
     if (f == 0) {
       const Aabb posed = character::posed_bounds(stage.scene);
       ctx.settings.light.position = character::default_light(posed, stage.up);
+      const float height = posed.upper[stage.up] - posed.lower[stage.up];
+      ctx.settings.light.radius = o.light_radius * height;
+      ctx.settings.ao_radius = o.ao_length * height;
       SINEW_ASSIGN_OR_RETURN(ctx.camera, rt::PinholeCamera::create(character::default_camera(posed, stage.up, o.width,
                                                                                           o.height),
                                                                    o.width, o.height));
@@ -465,8 +517,8 @@ Expected<ConfigResult> run_configuration(const character::Model& model, const rt
         }
         case Kind::kEmbree: {
 #ifdef SINEW_HAVE_EMBREE
-          SINEW_ASSIGN_OR_RETURN(sample, run_embree(ctx, *tracers[static_cast<std::size_t>(r.which.mode)],
-                                                    r.which.width, color, check, &r.gate));
+          SINEW_ASSIGN_OR_RETURN(sample, run_embree(ctx, *tracers[static_cast<std::size_t>(r.which.mode)], r.which,
+                                                    color, check, &r.gate));
 #endif
           break;
         }
@@ -538,33 +590,54 @@ void print_best_summary(const ConfigResult& r) {
               ratio_text(sinew_trace, trace).c_str());
 }
 
+// Rays a second of each kind, the ray counts of the last frame over the
+// median trace time of the kind.
+double mrays_per_s(std::uint64_t rays, double ms) { return ms > 0.0 ? static_cast<double>(rays) / (ms * 1e3) : 0.0; }
+
+void print_rays_by_kind(const ConfigResult& r) {
+  const ContenderResult* best = best_embree(r);
+  for (const ContenderResult* c : {&r.contenders.front(), best}) {
+    if (!c) continue;
+    std::printf("%s: shadow %llu rays at %.1f Mrays/s", c == best ? "best Embree" : "Sinew",
+                static_cast<unsigned long long>(c->shadow_rays),
+                mrays_per_s(c->shadow_rays, phase(c->timers, "trace shadow")));
+    if (c->ao_rays > 0) {
+      std::printf(", ambient occlusion %llu rays at %.1f Mrays/s", static_cast<unsigned long long>(c->ao_rays),
+                  mrays_per_s(c->ao_rays, phase(c->timers, "trace ao")));
+    }
+    std::printf(" (of a thread-second: trace ms are wall times)\n");
+  }
+}
+
 void print_config(const ConfigResult& r) {
   std::printf("\n### clip %s, %d thread%s\n\n", r.clip.c_str(), r.threads, r.threads == 1 ? "" : "s");
   std::printf("shared per frame (median ms): animation %.3f, skinning %.3f (Sinew's, identical for all)\n\n",
               phase(r.shared, "animation"), phase(r.shared, "skinning"));
-  std::printf("| contender | build/refit ms | primary ms | shadow ms | trace ms | shade ms | total ms | "
+  std::printf("| contender | build/refit ms | primary ms | shadow ms | ao ms | trace ms | shade ms | total ms | "
               "sinew/this build | sinew/this trace | sinew/this total | brute force |\n");
-  std::printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|\n");
+  std::printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|\n");
   const ContenderResult& sinew = r.contenders.front();
   const ContenderResult* best = best_embree(r);
   for (const ContenderResult& c : r.contenders) {
     const std::string check = std::to_string(c.gate.checked) + " px ok" +
                               (c.gate.grazes ? ", " + std::to_string(c.gate.grazes) + " edge grazes" : "");
     if (!c.gate.passed()) {
-      std::printf("| %s | FAILED brute-force check (%llu of %llu sampled pixels differ) | | | | | | | | | FAILED |\n",
+      std::printf("| %s | FAILED brute-force check (%llu of %llu sampled pixels differ) | | | | | | | | | | FAILED |\n",
                   contender_name(c.which).c_str(), static_cast<unsigned long long>(c.gate.mismatched),
                   static_cast<unsigned long long>(c.gate.checked));
       continue;
     }
     const double b = phase(c.timers, "build"), t = phase(c.timers, "trace"), tot = phase(c.timers, "total");
-    std::printf("| %s | %.3f | %.3f | %.3f | %.3f | %.3f | %.3f | %s | %s | %s | %s |\n", row_label(c, best).c_str(),
-                b, phase(c.timers, "trace primary"), phase(c.timers, "trace shadow"), t, phase(c.timers, "shade"), tot,
+    std::printf("| %s | %.3f | %.3f | %.3f | %.3f | %.3f | %.3f | %.3f | %s | %s | %s | %s |\n",
+                row_label(c, best).c_str(), b, phase(c.timers, "trace primary"), phase(c.timers, "trace shadow"),
+                phase(c.timers, "trace ao"), t, phase(c.timers, "shade"), tot,
                 ratio_text(phase(sinew.timers, "build"), b).c_str(), ratio_text(phase(sinew.timers, "trace"), t).c_str(),
                 ratio_text(phase(sinew.timers, "total"), tot).c_str(), check.c_str());
   }
   std::printf("\n");
   print_best_widths(r);
   print_best_summary(r);
+  print_rays_by_kind(r);
 }
 
 // A ratio for the JSON: null when either side is missing.
@@ -600,6 +673,7 @@ Json contender_json(const ContenderResult& c, const ContenderResult& sinew, cons
   entry["median_ms"] = {{"build", phase(c.timers, "build")},
                         {"primary", phase(c.timers, "trace primary")},
                         {"shadow", phase(c.timers, "trace shadow")},
+                        {"ao", phase(c.timers, "trace ao")},
                         {"trace", phase(c.timers, "trace")},
                         {"shade", phase(c.timers, "shade")},
                         {"total", total}};
@@ -611,6 +685,9 @@ Json contender_json(const ContenderResult& c, const ContenderResult& sinew, cons
       {"total", sinew_ok ? ratio_json(phase(sinew.timers, "total"), total) : Json(nullptr)}};
   entry["primary_hits"] = c.primary_hits;
   entry["shadow_rays"] = c.shadow_rays;
+  entry["ao_rays"] = c.ao_rays;
+  entry["shadow_mrays_per_s"] = mrays_per_s(c.shadow_rays, phase(c.timers, "trace shadow"));
+  entry["ao_mrays_per_s"] = mrays_per_s(c.ao_rays, phase(c.timers, "trace ao"));
   return entry;
 }
 
@@ -691,6 +768,13 @@ int run_embree_bench(const std::vector<std::string>& args, const std::string& co
               "  diffuse shading; brute-force check of every %dth pixel of the first frame\n",
               o.model.c_str(), o.instances, o.instances == 1 ? "" : "s",
               character::kLayoutNames[static_cast<int>(o.layout)], o.width, o.height, o.frames, o.check_stride);
+  if (o.light_radius > 0.0f) {
+    std::printf("  sphere light of radius %.2f x the character's height, %d shadow samples per hit\n", static_cast<double>(o.light_radius),
+                o.shadow_samples);
+  }
+  if (o.ao_rays > 0) {
+    std::printf("  %d ambient occlusion rays per hit, %.2f x the character's height long\n", o.ao_rays, static_cast<double>(o.ao_length));
+  }
   if (have_embree) {
     std::printf("  Embree modes %s at widths %s: every pair is a row\n", join_modes(o.embree_modes).c_str(),
                 join_ints(widths_of(o.embree_widths)).c_str());
@@ -707,6 +791,10 @@ int run_embree_bench(const std::vector<std::string>& args, const std::string& co
                   {"embree", have_embree},
                   {"embree_modes", mode_keys(o.embree_modes)},
                   {"embree_widths", widths_of(o.embree_widths)},
+                  {"light_radius_heights", o.light_radius},
+                  {"shadow_samples", o.shadow_samples},
+                  {"ao_rays", o.ao_rays},
+                  {"ao_length_heights", o.ao_length},
                   {"configurations", Json::array()}});
   std::string note;
   auto loaded = load_model_or_path(o.model, o.shared, note);

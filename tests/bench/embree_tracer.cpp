@@ -37,10 +37,8 @@ Status embree_error(RTCDevice device, const char* what) {
 
 struct TileRecord {
   std::uint64_t hits = 0;
-  std::uint64_t shadow_rays = 0;
-  std::uint64_t shadowed = 0;
+  rt::LightRayWork light;
   double primary_ns = 0.0;
-  double shadow_ns = 0.0;
   double shade_ns = 0.0;
 };
 
@@ -361,7 +359,7 @@ const char* embree_width_name(EmbreeWidth width) {
 Expected<EmbreeRenderStats> EmbreeTracer::render(const rt::Scene& scene, const rt::PinholeCamera& camera,
                                                  const rt::RenderSettings& settings,
                                                  std::span<std::uint8_t> color_rgba8, std::span<Hit> hits,
-                                                 JobSystem& jobs, EmbreeWidth width) {
+                                                 JobSystem& jobs, EmbreeWidth width, bool secondary_coherent) {
   const int w = camera.width();
   const int h = camera.height();
   const std::size_t pixels = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
@@ -374,8 +372,8 @@ Expected<EmbreeRenderStats> EmbreeTracer::render(const rt::Scene& scene, const r
   if (!state_->built) return invalid_argument("embree scene", "not built", "call update first");
   const RTCScene rtc_scene = state_->scene;
   const std::vector<std::uint32_t>& sinew_id = state_->sinew_id_of_geometry;
-  const rt::Light& light = settings.light;
-  const std::span<const rt::Light> lights(&light, 1);
+  const std::span<const rt::Light> lights =
+      settings.lights.empty() ? std::span<const rt::Light>(&settings.light, 1) : settings.lights;
   const int tile = std::max(1, settings.tile_size);
   const int tiles_x = (w + tile - 1) / tile;
   const int tiles_y = (h + tile - 1) / tile;
@@ -394,6 +392,10 @@ Expected<EmbreeRenderStats> EmbreeTracer::render(const rt::Scene& scene, const r
     // Primary rays of one tile are coherent; shadow rays towards one point
     // light from neighbouring hits nearly so.
     if (width != EmbreeWidth::k1) context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    // Area-light samples and ambient occlusion rays: whichever flag the
+    // caller found faster.
+    RTCIntersectContext secondary = context;
+    secondary.flags = secondary_coherent ? RTC_INTERSECT_CONTEXT_FLAG_COHERENT : RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
 
     const Clock::time_point t0 = Clock::now();
     rt::generate_camera_rays(camera, s);
@@ -449,46 +451,50 @@ Expected<EmbreeRenderStats> EmbreeTracer::render(const rt::Scene& scene, const r
     for (std::size_t b = 0; b < s.lanes / rt::kBlockLanes; ++b) {
       record.hits += static_cast<std::uint64_t>(std::popcount(static_cast<unsigned>(s.block_hits[b])));
     }
-    std::fill(s.lit.begin(), s.lit.begin() + static_cast<std::ptrdiff_t>(s.lanes), std::uint8_t{1});
     if (out.want_color()) rt::reconstruct_surfaces(scene, rt::surface_settings(settings, camera, out), s);
-    double shadow_ns = 0.0;
-    if (settings.shadows && out.want_color()) {
-      const Clock::time_point shadow_start = Clock::now();
-      rt::make_shadow_rays(light, 0, s);
-      record.shadow_rays += s.shadow_count;
+    // The renderer's own shadow and ambient occlusion rays, traced by
+    // Embree: the same rays, the same samples.
+    const auto embree_occluded = [&](int l, rt::TileScratch& rays, rt::TraversalCounters& counters) {
+      rt::offset_shadow_rays(rays);
+      rt::compact_shadow_rays(rays);
+      counters.rays += rays.shadow_count;
+      RTCIntersectContext* ray_context = rays.shadows_per_lane ? &secondary : &context;
+      const std::uint8_t dark = static_cast<std::uint8_t>(~(1u << l));
+      std::uint64_t blocked_count = 0;
       const int step = width == EmbreeWidth::k1 ? 1 : width == EmbreeWidth::k4 ? 4 : width == EmbreeWidth::k8 ? 8 : 16;
-      for (std::size_t i = 0; i < s.shadow_count; i += static_cast<std::size_t>(step)) {
+      for (std::size_t i = 0; i < rays.shadow_count; i += static_cast<std::size_t>(step)) {
         std::uint32_t blocked = 0;
         if (width == EmbreeWidth::k1) {
           RTCRay r;
-          r.org_x = s.so_x[i];
-          r.org_y = s.so_y[i];
-          r.org_z = s.so_z[i];
-          r.dir_x = s.sd_x[i];
-          r.dir_y = s.sd_y[i];
-          r.dir_z = s.sd_z[i];
+          r.org_x = rays.so_x[i];
+          r.org_y = rays.so_y[i];
+          r.org_z = rays.so_z[i];
+          r.dir_x = rays.sd_x[i];
+          r.dir_y = rays.sd_y[i];
+          r.dir_z = rays.sd_z[i];
           r.tnear = 0.0f;
-          r.tfar = s.s_tmax[i];
+          r.tfar = rays.s_tmax[i];
           r.time = 0.0f;
           r.mask = 0xFFFFFFFFu;
           r.id = 0;
           r.flags = 0;
-          rtcOccluded1(rtc_scene, &context, &r);
+          rtcOccluded1(rtc_scene, ray_context, &r);
           blocked = r.tfar < 0.0f ? 1u : 0u;
         } else if (width == EmbreeWidth::k4) {
-          blocked = trace_shadow_packet<4>(rtc_scene, &context, s, i);
+          blocked = trace_shadow_packet<4>(rtc_scene, ray_context, rays, i);
         } else if (width == EmbreeWidth::k8) {
-          blocked = trace_shadow_packet<8>(rtc_scene, &context, s, i);
+          blocked = trace_shadow_packet<8>(rtc_scene, ray_context, rays, i);
         } else {
-          blocked = trace_shadow_packet<16>(rtc_scene, &context, s, i);
+          blocked = trace_shadow_packet<16>(rtc_scene, ray_context, rays, i);
         }
         for (std::uint32_t m = blocked; m != 0; m &= m - 1) {
-          s.lit[s.shadow_pixel[i + static_cast<std::size_t>(std::countr_zero(m))]] = 0;
-          ++record.shadowed;
+          rays.lit[rays.shadow_pixel[i + static_cast<std::size_t>(std::countr_zero(m))]] &= dark;
+          ++blocked_count;
         }
       }
-      shadow_ns = ns_between(shadow_start, Clock::now());
-    }
+      return blocked_count;
+    };
+    if (out.want_color()) rt::trace_light_rays(settings, lights, s, record.light, embree_occluded);
     if (out.want_color()) rt::shade_and_write(settings, lights, out, s);
     if (!hits.empty()) {
       for (std::size_t k = 0; k < s.lanes; ++k) {
@@ -500,27 +506,29 @@ Expected<EmbreeRenderStats> EmbreeTracer::render(const rt::Scene& scene, const r
     }
     const Clock::time_point t3 = Clock::now();
     record.primary_ns = ns_between(t0, t1);
-    record.shadow_ns = shadow_ns;
-    record.shade_ns = ns_between(t1, t3) - shadow_ns;
+    record.shade_ns = ns_between(t1, t3) - record.light.shadow_ns - record.light.ao_ns;
   });
   const double wall_ms = ms_between(start, Clock::now());
 
   EmbreeRenderStats stats;
-  double primary_ns = 0.0, shadow_ns = 0.0, shade_ns = 0.0;
+  double primary_ns = 0.0, shadow_ns = 0.0, ao_ns = 0.0, shade_ns = 0.0;
   for (const TileRecord& r : records) {
     stats.primary_hits += r.hits;
-    stats.shadow_rays += r.shadow_rays;
-    stats.shadowed += r.shadowed;
+    stats.shadow_rays += r.light.shadow.rays;
+    stats.shadowed += r.light.shadowed;
+    stats.ao_rays += r.light.ao.rays;
     primary_ns += r.primary_ns;
-    shadow_ns += r.shadow_ns;
+    shadow_ns += r.light.shadow_ns;
+    ao_ns += r.light.ao_ns;
     shade_ns += r.shade_ns;
   }
   // As rt::Renderer: the render's wall time split in proportion to the time
   // the tiles spent in each phase.
-  const double busy_ns = primary_ns + shadow_ns + shade_ns;
+  const double busy_ns = primary_ns + shadow_ns + ao_ns + shade_ns;
   if (busy_ns > 0.0) {
     stats.trace_primary_ms = wall_ms * primary_ns / busy_ns;
     stats.trace_shadow_ms = wall_ms * shadow_ns / busy_ns;
+    stats.trace_ao_ms = wall_ms * ao_ns / busy_ns;
     stats.shade_ms = wall_ms * shade_ns / busy_ns;
   } else {
     stats.shade_ms = wall_ms;

@@ -54,8 +54,10 @@ struct EmbreeRenderStats {
   std::uint64_t primary_hits = 0;
   std::uint64_t shadow_rays = 0;
   std::uint64_t shadowed = 0;
+  std::uint64_t ao_rays = 0;
   double trace_primary_ms = 0.0;
   double trace_shadow_ms = 0.0;
+  double trace_ao_ms = 0.0;
   double shade_ms = 0.0;
 };
 
@@ -95,13 +97,19 @@ class EmbreeTracer {
   // Sinew's ids: the triangle index within its mesh and the mesh's id.
   Hit intersect1(const Ray& ray) const;
 
-  // Renders like rt::Renderer::render with `settings` (one light, its
-  // shadows, diffuse shading) into `color_rgba8` (width x height x 4, may be
-  // empty) and, when not empty, the primary hits into `hits` (width x height,
-  // Sinew's ids: triangle index within its mesh and the scene's instance id).
+  // Renders like rt::Renderer::render with `settings` (its lights and their
+  // shadows, hard or soft, its ambient occlusion, diffuse shading) into
+  // `color_rgba8` (width x height x 4, may be empty) and, when not empty,
+  // the primary hits into `hits` (width x height, Sinew's ids: triangle
+  // index within its mesh and the scene's instance id). The shadow and
+  // ambient occlusion rays are the renderer's own (rt::trace_light_rays),
+  // traced by Embree; area-light samples and ambient occlusion rays go with
+  // RTC_INTERSECT_CONTEXT_FLAG_COHERENT when `secondary_coherent`, else
+  // INCOHERENT.
   Expected<EmbreeRenderStats> render(const rt::Scene& scene, const rt::PinholeCamera& camera,
                                      const rt::RenderSettings& settings, std::span<std::uint8_t> color_rgba8,
-                                     std::span<Hit> hits, JobSystem& jobs, EmbreeWidth width = EmbreeWidth::k16);
+                                     std::span<Hit> hits, JobSystem& jobs, EmbreeWidth width = EmbreeWidth::k16,
+                                     bool secondary_coherent = true);
 
  private:
   struct State;

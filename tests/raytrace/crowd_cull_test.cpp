@@ -4,7 +4,7 @@
 // culling on and off, 1 and 2 threads, point and directional lights, poses
 // advancing frame by frame, some outside the pose space), culled ones are
 // not skinned nor in the top level, the off-screen ones kept do shadow the
-// view, and an instance's conservative bounds hold its skinned vertices in
+// view (hard and area lights, ambient occlusion), and an instance's conservative bounds hold its skinned vertices in
 // any pose.
 #include <gtest/gtest.h>
 
@@ -76,21 +76,46 @@ rt::PinholeCamera crowd_camera() {
       .value();
 }
 
-rt::RenderSettings crowd_settings(bool directional) {
+// The lights the cull is checked with: hard point and directional lights,
+// then soft ones (a sphere light, the sun, a rectangle) and ambient
+// occlusion, whose rays reach further than the hard ones'.
+enum class Lighting { kPoint, kDirectional, kSphere, kSun, kRect, kAmbientOcclusion };
+constexpr Lighting kLightings[] = {Lighting::kPoint, Lighting::kDirectional, Lighting::kSphere,
+                                   Lighting::kSun,   Lighting::kRect,        Lighting::kAmbientOcclusion};
+
+rt::RenderSettings crowd_settings(Lighting lighting) {
   rt::RenderSettings settings;
-  if (directional) {
-    settings.light.kind = rt::Light::Kind::kDirectional;
-    settings.light.direction = Vec3(1.0f, 0.35f, 0.1f);
-  } else {
-    settings.light.position = Vec3(9.0f, 1.2f, -4.0f);
+  settings.shadow_samples = 2;
+  rt::Light& light = settings.light;
+  light.position = Vec3(9.0f, 1.2f, -4.0f);
+  switch (lighting) {
+    case Lighting::kPoint: break;
+    case Lighting::kDirectional:
+    case Lighting::kSun:
+      light.kind = rt::Light::Kind::kDirectional;
+      light.direction = Vec3(1.0f, 0.35f, 0.1f);
+      if (lighting == Lighting::kSun) light.angular_radius = 0.2f;
+      break;
+    case Lighting::kSphere: light.radius = 1.5f; break;
+    case Lighting::kRect:
+      light.kind = rt::Light::Kind::kRect;
+      light.edge_u = Vec3(0.0f, 0.0f, 3.0f);
+      light.edge_v = Vec3(0.0f, 1.5f, 0.0f);
+      break;
+    case Lighting::kAmbientOcclusion:
+      settings.shadows = false;
+      settings.ao_rays = 2;
+      settings.ao_radius = 1.5f;
+      break;
   }
   return settings;
 }
 
-Image render(rt::Scene& scene, bool cull, bool directional, int threads, bool shadows = true) {
+Image render(rt::Scene& scene, bool cull, Lighting lighting, int threads, bool shadows = true) {
   const rt::PinholeCamera camera = crowd_camera();
-  rt::RenderSettings settings = crowd_settings(directional);
-  settings.shadows = shadows;
+  rt::RenderSettings settings = crowd_settings(lighting);
+  settings.shadows = settings.shadows && shadows;
+  if (!shadows) settings.ao_rays = 0;
   JobSystem jobs(threads);
   rt::FrameOptions options;
   if (cull) options.visibility = rt::frame_visibility(camera, settings);
@@ -101,22 +126,23 @@ Image render(rt::Scene& scene, bool cull, bool directional, int threads, bool sh
   image.depth.resize(n);
   image.instance.resize(n);
   rt::FrameBuffers buffers{camera.width(), camera.height(), image.color, {}, image.depth, {}, {}, image.instance,
-                           {}, {}, {}, {}};
+                           {}, {}, {}, {}, {}, {}};
   EXPECT_TRUE(rt::Renderer().render(scene, camera, settings, buffers, jobs).ok());
   return image;
 }
 
 TEST(CrowdCull, CulledCharactersNeverChangeTheImage) {
-  for (const bool directional : {false, true}) {
+  for (const Lighting lighting : kLightings) {
     Crowd crowd = make_crowd();
     for (int f = 0; f < 3; ++f) {
       pose_crowd(crowd, f);
-      const Image off = render(*crowd.scene, false, directional, 2);
+      const Image off = render(*crowd.scene, false, lighting, 2);
       EXPECT_EQ(off.frame.skinned_instances, static_cast<std::uint32_t>(kInstances));
       EXPECT_EQ(off.frame.culled_instances, 0u);
       for (const int threads : {1, 2}) {
-        const Image on = render(*crowd.scene, true, directional, threads);
-        SCOPED_TRACE(::testing::Message() << "directional " << directional << " frame " << f << " threads " << threads);
+        const Image on = render(*crowd.scene, true, lighting, threads);
+        SCOPED_TRACE(::testing::Message() << "lighting " << static_cast<int>(lighting) << " frame " << f
+                                          << " threads " << threads);
         EXPECT_EQ(on.color, off.color);
         EXPECT_EQ(on.depth, off.depth);
         EXPECT_EQ(on.instance, off.instance);
@@ -146,14 +172,14 @@ TEST(CrowdCull, CulledCharactersNeverChangeTheImage) {
 // between the light and the view are kept too, and they do shadow the view:
 // removing them changes the image.
 TEST(CrowdCull, OffScreenCastersAreKeptAndShadowTheView) {
-  for (const bool directional : {false, true}) {
-    SCOPED_TRACE(::testing::Message() << "directional " << directional);
+  for (const Lighting lighting : kLightings) {
+    SCOPED_TRACE(::testing::Message() << "lighting " << static_cast<int>(lighting));
     Crowd crowd = make_crowd();
     pose_crowd(crowd, 1);
-    const Image view_only = render(*crowd.scene, true, directional, 2, false);
+    const Image view_only = render(*crowd.scene, true, lighting, 2, false);
     std::vector<bool> in_view;
     for (const rt::InstanceFrame& frame : crowd.scene->instances()) in_view.push_back(!frame.culled);
-    const Image with_shadows = render(*crowd.scene, true, directional, 2);
+    const Image with_shadows = render(*crowd.scene, true, lighting, 2);
     EXPECT_GT(with_shadows.frame.skinned_instances, view_only.frame.skinned_instances);
     std::vector<std::uint32_t> casters;
     for (std::size_t i = 0; i < in_view.size(); ++i) {
@@ -166,7 +192,7 @@ TEST(CrowdCull, OffScreenCastersAreKeptAndShadowTheView) {
     }
     for (const std::uint32_t caster : casters) ASSERT_TRUE(crowd.scene->remove(caster).ok());
     pose_crowd(crowd, 1);
-    const Image without = render(*crowd.scene, false, directional, 2);
+    const Image without = render(*crowd.scene, false, lighting, 2);
     EXPECT_NE(without.color, with_shadows.color);
   }
 }

@@ -306,7 +306,7 @@ TEST(Renderer, AovsAreTheTraversalsHitsAndImagesDoNotDependOnThreads) {
     im.normal.resize(n);
     im.triangle.resize(n);
     im.instance.resize(n);
-    rt::FrameBuffers buffers{w, h, im.color, {}, im.depth, im.normal, im.triangle, im.instance, {}, {}, {}, {}};
+    rt::FrameBuffers buffers{w, h, im.color, {}, im.depth, im.normal, im.triangle, im.instance, {}, {}, {}, {}, {}, {}};
     rt::RenderSettings settings;
     settings.triangle_test = test;
     settings.packet_rays = packet_rays;

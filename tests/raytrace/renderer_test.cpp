@@ -51,7 +51,7 @@ Frame render(const rt::Scene& sc, const rt::PinholeCamera& camera, int tile, int
   f.normal.resize(n);
   f.triangle.resize(n);
   f.instance.resize(n);
-  rt::FrameBuffers buffers{camera.width(), camera.height(), f.color, {}, f.depth, f.normal, f.triangle, f.instance, {}, {}, {}, {}};
+  rt::FrameBuffers buffers{camera.width(), camera.height(), f.color, {}, f.depth, f.normal, f.triangle, f.instance, {}, {}, {}, {}, {}, {}};
   rt::RenderSettings settings;
   settings.tile_size = tile;
   settings.packet_rays = packet_rays;
@@ -125,7 +125,7 @@ TEST(Renderer, SplitShadowPacketsOnFineTrianglesShadeAsSingleRays) {
   const std::size_t n = static_cast<std::size_t>(camera.width() * camera.height());
   const auto color = [&](int packet_rays, bool split, rt::TraversalCounters* shadow) {
     std::vector<std::uint8_t> rgba(4 * n);
-    rt::FrameBuffers buffers{camera.width(), camera.height(), rgba, {}, {}, {}, {}, {}, {}, {}, {}, {}};
+    rt::FrameBuffers buffers{camera.width(), camera.height(), rgba, {}, {}, {}, {}, {}, {}, {}, {}, {}, {}, {}};
     rt::RenderSettings settings;
     settings.packet_rays = packet_rays;
     settings.split_fine_shadow_packets = split;

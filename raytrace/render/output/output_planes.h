@@ -80,15 +80,20 @@ struct OutputPlanes {
   OutputPlane<Vec2> uv;
   OutputPlane<Vec2> barycentric;
   OutputPlane<std::uint32_t> material;
+  OutputPlane<float> shadow;  // one channel per light
+  OutputPlane<float> ambient_occlusion;
 
   bool want_color() const { return rgba8.wanted() || rgba32f.wanted(); }
   // The hit's uv and material: read from the mesh with the surfaces.
   bool want_hit_attributes() const { return uv.wanted() || material.wanted(); }
-  bool want_surface() const { return want_color() || normal.wanted() || want_hit_attributes(); }
+  // The shadow and ambient occlusion rays: for the colour or their masks.
+  bool want_light_rays() const { return want_color() || shadow.wanted() || ambient_occlusion.wanted(); }
+  bool want_surface() const { return want_light_rays() || normal.wanted() || want_hit_attributes(); }
   // Any output besides colour RGBA8 (which has a path of its own).
   bool want_other_than_rgba8() const {
     return rgba32f.wanted() || depth.wanted() || normal.wanted() || triangle.wanted() || instance.wanted() ||
-           uv.wanted() || barycentric.wanted() || material.wanted();
+           uv.wanted() || barycentric.wanted() || material.wanted() || shadow.wanted() ||
+           ambient_occlusion.wanted();
   }
 };
 
@@ -105,6 +110,8 @@ void for_each_plane_pair(A& a, B& b, Fn&& fn) {
   fn(a.uv, b.uv);
   fn(a.barycentric, b.barycentric);
   fn(a.material, b.material);
+  fn(a.shadow, b.shadow);
+  fn(a.ambient_occlusion, b.ambient_occlusion);
 }
 
 }  // namespace sinew::rt

@@ -18,17 +18,12 @@ using namespace stages;
 
 namespace {
 
-// Bit i: bit l of lit[i], for eight bytes (each lane's bit gathered into
-// the top byte by one multiply: no two partial products overlap).
-std::uint32_t lane_bits(const std::uint8_t* lit, int l) {
-  std::uint64_t word;
-  std::memcpy(&word, lit, sizeof word);
-  return static_cast<std::uint32_t>((((word >> l) & 0x0101010101010101ull) * 0x0102040810204080ull) >> 56);
-}
-
 // A light's terms for the shading, eight lanes wide, made once per tile.
 struct LightTerms {
-  bool point;
+  bool point;  // a point, sphere or rectangle light: towards `at` from the hit
+  // Its shadow is the fraction of its samples that reach the hit
+  // (s.light_fraction), not a bit of s.lit.
+  bool soft;
   Vec3x8 at;  // the position (point) or the direction (directional)
   Vec3x8 color;
 };
@@ -37,33 +32,40 @@ struct LightTerms {
 struct ShadingLights {
   std::array<LightTerms, kMaxLights> terms;
   std::size_t count = 0;
-  explicit ShadingLights(std::span<const Light> lights) : count(std::min(lights.size(), kMaxLights)) {
+  bool ambient_occlusion = false;  // the ambient term is scaled by s.ao_open
+  ShadingLights(const RenderSettings& settings, std::span<const Light> lights)
+      : count(std::min(lights.size(), kMaxLights)), ambient_occlusion(settings.ao_rays > 0) {
     for (std::size_t l = 0; l < count; ++l) {
       const Light& light = lights[l];
-      const bool point = light.kind == Light::Kind::kPoint;
+      const bool point = light.kind != Light::Kind::kDirectional;
       const Vec3 at = point ? light.position : light.direction;
-      terms[l] = {point, {Float8(at.x), Float8(at.y), Float8(at.z)},
+      terms[l] = {point, settings.shadows && light.is_area(), {Float8(at.x), Float8(at.y), Float8(at.z)},
                   {Float8(light.color.x), Float8(light.color.y), Float8(light.color.z)}};
     }
   }
   std::span<const LightTerms> span() const { return {terms.data(), count}; }
 };
 
-// The linear colour of block b's hits: ambient plus each light's N·L where
-// it is unblocked, times the albedo.
-Vec3x8 block_color(const RenderSettings& settings, std::span<const LightTerms> lights, const TileScratch& s,
+// The linear colour of block b's hits: ambient (times the open fraction of
+// the ambient occlusion rays) plus each light's N·L to its centre, times
+// the fraction of it that reaches the hit (0 or 1 for a hard light), times
+// the albedo.
+Vec3x8 block_color(const RenderSettings& settings, const ShadingLights& shading, const TileScratch& s,
                    std::size_t b, std::uint32_t hits) {
   const std::size_t k0 = b * kBlockLanes;
   const Vec3x8 position = load3(s.px, s.py, s.pz, k0);
   const Vec3x8 n = load3(s.nx, s.ny, s.nz, k0);
   Vec3x8 radiance{Float8(settings.ambient.x), Float8(settings.ambient.y), Float8(settings.ambient.z)};
+  if (shading.ambient_occlusion) radiance = Float8::load(&s.ao_open[k0]) * radiance;
+  const std::span<const LightTerms> lights = shading.span();
   for (std::size_t l = 0; l < lights.size(); ++l) {
-    const std::uint32_t lit_bits = lane_bits(&s.lit[k0], static_cast<int>(l)) & hits;
-    if (lit_bits == 0) continue;
     const LightTerms& light = lights[l];
+    const std::uint32_t lit_bits = light.soft ? hits : lane_bits(&s.lit[k0], static_cast<int>(l)) & hits;
+    if (lit_bits == 0) continue;
     const Vec3x8 to_light = light.point ? light.at - position : light.at;
-    const Float8 cosine = select(Mask8::from_bits(lit_bits),
-                                 max(dot(n, to_light) / sqrt(dot(to_light, to_light)), Float8(0.0f)), Float8(0.0f));
+    Float8 cosine = select(Mask8::from_bits(lit_bits),
+                           max(dot(n, to_light) / sqrt(dot(to_light, to_light)), Float8(0.0f)), Float8(0.0f));
+    if (light.soft) cosine = cosine * Float8::load(&s.light_fraction[l * s.lanes + k0]);
     radiance = radiance + Vec3x8{light.color.x * cosine, light.color.y * cosine, light.color.z * cosine};
   }
   return {Float8::load(&s.ar[k0]) * radiance.x, Float8::load(&s.ag[k0]) * radiance.y,
@@ -78,8 +80,7 @@ Vec3x8 block_color(const RenderSettings& settings, std::span<const LightTerms> l
 // store.
 void shade_rgba8_only(const RenderSettings& settings, std::span<const Light> lights,
                       const OutputPlane<std::uint8_t>& plane, TileScratch& s) {
-  const ShadingLights terms(lights);
-  const std::span<const LightTerms> shading_lights = terms.span();
+  const ShadingLights shading_lights(settings, lights);
   std::byte* const base = plane.base;
   const std::size_t pitch = plane.pitch;
   const int x0 = plane.x0, y0 = plane.y0;
@@ -151,13 +152,26 @@ void shade_and_write(const RenderSettings& settings, std::span<const Light> ligh
   }
   const std::size_t blocks = s.lanes / kBlockLanes;
   const bool want_color = out.want_color();
-  const ShadingLights shading_lights(lights);
+  const ShadingLights shading_lights(settings, lights);
   const std::array<std::uint8_t, 4> background_bytes = {srgb_byte(settings.background.x),
                                                          srgb_byte(settings.background.y),
                                                          srgb_byte(settings.background.z), 255};
   // A row of a block that missed, whole.
   std::uint32_t background_row[kBlockWidth];
   for (std::uint32_t& pixel : background_row) std::memcpy(&pixel, background_bytes.data(), 4);
+  // The visibility masks of pixel (x, y), lane k: 1 on a miss.
+  const bool ambient_occlusion = settings.ao_rays > 0;
+  const auto write_masks = [&](int x, int y, std::size_t k, bool hit) {
+    if (out.shadow.wanted()) {
+      float* mask = out.shadow.at(x, y);
+      for (std::size_t l = 0; l < out.shadow.channels; ++l) {
+        const bool soft = shading_lights.terms[l].soft;
+        mask[l] = !hit ? 1.0f : soft ? s.light_fraction[l * s.lanes + k] : static_cast<float>(s.lit[k] >> l & 1u);
+      }
+    }
+    if (out.ambient_occlusion.wanted()) *out.ambient_occlusion.at(x, y) = hit && ambient_occlusion ? s.ao_open[k] : 1.0f;
+  };
+  const bool want_masks = out.shadow.wanted() || out.ambient_occlusion.wanted();
   static constexpr float kMissDepths[kBlockWidth] = {kInf, kInf, kInf, kInf};
   static constexpr std::uint32_t kMissIds[kBlockWidth] = {kInvalidId, kInvalidId, kInvalidId, kInvalidId};
   for (std::size_t b = 0; b < blocks; ++b) {
@@ -174,7 +188,7 @@ void shade_and_write(const RenderSettings& settings, std::span<const Light> ligh
         (Float8::load(&s.t[k0]) * sqrt(dot(dir, dir))).store(depth);
       }
       if (want_color) {
-        const Vec3x8 color = block_color(settings, shading_lights.span(), s, b, hits);
+        const Vec3x8 color = block_color(settings, shading_lights, s, b, hits);
         color.x.store(linear[0]);
         color.y.store(linear[1]);
         color.z.store(linear[2]);
@@ -189,6 +203,9 @@ void shade_and_write(const RenderSettings& settings, std::span<const Light> ligh
       for (int row = 0; row < kBlockHeight; ++row) {
         const std::size_t k = k0 + static_cast<std::size_t>(row * kBlockWidth);
         const int y = by + row;
+        if (want_masks) {
+          for (int i = 0; i < kBlockWidth; ++i) write_masks(bx + i, y, k + static_cast<std::size_t>(i), hits != 0u);
+        }
         if (out.triangle.wanted()) std::memcpy(out.triangle.at(bx, y), &s.triangle[k], 4 * sizeof(std::uint32_t));
         if (out.instance.wanted()) std::memcpy(out.instance.at(bx, y), &s.instance[k], 4 * sizeof(std::uint32_t));
         if (hits == 0u) {
@@ -233,6 +250,7 @@ void shade_and_write(const RenderSettings& settings, std::span<const Light> ligh
       const std::size_t k = k0 + static_cast<std::size_t>(lane);
       const int x = bx + lane % kBlockWidth;
       const int y = by + lane / kBlockWidth;
+      if (want_masks) write_masks(x, y, k, (hits >> lane & 1u) != 0);
       if (out.triangle.wanted()) *out.triangle.at(x, y) = s.triangle[k];
       if (out.instance.wanted()) *out.instance.at(x, y) = s.instance[k];
       if (!(hits >> lane & 1u)) {

@@ -49,16 +49,7 @@ struct ShadowLight {
   // by the rounding bound (for a point light shadow_ray_from_light's wider
   // one): the offset, and the moved points.
   Vec3x8 offset(const TileScratch& s, std::size_t k0) const {
-    const Vec3x8 position = load3(s.px, s.py, s.pz, k0);
-    const Vec3x8 facing = load3(s.gx, s.gy, s.gz, k0);
-    Float8 e = Float8::load(&s.error[k0]);
-    if (point) {
-      const Vec3x8 to = to_light(position);
-      const Float8 reach = Float8(magnitude) + Float8(2.0f) * max(max(abs(to.x), abs(to.y)), abs(to.z));
-      e = e + Float8(gamma(32)) * reach;
-    }
-    const Float8 distance = abs(facing.x) * e + abs(facing.y) * e + abs(facing.z) * e;
-    return distance * facing;
+    return point ? surface_push_from(s, k0, at, Float8(magnitude)) : surface_push(s, k0);
   }
 
   // Block b's rays: the moved points one float further on every axis they
@@ -80,6 +71,7 @@ void start_shadow_rays(const Light& light, TileScratch& s) {
   s.shadow_count = 0;
   s.shadow_region_begin.clear();
   s.shadows_from_point = light.kind == Light::Kind::kPoint;
+  s.shadows_per_lane = false;
   s.shadow_origin = light.position;
   s.shadow_direction = light.direction;
   s.shadow_ends = Aabb::empty();  // only aiming bounds the ends
@@ -203,6 +195,8 @@ void compact_shadow_rays(TileScratch& s) {
   if (s.shadows_compacted) return;
   s.shadows_compacted = true;
   const bool point = s.shadows_from_point;
+  const bool per_lane = s.shadows_per_lane;
+  const float tmax = per_lane ? s.shadow_tmax : point ? 1.0f : kInf;
   const Vec3x8 light_at{Float8(s.shadow_origin.x), Float8(s.shadow_origin.y), Float8(s.shadow_origin.z)};
   const Vec3x8 light_dir{Float8(s.shadow_direction.x), Float8(s.shadow_direction.y), Float8(s.shadow_direction.z)};
   s.shadow_count = 0;
@@ -212,8 +206,10 @@ void compact_shadow_rays(TileScratch& s) {
   const auto add_block = [&](std::size_t b, std::uint32_t lanes) {
     const std::size_t k0 = b * kBlockLanes;
     const Vec3x8 placed = load3(s.shadow_lane_x, s.shadow_lane_y, s.shadow_lane_z, k0);
-    const Vec3x8 origin = point ? light_at : placed;
-    const Vec3x8 direction = point ? placed : light_dir;
+    const Vec3x8 origin = per_lane ? load3(s.shadow_from_x, s.shadow_from_y, s.shadow_from_z, k0)
+                          : point  ? light_at
+                                   : placed;
+    const Vec3x8 direction = point || per_lane ? placed : light_dir;
     const std::size_t i = s.shadow_count;
     compress_store(&s.so_x[i], origin.x, lanes);
     compress_store(&s.so_y[i], origin.y, lanes);
@@ -221,7 +217,7 @@ void compact_shadow_rays(TileScratch& s) {
     compress_store(&s.sd_x[i], direction.x, lanes);
     compress_store(&s.sd_y[i], direction.y, lanes);
     compress_store(&s.sd_z[i], direction.z, lanes);
-    Float8(point ? 1.0f : kInf).store(&s.s_tmax[i]);
+    Float8(tmax).store(&s.s_tmax[i]);
     compress_store_lane_indices(&s.shadow_pixel[i], static_cast<std::uint32_t>(k0), lanes);
     s.shadow_count += static_cast<std::size_t>(std::popcount(lanes));
   };

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <vector>
 
@@ -29,6 +30,33 @@ inline void store3(const Vec3x8& v, std::vector<float>& x, std::vector<float>& y
   v.x.store(&x[k]);
   v.y.store(&y[k]);
   v.z.store(&z[k]);
+}
+
+// offset_origin's push of block k0's hits along their camera-facing
+// normal, by the position's rounding bound: the offset to add.
+inline Vec3x8 surface_push(const TileScratch& s, std::size_t k0, Float8 e) {
+  const Vec3x8 facing = load3(s.gx, s.gy, s.gz, k0);
+  const Float8 distance = abs(facing.x) * e + abs(facing.y) * e + abs(facing.z) * e;
+  return distance * facing;
+}
+inline Vec3x8 surface_push(const TileScratch& s, std::size_t k0) {
+  return surface_push(s, k0, Float8::load(&s.error[k0]));
+}
+// The same for rays that run from a point `from` (a light's, of largest
+// |coordinate| `magnitude`) to the hits: shadow_ray_from_light's wider
+// bound, which also covers the rounding of from - hit.
+inline Vec3x8 surface_push_from(const TileScratch& s, std::size_t k0, const Vec3x8& from, Float8 magnitude) {
+  const Vec3x8 to = from - load3(s.px, s.py, s.pz, k0);
+  const Float8 reach = magnitude + Float8(2.0f) * max(max(abs(to.x), abs(to.y)), abs(to.z));
+  return surface_push(s, k0, Float8::load(&s.error[k0]) + Float8(gamma(32)) * reach);
+}
+
+// Bit i: bit l of lit[i], for eight bytes (each lane's bit gathered into
+// the top byte by one multiply: no two partial products overlap).
+inline std::uint32_t lane_bits(const std::uint8_t* lit, int l) {
+  std::uint64_t word;
+  std::memcpy(&word, lit, sizeof word);
+  return static_cast<std::uint32_t>((((word >> l) & 0x0101010101010101ull) * 0x0102040810204080ull) >> 56);
 }
 
 // Per-thread list of the objects a tile's rays may enter.

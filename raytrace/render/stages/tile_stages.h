@@ -11,6 +11,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <span>
 
 #include "raytrace/camera/camera.h"
@@ -111,6 +112,55 @@ std::uint64_t trace_shadow_rays(const Scene& scene, TriangleTest test, int l, Ti
 // bit l of each blocked ray's pixel and returns how many were blocked;
 // counts object visits and triangle tests, not rays.
 std::uint64_t occluded_static_tile(const StaticTile& tile, int l, TileScratch& s, TraversalCounters& counters);
+
+// The stochastic rays (docs/RAYTRACE.md, "Soft shadows and ambient
+// occlusion"), a round at a time: each round places one sample per hit as
+// segments (s.shadows_per_lane) that trace_shadow_rays traces like any
+// shadow rays, clearing bit l of s.lit where blocked; count_unblocked then
+// adds the round's open rays to a per-hit fraction.
+//
+// shift_pixels: each hit pixel's shift of stream `stream`'s pattern
+// (render/sampling/sample_pattern.h), for the rounds that follow.
+void shift_pixels(std::uint32_t seed, std::uint32_t stream, TileScratch& s);
+// Sample j of n of an area light (Light::is_area) per hit: from a point on
+// the sphere's disk facing the hit, or on the rectangle, to the hit pushed
+// off as a point light's rays end (t in [0, 1)); or, for the sun, from the
+// hit pushed off along a direction within its angular radius (t unbounded).
+// Hits whose surface faces away from their sample lose bit l of s.lit.
+void place_light_samples(const Light& light, int l, int j, int n, TileScratch& s);
+// Ambient occlusion ray j of n per hit: cosine distributed about the
+// camera-facing geometric normal, `radius` long (t in [0, 1) along radius
+// times the unit direction), from the hit pushed off.
+void place_ao_rays(float radius, int l, int j, int n, TileScratch& s);
+// Sets bit l of s.lit on every lane (a round's start).
+void set_lit_bit(int l, TileScratch& s);
+// fraction[k] += weight for each hit k whose bit l of s.lit is set.
+void count_unblocked(int l, float weight, float* fraction, const TileScratch& s);
+
+// What trace_light_rays traced, and the time it took.
+struct LightRayWork {
+  TraversalCounters shadow, ao;
+  std::uint64_t shadowed = 0, ao_occluded = 0;  // blocked rays
+  double shadow_ns = 0.0, ao_ns = 0.0;
+};
+
+// The rays the shading and the visibility masks need from the tile's hits
+// (their surfaces reconstructed): with settings.ao_rays, the ambient
+// occlusion rounds (into s.ao_open); with settings.shadows, each hard
+// light's shadow rays (into its bit of s.lit, which this sets for every
+// light first) and each area light's sample rounds (into its span of
+// s.light_fraction).
+void trace_light_rays(const Scene& scene, const RenderSettings& settings, std::span<const Light> lights,
+                      TileScratch& s, LightRayWork& work);
+
+// The same with another tracer of the shadow rays (the Embree peer of the
+// benchmarks), so that both trace the same rays: trace(l, s, counters)
+// traces the rays aimed or placed for bit l (offset_shadow_rays and
+// compact_shadow_rays make them ready), clears bit l of s.lit for each
+// blocked one and returns how many were.
+using ShadowTracer = std::function<std::uint64_t(int l, TileScratch& s, TraversalCounters& counters)>;
+void trace_light_rays(const RenderSettings& settings, std::span<const Light> lights, TileScratch& s,
+                      LightRayWork& work, const ShadowTracer& trace);
 
 // Diffuse shading (ambient + each unblocked light's N.L) and the requested
 // outputs of the tile's pixels, through s.staging: line-aligned planes get

@@ -123,7 +123,17 @@ std::uint64_t trace_shadow_rays(const Scene& scene, TriangleTest test, int l, Ti
     // The tile's rays bounded as placed, lane by lane (the same rays, so
     // the same bound as over the compacted ones).
     const float* const placed[3] = {s.shadow_lane_x.data(), s.shadow_lane_y.data(), s.shadow_lane_z.data()};
-    if (s.shadows_from_point) {
+    if (s.shadows_per_lane) {
+      alignas(32) float t_max[kPacketSize];
+      std::fill_n(t_max, kPacketSize, s.shadow_tmax);
+      for (std::size_t b = 0; b < s.blocks(); ++b) {
+        if (s.shadow_lanes[b] == 0) continue;
+        const std::size_t k0 = b * kBlockLanes;
+        const float* const o[3] = {&s.shadow_from_x[k0], &s.shadow_from_y[k0], &s.shadow_from_z[k0]};
+        const float* const d[3] = {placed[0] + k0, placed[1] + k0, placed[2] + k0};
+        tile_bound.add_lanes(o, d, kZeros, t_max, s.shadow_lanes[b]);
+      }
+    } else if (s.shadows_from_point) {
       tile_bound.add_groups(s.shadow_origin, placed, 0.0f, 1.0f, std::span(s.shadow_lanes.data(), s.blocks()));
     } else {
       alignas(32) float d[3][kPacketSize], t_max[kPacketSize];
