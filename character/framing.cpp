@@ -13,6 +13,8 @@ constexpr double kInstanceTimeStep = 0.37;  // seconds between instances' clip t
 constexpr float kInstanceSpacing = 1.2f;    // x the rest bounds' largest extent
 constexpr float kGroundReach = 50.0f;       // x the character's height, beyond half the layout
 constexpr float kDefaultFovyDegrees = 40.0f;
+constexpr float kAoRadius = 0.5f;     // x the character's height
+constexpr float kLightRadius = 0.3f;  // x the character's height
 
 Vec3 axis_vector(int axis, float sign = 1.0f) {
   Vec3 v(0.0f);
@@ -65,6 +67,12 @@ int up_axis_of(const Aabb& rest) {
   return e.y >= e.z ? 1 : 2;
 }
 
+float character_height(const Aabb& rest) { return std::max(rest.extent()[up_axis_of(rest)], 1e-3f); }
+
+float default_ao_radius(const Aabb& rest) { return kAoRadius * character_height(rest); }
+
+float suggested_light_radius(const Aabb& rest) { return kLightRadius * character_height(rest); }
+
 int layout_columns(int instances, Layout layout) {
   const int n = std::max(instances, 1);
   if (layout == Layout::kRow) return n;
@@ -100,7 +108,7 @@ rt::StaticMeshDesc ground_plane_for(const Aabb& rest, int instances, Layout layo
   const int up = up_axis_of(rest);
   const int a = (up + 1) % 3;
   const int b = (up + 2) % 3;
-  const float height = std::max(rest.extent()[up], 1e-3f);
+  const float height = character_height(rest);
   // Centred under the layout and reaching far past it, so the ground fills
   // the background of the default camera.
   const Aabb layout_box = layout_bounds(rest, instances, layout);

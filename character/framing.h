@@ -39,6 +39,16 @@ namespace sinew::character {
 Aabb rest_bounds(const Model& model);
 // 1 (Y) or 2 (Z).
 int up_axis_of(const Aabb& rest);
+// The character's height: its rest extent along the up axis (at least
+// 1e-3, so a flat model still gets sizes derived from it).
+float character_height(const Aabb& rest);
+// Soft lighting sized by the character, so the same default suits a model
+// in centimetres and one in metres: ambient occlusion reaches half its
+// height (the ground darkens around its feet and its own creases darken,
+// while a neighbour a body length away does not), and the sphere light
+// the tools suggest for soft shadows has 0.3 of its height as radius.
+float default_ao_radius(const Aabb& rest);
+float suggested_light_radius(const Aabb& rest);
 // How instances are laid out: a row along +X, or a grid (above).
 enum class Layout : std::uint8_t { kRow, kGrid };
 inline constexpr const char* kLayoutNames[] = {"row", "grid"};  // by Layout, as options spell them

@@ -36,7 +36,8 @@ struct DemoFlags {
         lights(l.repeated_option("--light", "X,Y,Z|point:X,Y,Z|dir:X,Y,Z[:R,G,B]",
                                  "a point light at X,Y,Z or a directional light towards X,Y,Z, with\n"
                                  "its linear colour (default 1,1,1); up to 8 (default: the arena's\n"
-                                 "point light)")) {}
+                                 "point light)")),
+        soft(l) {}
 
   const bool& headless;
   const std::optional<std::string>& frames;
@@ -51,6 +52,7 @@ struct DemoFlags {
   const std::optional<std::string>& screenshot;
   const bool& no_hud;
   const std::vector<std::string>& lights;
+  SoftLightingFlags soft;
 };
 
 const char* const kDescription =
@@ -112,6 +114,7 @@ Expected<DemoOptions> parse_demo_options(const std::vector<std::string>& args) {
     SINEW_ASSIGN_OR_RETURN(const cli::LightOption light, cli::parse_light("--light", text));
     o.lights.push_back(character::light_from_option(light));
   }
+  SINEW_ASSIGN_OR_RETURN(o.soft, f.soft.parse());
   if (o.headless && o.frames == 0) o.frames = 120;
   return o;
 }

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "game_demo/soft_lighting.h"
 #include "raytrace/render/render_settings.h"
 #include "runtime/core/expected.h"
 
@@ -27,6 +28,7 @@ struct DemoOptions {
   std::string screenshot_path;  // windowed: the last frame as shown, HUD included, as PNG
   bool hud = true;              // windowed: HUD shown at start
   std::vector<rt::Light> lights;  // empty: the arena's point light
+  SoftLighting soft;              // --soft and its options: off by default
   bool help = false;
 };
 

@@ -15,7 +15,6 @@
 namespace sinew::demo {
 namespace {
 
-constexpr float kCharacterHeight = 1.8f;
 constexpr int kObstacles = 8;
 
 
@@ -138,8 +137,18 @@ Expected<std::unique_ptr<DemoSession>> DemoSession::create(const SessionOptions&
     s.settings_.lights = std::span<const rt::Light>(s.options_.lights.data(), count);
   }
   s.settings_.background = Vec3(0.30f, 0.38f, 0.50f);
+  s.set_soft_lighting(options.soft);
   s.rgba_.assign(static_cast<std::size_t>(options.width) * static_cast<std::size_t>(options.height) * 4, 0);
   return session;
+}
+
+void DemoSession::set_soft_lighting(const SoftLighting& soft) {
+  options_.soft = soft;
+  // The lights the frames shade with: the arena's, or those given (which
+  // settings_.lights views).
+  std::span<rt::Light> lights = options_.lights.empty() ? std::span<rt::Light>(&settings_.light, 1)
+                                                         : std::span<rt::Light>(options_.lights);
+  apply_soft_lighting(soft, settings_, lights);
 }
 
 Expected<FrameReport> DemoSession::frame(float dt, PlayerInput input, const FollowCamera& camera, JobSystem& jobs) {

@@ -21,6 +21,7 @@
 #include "character/model.h"
 #include "character/pack.h"
 #include "game_demo/arena.h"
+#include "game_demo/soft_lighting.h"
 #include "game_demo/world.h"
 #include "raytrace/camera/camera.h"
 #include "raytrace/render/renderer.h"
@@ -43,6 +44,7 @@ struct SessionOptions {
   bool textures = true;  // textured materials show their textures (RenderSettings::textures)
   rt::TriangleTest triangle_test = rt::TriangleTest::kFast;
   std::vector<rt::Light> lights;  // at most rt::kMaxLights; empty: the arena's point light
+  SoftLighting soft;              // soft shadows and ambient occlusion (off by default)
 };
 
 // The third-person camera's free parameters; it follows the player.
@@ -97,6 +99,10 @@ class DemoSession {
   const Arena& arena() const { return arena_; }
   // Render settings the HUD may change between frames.
   rt::RenderSettings& render_settings() { return settings_; }
+  // Soft shadows and ambient occlusion from the next frame on: the
+  // settings, and the radius of every point light (the HUD's toggles).
+  void set_soft_lighting(const SoftLighting& soft);
+  const SoftLighting& soft_lighting() const { return options_.soft; }
   // The camera of the last frame (call after frame()).
   const rt::PinholeCamera& camera() const { return *camera_; }
 

@@ -17,8 +17,14 @@ namespace sinew::demo {
 struct HudFrame {
   double fps = 0.0;  // smoothed over recent frames, display included
   std::vector<std::pair<std::string, double>> phases_ms;  // the last frame's
-  std::uint64_t rays = 0;        // primary + shadow rays of the last frame
+  std::uint64_t rays = 0;        // primary, shadow and ambient occlusion rays of the last frame
   double trace_ms = 0.0;         // their trace time
+  // The soft-lighting costs apart: the last frame's shadow rays (hard or
+  // soft) and ambient occlusion rays, each with its trace time.
+  std::uint64_t shadow_rays = 0;
+  double shadow_ms = 0.0;
+  std::uint64_t ao_rays = 0;
+  double ao_ms = 0.0;
   int characters = 0;
   int player = 0;
   CharacterCost per_character;  // the last frame's update and trace, per character
@@ -35,6 +41,17 @@ struct HudControls {
   bool shadows = true;
   bool textures = true;     // textured materials show their textures
   bool watertight = false;  // the watertight triangle test instead of the fast one
+  // Soft shadows and ambient occlusion, each a toggle over its own values,
+  // which stay while it is off (so turning it on again restores them).
+  bool soft_shadows = false;
+  bool ambient_occlusion = false;
+  SoftLighting soft = soft_preset();
+
+  // The toggles and values from the session's lighting; values of what is
+  // off start at the --soft preset's.
+  void take(const SoftLighting& lighting);
+  // What the session renders with: the values of what is on.
+  SoftLighting soft_lighting() const;
 };
 
 // Draws the HUD window (call between ImGuiLayer::begin_frame and

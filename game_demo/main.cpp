@@ -96,6 +96,11 @@ int run_headless(const DemoOptions& opt, const InputScript* script, DemoSession&
               "on %d threads (headless)\n",
               session.world().character_count(), bake.model.c_str(), bake.triangles, bake.pose_samples, bake.bake_ms,
               frames_run, session.width(), session.height(), jobs.thread_count());
+  if (const SoftLighting& soft = session.soft_lighting(); soft.light_radius > 0.0f || soft.ao_rays > 0) {
+    std::printf("soft lighting: light radius %.2f m, %d shadow samples; %d ambient occlusion rays of %.2f m\n",
+                static_cast<double>(soft.light_radius), soft.shadow_samples, soft.ao_rays,
+                static_cast<double>(soft.ao_radius));
+  }
   std::printf("%s", session.timers().table().c_str());
   std::printf("fps (1000 / sum of phase medians): %.1f; escaped triangles over the run: %llu\n",
               1000.0 / session.timers().median_total_ms(), static_cast<unsigned long long>(escaped));
@@ -169,6 +174,7 @@ int run(const std::vector<std::string>& args) {
   so.width = opt.width;
   so.height = opt.height;
   so.lights = opt.lights;
+  so.soft = opt.soft;
   std::printf("sinew-demo: loading %s...\n", opt.model_path.empty() ? "the mannequin" : opt.model_path.c_str());
   std::fflush(stdout);
   auto session = DemoSession::create(so, *jobs);

@@ -59,8 +59,13 @@ HudFrame hud_frame(const DemoSession& session, const FrameReport& report, const 
   HudFrame h;
   h.fps = fps;
   h.phases_ms = timers.latest();
-  h.rays = report.render.primary_rays + report.render.shadow_rays;
-  h.trace_ms = report.render.trace_primary_ms + report.render.trace_shadow_ms;
+  const rt::RenderStats& r = report.render;
+  h.rays = r.primary_rays + r.shadow_rays + r.ao_rays;
+  h.trace_ms = r.trace_primary_ms + r.trace_shadow_ms + r.trace_ao_ms;
+  h.shadow_rays = r.shadow_rays;
+  h.shadow_ms = r.trace_shadow_ms;
+  h.ao_rays = r.ao_rays;
+  h.ao_ms = r.trace_ao_ms;
   h.characters = session.world().character_count();
   h.player = session.world().player();
   h.per_character = per_character_cost(h.phases_ms, h.characters);
@@ -86,6 +91,7 @@ Expected<WindowRunResult> run_window(DemoSession& session, std::unique_ptr<JobSy
   controls.shadows = session.render_settings().shadows;
   controls.textures = session.render_settings().textures;
   controls.watertight = session.render_settings().triangle_test == rt::TriangleTest::kWatertight;
+  controls.take(session.soft_lighting());
   bool hud = options.hud;
   KeySnapshot previous_keys;
   WindowRunResult result;
@@ -122,6 +128,7 @@ Expected<WindowRunResult> run_window(DemoSession& session, std::unique_ptr<JobSy
         session.render_settings().textures = controls.textures;
         session.render_settings().triangle_test =
             controls.watertight ? rt::TriangleTest::kWatertight : rt::TriangleTest::kFast;
+        session.set_soft_lighting(controls.soft_lighting());
         if (controls.threads != jobs->thread_count()) jobs = std::make_unique<JobSystem>(controls.threads);
       }
       imgui->end_frame();

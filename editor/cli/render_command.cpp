@@ -38,6 +38,10 @@ namespace {
 
 constexpr double kFramesPerSecond = 30.0;
 constexpr int kMaxImageSide = 16384;
+// The largest light radius and ambient occlusion reach taken, in scene
+// units: far beyond any scene the tools frame, small enough that squares
+// of it stay finite in float.
+constexpr double kMaxLightingLength = 1e6;
 
 const char* const kProgram = "sinew-editor render";
 
@@ -66,6 +70,15 @@ struct RenderFlags {
                                 "a point light at X,Y,Z or a directional light towards X,Y,Z, with\n"
                                 "its linear colour (default 1,1,1); up to 8 (default: one point\n"
                                 "light above-front of the model)")),
+        light_radius(l.option("--light-radius", "R",
+                              "every point light becomes a sphere of radius R casting soft shadows\n"
+                              "(scene units; default 0: hard point lights)")),
+        shadow_samples(l.option("--shadow-samples", "S",
+                                "shadow rays per hit towards each sphere light (1-256, default 4)")),
+        ao_rays(l.option("--ao-rays", "A", "ambient occlusion rays per hit (0-256; default 0: none)")),
+        ao_radius(l.option("--ao-radius", "R",
+                           "how far ambient occlusion rays reach (scene units; default half\n"
+                           "the character's height)")),
         threads(l.option("--threads", "N", "worker threads (default 0: all cores)")),
         instances(l.option("--instances", "N", "copies of the model, copy i 0.37 s * i later (default 1)")),
         layout(l.option("--layout", "row|grid",
@@ -109,6 +122,10 @@ struct RenderFlags {
   const std::optional<std::string>& shadows;
   const std::optional<std::string>& textures;
   const std::vector<std::string>& light;
+  const std::optional<std::string>& light_radius;
+  const std::optional<std::string>& shadow_samples;
+  const std::optional<std::string>& ao_rays;
+  const std::optional<std::string>& ao_radius;
   const std::optional<std::string>& threads;
   const std::optional<std::string>& instances;
   const std::optional<std::string>& layout;
@@ -217,6 +234,37 @@ Status parse_view(const RenderFlags& f, RenderOptions& o) {
     SINEW_ASSIGN_OR_RETURN(const cli::Size2 size, cli::parse_size("--size", *text, kMaxImageSide));
     o.width = size.width;
     o.height = size.height;
+  }
+  return {};
+}
+
+// Soft shadows and ambient occlusion; after parse_view, which reads the
+// lights --light-radius applies to.
+Status parse_lighting(const RenderFlags& f, RenderOptions& o) {
+  if (const std::optional<std::string>& text = f.light_radius) {
+    SINEW_ASSIGN_OR_RETURN(const double r, cli::parse_double("--light-radius", *text, 0.0, kMaxLightingLength));
+    const bool any_point = o.lights.empty() || std::any_of(o.lights.begin(), o.lights.end(), [](const rt::Light& l) {
+                             return l.kind == rt::Light::Kind::kPoint;
+                           });
+    if (r > 0.0 && !any_point) {
+      return invalid_argument("--light-radius", *text,
+                              "applies to point lights, and every --light is directional");
+    }
+    o.light_radius = static_cast<float>(r);
+  }
+  if (const std::optional<std::string>& text = f.shadow_samples) {
+    SINEW_ASSIGN_OR_RETURN(const std::int64_t n, cli::parse_int("--shadow-samples", *text, 1, rt::kMaxSamples));
+    o.shadow_samples = static_cast<int>(n);
+  }
+  if (const std::optional<std::string>& text = f.ao_rays) {
+    SINEW_ASSIGN_OR_RETURN(const std::int64_t n, cli::parse_int("--ao-rays", *text, 0, rt::kMaxSamples));
+    o.ao_rays = static_cast<int>(n);
+  }
+  if (const std::optional<std::string>& text = f.ao_radius) {
+    SINEW_ASSIGN_OR_RETURN(const double r, cli::parse_double("--ao-radius", *text, 0.0, kMaxLightingLength));
+    // A ray of length 0 finds nothing: the renderer refuses it, so say so here.
+    if (!(r > 0.0)) return invalid_argument("--ao-radius", *text, "expected a length above 0");
+    o.ao_radius = static_cast<float>(r);
   }
   return {};
 }
@@ -373,14 +421,18 @@ Expected<std::string> stats_document(const RenderOptions& options, const charact
                  {"pose_sampling_ms", bake.pose_sampling_ms}};
   doc["phases"] = phases;
   doc["frame_ms"] = {{"median_ms", s.median_frame_ms}};
-  doc["rays"] = {{"primary", s.primary_rays}, {"shadow", s.shadow_rays}};
+  doc["lighting"] = {{"light_radius", options.light_radius},
+                     {"shadow_samples", options.shadow_samples},
+                     {"ao_rays", options.ao_rays},
+                     {"ao_radius", outputs.ao_radius}};
+  doc["rays"] = {{"primary", s.primary_rays}, {"shadow", s.shadow_rays}, {"ao", s.ao_rays}};
   const auto work = [](const rt::TraversalCounters& c) {
     return nlohmann::json{{"rays", c.rays},
                           {"node_visits", c.node_visits},
                           {"object_visits", c.object_visits},
                           {"triangle_tests", c.triangle_tests}};
   };
-  doc["work"] = {{"primary", work(s.primary_work)}, {"shadow", work(s.shadow_work)}};
+  doc["work"] = {{"primary", work(s.primary_work)}, {"shadow", work(s.shadow_work)}, {"ao", work(s.ao_work)}};
   doc["escapes"] = {{"escaped_checks", s.escaped_checks},
                     {"escaped_triangles", s.escaped_triangles},
                     {"total_escaped_checks", s.total_escaped_checks},
@@ -431,6 +483,7 @@ Expected<RenderOptions> parse_render_options(const std::vector<std::string>& arg
   o.model_path = flags.model.front();
   SINEW_RETURN_IF_ERROR(parse_run(flags, o));
   SINEW_RETURN_IF_ERROR(parse_view(flags, o));
+  SINEW_RETURN_IF_ERROR(parse_lighting(flags, o));
   SINEW_RETURN_IF_ERROR(parse_pose_space(flags, o));
   if (o.out_dir.empty()) return invalid_argument("--out", "", "missing: the output folder is required");
   return o;
@@ -513,6 +566,10 @@ Expected<RenderOutputs> render_model(const RenderOptions& options) {
   settings.split_fine_shadow_packets = options.split_fine_shadows;
   settings.shadows = options.shadows;
   settings.textures = options.textures;
+  settings.shadow_samples = options.shadow_samples;
+  settings.ao_rays = options.ao_rays;
+  out.ao_radius = options.ao_radius.value_or(character::default_ao_radius(rest));
+  settings.ao_radius = out.ao_radius;
 
   const std::size_t pixels = static_cast<std::size_t>(options.width) * static_cast<std::size_t>(options.height);
   out.color_rgba8.assign(4 * pixels, 0);
@@ -559,6 +616,9 @@ Expected<RenderOutputs> render_model(const RenderOptions& options) {
         out.lights.emplace_back();
         out.lights.back().position = character::default_light(posed, up);
       }
+      for (rt::Light& light : out.lights) {
+        if (light.kind == rt::Light::Kind::kPoint) light.radius = options.light_radius;
+      }
       settings.lights = out.lights;
       SINEW_ASSIGN_OR_RETURN(camera, rt::PinholeCamera::create(out.camera, options.width, options.height));
     }
@@ -574,8 +634,13 @@ Expected<RenderOutputs> render_model(const RenderOptions& options) {
     frame_ms.push_back(total);
     stats.primary_rays = rendered.primary_rays;
     stats.shadow_rays = rendered.shadow_rays;
+    stats.ao_rays = rendered.ao_rays;
     stats.primary_work = rendered.primary;
     stats.shadow_work = rendered.shadow;
+    stats.ao_work = rendered.ao;
+    stats.trace_primary_ms = rendered.trace_primary_ms;
+    stats.trace_shadow_ms = rendered.trace_shadow_ms;
+    stats.trace_ao_ms = rendered.trace_ao_ms;
     stats.escaped_checks = frame.escaped_checks;
     stats.escaped_triangles = frame.escaped_triangles;
     stats.total_escaped_checks += frame.escaped_checks;
@@ -622,8 +687,21 @@ void print_summary(const RenderOptions& options, const RenderOutputs& o, std::os
          << static_cast<double>(c.object_visits) / n << " objects, " << static_cast<double>(c.triangle_tests) / n
          << " triangle tests\n";
   };
+  if (options.light_radius > 0.0f) {
+    text << "soft shadows: point lights of radius " << options.light_radius << ", " << options.shadow_samples
+         << " shadow samples per hit\n";
+  }
+  if (options.ao_rays > 0) {
+    text << "ambient occlusion: " << options.ao_rays << " rays per hit, radius " << o.ao_radius << "\n";
+  }
+  // Each kind's count with its share of the last frame's render time.
+  text << "rays (last frame): " << s.primary_rays << " primary in " << s.trace_primary_ms << " ms, " << s.shadow_rays
+       << " shadow in " << s.trace_shadow_ms << " ms";
+  if (options.ao_rays > 0) text << ", " << s.ao_rays << " ambient occlusion in " << s.trace_ao_ms << " ms";
+  text << "\n";
   per_ray("primary", s.primary_work);
   if (s.shadow_work.rays > 0) per_ray("shadow", s.shadow_work);
+  if (s.ao_work.rays > 0) per_ray("ambient occlusion", s.ao_work);
   text << "escapes (last frame): " << s.escaped_checks << " checks, " << s.escaped_triangles
        << " triangles; over all frames: " << s.total_escaped_checks << " checks, " << s.total_escaped_triangles
        << " triangles\n";

@@ -4,7 +4,8 @@
 //
 //   sinew-editor render MODEL [--clip NAME] [--time SECONDS] [--camera ex,ey,ez,tx,ty,tz,ux,uy,uz,fovy_deg]
 //       [--size WxH] --out DIR [--pose-space arbitrary|limits|clips|clip:NAME] [--clips a,b,c]
-//       [--samples N] [--seed S] [--shadows on|off] [--textures on|off] [--light x,y,z] [--threads N] [--instances N]
+//       [--samples N] [--seed S] [--shadows on|off] [--textures on|off] [--light x,y,z] [--light-radius R]
+//       [--shadow-samples S] [--ao-rays A] [--ao-radius R] [--threads N] [--instances N]
 //       [--layout row|grid] [--frames N] [--triangle-test fast|watertight] [--bone-boxes exact|cheap]
 //       [--fallback on|off] [--ground on|off] [--limits FILE.json]
 //
@@ -63,6 +64,15 @@ struct RenderOptions {
   // At most rt::kMaxLights; empty: one white point light placed
   // automatically (character::default_light).
   std::vector<rt::Light> lights;
+  // Soft shadows and ambient occlusion (rt::RenderSettings): every point
+  // light becomes a sphere of this radius (scene units; 0: a hard point
+  // light), shading each hit with shadow_samples rays towards it; ao_rays
+  // rays per hit (0: no ambient occlusion) reach ao_radius (scene units;
+  // empty: character::default_ao_radius, half the character's height).
+  float light_radius = 0.0f;
+  int shadow_samples = rt::RenderSettings{}.shadow_samples;
+  int ao_rays = 0;
+  std::optional<float> ao_radius;
   int threads = 0;  // 0: all cores
   int instances = 1;
   character::Layout layout = character::Layout::kRow;  // --layout: how the instances stand
@@ -97,9 +107,16 @@ struct RenderStatsSummary {
   double fps = 0.0;
   double median_frame_ms = 0.0;
   std::uint64_t primary_rays = 0;  // last frame
-  std::uint64_t shadow_rays = 0;   // last frame
+  std::uint64_t shadow_rays = 0;   // last frame: hard and area lights'
+  std::uint64_t ao_rays = 0;       // last frame
   rt::TraversalCounters primary_work;  // last frame
   rt::TraversalCounters shadow_work;   // last frame
+  rt::TraversalCounters ao_work;       // last frame
+  // Last frame: each kind of ray's share of the render's wall time
+  // (rt::RenderStats).
+  double trace_primary_ms = 0.0;
+  double trace_shadow_ms = 0.0;
+  double trace_ao_ms = 0.0;
   std::size_t escaped_checks = 0;  // last frame
   std::size_t escaped_triangles = 0;
   std::size_t total_escaped_checks = 0;  // over all frames
@@ -120,6 +137,7 @@ struct RenderOutputs {
   LineAlignedVector<std::uint32_t> instance_id;
   rt::CameraDesc camera;   // the camera used (given or framed)
   std::vector<rt::Light> lights;  // the lights used
+  float ao_radius = 0.0f;          // the ambient occlusion reach used (given or derived)
   std::string clip_name;   // empty: rest pose
   double last_frame_seconds = 0.0;  // playback time of instance 0 in the written frame
   std::vector<Affine3> instance_placements;  // per instance: model -> world

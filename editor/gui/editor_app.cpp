@@ -279,6 +279,10 @@ Expected<bool> EditorApp::step() {
     s.phases_ms = m.timers.latest();
     s.escaped_triangles = frame.scene.escaped_triangles;
     s.escaped_pixels = frame.escaped_pixels;
+    s.shadow_rays = frame.render.shadow_rays;
+    s.ao_rays = frame.render.ao_rays;
+    s.trace_shadow_ms = frame.render.trace_shadow_ms;
+    s.trace_ao_ms = frame.render.trace_ao_ms;
     if (m.loaded) {
       const rt::FuzzyBakeStats& b = m.loaded->stats();
       s.triangles = m.loaded->model().mesh.triangle_count();

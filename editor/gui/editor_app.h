@@ -70,6 +70,12 @@ struct EditorStats {
   double fuzzy_area_ratio = 0.0;  // fuzzy_area / rest_area of the trees in use
   std::size_t escaped_triangles = 0;  // this frame
   std::size_t escaped_pixels = 0;     // painted by the escapes overlay this frame
+  // This frame's shadow and ambient occlusion rays, and their share of the
+  // render's time (rt::RenderStats).
+  std::uint64_t shadow_rays = 0;
+  std::uint64_t ao_rays = 0;
+  double trace_shadow_ms = 0.0;
+  double trace_ao_ms = 0.0;
   bool from_pack = false;             // the trees in use came from a pack
 };
 

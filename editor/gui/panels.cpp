@@ -11,6 +11,12 @@
 namespace sinew::editor::gui {
 namespace {
 
+// The sliders' ends: more samples than this are for offline renders (the
+// command line takes up to rt::kMaxSamples); a sun wider than this is no
+// longer a sun.
+constexpr int kMaxPanelSamples = 64;
+constexpr float kMaxSunDegrees = 10.0f;
+
 // Every widget goes through these, so the frame's WidgetLog (when asked
 // for) holds all of them.
 bool header(const PanelContext& ctx, const char* label, ImGuiTreeNodeFlags flags = 0) {
@@ -127,8 +133,46 @@ void overlay_panel(PanelState& state, const PanelContext& ctx) {
   if (button(ctx, "Reframe camera")) viewport.request_reframe();
 }
 
+// Soft shadows and ambient occlusion for every light: shadow rays per hit
+// towards each area light, and the occlusion rays with their reach. Lengths
+// are offered up to multiples of the character's height, so the sliders
+// suit a model in centimetres and one in metres alike.
+void soft_lighting_fields(const PanelContext& ctx) {
+  rt::RenderSettings& settings = ctx.viewport->settings;
+  const float height = ctx.viewport->character_height();
+  field(ctx, "shadow samples",
+        [&](const char* l) { return ImGui::SliderInt(l, &settings.shadow_samples, 1, kMaxPanelSamples); });
+  field(ctx, "AO rays", [&](const char* l) { return ImGui::SliderInt(l, &settings.ao_rays, 0, kMaxPanelSamples); });
+  field(ctx, "AO radius", [&](const char* l) {
+    return ImGui::SliderFloat(l, &settings.ao_radius, 0.01f * height, 2.0f * height, "%.3f");
+  });
+  // Typed values (ctrl+click) may leave a slider's range: keep what the
+  // renderer takes.
+  settings.shadow_samples = std::clamp(settings.shadow_samples, 1, rt::kMaxSamples);
+  settings.ao_rays = std::clamp(settings.ao_rays, 0, rt::kMaxSamples);
+  settings.ao_radius = std::max(settings.ao_radius, 1e-3f * height);
+}
+
+// A light's size, which makes it an area light with soft shadows: a point
+// light's sphere radius (scene units), the sun's angular radius (degrees).
+void light_size_field(const PanelContext& ctx, rt::Light& light) {
+  if (light.kind == rt::Light::Kind::kDirectional) {
+    float degrees = glm::degrees(light.angular_radius);
+    if (field(ctx, "sun radius (deg)",
+              [&](const char* l) { return ImGui::SliderFloat(l, &degrees, 0.0f, kMaxSunDegrees, "%.2f"); })) {
+      light.angular_radius = glm::radians(std::clamp(degrees, 0.0f, kMaxSunDegrees));
+    }
+    return;
+  }
+  const float height = ctx.viewport->character_height();
+  if (field(ctx, "radius", [&](const char* l) { return ImGui::SliderFloat(l, &light.radius, 0.0f, height, "%.3f"); })) {
+    light.radius = std::max(light.radius, 0.0f);
+  }
+}
+
 // The view's lights: each point or directional, its position or the
-// direction towards it, its colour; up to rt::kMaxLights, at least one.
+// direction towards it, its colour and its size; up to rt::kMaxLights, at
+// least one; then the soft-lighting settings they share.
 void lights_panel(const PanelContext& ctx) {
   if (ctx.model == nullptr || !header(ctx, "Lights")) return;
   std::vector<rt::Light>& lights = ctx.viewport->lights;
@@ -146,6 +190,7 @@ void lights_panel(const PanelContext& ctx) {
     field(ctx, kind == 1 ? "towards" : "position",
           [&](const char* l) { return ImGui::DragFloat3(l, &where.x, 0.05f); });
     field(ctx, "colour", [&](const char* l) { return ImGui::ColorEdit3(l, &light.color.x, ImGuiColorEditFlags_Float); });
+    light_size_field(ctx, light);
     if (lights.size() > 1 && button(ctx, "Remove light", true)) remove = i;
     ImGui::PopID();
   }
@@ -155,6 +200,7 @@ void lights_panel(const PanelContext& ctx) {
     added.color = Vec3(0.5f);
     lights.push_back(added);
   }
+  soft_lighting_fields(ctx);
 }
 
 void bake_panel(PanelState& state, const PanelContext& ctx, PanelActions& actions) {
@@ -230,6 +276,9 @@ void stats_panel(const PanelContext& ctx) {
   ImGui::Text("pose samples %u%s", s.pose_samples, s.from_pack ? " (pack)" : "");
   ImGui::Text("fuzzy area ratio %.2f", s.fuzzy_area_ratio);
   ImGui::Text("escaped triangles %zu", s.escaped_triangles);
+  // The soft-lighting cost of the last frame, beside the rays it traced.
+  ImGui::Text("shadow rays %llu   %.2f ms", static_cast<unsigned long long>(s.shadow_rays), s.trace_shadow_ms);
+  ImGui::Text("AO rays %llu   %.2f ms", static_cast<unsigned long long>(s.ao_rays), s.trace_ao_ms);
 }
 
 }  // namespace

@@ -17,6 +17,7 @@ Status Viewport::reset(const character::Model& model, const rt::FuzzyCharacterVi
   SINEW_ASSIGN_OR_RETURN(const std::uint32_t ground, scene->add_static_mesh(character::ground_plane_for(rest, 1)));
   (void)ground;
   up_ = character::up_axis_of(rest);
+  character_height_ = character::character_height(rest);
   scene_ = std::move(scene);
   model_ = &model;
   fuzzy_ = fuzzy;
@@ -25,6 +26,7 @@ Status Viewport::reset(const character::Model& model, const rt::FuzzyCharacterVi
   if (reframe) {
     reframe_ = true;
     lights.clear();  // a new model gets its own default light
+    settings.ao_radius = character::default_ao_radius(rest);  // and an occlusion reach of its size
   }
   return Status{};
 }

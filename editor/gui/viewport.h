@@ -45,6 +45,9 @@ class Viewport {
 
   Overlay overlay = Overlay::kNone;
   std::uint32_t bone = 0;  // for the boxes overlay
+  // Soft shadows and ambient occlusion are in here too: shadow_samples,
+  // ao_rays, and ao_radius, which a newly loaded model sets to
+  // character::default_ao_radius (the Lights panel edits them).
   rt::RenderSettings settings;
   rt::FrameOptions frame_options;
   // The lights the view shades with (1 to rt::kMaxLights; the Lights panel
@@ -52,6 +55,9 @@ class Viewport {
   // light above and in front of it (character::default_light).
   std::vector<rt::Light> lights;
 
+  // The loaded character's height (character::character_height): what the
+  // Lights panel's lengths are scaled by.
+  float character_height() const { return character_height_; }
   int width() const { return width_; }
   int height() const { return height_; }
   const rt::CameraDesc& camera() const { return camera_; }
@@ -71,6 +77,7 @@ class Viewport {
   std::unique_ptr<rt::Scene> scene_;
   std::uint32_t instance_ = 0;
   int up_ = 1;
+  float character_height_ = 1.0f;
   std::vector<std::uint32_t> heat_;
   rt::CameraDesc camera_;
   bool reframe_ = true;

@@ -144,9 +144,15 @@ TEST_F(EditorInputTest, ClickingBakeThenSaveWritesAPackOfTheNewBake) {
 }
 
 TEST_F(EditorInputTest, EveryPanelWidgetHasItsOwnId) {
-  // The one panel closed by default, opened by a click on its header.
+  // A panel closed by default, opened by a click on its header.
   EXPECT_TRUE(click(WidgetKind::kHeader, "Joint limits"));
   ASSERT_NE(find(WidgetKind::kButton, "Save limits"), nullptr);
+  // The Lights panel, above it, closed by default too: its soft-lighting
+  // fields join the check.
+  EXPECT_TRUE(click(WidgetKind::kHeader, "Lights"));
+  for (const char* label : {"radius", "shadow samples", "AO rays", "AO radius"}) {
+    EXPECT_NE(find(WidgetKind::kField, label), nullptr) << label;
+  }
   std::map<std::uint32_t, std::vector<std::string>> by_id;
   for (const PanelWidget& w : app_->widgets()) by_id[w.id].push_back(w.label);
   EXPECT_GT(by_id.size(), 20u);

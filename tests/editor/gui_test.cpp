@@ -203,6 +203,57 @@ TEST_F(EditorGuiTest, TheViewShadesWithEveryLightInItsList) {
   EXPECT_GT(differ_from_first, static_cast<std::size_t>(vw * vh / 50));
 }
 
+// The Lights panel's soft lighting is what the view renders with: a sphere
+// light and ambient occlusion give exactly a headless render with them and
+// change the picture; a new model's occlusion reaches half its height; the
+// Stats panel's figures count the shadow and occlusion rays.
+TEST_F(EditorGuiTest, TheViewShadesWithItsSoftShadowsAndAmbientOcclusion) {
+  Viewport& view = app_->viewport();
+  (void)show("idle", 0.5, Overlay::kNone);
+  ASSERT_EQ(view.lights.size(), 1u);
+  EXPECT_EQ(view.lights[0].radius, 0.0f) << "a hard light by default";
+  EXPECT_EQ(view.settings.ao_rays, 0) << "no ambient occlusion by default";
+  EXPECT_FLOAT_EQ(view.settings.ao_radius, 0.5f * view.character_height());
+  const EditorStats hard = app_->stats();
+  EXPECT_GT(hard.shadow_rays, 0u);
+  EXPECT_EQ(hard.ao_rays, 0u);
+  const std::vector<rt::Light> saved = view.lights;
+  rt::RenderSettings settings = view.settings;
+  settings.lights = saved;
+  const std::vector<std::uint8_t> hard_render = headless_render(settings);
+
+  view.lights[0].radius = 0.3f * view.character_height();
+  view.settings.shadow_samples = 4;
+  view.settings.ao_rays = 4;
+  const Screenshot shot = show("idle", 0.5, Overlay::kNone);
+  const EditorStats soft = app_->stats();
+  const std::vector<rt::Light> soft_lights = view.lights;
+  settings = view.settings;
+  settings.lights = soft_lights;
+  const std::vector<std::uint8_t> soft_render = headless_render(settings);
+  view.lights = saved;
+  view.settings.ao_rays = 0;
+  (void)show("idle", 0.5, Overlay::kNone);
+
+  const int vw = view.width(), vh = view.height();
+  std::size_t mismatches = 0, differ_from_hard = 0;
+  for (int y = 0; y < vh; ++y) {
+    for (int x = 0; x < vw; ++x) {
+      const std::size_t i = 4 * (static_cast<std::size_t>(y) * static_cast<std::size_t>(vw) + static_cast<std::size_t>(x));
+      const Rgb p = shot_pixel(shot, x, y);
+      mismatches += p.r != soft_render[i] || p.g != soft_render[i + 1] || p.b != soft_render[i + 2];
+      differ_from_hard += soft_render[i] != hard_render[i] || soft_render[i + 1] != hard_render[i + 1] ||
+                          soft_render[i + 2] != hard_render[i + 2];
+    }
+  }
+  EXPECT_EQ(mismatches, 0u);
+  EXPECT_GT(differ_from_hard, static_cast<std::size_t>(vw * vh / 100));
+  EXPECT_GT(soft.shadow_rays, 3 * hard.shadow_rays) << "4 samples per lit hit";
+  EXPECT_GT(soft.ao_rays, 0u);
+  EXPECT_GE(soft.trace_ao_ms, 0.0);
+  EXPECT_GE(soft.trace_shadow_ms, 0.0);
+}
+
 TEST_F(EditorGuiTest, BoxesOverlayDrawsTheBoneBoxWireframe) {
   ASSERT_TRUE(app_->set_bone("chest").ok());
   const Screenshot plain = show("idle", 0.5, Overlay::kNone);

@@ -353,6 +353,103 @@ TEST(RenderCommand, TexturesOnShowTheMapAndOffShowTheMaterialColour) {
   EXPECT_EQ(coloured_pixels(*off), 0);
 }
 
+// --- soft shadows and ambient occlusion -------------------------------------------
+
+TEST(RenderCommand, SoftLightingOptionsMapToTheirSettings) {
+  const auto d = parse_render_options({"m.glb", "--out", "o"});
+  ASSERT_TRUE(d.ok()) << d.status().message();
+  EXPECT_EQ(d->light_radius, 0.0f) << "hard point lights by default";
+  EXPECT_EQ(d->shadow_samples, 4);
+  EXPECT_EQ(d->ao_rays, 0) << "no ambient occlusion by default";
+  EXPECT_FALSE(d->ao_radius.has_value()) << "derived from the character's height";
+
+  const auto o = parse_render_options({"m.glb", "--out", "o", "--light-radius", "0.25", "--shadow-samples", "16",
+                                       "--ao-rays", "8", "--ao-radius=0.75"});
+  ASSERT_TRUE(o.ok()) << o.status().message();
+  EXPECT_EQ(o->light_radius, 0.25f);
+  EXPECT_EQ(o->shadow_samples, 16);
+  EXPECT_EQ(o->ao_rays, 8);
+  ASSERT_TRUE(o->ao_radius.has_value());
+  EXPECT_EQ(*o->ao_radius, 0.75f);
+
+  // The extremes the renderer takes; a radius of 0 is a hard light, also
+  // beside directional lights alone, and a radius applies where one point
+  // light is among them.
+  const auto extremes = parse_render_options({"m.glb", "--out", "o", "--shadow-samples", "256", "--ao-rays", "256"});
+  ASSERT_TRUE(extremes.ok()) << extremes.status().message();
+  EXPECT_EQ(extremes->shadow_samples, rt::kMaxSamples);
+  EXPECT_EQ(extremes->ao_rays, rt::kMaxSamples);
+  EXPECT_TRUE(parse_render_options({"m.glb", "--out", "o", "--light", "dir:0,1,0", "--light-radius", "0"}).ok());
+  EXPECT_TRUE(parse_render_options(
+                  {"m.glb", "--out", "o", "--light", "dir:0,1,0", "--light", "1,2,3", "--light-radius", "0.5"})
+                  .ok());
+}
+
+// A sphere light of the suggested radius changes the picture (the shadow's
+// edge becomes a penumbra) and takes --shadow-samples rays per lit hit;
+// ambient occlusion only ever darkens (it scales the ambient term), does so
+// in places, and reaches the character's half height by default.
+TEST(RenderCommand, ASphereLightSoftensTheShadowAndAmbientOcclusionDarkens) {
+  const auto model = import_gltf(kCesiumMan);
+  ASSERT_TRUE(model.ok()) << model.status().message();
+  const Aabb rest = character::rest_bounds(*model);
+
+  RenderOptions o = small_options(kCesiumMan);
+  const auto hard = render_model(o);
+  ASSERT_TRUE(hard.ok()) << hard.status().message();
+  o.light_radius = character::suggested_light_radius(rest);
+  const auto soft = render_model(o);
+  ASSERT_TRUE(soft.ok()) << soft.status().message();
+  ASSERT_EQ(soft->lights.size(), 1u);
+  EXPECT_EQ(soft->lights[0].radius, o.light_radius);
+  std::size_t differ = 0;
+  for (std::size_t i = 0; i < hard->color_rgba8.size(); ++i) differ += hard->color_rgba8[i] != soft->color_rgba8[i];
+  EXPECT_GT(differ, 30u) << "a sphere light's image equals the point light's";
+  EXPECT_EQ(hard->stats.ao_rays, 0u);
+  EXPECT_GT(hard->stats.shadow_rays, 0u);
+  EXPECT_GT(soft->stats.shadow_rays, 3 * hard->stats.shadow_rays) << "4 samples per lit hit";
+  EXPECT_LE(soft->stats.shadow_rays, 4 * hard->stats.primary_rays);
+
+  o.light_radius = 0.0f;
+  o.ao_rays = 8;
+  const auto occluded = render_model(o);
+  ASSERT_TRUE(occluded.ok()) << occluded.status().message();
+  EXPECT_FLOAT_EQ(occluded->ao_radius, 0.5f * character::character_height(rest));
+  std::size_t darker = 0, brighter = 0;
+  for (std::size_t i = 0; i < hard->color_rgba8.size(); ++i) {
+    if (i % 4 == 3) continue;  // alpha
+    darker += occluded->color_rgba8[i] < hard->color_rgba8[i];
+    brighter += occluded->color_rgba8[i] > hard->color_rgba8[i];
+  }
+  EXPECT_GT(darker, 100u);
+  EXPECT_EQ(brighter, 0u);
+  EXPECT_GT(occluded->stats.ao_rays, 0u);
+  EXPECT_LE(occluded->stats.ao_rays, 8 * occluded->stats.primary_rays);
+  EXPECT_EQ(occluded->stats.ao_work.rays, occluded->stats.ao_rays);
+  const nlohmann::json stats = nlohmann::json::parse(occluded->stats_json);
+  EXPECT_EQ(stats["rays"]["ao"], occluded->stats.ao_rays);
+  EXPECT_EQ(stats["lighting"]["ao_rays"], 8);
+  EXPECT_FLOAT_EQ(stats["lighting"]["ao_radius"].get<float>(), occluded->ao_radius);
+  EXPECT_TRUE(stats["phases"].contains("trace ao"));
+  EXPECT_FALSE(nlohmann::json::parse(hard->stats_json)["phases"].contains("trace ao"));
+}
+
+// The summary names the lighting and each kind of ray's count and time.
+TEST(RenderCommand, SummaryPrintsTheShadowAndAmbientOcclusionRays) {
+  const std::string dir = fresh_dir("soft_summary");
+  std::ostringstream out, err;
+  const int code = run_render({kCesiumMan, "--out", dir, "--size", "48x48", "--threads", "2", "--light-radius",
+                               "0.2", "--shadow-samples", "2", "--ao-rays", "3", "--ao-radius", "0.4"},
+                              out, err);
+  ASSERT_EQ(code, 0) << err.str();
+  const std::string text = out.str();
+  for (const char* line : {"soft shadows: point lights of radius 0.20, 2 shadow samples per hit\n",
+                           "ambient occlusion: 3 rays per hit, radius 0.40\n", "rays (last frame): 2304 primary in ",
+                           " ambient occlusion in ", "  ambient occlusion work per ray: ", "  trace ao "}) {
+    EXPECT_NE(text.find(line), std::string::npos) << "no '" << line << "' in:\n" << text;
+  }
+}
+
 #if SINEW_HAVE_CAL3D
 // Cally's skeleton and meshes (paths made absolute) under a .cfg of our own
 // with `scale=` first.
@@ -648,6 +745,16 @@ TEST(RenderCommand, UsageErrorsNameTheFlagAndValue) {
       {{kCesiumMan, "--out", dir, "--light", "1,2,3", "--light", "1,2,3", "--light", "1,2,3", "--light", "1,2,3",
         "--light", "1,2,3", "--light", "1,2,3", "--light", "1,2,3", "--light", "1,2,3", "--light", "4,5,6"},
        "--light = 4,5,6: at most 8 lights"},
+      {{kCesiumMan, "--out", dir, "--light-radius", "-1"}, "--light-radius = -1: expected a number from 0 to"},
+      {{kCesiumMan, "--out", dir, "--light-radius", "nan"}, "--light-radius = nan: expected a number"},
+      {{kCesiumMan, "--out", dir, "--light-radius", "0.5", "--light", "dir:0,1,0"},
+       "--light-radius = 0.5: applies to point lights, and every --light is directional"},
+      {{kCesiumMan, "--out", dir, "--shadow-samples", "0"}, "--shadow-samples = 0: expected an integer from 1 to 256"},
+      {{kCesiumMan, "--out", dir, "--shadow-samples", "257"}, "--shadow-samples = 257: expected an integer from 1"},
+      {{kCesiumMan, "--out", dir, "--ao-rays", "-1"}, "--ao-rays = -1: expected an integer from 0 to 256"},
+      {{kCesiumMan, "--out", dir, "--ao-rays", "four"}, "--ao-rays = four: expected an integer"},
+      {{kCesiumMan, "--out", dir, "--ao-radius", "0"}, "--ao-radius = 0: expected a length above 0"},
+      {{kCesiumMan, "--out", dir, "--ao-radius", "inf"}, "--ao-radius = inf: expected a number"},
       {{kCesiumMan, "--out", dir, "--pose-space", "limits"}, "--pose-space = limits: needs --limits"},
       {{kCesiumMan, "--out", dir, "--pose-space", "clip"}, "--pose-space = clip: expected"},
       {{kCesiumMan, "--out", dir, "--pose-space", "arbitrary", "--clips", "a"}, "--clips = a: applies to"},
