@@ -152,6 +152,16 @@ struct LightRayWork {
 void trace_light_rays(const Scene& scene, const RenderSettings& settings, std::span<const Light> lights,
                       TileScratch& s, LightRayWork& work);
 
+// The visibility masks of the tile's pixels into `out` (the tile's staged
+// planes or the host's; each written only when wanted), from what
+// trace_light_rays left: per light its bit of s.lit (a hard light) or its
+// fraction of samples (an area light, with shadows on), and the open
+// fraction of the ambient occlusion rays (with ao_rays). A pixel without a
+// surface gets 1 everywhere. The one writer of the masks (shade_and_write
+// calls it), for every path that traces the light rays.
+void write_visibility_masks(const RenderSettings& settings, std::span<const Light> lights, const OutputPlanes& out,
+                            const TileScratch& s);
+
 // Diffuse shading (ambient + each unblocked light's N.L) and the requested
 // outputs of the tile's pixels, through s.staging: line-aligned planes get
 // whole lines by streaming stores, the others are written in place.
