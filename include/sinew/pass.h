@@ -137,7 +137,7 @@ struct PassInputs {
   // drawn, a ground that receives shadows but casts none.
   std::uint32_t camera_ray_mask = 0xFFFFFFFFu;
   std::uint32_t shadow_ray_mask = 0xFFFFFFFFu;
-  // Soft shadows and ambient occlusion (docs/API.md): rays per hit towards
+  // Soft shadows and ambient occlusion (docs/EMBEDDING.md): rays per hit towards
   // each area light (Light::radius, angular_radius, kRect), 1 to 256; ambient
   // occlusion rays per hit (0: off, up to 256), cosine distributed about the
   // surface, each ao_radius long (world units), which scale the ambient

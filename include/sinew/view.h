@@ -25,7 +25,7 @@ struct Light {
   // The light's size. A light of size 0 is hard: one shadow ray per hit.
   // An area light casts PassInputs::shadow_samples rays per hit towards
   // stratified points on it, and its shadow is the fraction that arrive: a
-  // soft shadow whose penumbra widens with the size (docs/API.md, "Soft
+  // soft shadow whose penumbra widens with the size (docs/EMBEDDING.md, "Soft
   // shadows and ambient occlusion").
   float radius = 0.0f;          // kPoint: a sphere light's radius (world units)
   float angular_radius = 0.0f;  // kDirectional: the sun's half angle (radians, below 1.5)
