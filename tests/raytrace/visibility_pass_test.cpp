@@ -1,7 +1,7 @@
 // Renderer::render_visibility, the light rays from a host's own surfaces:
 // fed the surfaces Sinew's camera path computes (position, camera-facing
 // geometric normal, rounding bound), its masks are the camera path's, bit
-// for bit, for any thread count; on a host's ground that is not in the
+// for bit, for every kind of light and any thread count; on a host's ground that is not in the
 // scene, every hard shadow ray answers as brute force over the scene's
 // triangles and the soft masks are fractions of their samples; pixels
 // without a surface get 1; bad inputs are refused by name.
@@ -108,11 +108,18 @@ TEST(VisibilityPass, SinewsOwnSurfacesGiveTheCameraPathsMasks) {
       rt::PinholeCamera::create({Vec3(0.5f, 1.6f, 3.2f), Vec3(0.0f, 0.5f, 0.0f), Vec3(0, 1, 0), 55.0f}, 64, 48)
           .value();
   const Surfaces surfaces = camera_surfaces(sc, camera);
-  rt::Light hard, sphere;
+  rt::Light hard, sphere, rect, sun;
   hard.position = Vec3(2.0f, 4.0f, 3.0f);
   sphere.position = Vec3(1.0f, 2.5f, 1.5f);
   sphere.radius = 0.8f;
-  const std::vector<rt::Light> lights = {hard, sphere};
+  rect.kind = rt::Light::Kind::kRect;
+  rect.position = Vec3(-1.5f, 3.0f, 1.0f);
+  rect.edge_u = Vec3(1.0f, 0.0f, 0.0f);
+  rect.edge_v = Vec3(0.0f, 0.2f, 0.8f);
+  sun.kind = rt::Light::Kind::kDirectional;
+  sun.direction = Vec3(-0.3f, 1.0f, 0.4f);
+  sun.angular_radius = 0.1f;
+  const std::vector<rt::Light> lights = {hard, sphere, rect, sun};
   rt::RenderSettings settings;
   settings.lights = lights;
   settings.shadow_samples = 4;
