@@ -3,7 +3,9 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "embed/api_errors.h"
@@ -23,7 +25,8 @@ namespace {
 constexpr int kMaxSide = 16384;
 constexpr std::uint32_t kAllOutputs = (Output::kColorRgba8 | Output::kColorRgba32f | Output::kDepth |
                                       Output::kNormal | Output::kInstanceId | Output::kTriangleId | Output::kUv |
-                                      Output::kBarycentrics | Output::kMaterialId)
+                                      Output::kBarycentrics | Output::kMaterialId | Output::kShadowMask |
+                                      Output::kAmbientOcclusion)
                                          .bits();
 
 struct OutputInfo {
@@ -42,21 +45,107 @@ constexpr OutputInfo kOutputs[] = {
     {Output::kUv, "uv", 8, &PassOutputs::uv},
     {Output::kBarycentrics, "barycentrics", 8, &PassOutputs::barycentrics},
     {Output::kMaterialId, "material_id", 4, &PassOutputs::material_id},
+    {Output::kShadowMask, "shadow_mask", 4, &PassOutputs::shadow_mask},  // per light
+    {Output::kAmbientOcclusion, "ambient_occlusion", 4, &PassOutputs::ambient_occlusion},
 };
+// What the G-buffer mode writes: the masks alone.
+constexpr OutputMask kMaskOutputs = Output::kShadowMask | Output::kAmbientOcclusion;
 
 Error bad(const std::string& what) { return Error{ErrorCode::kInvalidArgument, "RayTracePass: " + what}; }
 
-// A typed span over a host buffer of `height` rows `pitch` bytes apart (0:
-// packed), covering exactly the bytes the renderer may touch, rounded up
-// to whole elements; the renderer checks the pitch itself.
+// The elements of a host buffer of `height` rows `pitch` bytes apart (0:
+// packed): exactly the bytes the renderer may touch, rounded up to whole
+// elements; the renderer checks the pitch itself.
+template <class T>
+std::size_t host_elements(std::size_t row_pitch, std::size_t channels, int width, int height) {
+  const std::size_t row = static_cast<std::size_t>(width) * channels * sizeof(T);
+  const std::size_t pitch = row_pitch == 0 ? row : row_pitch;
+  const std::size_t bytes = (static_cast<std::size_t>(height) - 1) * pitch + row;
+  return row_pitch == 0 ? static_cast<std::size_t>(width) * static_cast<std::size_t>(height) * channels
+                        : (bytes + sizeof(T) - 1) / sizeof(T);
+}
 template <class T>
 std::span<T> host_span(const OutputBuffer& buffer, std::size_t channels, int width, int height) {
-  const std::size_t row = static_cast<std::size_t>(width) * channels * sizeof(T);
-  const std::size_t pitch = buffer.row_pitch == 0 ? row : buffer.row_pitch;
-  const std::size_t bytes = (static_cast<std::size_t>(height) - 1) * pitch + row;
-  const std::size_t elements = buffer.row_pitch == 0 ? static_cast<std::size_t>(width) * static_cast<std::size_t>(height) * channels
-                                                     : (bytes + sizeof(T) - 1) / sizeof(T);
-  return {static_cast<T*>(buffer.data), elements};
+  return {static_cast<T*>(buffer.data), host_elements<T>(buffer.row_pitch, channels, width, height)};
+}
+template <class T>
+std::span<const T> host_span(const InputBuffer& buffer, int width, int height) {
+  return {static_cast<const T*>(buffer.data), host_elements<T>(buffer.row_pitch, 1, width, height)};
+}
+
+bool finite(const Float3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+// Light i of the inputs, checked, as the renderer's.
+Result<rt::Light> internal_light(const Light& in, std::size_t i) {
+  const std::string name = "inputs.lights[" + std::to_string(i) + "]";
+  if (!finite(in.position) || !finite(in.direction) || !finite(in.color)) return bad(name + ": not finite");
+  rt::Light light;
+  switch (in.kind) {
+    case Light::Kind::kPoint: light.kind = rt::Light::Kind::kPoint; break;
+    case Light::Kind::kDirectional: light.kind = rt::Light::Kind::kDirectional; break;
+    case Light::Kind::kRect: light.kind = rt::Light::Kind::kRect; break;
+    default: return bad(name + ".kind = " + std::to_string(static_cast<int>(in.kind)) + ": not a Light::Kind");
+  }
+  if (!(std::isfinite(in.radius) && in.radius >= 0.0f)) {
+    return bad(name + ".radius = " + std::to_string(in.radius) + ": expected finite and >= 0");
+  }
+  if (!(in.angular_radius >= 0.0f && in.angular_radius < 1.5f)) {
+    return bad(name + ".angular_radius = " + std::to_string(in.angular_radius) + ": expected 0 to below 1.5 radians");
+  }
+  light.position = detail::to_internal(in.position);
+  light.direction = detail::to_internal(in.direction);
+  light.color = detail::to_internal(in.color);
+  light.radius = in.radius;
+  light.angular_radius = in.angular_radius;
+  light.edge_u = detail::to_internal(in.edge_u);
+  light.edge_v = detail::to_internal(in.edge_v);
+  if (in.kind == Light::Kind::kRect &&
+      !(finite(in.edge_u) && finite(in.edge_v) && glm::length(glm::cross(light.edge_u, light.edge_v)) > 0.0f)) {
+    return bad(name + ".edge_u, edge_v: a rectangle light needs two finite edges spanning an area");
+  }
+  return light;
+}
+
+// The sample counts and the ambient occlusion radius.
+Status check_sampling(const PassInputs& inputs) {
+  if (inputs.shadow_samples < 1 || inputs.shadow_samples > rt::kMaxSamples) {
+    return bad("inputs.shadow_samples = " + std::to_string(inputs.shadow_samples) + ": expected 1 to " +
+               std::to_string(rt::kMaxSamples));
+  }
+  if (inputs.ao_rays < 0 || inputs.ao_rays > rt::kMaxSamples) {
+    return bad("inputs.ao_rays = " + std::to_string(inputs.ao_rays) + ": expected 0 to " +
+               std::to_string(rt::kMaxSamples));
+  }
+  if (inputs.ao_rays > 0 && !(std::isfinite(inputs.ao_radius) && inputs.ao_radius > 0.0f)) {
+    return bad("inputs.ao_radius = " + std::to_string(inputs.ao_radius) + ": expected finite and above 0");
+  }
+  return Status();
+}
+
+// The G-buffer's buffers and offset as the renderer's HostSurfaces; the
+// pitches are checked here, where the inputs' own names are known.
+Result<rt::HostSurfaces> host_surfaces(const GBufferInputs& gbuffer, int width, int height) {
+  if (gbuffer.normal.data == nullptr) return bad("inputs.gbuffer.normal.data: null, but gbuffer.position is set");
+  const std::size_t row = static_cast<std::size_t>(width) * 3 * sizeof(float);
+  for (const auto& [buffer, name] : {std::pair{&gbuffer.position, "position"}, std::pair{&gbuffer.normal, "normal"}}) {
+    const std::size_t pitch = buffer->row_pitch;
+    if (pitch != 0 && (pitch < row || pitch % 4 != 0)) {
+      return bad(std::string("inputs.gbuffer.") + name + ".row_pitch = " + std::to_string(pitch) +
+                 ": expected 0 or a multiple of 4 bytes holding a row of " + std::to_string(row));
+    }
+  }
+  if (!std::isfinite(gbuffer.normal_offset)) {
+    return bad("inputs.gbuffer.normal_offset = " + std::to_string(gbuffer.normal_offset) + ": expected finite");
+  }
+  rt::HostSurfaces surfaces;
+  surfaces.width = width;
+  surfaces.height = height;
+  surfaces.position = host_span<Vec3>(gbuffer.position, width, height);
+  surfaces.normal = host_span<Vec3>(gbuffer.normal, width, height);
+  surfaces.row_pitch.position = gbuffer.position.row_pitch;
+  surfaces.row_pitch.normal = gbuffer.normal.row_pitch;
+  surfaces.normal_offset = gbuffer.normal_offset < 0.0f ? rt::kAutomaticNormalOffset : gbuffer.normal_offset;
+  return surfaces;
 }
 
 // The host's scheduler as an Executor: each batch goes through run_batch.
@@ -115,6 +204,7 @@ Result<RayTracePass> RayTracePass::create(const PassDesc& desc) noexcept {
         {"camera", ResourceDecl::Access::kRead, false, 0},
         {"lights", ResourceDecl::Access::kRead, true, 0},
         {"static_geometry", ResourceDecl::Access::kRead, true, 0},
+        {"gbuffer", ResourceDecl::Access::kRead, true, 0},
     };
     for (const OutputInfo& o : kOutputs) {
       if (desc.outputs.has(o.output)) {
@@ -136,6 +226,20 @@ Result<PassStats> RayTracePass::execute(World& world, const PassInputs& inputs, 
     const int w = desc.width;
     const int h = desc.height;
 
+    // The G-buffer mode writes the masks alone.
+    const bool gbuffer = inputs.gbuffer.active();
+    if (gbuffer) {
+      for (const OutputInfo& o : kOutputs) {
+        if (desc.outputs.has(o.output) && !kMaskOutputs.has(o.output)) {
+          return bad(std::string("desc.outputs asks for ") + o.name +
+                     ", but the G-buffer mode (inputs.gbuffer.position set) writes only shadow_mask and "
+                     "ambient_occlusion");
+        }
+      }
+    }
+    if (desc.outputs.has(Output::kShadowMask) && inputs.lights.empty()) {
+      return bad("outputs.shadow_mask: asked for, but inputs.lights is empty (one channel per light)");
+    }
     // Outputs: every requested one needs a buffer; the others are ignored.
     for (const OutputInfo& o : kOutputs) {
       if (desc.outputs.has(o.output) && (outputs.*(o.buffer)).data == nullptr) {
@@ -163,12 +267,26 @@ Result<PassStats> RayTracePass::execute(World& world, const PassInputs& inputs, 
     bind(Output::kUv, outputs.uv, 1, buffers.uv, pitch.uv);
     bind(Output::kBarycentrics, outputs.barycentrics, 1, buffers.barycentric, pitch.barycentric);
     bind(Output::kMaterialId, outputs.material_id, 1, buffers.material_id, pitch.material_id);
+    bind(Output::kShadowMask, outputs.shadow_mask, inputs.lights.size(), buffers.shadow, pitch.shadow);
+    bind(Output::kAmbientOcclusion, outputs.ambient_occlusion, 1, buffers.ambient_occlusion,
+         pitch.ambient_occlusion);
 
-    // Inputs.
-    const rt::CameraDesc camera_desc{detail::to_internal(inputs.camera.eye), detail::to_internal(inputs.camera.target),
-                                     detail::to_internal(inputs.camera.up), inputs.camera.fovy_degrees};
-    const auto camera = rt::PinholeCamera::create(camera_desc, w, h);
-    if (!camera.ok()) return bad("inputs.camera: " + camera.status().message());
+    // Inputs: the camera, or the host's surfaces in its place.
+    std::optional<rt::PinholeCamera> camera;
+    rt::HostSurfaces surfaces;
+    if (gbuffer) {
+      auto host = host_surfaces(inputs.gbuffer, w, h);
+      if (!host.ok()) return host.error();
+      surfaces = *host;
+    } else {
+      const rt::CameraDesc camera_desc{detail::to_internal(inputs.camera.eye),
+                                       detail::to_internal(inputs.camera.target),
+                                       detail::to_internal(inputs.camera.up), inputs.camera.fovy_degrees};
+      auto made = rt::PinholeCamera::create(camera_desc, w, h);
+      if (!made.ok()) return bad("inputs.camera: " + made.status().message());
+      camera = *made;
+    }
+    if (const Status sampling = check_sampling(inputs); !sampling.ok()) return sampling.error();
     if (inputs.lights.size() > kMaxLights) {
       return bad("inputs.lights: " + std::to_string(inputs.lights.size()) + " lights, at most " +
                  std::to_string(kMaxLights));
@@ -181,20 +299,15 @@ Result<PassStats> RayTracePass::execute(World& world, const PassInputs& inputs, 
     settings.background = detail::to_internal(inputs.background);
     settings.camera_mask = inputs.camera_ray_mask;
     settings.shadow_mask = inputs.shadow_ray_mask;
+    settings.shadow_samples = inputs.shadow_samples;
+    settings.ao_rays = inputs.ao_rays;
+    settings.ao_radius = inputs.ao_radius;
+    settings.sample_seed = inputs.sample_seed;
     std::vector<rt::Light> lights;
     for (std::size_t i = 0; i < inputs.lights.size(); ++i) {
-      const Light& in = inputs.lights[i];
-      rt::Light light;
-      light.kind = in.kind == Light::Kind::kDirectional ? rt::Light::Kind::kDirectional : rt::Light::Kind::kPoint;
-      light.position = detail::to_internal(in.position);
-      light.direction = detail::to_internal(in.direction);
-      light.color = detail::to_internal(in.color);
-      for (const Vec3& v : {light.position, light.direction, light.color}) {
-        if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z)) {
-          return bad("inputs.lights[" + std::to_string(i) + "]: not finite");
-        }
-      }
-      lights.push_back(light);
+      auto light = internal_light(inputs.lights[i], i);
+      if (!light.ok()) return light.error();
+      lights.push_back(*light);
     }
     if (lights.empty()) {
       settings.light.color = Vec3(0.0f);  // ambient only: nothing to cast shadows for
@@ -221,7 +334,9 @@ Result<PassStats> RayTracePass::execute(World& world, const PassInputs& inputs, 
     frame.bone_boxes = desc.exact_bone_boxes ? rt::BoneBoxMode::kExact : rt::BoneBoxMode::kCheap;
     frame.fallback = desc.fallback;
     frame.normals = wanted(Output::kColorRgba8) || wanted(Output::kColorRgba32f) || wanted(Output::kNormal);
-    frame.visibility = rt::frame_visibility(*camera, settings);  // skin only what the rays can reach
+    // Skin only what the camera's rays can reach; the host's surfaces may
+    // be anywhere, so without a camera every instance is prepared.
+    if (camera) frame.visibility = rt::frame_visibility(*camera, settings);
     rt::Scene& scene = world.impl().scene;
     const auto start = std::chrono::steady_clock::now();
     World::Impl& state = world.impl();
@@ -237,12 +352,14 @@ Result<PassStats> RayTracePass::execute(World& world, const PassInputs& inputs, 
     stats.fallback_ms = prepared->fallback_ms;
     stats.skinned_instances = prepared->skinned_instances;
     stats.culled_instances = prepared->culled_instances;
-    const auto rendered = impl_->renderer.render(scene, *camera, settings, buffers, jobs);
+    const auto rendered = camera ? impl_->renderer.render(scene, *camera, settings, buffers, jobs)
+                                 : impl_->renderer.render_visibility(scene, surfaces, settings, buffers, jobs);
     if (!rendered.ok()) return bad(rendered.status().message());
-    stats.trace_ms = rendered->trace_primary_ms + rendered->trace_shadow_ms;
+    stats.trace_ms = rendered->trace_primary_ms + rendered->trace_shadow_ms + rendered->trace_ao_ms;
     stats.shade_ms = rendered->shade_ms;
     stats.primary_rays = rendered->primary_rays;
     stats.shadow_rays = rendered->shadow_rays;
+    stats.ao_rays = rendered->ao_rays;
     return stats;
   });
 }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 
 namespace host {
 namespace {
@@ -91,27 +92,20 @@ double edge(ScreenPoint a, ScreenPoint b, double px, double py) {
   return (b.x - a.x) * (py - a.y) - (b.y - a.y) * (px - a.x);
 }
 
-struct GroundShading {
-  const Ground& ground;
-  const HostLighting& lighting;
+// A checkerboard, so the ground visibly moves with the camera, lit by the
+// point light: the host's own shading, with only the shadow from Sinew.
+Vec3 shade_ground(const Ground& ground, const HostLighting& lighting, Vec3 world, Vec3 normal, float shadow) {
+  const int a = (ground.up_axis + 1) % 3;
+  const int b = (ground.up_axis + 2) % 3;
+  const auto cell = static_cast<long>(std::floor(axis(world, a) / ground.checker_size)) +
+                    static_cast<long>(std::floor(axis(world, b) / ground.checker_size));
+  const float albedo = (cell & 1) != 0 ? 0.35f : 0.6f;
+  const float lambert = shadow * std::max(0.0f, dot(normal, normalize(lighting.light_position - world)));
+  return albedo * (lighting.ambient + Vec3{lambert, lambert, lambert});
+}
 
-  // A checkerboard, so the ground visibly moves with the camera, lit by the
-  // point light without shadows (the host knows nothing of the character).
-  Vec3 operator()(Vec3 world) const {
-    const int a = (ground.up_axis + 1) % 3;
-    const int b = (ground.up_axis + 2) % 3;
-    const auto cell = static_cast<long>(std::floor(axis(world, a) / ground.checker_size)) +
-                      static_cast<long>(std::floor(axis(world, b) / ground.checker_size));
-    const float albedo = (cell & 1) != 0 ? 0.35f : 0.6f;
-    Vec3 normal;
-    axis(normal, ground.up_axis) = 1.0f;
-    const float lambert = std::max(0.0f, dot(normal, normalize(lighting.light_position - world)));
-    return albedo * (lighting.ambient + Vec3{lambert, lambert, lambert});
-  }
-};
-
-void draw_triangle(const PinholeCamera& camera, const std::array<ViewVertex, 3>& tri, const GroundShading& shade,
-                   Image& color, Image& depth) {
+void draw_triangle(const PinholeCamera& camera, const std::array<ViewVertex, 3>& tri, Vec3 normal,
+                   GBuffer& gbuffer) {
   const ScreenPoint p0 = project(camera, tri[0].view);
   const ScreenPoint p1 = project(camera, tri[1].view);
   const ScreenPoint p2 = project(camera, tri[2].view);
@@ -125,8 +119,9 @@ void draw_triangle(const PinholeCamera& camera, const std::array<ViewVertex, 3>&
   const int y_begin = clamped(std::floor(std::min({p0.y, p1.y, p2.y})), camera.height);
   const int y_end = clamped(std::ceil(std::max({p0.y, p1.y, p2.y})), camera.height);
   for (int y = y_begin; y < y_end; ++y) {
-    std::uint8_t* color_row = color.row<std::uint8_t>(y);
-    float* depth_row = depth.row<float>(y);
+    float* depth_row = gbuffer.depth.row<float>(y);
+    Vec3* position_row = gbuffer.position.row<Vec3>(y);
+    Vec3* normal_row = gbuffer.normal.row<Vec3>(y);
     const double py = y + 0.5;
     for (int x = x_begin; x < x_end; ++x) {
       const double px = x + 0.5;
@@ -146,7 +141,8 @@ void draw_triangle(const PinholeCamera& camera, const std::array<ViewVertex, 3>&
       const float distance = length(world - camera.eye);
       if (distance >= depth_row[x]) continue;
       depth_row[x] = distance;
-      put(color_row + 4 * x, shade(world));
+      position_row[x] = world;
+      normal_row[x] = normal;
     }
   }
 }
@@ -179,18 +175,13 @@ Vec3 PinholeCamera::ray_direction(int x, int y) const {
   return normalize(forward + (sx * tan_half_fovy * aspect) * right + (sy * tan_half_fovy) * up);
 }
 
-void draw_host_pass(const PinholeCamera& camera, const Ground& ground, const HostLighting& lighting,
-                    Image& color, Image& depth) {
-  // Sky: a gradient on the view ray's elevation; nothing there, so depth +inf.
+void draw_host_gbuffer(const PinholeCamera& camera, const Ground& ground, GBuffer& gbuffer) {
+  // Nothing drawn yet: depth +inf, and no surface for Sinew's rays.
+  const float nan = std::numeric_limits<float>::quiet_NaN();
   for (int y = 0; y < camera.height; ++y) {
-    std::uint8_t* color_row = color.row<std::uint8_t>(y);
-    float* depth_row = depth.row<float>(y);
-    for (int x = 0; x < camera.width; ++x) {
-      const float elevation = std::clamp(axis(camera.ray_direction(x, y), ground.up_axis), 0.0f, 1.0f);
-      const float t = std::sqrt(elevation);
-      put(color_row + 4 * x, (1.0f - t) * Vec3{0.75f, 0.80f, 0.85f} + t * Vec3{0.20f, 0.35f, 0.70f});
-      depth_row[x] = kFarAway;
-    }
+    std::fill_n(gbuffer.depth.row<float>(y), camera.width, kFarAway);
+    std::fill_n(gbuffer.position.row<Vec3>(y), camera.width, Vec3{nan, nan, nan});
+    std::fill_n(gbuffer.normal.row<Vec3>(y), camera.width, Vec3{});
   }
 
   const int a = (ground.up_axis + 1) % 3;
@@ -206,9 +197,31 @@ void draw_host_pass(const PinholeCamera& camera, const Ground& ground, const Hos
   // The quad (two triangles) is convex: clip it as one polygon, draw the
   // part in front of the eye as a fan of triangles.
   const std::vector<ViewVertex> visible = clip_near(quad);
-  const GroundShading shade{ground, lighting};
+  Vec3 up;
+  axis(up, ground.up_axis) = 1.0f;
   for (std::size_t i = 1; i + 1 < visible.size(); ++i) {
-    draw_triangle(camera, {visible[0], visible[i], visible[i + 1]}, shade, color, depth);
+    draw_triangle(camera, {visible[0], visible[i], visible[i + 1]}, up, gbuffer);
+  }
+}
+
+void shade_host_pass(const PinholeCamera& camera, const Ground& ground, const HostLighting& lighting,
+                     const GBuffer& gbuffer, const Image& shadow, Image& color) {
+  for (int y = 0; y < camera.height; ++y) {
+    std::uint8_t* color_row = color.row<std::uint8_t>(y);
+    const float* depth_row = gbuffer.depth.row<float>(y);
+    const Vec3* position_row = gbuffer.position.row<Vec3>(y);
+    const Vec3* normal_row = gbuffer.normal.row<Vec3>(y);
+    const float* shadow_row = shadow.row<float>(y);
+    for (int x = 0; x < camera.width; ++x) {
+      if (depth_row[x] == kFarAway) {
+        // Sky: a gradient on the view ray's elevation.
+        const float elevation = std::clamp(axis(camera.ray_direction(x, y), ground.up_axis), 0.0f, 1.0f);
+        const float t = std::sqrt(elevation);
+        put(color_row + 4 * x, (1.0f - t) * Vec3{0.75f, 0.80f, 0.85f} + t * Vec3{0.20f, 0.35f, 0.70f});
+        continue;
+      }
+      put(color_row + 4 * x, shade_ground(ground, lighting, position_row[x], normal_row[x], shadow_row[x]));
+    }
   }
 }
 

@@ -1,6 +1,10 @@
 // The host engine's own rendering: a tiny z-buffered software rasteriser
-// standing in for whatever a real engine draws (its level, its sky), and the
-// depth composite that merges Sinew's pass into that frame.
+// standing in for whatever a real engine draws (its level, its sky), in two
+// steps as a deferred renderer draws: a G-buffer (depth, world position,
+// normal), then the shading, which takes Sinew's shadow mask of those very
+// surfaces (the pass's G-buffer mode), so the characters' soft shadows fall
+// on the host's ground. Then the depth composite that merges Sinew's own
+// image of the characters into that frame.
 //
 // The contract that makes the composite work: the host's camera is the same
 // pinhole camera as Sinew's (sinew/pass.h Camera, y = 0 the top row), and the
@@ -91,11 +95,28 @@ struct HostLighting {
   Vec3 ambient{0.18f, 0.18f, 0.18f};  // Sinew's default, so both passes read as one scene
 };
 
-// The host pass: clears colour to a sky gradient and depth to +inf, then
-// draws the ground as two z-buffered triangles. Colour: RGBA8 sRGB, like
-// Sinew's kColorRgba8; depth: float.
-void draw_host_pass(const PinholeCamera& camera, const Ground& ground, const HostLighting& lighting,
-                    Image& color, Image& depth);
+// What the host's rasteriser leaves per pixel for its shading (and for
+// Sinew's G-buffer mode, which reads position and normal as they are: 3
+// floats a pixel, rows row_pitch() bytes apart).
+struct GBuffer {
+  GBuffer(int width, int height)
+      : depth(width, height, sizeof(float)), position(width, height, sizeof(Vec3)), normal(width, height, sizeof(Vec3)) {}
+  Image depth;     // float: the ray distance; kFarAway where nothing was drawn
+  Image position;  // Vec3: world position; NaN where nothing was drawn (no surface for Sinew)
+  Image normal;    // Vec3: unit world normal; 0 where nothing was drawn
+};
+
+// The host pass, first half: clears the G-buffer (depth +inf, no surface),
+// then draws the ground as two z-buffered triangles into it.
+void draw_host_gbuffer(const PinholeCamera& camera, const Ground& ground, GBuffer& gbuffer);
+
+// The host pass, second half: a sky gradient where nothing was drawn; the
+// ground's checkerboard lit by the ambient light and the point light, whose
+// direct light is scaled by `shadow` (float per pixel: the fraction of the
+// light that reaches the surface, Sinew's shadow mask). Colour: RGBA8 sRGB,
+// like Sinew's kColorRgba8.
+void shade_host_pass(const PinholeCamera& camera, const Ground& ground, const HostLighting& lighting,
+                     const GBuffer& gbuffer, const Image& shadow, Image& color);
 
 // Per pixel: Sinew's colour where Sinew's depth is nearer than the host's,
 // else the host's. Writes into the host's buffers (colour and depth), so a

@@ -2,8 +2,13 @@
 //
 // The host owns the camera, the light and a rasterised pass of its own (sky
 // and ground). Each frame it animates Sinew's world, runs Sinew's ray-trace
-// pass into host-owned colour and depth buffers, and composites the two
-// passes by depth. Everything Sinew-specific goes through <sinew/sinew.h>.
+// pass into host-owned colour and depth buffers, rasterises its ground into
+// a G-buffer, asks a second Sinew pass (the G-buffer mode) how much of the
+// light reaches each of its ground's pixels past the characters, shades
+// the ground with that shadow mask, and composites the two passes by
+// depth. The light is a sphere light: both the characters and the
+// characters' shadows on the ground are soft. Everything Sinew-specific
+// goes through <sinew/sinew.h>.
 //
 //   host_engine --pack cesium.pack --headless --out frames/
 //   host_engine --pack cesium.pack --scheduler host --threads 4   (a window)
@@ -59,6 +64,8 @@ struct Options {
   int height = 480;
   std::optional<api::Camera> camera;
   std::optional<api::Float3> light;
+  std::optional<float> light_radius;
+  int shadow_samples = 8;
   int instances = 1;
   int frames = 0;  // 0: one frame posed with pose_at; N: N frames of advance()
   int threads = 0;
@@ -76,14 +83,18 @@ const char* const kUsage =
     "  --size WxH             image size (default 640x480)\n"
     "  --camera ex,ey,ez,tx,ty,tz,ux,uy,uz,fovy_deg\n"
     "                         default: frames the character's bind-pose skeleton\n"
-    "  --light x,y,z          point light (default: above, in front, to the right)\n"
+    "  --light x,y,z          the light's centre (default: above, in front, to the right)\n"
+    "  --light-radius R       the sphere light's radius, scene units (0: a point light with hard\n"
+    "                         shadows; default: a tenth of the character's height)\n"
+    "  --shadow-samples N     shadow rays per pixel towards the sphere light (default 8)\n"
     "  --instances N          copies 1 unit apart along +X (default 1)\n"
     "  --frames N             animate N frames at 30 fps with World::advance (headless: write\n"
     "                         the last; windowed: close after N). Default headless: one frame\n"
     "                         posed with World::pose_at; windowed: run until Esc\n"
     "  --threads N            worker threads (default 0: all cores)\n"
     "  --scheduler tbb|host   Sinew's own TBB arena, or the host's thread pool (default tbb)\n"
-    "  --headless             no window: write OUT/sinew_color.ppm, sinew_depth.pfm, frame.ppm\n"
+    "  --headless             no window: write OUT/sinew_color.ppm, sinew_depth.pfm,\n"
+    "                         ground_shadow.pfm (the host ground's shadow mask), frame.ppm\n"
     "  --out DIR              output folder of --headless (default .)\n"
     "  --pick X,Y             select the character under pixel X,Y (0,0 the top left) before the\n"
     "                         written (windowed: the first) frame; frame.ppm shows it tinted\n"
@@ -163,6 +174,12 @@ std::string parse_options(int argc, char** argv, Options& o) {
       const auto v = parse_floats(value, 3);
       if (!v) return bad;
       o.light = api::Float3{(*v)[0], (*v)[1], (*v)[2]};
+    } else if (flag == "--light-radius") {
+      float r = 0.0f;
+      if (!parse_number(value, r) || r < 0.0f) return bad;
+      o.light_radius = r;
+    } else if (flag == "--shadow-samples") {
+      if (!parse_number(value, o.shadow_samples) || o.shadow_samples < 1 || o.shadow_samples > 256) return bad;
     } else if (flag == "--instances") {
       if (!parse_number(value, o.instances) || o.instances < 1) return bad;
     } else if (flag == "--frames") {
@@ -324,19 +341,22 @@ struct Frame {
       : sinew_color(w, h, 4),
         sinew_depth(w, h, sizeof(float)),
         sinew_instance(w, h, sizeof(api::InstanceId)),
-        host_color(w, h, 4),
-        host_depth(w, h, sizeof(float)) {}
+        gbuffer(w, h),
+        ground_shadow(w, h, sizeof(float)),
+        host_color(w, h, 4) {}
   host::Image sinew_color;
   host::Image sinew_depth;
   host::Image sinew_instance;  // which instance each pixel shows: the selection's highlight
-  host::Image host_color;  // after composite_by_depth: the finished frame
-  host::Image host_depth;
+  host::GBuffer gbuffer;       // the host's rasterised ground; its depth is the composite's too
+  host::Image ground_shadow;   // Sinew's shadow mask of the host's G-buffer
+  host::Image host_color;      // after composite_by_depth: the finished frame
 };
 
 struct Engine {
   api::Character character;
   api::World world;
   api::RayTracePass pass;
+  api::RayTracePass shadow_pass;  // the G-buffer mode: the host ground's shadow mask
   std::vector<api::InstanceId> instances;
   api::Light light;
   api::PassInputs inputs;
@@ -352,6 +372,7 @@ struct Engine {
 
 struct FrameStats {
   api::PassStats sinew;
+  api::PassStats ground_shadow;
   double host_ms = 0.0;
   double composite_ms = 0.0;
 };
@@ -360,28 +381,47 @@ double ms_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
-// One frame: Sinew's pass, the host's pass, then the composite. Sinew goes
-// first only because it validates the camera the two passes share (a real
-// engine would run both at once: they share no buffer until the composite).
+// One frame: Sinew's pass, the host's pass (its G-buffer, Sinew's shadow
+// mask of it, its shading), then the composite. Sinew goes first only
+// because it validates the camera the passes share (a real engine would
+// run the character pass beside its own: they share no buffer until the
+// composite).
 api::Result<FrameStats> render_frame(Engine& e) {
   FrameStats stats;
+  const api::TaskScheduler* scheduler = e.pool ? &e.scheduler : nullptr;
   api::PassOutputs outputs;
   outputs.color_rgba8 = e.frame.sinew_color.as_output();
   outputs.depth = e.frame.sinew_depth.as_output();
   outputs.instance_id = e.frame.sinew_instance.as_output();
-  auto sinew = e.pass.execute(e.world, e.inputs, outputs, e.pool ? &e.scheduler : nullptr);
+  auto sinew = e.pass.execute(e.world, e.inputs, outputs, scheduler);
   if (!sinew) return sinew.error();
   stats.sinew = *sinew;
 
   auto start = std::chrono::steady_clock::now();
-  host::draw_host_pass(e.camera, e.ground, e.lighting, e.frame.host_color, e.frame.host_depth);
+  host::GBuffer& gbuffer = e.frame.gbuffer;
+  host::draw_host_gbuffer(e.camera, e.ground, gbuffer);
   stats.host_ms = ms_since(start);
 
+  // The host's surfaces as the rays' origins: Sinew's characters shadow
+  // the host's ground, which Sinew's World does not hold.
+  api::PassInputs shadow_inputs = e.inputs;
+  shadow_inputs.gbuffer.position = {gbuffer.position.data(), gbuffer.position.row_pitch()};
+  shadow_inputs.gbuffer.normal = {gbuffer.normal.data(), gbuffer.normal.row_pitch()};
+  api::PassOutputs shadow_outputs;
+  shadow_outputs.shadow_mask = e.frame.ground_shadow.as_output();
+  auto shadow = e.shadow_pass.execute(e.world, shadow_inputs, shadow_outputs, scheduler);
+  if (!shadow) return shadow.error();
+  stats.ground_shadow = *shadow;
+
   start = std::chrono::steady_clock::now();
-  host::composite_by_depth(e.frame.sinew_color, e.frame.sinew_depth, e.frame.host_color, e.frame.host_depth);
+  host::shade_host_pass(e.camera, e.ground, e.lighting, gbuffer, e.frame.ground_shadow, e.frame.host_color);
+  stats.host_ms += ms_since(start);
+
+  start = std::chrono::steady_clock::now();
+  host::composite_by_depth(e.frame.sinew_color, e.frame.sinew_depth, e.frame.host_color, gbuffer.depth);
   if (e.selection != api::kNoHit) {
     host::highlight_instance(e.frame.sinew_instance, e.frame.sinew_depth, e.selection, e.frame.host_color,
-                             e.frame.host_depth);
+                             gbuffer.depth);
   }
   stats.composite_ms = ms_since(start);
   return stats;
@@ -389,10 +429,10 @@ api::Result<FrameStats> render_frame(Engine& e) {
 
 void print_stats(int frame, const FrameStats& s) {
   std::printf(
-      "frame %d: sinew prepare %.2f ms, trace %.2f ms, shade %.2f ms, %zu escaped triangles | host raster %.2f ms, "
-      "composite %.2f ms\n",
-      frame, s.sinew.prepare_ms, s.sinew.trace_ms, s.sinew.shade_ms, s.sinew.escaped_triangles, s.host_ms,
-      s.composite_ms);
+      "frame %d: sinew prepare %.2f ms, trace %.2f ms, shade %.2f ms, %zu escaped triangles | ground shadow "
+      "prepare %.2f ms, trace %.2f ms | host raster %.2f ms, composite %.2f ms\n",
+      frame, s.sinew.prepare_ms, s.sinew.trace_ms, s.sinew.shade_ms, s.sinew.escaped_triangles,
+      s.ground_shadow.prepare_ms, s.ground_shadow.trace_ms, s.host_ms, s.composite_ms);
   std::fflush(stdout);
 }
 
@@ -481,6 +521,22 @@ api::Status start_playing(Engine& e, const Options& o) {
   return e.world.advance(static_cast<float>(o.time));
 }
 
+// How much of the host's ground the characters shadow, from Sinew's mask:
+// pixels the light reaches only in part (below 1), and of those the
+// penumbra (above 0), where a sphere light's shadow is soft.
+void report_ground_shadow(const host::Image& shadow) {
+  std::size_t shadowed = 0;
+  std::size_t penumbra = 0;
+  for (int y = 0; y < shadow.height(); ++y) {
+    const float* row = shadow.row<float>(y);
+    for (int x = 0; x < shadow.width(); ++x) {
+      shadowed += row[x] < 1.0f ? 1 : 0;
+      penumbra += row[x] > 0.0f && row[x] < 1.0f ? 1 : 0;
+    }
+  }
+  std::printf("ground shadow: %zu pixels shadowed, %zu of them in penumbra\n", shadowed, penumbra);
+}
+
 int run_headless(Engine& e, const Options& o) {
   if (o.frames == 0) {
     for (const api::InstanceId id : e.instances) {
@@ -502,16 +558,18 @@ int run_headless(Engine& e, const Options& o) {
     if (!stats) return sinew_failed(stats.error());
     if (auto s = report_frame(e, f, *stats); !s) return sinew_failed(s.error());
   }
+  report_ground_shadow(e.frame.ground_shadow);
   std::error_code ec;
   std::filesystem::create_directories(o.out, ec);
   const std::filesystem::path dir(o.out);
   if (!host::write_ppm((dir / "sinew_color.ppm").string(), e.frame.sinew_color) ||
       !host::write_pfm((dir / "sinew_depth.pfm").string(), e.frame.sinew_depth) ||
+      !host::write_pfm((dir / "ground_shadow.pfm").string(), e.frame.ground_shadow) ||
       !host::write_ppm((dir / "frame.ppm").string(), e.frame.host_color)) {
     std::fprintf(stderr, "host_engine: cannot write the images into %s\n", o.out.c_str());
     return kExitSinewError;
   }
-  std::printf("wrote %s/{sinew_color.ppm,sinew_depth.pfm,frame.ppm}\n", o.out.c_str());
+  std::printf("wrote %s/{sinew_color.ppm,sinew_depth.pfm,ground_shadow.pfm,frame.ppm}\n", o.out.c_str());
   return 0;
 }
 
@@ -638,10 +696,13 @@ api::Result<std::unique_ptr<Engine>> make_engine(const Options& o) {
   desc.threads = o.threads;
   auto pass = api::RayTracePass::create(desc);
   if (!pass) return pass.error();
+  desc.outputs = api::Output::kShadowMask;  // one light: one float a pixel
+  auto shadow_pass = api::RayTracePass::create(desc);
+  if (!shadow_pass) return shadow_pass.error();
 
-  auto e = std::unique_ptr<Engine>(new Engine{std::move(*character), std::move(*world), std::move(*pass), {}, {}, {},
-                                              nullptr, {}, {}, {}, {}, Frame(o.width, o.height), {},
-                                              api::kNoHit});
+  auto e = std::unique_ptr<Engine>(new Engine{std::move(*character), std::move(*world), std::move(*pass),
+                                              std::move(*shadow_pass), {}, {}, {}, nullptr, {}, {}, {}, {},
+                                              Frame(o.width, o.height), {}, api::kNoHit});
   for (int i = 0; i < o.instances; ++i) {
     api::InstanceDesc instance;
     instance.transform = api::Matrix3x4::translation(kInstanceSpacing * static_cast<float>(i), 0.0f, 0.0f);
@@ -660,7 +721,11 @@ api::Result<std::unique_ptr<Engine>> make_engine(const Options& o) {
   e->inputs.camera = o.camera ? *o.camera : default_camera(*framing, o.width, o.height);
   e->light.kind = api::Light::Kind::kPoint;
   e->light.position = o.light ? *o.light : default_light(*framing);
+  // A sphere light: soft shadows on the characters and on the host's ground.
+  e->light.radius =
+      o.light_radius ? *o.light_radius : 0.1f * (axis(framing->high, framing->up_axis) - axis(framing->low, framing->up_axis));
   e->inputs.lights = {&e->light, 1};
+  e->inputs.shadow_samples = o.shadow_samples;
   e->camera = host::PinholeCamera::from(e->inputs.camera, o.width, o.height);
   e->lighting.light_position = {e->light.position.x, e->light.position.y, e->light.position.z};
   e->lighting.ambient = {e->inputs.ambient.x, e->inputs.ambient.y, e->inputs.ambient.z};

@@ -12,7 +12,8 @@
 //
 // execute() prepares the frame (skinning, the escape check, bone boxes, the
 // fallback for escaped triangles, the top-level tree), then traces and
-// shades the image in tiles. Images are identical for any thread count or
+// shades the image in tiles; or, given the host's G-buffer (GBufferInputs),
+// traces shadow and ambient occlusion rays from the host's own surfaces. Images are identical for any thread count or
 // scheduler.
 #pragma once
 
@@ -41,6 +42,15 @@ enum class Output : std::uint32_t {
   kUv = 1u << 6,            // 2 x float: texture coordinates (the corners' uvs blended); 0 without uvs or on a miss
   kBarycentrics = 1u << 7,  // 2 x float: u, v, the hit's weights of the triangle's corners 1 and 2; 0 on a miss
   kMaterialId = 1u << 8,    // uint32: the triangle's material, as the pack numbers them; kNoHit without one or on a miss
+  // Visibility masks, 1 where nothing blocks and where there is no surface:
+  // float per light, interleaved (inputs.lights.size() floats a pixel, in
+  // the lights' order): 0 or 1 for a hard light, for an area light the
+  // fraction of its samples that reach the surface; 0 where the surface
+  // faces away from the light. 1 for every light with desc.shadows off.
+  kShadowMask = 1u << 9,
+  // float: the fraction of the ambient occlusion rays that escape
+  // (PassInputs::ao_rays; 1 without them).
+  kAmbientOcclusion = 1u << 10,
 };
 // A set of outputs: `Output::kColorRgba8 | Output::kDepth`, or one Output.
 class OutputMask {
@@ -66,7 +76,7 @@ struct PassDesc {
   int width = 1024;
   int height = 1024;
   OutputMask outputs = Output::kColorRgba8;
-  bool shadows = true;  // one shadow ray per hit and light (colour outputs only)
+  bool shadows = true;  // shadow rays per hit and light (for the colour and the shadow mask)
   TriangleTest triangle_test = TriangleTest::kFast;
   // Exact per-bone world boxes (a pass over the bone's triangles) or the
   // cheap fuzzy root box carried by the bone matrix: looser, faster to make.
@@ -84,8 +94,40 @@ struct PassDesc {
 // Camera and Light: sinew/view.h (Character::framing suggests both).
 inline constexpr std::size_t kMaxLights = 8;
 
+// A host buffer the pass reads: `height` rows `row_pitch` bytes apart (0:
+// packed), a multiple of 4 bytes.
+struct InputBuffer {
+  const void* data = nullptr;
+  std::size_t row_pitch = 0;
+};
+
+// The G-buffer mode (hybrid rendering): the host's own rasterised surfaces
+// as the origins of the shadow and ambient occlusion rays, in place of the
+// pass's camera. The host's surfaces receive; Sinew's characters and static
+// meshes (World) occlude; the host's surfaces block nothing (they are not
+// in the World). The pass then writes only the masks (Output::kShadowMask,
+// kAmbientOcclusion), desc.width x desc.height pixels, one per G-buffer
+// pixel.
+struct GBufferInputs {
+  // 3 x float per pixel: the surface's world position; a non-finite one
+  // (the sky, or what the host left empty) has no surface: its masks are 1.
+  InputBuffer position;
+  // 3 x float per pixel: the surface's unit world normal, on the side the
+  // rays leave from (a normal a little off unit, from an 8- or 16-bit
+  // encoding, is normalised); zero or non-finite: no surface.
+  InputBuffer normal;
+  // How far each ray's origin is pushed off the surface along its normal
+  // (world units), so that a host surface that coincides with Sinew's own
+  // (the host also rasterises the characters) does not shadow itself
+  // through the rounding of its reconstructed position. Negative: automatic,
+  // a ten-thousandth of the diagonal of the World's bounds this frame.
+  float normal_offset = -1.0f;
+
+  bool active() const { return position.data != nullptr; }
+};
+
 struct PassInputs {
-  Camera camera;
+  Camera camera;  // unused in the G-buffer mode
   std::span<const Light> lights;  // 0 to kMaxLights; none: ambient only
   Float3 ambient{0.18f, 0.18f, 0.18f};
   Float3 background{0.32f, 0.36f, 0.42f};  // linear RGB of a miss
@@ -95,6 +137,20 @@ struct PassInputs {
   // drawn, a ground that receives shadows but casts none.
   std::uint32_t camera_ray_mask = 0xFFFFFFFFu;
   std::uint32_t shadow_ray_mask = 0xFFFFFFFFu;
+  // Soft shadows and ambient occlusion (docs/EMBEDDING.md): rays per hit towards
+  // each area light (Light::radius, angular_radius, kRect), 1 to 256; ambient
+  // occlusion rays per hit (0: off, up to 256), cosine distributed about the
+  // surface, each ao_radius long (world units), which scale the ambient
+  // term by the fraction that escape. The sample pattern is a fixed
+  // function of sample_seed, the pixel and the sample: the same image for
+  // any thread count.
+  int shadow_samples = 4;
+  int ao_rays = 0;
+  float ao_radius = 1.0f;
+  std::uint32_t sample_seed = 0;
+  // Set gbuffer.position (and normal) to trace from the host's surfaces
+  // instead of the camera (GBufferInputs).
+  GBufferInputs gbuffer;
 };
 
 // A host buffer: `data` holds `height` rows, `row_pitch` bytes apart (0:
@@ -118,23 +174,28 @@ struct PassOutputs {
   OutputBuffer uv;
   OutputBuffer barycentrics;
   OutputBuffer material_id;
+  OutputBuffer shadow_mask;
+  OutputBuffer ambient_occlusion;
 };
 
 // One declared resource, for a render graph's bookkeeping.
 struct ResourceDecl {
   enum class Access : std::uint8_t { kRead, kWrite };
-  const char* name;  // "bone_matrices", "camera", "lights", "static_geometry", "color_rgba8", ...
+  const char* name;  // "bone_matrices", "camera", "lights", "static_geometry", "gbuffer", "color_rgba8", ...
   Access access;
   bool optional;
-  std::size_t bytes_per_pixel;  // outputs: the element size per pixel; inputs: 0
+  // Outputs: the element size per pixel (the shadow mask's per light);
+  // inputs: 0.
+  std::size_t bytes_per_pixel;
 };
 
 struct PassStats {
   double prepare_ms = 0.0;  // skinning, boxes, fallback, top level
-  double trace_ms = 0.0;    // primary and shadow rays
+  double trace_ms = 0.0;    // primary, shadow and ambient occlusion rays
   double shade_ms = 0.0;
   std::uint64_t primary_rays = 0;
   std::uint64_t shadow_rays = 0;
+  std::uint64_t ao_rays = 0;
   std::size_t escaped_triangles = 0;  // triangles outside their fuzzy boxes this frame
   // Of prepare_ms: building the per-frame tree over the escaped triangles,
   // what poses outside the baked pose space cost (0 inside it; the rays
@@ -163,11 +224,15 @@ class SINEW_API RayTracePass {
   // The pass's inputs, then the outputs its desc asked for.
   std::span<const ResourceDecl> resources() const noexcept;
 
-  // Renders `world` into `outputs`. With a scheduler, every parallel batch
-  // runs through it; otherwise on the pass's TBB arena. Errors:
-  // kInvalidArgument naming the input or output (a null buffer for a
-  // requested output, a bad pitch, a bad camera, too many lights); nothing
-  // is written then.
+  // Renders `world` into `outputs`; in the G-buffer mode
+  // (inputs.gbuffer.active()), traces from the host's surfaces and writes
+  // only the masks. With a scheduler, every parallel batch runs through it;
+  // otherwise on the pass's TBB arena. Errors: kInvalidArgument naming the
+  // input or output (a null buffer for a requested output, a bad pitch, a
+  // bad camera, too many lights, a light's bad size, sample counts out of
+  // range, a shadow mask without lights, in the G-buffer mode an output
+  // other than the masks or a missing normal buffer); nothing is written
+  // then.
   Result<PassStats> execute(World& world, const PassInputs& inputs, const PassOutputs& outputs,
                             const TaskScheduler* scheduler = nullptr) noexcept;
 

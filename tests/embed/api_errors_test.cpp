@@ -143,17 +143,19 @@ TEST(ApiPassErrors, DescriptionsAreChecked) {
   desc.outputs = api::Output::kDepth | api::Output::kTriangleId;
   auto pass = api::RayTracePass::create(desc);
   ASSERT_TRUE(pass.ok());
-  // Declared resources: the four inputs, then the two outputs asked for.
+  // Declared resources: the five inputs, then the two outputs asked for.
   const auto resources = pass->resources();
-  ASSERT_EQ(resources.size(), 6u);
+  ASSERT_EQ(resources.size(), 7u);
   EXPECT_STREQ(resources[0].name, "bone_matrices");
   EXPECT_FALSE(resources[0].optional);
   EXPECT_STREQ(resources[3].name, "static_geometry");
   EXPECT_TRUE(resources[3].optional);
-  EXPECT_STREQ(resources[4].name, "depth");
-  EXPECT_EQ(resources[4].access, api::ResourceDecl::Access::kWrite);
-  EXPECT_EQ(resources[4].bytes_per_pixel, 4u);
-  EXPECT_STREQ(resources[5].name, "triangle_id");
+  EXPECT_STREQ(resources[4].name, "gbuffer");
+  EXPECT_TRUE(resources[4].optional);
+  EXPECT_STREQ(resources[5].name, "depth");
+  EXPECT_EQ(resources[5].access, api::ResourceDecl::Access::kWrite);
+  EXPECT_EQ(resources[5].bytes_per_pixel, 4u);
+  EXPECT_STREQ(resources[6].name, "triangle_id");
 }
 
 TEST(ApiPassErrors, BadOutputsAndInputsWriteNothing) {

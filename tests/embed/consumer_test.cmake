@@ -26,13 +26,14 @@ run(${CMAKE_COMMAND} --build ${WORK_DIR}/host-build)
 pkg_config_flags(${prefix} pc_flags)
 run(${CXX} ${SOURCE_DIR}/examples/minimal/minimal.cpp ${pc_flags} -o ${WORK_DIR}/minimal)
 
-# 4. One frame: the editor's and the host's, same pack, pose, camera, light.
+# 4. One frame: the editor's and the host's, same pack, pose, camera, light
+#    (a point light: the host's default is a sphere light).
 set(camera 0.0108692,1.37059,3.10876,0.0108692,0.754971,0.0306663,0,1,0,40)
 run(${EDITOR} bake ${MODEL} -o ${WORK_DIR}/cesium.pack --threads 2)
 run(${EDITOR} render ${WORK_DIR}/cesium.pack --clip "#0" --time 0.7 --camera ${camera} --light 2,4,3
     --size 200x150 --instances 1 --ground off --threads 2 --out ${WORK_DIR}/editor)
 run(${WORK_DIR}/host-build/host_engine --headless --pack ${WORK_DIR}/cesium.pack --clip "#0" --time 0.7
-    --camera ${camera} --light 2,4,3 --size 200x150 --threads 2 --out ${WORK_DIR}/host)
+    --camera ${camera} --light 2,4,3 --light-radius 0 --size 200x150 --threads 2 --out ${WORK_DIR}/host)
 run(${IMAGE_DIFF} ${WORK_DIR}/host/sinew_color.ppm ${WORK_DIR}/editor/color.png
     --max-channel-diff 0 --max-differing-pixels 0)
 # The host's own pass shows around the character in its composite.
@@ -43,9 +44,20 @@ if(rc EQUAL 0)
   message(FATAL_ERROR "the composite equals Sinew's output: the host's pass is missing")
 endif()
 
+# 4b. The host's default light is a sphere light: the characters' shadows
+#     fall soft on the host's ground (Sinew's G-buffer mode), with a
+#     penumbra around them.
+run(${WORK_DIR}/host-build/host_engine --headless --pack ${WORK_DIR}/cesium.pack --clip "#0" --time 0.7
+    --size 200x150 --threads 2 --out ${WORK_DIR}/host-soft)
+string(REGEX MATCH "ground shadow: ([0-9]+) pixels shadowed, ([0-9]+) of them in penumbra" shadow_line
+       "${run_output}")
+if(NOT shadow_line OR CMAKE_MATCH_1 EQUAL 0 OR CMAKE_MATCH_2 EQUAL 0)
+  message(FATAL_ERROR "no soft shadow of the character on the host's ground: '${shadow_line}'")
+endif()
+
 # 5. Through the host's own thread pool: the same image.
 run(${WORK_DIR}/host-build/host_engine --headless --pack ${WORK_DIR}/cesium.pack --clip "#0" --time 0.7
-    --camera ${camera} --light 2,4,3 --size 200x150 --scheduler host --threads 3 --out ${WORK_DIR}/host-pool)
+    --camera ${camera} --light 2,4,3 --light-radius 0 --size 200x150 --scheduler host --threads 3 --out ${WORK_DIR}/host-pool)
 run(${IMAGE_DIFF} ${WORK_DIR}/host-pool/frame.ppm ${WORK_DIR}/host/frame.ppm --max-channel-diff 0)
 
 # 6. Ray queries: the camera frames CesiumMan in the image's centre, so
@@ -53,7 +65,7 @@ run(${IMAGE_DIFF} ${WORK_DIR}/host-pool/frame.ppm ${WORK_DIR}/host/frame.ppm --m
 #    clear. The highlight goes into frame.ppm only: a query before the pass
 #    leaves Sinew's own output identical to the editor's.
 run(${WORK_DIR}/host-build/host_engine --headless --pack ${WORK_DIR}/cesium.pack --clip "#0" --time 0.7
-    --camera ${camera} --light 2,4,3 --size 200x150 --threads 2 --pick 100,75 --out ${WORK_DIR}/host-pick)
+    --camera ${camera} --light 2,4,3 --light-radius 0 --size 200x150 --threads 2 --pick 100,75 --out ${WORK_DIR}/host-pick)
 expect_output("pick 100,75: selected instance 0,")
 expect_output("line of sight from the light: instance 0 visible")
 run(${IMAGE_DIFF} ${WORK_DIR}/host-pick/sinew_color.ppm ${WORK_DIR}/editor/color.png

@@ -7,6 +7,7 @@ sinew_add_test_binary(sinew_api_tests
           ${CMAKE_CURRENT_LIST_DIR}/api_queries_test.cpp
           ${CMAKE_CURRENT_LIST_DIR}/api_animation_test.cpp
           ${CMAKE_CURRENT_LIST_DIR}/api_framing_test.cpp
+          ${CMAKE_CURRENT_LIST_DIR}/api_gbuffer_test.cpp
   LIBS Sinew::raytrace sinew::editor sinew::content)
 target_include_directories(sinew_api_tests PRIVATE ${PROJECT_SOURCE_DIR})
 

@@ -1,7 +1,8 @@
 // Shared by the render tests (sinew_render_tests): the triangle tests the
 // packet and renderer tests run with, a random float in [0, 1), and the
 // scene of two mannequins on a ground quad that the packet, static-tile,
-// tile-stage and renderer tests trace.
+// tile-stage and renderer tests trace (and the mannequins alone, over a
+// host's ground that is not in the scene).
 #pragma once
 
 #include <gtest/gtest.h>
@@ -24,8 +25,9 @@ inline constexpr float kInf = std::numeric_limits<float>::infinity();
 inline float unit(std::mt19937& g) { return static_cast<float>(g() >> 8) * 0x1.0p-24f; }
 
 // Two mannequins on a ground quad, one idling inside its pose space, one
-// kicking out of it (its escaped triangles go through the fallback).
-inline std::unique_ptr<rt::Scene> make_scene() {
+// kicking out of it (its escaped triangles go through the fallback);
+// without the quad, the mannequins alone (standing on y = 0).
+inline std::unique_ptr<rt::Scene> make_scene(bool with_ground = true) {
   const testing_support::BakedModel& m = testing_support::idle_mannequin();
   auto scene = std::make_unique<rt::Scene>();
   const std::uint32_t character = scene->add_character(m.model.mesh, m.bake.fuzzy.view()).value();
@@ -37,10 +39,12 @@ inline std::unique_ptr<rt::Scene> make_scene() {
                                                                      i == 1 ? 0.4 : 0.3, place))
                     .ok());
   }
-  rt::StaticMeshDesc ground;
-  ground.positions = {{-5, 0, -5}, {5, 0, -5}, {-5, 0, 5}, {5, 0, 5}};
-  ground.triangles = {{0, 2, 1}, {1, 2, 3}};
-  EXPECT_TRUE(scene->add_static_mesh(ground).ok());
+  if (with_ground) {
+    rt::StaticMeshDesc ground;
+    ground.positions = {{-5, 0, -5}, {5, 0, -5}, {-5, 0, 5}, {5, 0, 5}};
+    ground.triangles = {{0, 2, 1}, {1, 2, 3}};
+    EXPECT_TRUE(scene->add_static_mesh(ground).ok());
+  }
   JobSystem jobs(2);
   EXPECT_TRUE(scene->prepare_frame(rt::FrameOptions{}, jobs).ok());
   return scene;
@@ -48,6 +52,11 @@ inline std::unique_ptr<rt::Scene> make_scene() {
 
 inline const rt::Scene& scene() {
   static const std::unique_ptr<rt::Scene> s = make_scene();
+  return *s;
+}
+
+inline const rt::Scene& mannequins_scene() {
+  static const std::unique_ptr<rt::Scene> s = make_scene(false);
   return *s;
 }
 

@@ -141,6 +141,37 @@ void shade_rgba8_only(const RenderSettings& settings, std::span<const Light> lig
 
 }  // namespace
 
+void write_visibility_masks(const RenderSettings& settings, std::span<const Light> lights, const OutputPlanes& out,
+                            const TileScratch& s) {
+  // Which lights' masks are fractions of samples (light_fraction) rather
+  // than their bit of s.lit.
+  std::uint32_t soft = 0;
+  for (std::size_t l = 0; l < out.shadow.channels && l < lights.size(); ++l) {
+    if (settings.shadows && lights[l].is_area()) soft |= 1u << l;
+  }
+  const bool ambient_occlusion = settings.ao_rays > 0;
+  for (std::size_t b = 0; b < s.blocks(); ++b) {
+    const std::uint32_t hits = s.block_hits[b];
+    for (std::uint32_t m = s.block_pixels[b]; m != 0; m &= m - 1) {
+      const int lane = std::countr_zero(m);
+      const std::size_t k = b * kBlockLanes + static_cast<std::size_t>(lane);
+      const int x = s.block_x0(b) + lane % kBlockWidth;
+      const int y = s.block_y0(b) + lane / kBlockWidth;
+      const bool hit = (hits >> lane & 1u) != 0;
+      if (out.shadow.wanted()) {
+        float* mask = out.shadow.at(x, y);
+        for (std::size_t l = 0; l < out.shadow.channels; ++l) {
+          const bool fraction = (soft >> l & 1u) != 0;
+          mask[l] = !hit ? 1.0f : fraction ? s.light_fraction[l * s.lanes + k] : static_cast<float>(s.lit[k] >> l & 1u);
+        }
+      }
+      if (out.ambient_occlusion.wanted()) {
+        *out.ambient_occlusion.at(x, y) = hit && ambient_occlusion ? s.ao_open[k] : 1.0f;
+      }
+    }
+  }
+}
+
 void shade_and_write(const RenderSettings& settings, std::span<const Light> lights, const OutputPlanes& host,
                      TileScratch& s) {
   // Written to the tile's staging planes, stored to the host's at the end.
@@ -159,19 +190,7 @@ void shade_and_write(const RenderSettings& settings, std::span<const Light> ligh
   // A row of a block that missed, whole.
   std::uint32_t background_row[kBlockWidth];
   for (std::uint32_t& pixel : background_row) std::memcpy(&pixel, background_bytes.data(), 4);
-  // The visibility masks of pixel (x, y), lane k: 1 on a miss.
-  const bool ambient_occlusion = settings.ao_rays > 0;
-  const auto write_masks = [&](int x, int y, std::size_t k, bool hit) {
-    if (out.shadow.wanted()) {
-      float* mask = out.shadow.at(x, y);
-      for (std::size_t l = 0; l < out.shadow.channels; ++l) {
-        const bool soft = shading_lights.terms[l].soft;
-        mask[l] = !hit ? 1.0f : soft ? s.light_fraction[l * s.lanes + k] : static_cast<float>(s.lit[k] >> l & 1u);
-      }
-    }
-    if (out.ambient_occlusion.wanted()) *out.ambient_occlusion.at(x, y) = hit && ambient_occlusion ? s.ao_open[k] : 1.0f;
-  };
-  const bool want_masks = out.shadow.wanted() || out.ambient_occlusion.wanted();
+  if (out.shadow.wanted() || out.ambient_occlusion.wanted()) write_visibility_masks(settings, lights, out, s);
   static constexpr float kMissDepths[kBlockWidth] = {kInf, kInf, kInf, kInf};
   static constexpr std::uint32_t kMissIds[kBlockWidth] = {kInvalidId, kInvalidId, kInvalidId, kInvalidId};
   for (std::size_t b = 0; b < blocks; ++b) {
@@ -203,9 +222,6 @@ void shade_and_write(const RenderSettings& settings, std::span<const Light> ligh
       for (int row = 0; row < kBlockHeight; ++row) {
         const std::size_t k = k0 + static_cast<std::size_t>(row * kBlockWidth);
         const int y = by + row;
-        if (want_masks) {
-          for (int i = 0; i < kBlockWidth; ++i) write_masks(bx + i, y, k + static_cast<std::size_t>(i), hits != 0u);
-        }
         if (out.triangle.wanted()) std::memcpy(out.triangle.at(bx, y), &s.triangle[k], 4 * sizeof(std::uint32_t));
         if (out.instance.wanted()) std::memcpy(out.instance.at(bx, y), &s.instance[k], 4 * sizeof(std::uint32_t));
         if (hits == 0u) {
@@ -250,7 +266,6 @@ void shade_and_write(const RenderSettings& settings, std::span<const Light> ligh
       const std::size_t k = k0 + static_cast<std::size_t>(lane);
       const int x = bx + lane % kBlockWidth;
       const int y = by + lane / kBlockWidth;
-      if (want_masks) write_masks(x, y, k, (hits >> lane & 1u) != 0);
       if (out.triangle.wanted()) *out.triangle.at(x, y) = s.triangle[k];
       if (out.instance.wanted()) *out.instance.at(x, y) = s.instance[k];
       if (!(hits >> lane & 1u)) {

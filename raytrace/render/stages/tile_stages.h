@@ -5,6 +5,9 @@
 //   -> per light: aim_shadow_rays -> trace_shadow_rays
 //   -> shade_and_write
 //
+// or, on a host's own surfaces (render/host_surfaces.h), the surfaces
+// filled from its buffers -> trace_light_rays -> write_visibility_masks.
+//
 // Renderer::render runs them per tile; the Embree peer of the benchmarks
 // runs the same stages with its own two trace stages, so camera rays,
 // surfaces, shadow-ray origins and shading are the same code for both.
@@ -161,6 +164,16 @@ void trace_light_rays(const Scene& scene, const RenderSettings& settings, std::s
 using ShadowTracer = std::function<std::uint64_t(int l, TileScratch& s, TraversalCounters& counters)>;
 void trace_light_rays(const RenderSettings& settings, std::span<const Light> lights, TileScratch& s,
                       LightRayWork& work, const ShadowTracer& trace);
+
+// The visibility masks of the tile's pixels into `out` (the tile's staged
+// planes or the host's; each written only when wanted), from what
+// trace_light_rays left: per light its bit of s.lit (a hard light) or its
+// fraction of samples (an area light, with shadows on), and the open
+// fraction of the ambient occlusion rays (with ao_rays). A pixel without a
+// surface gets 1 everywhere. The one writer of the masks, for the camera
+// path (shade_and_write) and a host's surfaces (Renderer::render_visibility).
+void write_visibility_masks(const RenderSettings& settings, std::span<const Light> lights, const OutputPlanes& out,
+                            const TileScratch& s);
 
 // Diffuse shading (ambient + each unblocked light's N.L) and the requested
 // outputs of the tile's pixels, through s.staging: line-aligned planes get
