@@ -183,6 +183,23 @@ struct EmbreeTracer::State {
     }
     return {};
   }
+
+  // The geometry built from `source` (a scene or caller-skinned meshes) on
+  // the first call, its positions refreshed on later ones; then the
+  // rebuild or refit. Returns milliseconds.
+  template <class Source>
+  Expected<double> update(const Source& source) {
+    const Clock::time_point start = Clock::now();
+    if (!built) {
+      SINEW_RETURN_IF_ERROR(first_build(source));
+    } else {
+      SINEW_RETURN_IF_ERROR(refresh(source));
+    }
+    rtcCommitScene(scene);
+    const double ms = ms_between(start, Clock::now());
+    if (rtcGetDeviceError(device) != RTC_ERROR_NONE) return embree_error(device, "rtcCommitScene");
+    return ms;
+  }
 };
 
 EmbreeTracer::EmbreeTracer(std::unique_ptr<State> state) : state_(std::move(state)) {}
@@ -204,33 +221,9 @@ Expected<std::unique_ptr<EmbreeTracer>> EmbreeTracer::create(EmbreeMode mode, in
   return std::unique_ptr<EmbreeTracer>(new EmbreeTracer(std::move(state)));
 }
 
-Expected<double> EmbreeTracer::update(const rt::Scene& scene) {
-  State& s = *state_;
-  const Clock::time_point start = Clock::now();
-  if (!s.built) {
-    SINEW_RETURN_IF_ERROR(s.first_build(scene));
-  } else {
-    SINEW_RETURN_IF_ERROR(s.refresh(scene));
-  }
-  rtcCommitScene(s.scene);
-  const double ms = ms_between(start, Clock::now());
-  if (rtcGetDeviceError(s.device) != RTC_ERROR_NONE) return embree_error(s.device, "rtcCommitScene");
-  return ms;
-}
+Expected<double> EmbreeTracer::update(const rt::Scene& scene) { return state_->update(scene); }
 
-Expected<double> EmbreeTracer::update(std::span<const EmbreeMesh> meshes) {
-  State& s = *state_;
-  const Clock::time_point start = Clock::now();
-  if (!s.built) {
-    SINEW_RETURN_IF_ERROR(s.first_build(meshes));
-  } else {
-    SINEW_RETURN_IF_ERROR(s.refresh(meshes));
-  }
-  rtcCommitScene(s.scene);
-  const double ms = ms_between(start, Clock::now());
-  if (rtcGetDeviceError(s.device) != RTC_ERROR_NONE) return embree_error(s.device, "rtcCommitScene");
-  return ms;
-}
+Expected<double> EmbreeTracer::update(std::span<const EmbreeMesh> meshes) { return state_->update(meshes); }
 
 Hit EmbreeTracer::intersect1(const Ray& ray) const {
   RTCIntersectContext context;
