@@ -244,7 +244,7 @@ TEST_F(TextureDecode, BytesNoDecoderReadsAndMissingFilesAreErrorsNamingTheImage)
   // (libpng's longjmp leaves it behind), with no frame of Sinew's for a
   // suppression to name: LeakSanitizer ignores that one call's allocations.
   {
-    LeakCheckPause pause;
+    [[maybe_unused]] const LeakCheckPause pause;
     EXPECT_FALSE(decode_texture(std::as_bytes(std::span(file)), "image/png", "half", TextureWrap::kRepeat,
                                 TextureWrap::kRepeat)
                      .ok());
