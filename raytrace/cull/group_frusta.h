@@ -1,6 +1,8 @@
 // GroupFrusta: for each group of eight rays from one apex (camera rays, a
 // point light's shadow rays), four planes through the apex that hold its
-// rays, and for rays that end (shadow rays) a far plane. A triangle whose
+// rays, and for rays that end (shadow rays) a far plane. Segments that
+// start anywhere within a radius of the apex (an area light's samples) get
+// the four side planes tilted to hold them (tilt_side). A triangle whose
 // corners all lie beyond one plane is missed by the whole group, so a leaf's
 // triangle is tested only by the groups it reaches. Also the packet's own
 // frustum, tested first, and each group's slab in the packet's basis
@@ -37,6 +39,35 @@ inline Float8 grown_slope(Float8 s) { return Float8(kFrustumMargin) * (Float8(1.
 // A far plane's offset from the largest reach of its rays along its normal.
 inline float far_offset(float reach) { return reach * (1.0f + kFrustumMargin); }
 inline Float8 far_offset(Float8 reach) { return reach * Float8(1.0f + kFrustumMargin); }
+
+// A side plane n . x <= 0 of segments' far ends x = q (relative to the
+// apex, each q with n . q <= 0 and depth c . q <= far along the unit
+// centre c) made to hold the whole segments when each starts at some w
+// within `radius` of the apex: a point (1 - t) w + t q has
+//   n . x + alpha c . x <= (1 - t)(R |n| + alpha R) + t alpha far,
+// so the plane n + alpha c with offset max(R |n| + alpha R, alpha far)
+// holds it for any alpha >= 0; alpha = R |n| / (far - R) makes both terms
+// equal: the plane is tangent to the ball at the apex and meets the
+// deepest ends. `far` must exceed the radius (set_block asks for twice);
+// both offsets' sums are grown as far planes are.
+struct TiltedSide {
+  Vec3x8 n;
+  Float8 offset;
+};
+inline TiltedSide tilt_side(const Vec3x8& n, const Vec3x8& c, Float8 far, float radius) {
+  const Float8 r(radius);
+  const Float8 rn = r * sqrt(dot(n, n));
+  const Float8 alpha = rn / max(far - r, Float8(std::numeric_limits<float>::min()));
+  return {n + alpha * c, far_offset(max(rn + alpha * r, alpha * far))};
+}
+// tilt_side for one plane; returns the slope alpha added along c.
+inline float tilt_side(Vec3& n, float& offset, const Vec3& c, float far, float radius) {
+  const float rn = radius * std::sqrt(glm::dot(n, n));
+  const float alpha = rn / std::max(far - radius, std::numeric_limits<float>::min());
+  n = n + alpha * c;
+  offset = far_offset(std::max(rn + alpha * radius, alpha * far));
+  return alpha;
+}
 
 // How far beyond a plane a shape must lie to be culled, per unit of the
 // plane's L1 norm: kFrustumMargin of the coordinate magnitudes involved (its
@@ -99,9 +130,13 @@ class GroupFrusta {
 
  public:
   // A packet of `groups` groups whose rays' points are apex + s q, s >= 0;
-  // every group starts with no frustum (it reaches every triangle).
-  void reset(const Vec3& apex, int groups) {
+  // every group starts with no frustum (it reaches every triangle). With a
+  // radius, the rays are segments from points within it of the apex to
+  // apex + reach q, and only frusta with far planes are built, their sides
+  // tilted to hold the segments (tilt_side).
+  void reset(const Vec3& apex, int groups, float radius = 0.0f) {
     apex_ = apex;
+    apex_radius_ = radius;
     apex_magnitude_ = std::max({std::fabs(apex.x), std::fabs(apex.y), std::fabs(apex.z)});
     groups_ = std::clamp(groups, 0, kMaxGroups);
     // The planes themselves are left as they are: reached() reads only
@@ -155,7 +190,7 @@ class GroupFrusta {
   void set_bound(std::uint64_t groups, float sign, Q&& q, Lanes&& lanes, Reach&& reach) {
     bound_groups_ = 0;
     groups &= live_groups();
-    if (groups == 0) return;
+    if (groups == 0 || (!kFar && apex_radius_ > 0.0f)) return;
     const Float8 zero(0.0f);
     const auto directions = [&](int g, std::uint32_t use_bits) {
       const Mask8 use = Mask8::from_bits(use_bits);
@@ -208,20 +243,33 @@ class GroupFrusta {
       a_hi = max(a_hi, ga_hi);
       b_lo = min(b_lo, gb_lo);
       b_hi = max(b_hi, gb_hi);
-      const float ranges[4] = {reduce_min(ga_lo), reduce_max(ga_hi), reduce_min(gb_lo), reduce_max(gb_hi)};
-      for (int i = 0; i < 4; ++i) {
-        const float grown = i % 2 == 0 ? ranges[i] - grown_slope(ranges[i]) : ranges[i] + grown_slope(ranges[i]);
-        slab_[i][g] = grown;
-        // |n|_1 of the side's plane (u or v minus grown times c), as store_planes.
-        slab_scale_[i][g] = 1.001f * ((i < 2 ? u1 : v1) + std::fabs(grown) * c1);
-      }
+      float group_offset = big;
       if constexpr (kFar) {
         alignas(32) float r[8] = {};
         reach(g, r);
         const Float8 group_far = select(use, Float8::load(r) * dc, zero);
         far = max(far, group_far);
         const float offset = far_offset(reduce_max(group_far));
-        slab_far_[g] = std::isfinite(offset) ? offset : big;
+        group_offset = std::isfinite(offset) ? offset : big;
+        slab_far_[g] = group_offset;
+      }
+      if (apex_radius_ > 0.0f && !(group_offset > 2.0f * apex_radius_)) return;
+      const float ranges[4] = {reduce_min(ga_lo), reduce_max(ga_hi), reduce_min(gb_lo), reduce_max(gb_hi)};
+      for (int i = 0; i < 4; ++i) {
+        const bool low = i % 2 == 0;
+        float grown = low ? ranges[i] - grown_slope(ranges[i]) : ranges[i] + grown_slope(ranges[i]);
+        slab_offset_[i][g] = 0.0f;
+        if (apex_radius_ > 0.0f) {
+          // The side's plane, (u or v) - grown c on the high side and its
+          // negation on the low, tilted by alpha c: the slope moves in.
+          const Vec3& w = i < 2 ? u : v;
+          Vec3 n = low ? grown * c - w : w - grown * c;
+          const float alpha = tilt_side(n, slab_offset_[i][g], c, group_offset, apex_radius_);
+          grown = low ? grown + alpha : grown - alpha;
+        }
+        slab_[i][g] = grown;
+        // |n|_1 of the side's plane (u or v minus grown times c), as store_planes.
+        slab_scale_[i][g] = 1.001f * ((i < 2 ? u1 : v1) + std::fabs(grown) * c1);
       }
     }
     slab_basis_[0] = c;
@@ -230,8 +278,13 @@ class GroupFrusta {
     slab_far_scale_ = 1.001f * c1;
     slab_groups_ = groups;
     const float alo = reduce_min(a_lo), ahi = reduce_max(a_hi), blo = reduce_min(b_lo), bhi = reduce_max(b_hi);
-    const Vec3 planes[4] = {u - (ahi + grown_slope(ahi)) * c, (alo - grown_slope(alo)) * c - u, v - (bhi + grown_slope(bhi)) * c,
-                            (blo - grown_slope(blo)) * c - v};
+    Vec3 planes[4] = {u - (ahi + grown_slope(ahi)) * c, (alo - grown_slope(alo)) * c - u, v - (bhi + grown_slope(bhi)) * c,
+                      (blo - grown_slope(blo)) * c - v};
+    float side_offsets[4] = {};
+    const float far_reach = far_offset(reduce_max(far));
+    if (apex_radius_ > 0.0f) {
+      for (int i = 0; i < 4; ++i) tilt_side(planes[i], side_offsets[i], c, far_reach, apex_radius_);
+    }
     // Lane i: plane i (the unused lanes' zero normals never cut).
     for (int a = 0; a < 3; ++a) std::fill(std::begin(bound_n_[a]), std::end(bound_n_[a]), 0.0f);
     std::fill(std::begin(bound_scale_), std::end(bound_scale_), 0.0f);
@@ -243,10 +296,9 @@ class GroupFrusta {
       bound_scale_[i] = 1.001f * (std::fabs(n.x) + std::fabs(n.y) + std::fabs(n.z));
       bound_offset_[i] = offset;
     };
-    for (int i = 0; i < 4; ++i) set(i, planes[i], 0.0f);
+    for (int i = 0; i < 4; ++i) set(i, planes[i], side_offsets[i]);
     if constexpr (kFar) {
-      const float offset = far_offset(reduce_max(far));
-      if (std::isfinite(offset)) set(4, c, offset);
+      if (std::isfinite(far_reach)) set(4, c, far_reach);
     }
     bound_groups_ = groups;
   }
@@ -305,13 +357,22 @@ class GroupFrusta {
         Mask8 cut = Mask8::from_bits(0);
         const auto d = [&](int i) { return x.nearest(n_[i][0][g], n_[i][1][g], n_[i][2][g]); };
         if (sides) {
-          for (int i = 0; i < 4; ++i) cut = cut | (d(i) > Float8(scale_[i][g]) * x.margin);
+          for (int i = 0; i < 4; ++i) cut = cut | (d(i) > Float8(scale_[i][g]) * x.margin + Float8(offset_[i][g]));
         }
-        if (far) cut = cut | (d(4) > Float8(scale_[4][g]) * x.margin + Float8(offset_[g]));
+        if (far) cut = cut | (d(4) > Float8(scale_[4][g]) * x.margin + Float8(offset_[4][g]));
         reach &= ~cut.bits();
       }
       for (; reach != 0; reach &= reach - 1) out[std::countr_zero(reach)] |= std::uint64_t{1} << g;
     }
+  }
+
+  // Whether any group or the packet has a plane to cull with.
+  bool any_plane() const {
+    if (bound_groups_ != 0) return true;
+    for (std::size_t b = 0; b < sides_.size(); ++b) {
+      if ((sides_[b] | far_[b]) != 0) return true;
+    }
+    return false;
   }
 
   // Whether reached() tests triangles against the groups' slabs in the
@@ -405,10 +466,10 @@ class GroupFrusta {
       if (part == 0) continue;
       const SlabDistances d = distances(Float8::load(&slab_[0][base]), Float8::load(&slab_[1][base]),
                                         Float8::load(&slab_[2][base]), Float8::load(&slab_[3][base]));
-      const Mask8 cut = (d.a_hi > Float8::load(&slab_scale_[1][base]) * margin) |
-                        (d.a_lo > Float8::load(&slab_scale_[0][base]) * margin) |
-                        (d.b_hi > Float8::load(&slab_scale_[3][base]) * margin) |
-                        (d.b_lo > Float8::load(&slab_scale_[2][base]) * margin) |
+      const auto beyond = [&](Float8 distance, int i) {
+        return distance > Float8::load(&slab_scale_[i][base]) * margin + Float8::load(&slab_offset_[i][base]);
+      };
+      const Mask8 cut = beyond(d.a_hi, 1) | beyond(d.a_lo, 0) | beyond(d.b_hi, 3) | beyond(d.b_lo, 2) |
                         (z_min > Float8::load(&slab_far_[base]) + Float8(slab_far_scale_) * margin);
       out |= (part & ~static_cast<std::uint64_t>(cut.bits())) << base;
     }
@@ -440,9 +501,9 @@ class GroupFrusta {
       for (int i = 0; i < (far != 0 ? 5 : 4); ++i) {
         const Float8 d = nearest(Float8::load(&n_[i][0][base]), Float8::load(&n_[i][1][base]),
                                  Float8::load(&n_[i][2][base]));
-        const Float8 limit = Float8::load(&scale_[i][base]) * margin;
+        const Float8 limit = Float8::load(&scale_[i][base]) * margin + Float8::load(&offset_[i][base]);
         if (i == 4) {
-          culled_by_far = d > limit + Float8::load(&offset_[base]);
+          culled_by_far = d > limit;
         } else {
           culled_by_sides = culled_by_sides | (d > limit);
         }
@@ -458,6 +519,7 @@ class GroupFrusta {
   // lanes(g) repeat its first live lane, so they widen nothing.
   template <bool kFar, class Q, class Lanes, class Reach>
   void set_block(int base, std::uint32_t block, float sign, Q& q, Lanes& lanes, Reach& reach) {
+    if (!kFar && apex_radius_ > 0.0f) return;  // segments need their ends
     alignas(32) float t[3][8][8];    // [axis][ray][group]
     alignas(32) float r[8][8] = {};  // [ray][group]
     std::uint32_t full = 0;          // the groups with live lanes
@@ -514,28 +576,38 @@ class GroupFrusta {
       b_hi = max(b_hi, b);
       if constexpr (kFar) far = max(far, Float8::load(r[j]) * dc[j]);
     }
-    store_planes(0, base, u - (a_hi + grown_slope(a_hi)) * c, ok);
-    store_planes(1, base, (a_lo - grown_slope(a_lo)) * c - u, ok);
-    store_planes(2, base, v - (b_hi + grown_slope(b_hi)) * c, ok);
-    store_planes(3, base, (b_lo - grown_slope(b_lo)) * c - v, ok);
+    const Float8 far_reach = far_offset(far);
+    const Vec3x8 planes[4] = {u - (a_hi + grown_slope(a_hi)) * c, (a_lo - grown_slope(a_lo)) * c - u,
+                              v - (b_hi + grown_slope(b_hi)) * c, (b_lo - grown_slope(b_lo)) * c - v};
+    if (apex_radius_ > 0.0f) {
+      // Segments from within the radius: only groups whose ends lie well
+      // beyond it, each side tilted to hold them.
+      ok = ok & (far_reach > Float8(2.0f * apex_radius_)) & is_finite(far_reach);
+      if (ok.bits() == 0) return;
+      for (int i = 0; i < 4; ++i) {
+        const TiltedSide side = tilt_side(planes[i], c, far_reach, apex_radius_);
+        store_planes(i, base, side.n, side.offset, ok);
+      }
+    } else {
+      for (int i = 0; i < 4; ++i) store_planes(i, base, planes[i], zero, ok);
+    }
     sides_[static_cast<std::size_t>(base / 8)] |= static_cast<std::uint8_t>(ok.bits());
     if constexpr (kFar) {
-      const Float8 offset = far_offset(far);
-      const Mask8 far_ok = ok & is_finite(offset);
+      const Mask8 far_ok = ok & is_finite(far_reach);
       if (far_ok.bits() != 0) {
-        store_planes(4, base, c, far_ok);
-        select(far_ok, offset, Float8::load(&offset_[base])).store(&offset_[base]);
+        store_planes(4, base, c, far_reach, far_ok);
         far_[static_cast<std::size_t>(base / 8)] |= static_cast<std::uint8_t>(far_ok.bits());
       }
     }
   }
-  // Plane i of the groups base + k for the lanes k of `m`, and its |n|_1
-  // (slightly more, for the rounding of the products).
-  void store_planes(int i, int base, const Vec3x8& n, Mask8 m) {
+  // Plane i of the groups base + k for the lanes k of `m`: its normal, its
+  // |n|_1 (slightly more, for the rounding of the products) and its offset.
+  void store_planes(int i, int base, const Vec3x8& n, Float8 offset, Mask8 m) {
     const Float8* const axis[3] = {&n.x, &n.y, &n.z};
     for (int a = 0; a < 3; ++a) select(m, *axis[a], Float8::load(&n_[i][a][base])).store(&n_[i][a][base]);
     const Float8 scale = Float8(1.001f) * ((abs(n.x) + abs(n.y)) + abs(n.z));
     select(m, scale, Float8::load(&scale_[i][base])).store(&scale_[i][base]);
+    select(m, offset, Float8::load(&offset_[i][base])).store(&offset_[i][base]);
   }
 
   std::uint64_t live_groups() const { return groups_ >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << groups_) - 1u; }
@@ -575,6 +647,7 @@ class GroupFrusta {
     return true;
   }
   Vec3 apex_{0.0f};
+  float apex_radius_ = 0.0f;  // reset(): the segments start within it of the apex
   float apex_magnitude_ = 0.0f;
   int groups_ = 0;
   // Per plane (four sides, then the far plane), axis and group; read only
@@ -583,7 +656,7 @@ class GroupFrusta {
   alignas(32) std::array<std::array<std::array<float, kMaxGroups>, 3>, 5> n_{};
   std::array<std::uint8_t, kMaxGroups / 8> sides_{}, far_{};
   alignas(32) std::array<std::array<float, kMaxGroups>, 5> scale_{};
-  alignas(32) std::array<float, kMaxGroups> offset_{};  // the far plane's, per group
+  alignas(32) std::array<std::array<float, kMaxGroups>, 5> offset_{};  // per plane and group
   // The packet's frustum (set_bound): lane i of each array is plane i (four
   // sides, then the far plane), for the groups of bound_groups_.
   alignas(32) float bound_n_[3][8] = {};
@@ -598,6 +671,7 @@ class GroupFrusta {
   Vec3 slab_basis_[3] = {Vec3(0.0f), Vec3(0.0f), Vec3(0.0f)};  // c, u, v
   alignas(32) std::array<std::array<float, kMaxGroups>, 4> slab_{};
   alignas(32) std::array<std::array<float, kMaxGroups>, 4> slab_scale_{};
+  alignas(32) std::array<std::array<float, kMaxGroups>, 4> slab_offset_{};  // tilted sides' (tilt_side)
   alignas(32) std::array<float, kMaxGroups> slab_far_{};
   float slab_far_scale_ = 0.0f;
 };

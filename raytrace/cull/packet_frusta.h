@@ -33,20 +33,22 @@ class PacketFrusta {
   }
   bool on() const { return on_; }
 
-  // For `groups` groups of rays from `apex`, t >= 0: the grid's planes when
-  // the packet has a grid that bounds its rays, else group frusta built as
-  // leaves need them (`slabs`: each group's slab in the packet's basis, for
-  // shadow packets). directions(g): group g's directions [3][8]; lanes(g):
-  // its live lanes.
+  // For `groups` groups of rays from `apex`, t >= 0 (or with a radius,
+  // segments from within it of the apex to apex + reach directions; see
+  // GroupFrusta::reset): the grid's planes when the packet has a grid that
+  // bounds its rays, else group frusta built as leaves need them (`slabs`:
+  // each group's slab in the packet's basis, for shadow packets).
+  // directions(g): group g's directions [3][8]; lanes(g): its live lanes.
   template <class Directions, class Lanes>
-  void start(const Vec3& apex, int groups, const Grid& grid, bool slabs, Directions&& directions, Lanes&& lanes) {
+  void start(const Vec3& apex, float radius, int groups, const Grid& grid, bool slabs, Directions&& directions,
+             Lanes&& lanes) {
     off();
     on_ = true;
-    if (grid.columns > 0 &&
+    if (grid.columns > 0 && radius == 0.0f &&
         grid_.build(apex, grid.forward, grid.right, grid.up, groups, grid.columns, directions, lanes)) {
       return;
     }
-    frusta_.reset(apex, groups);
+    frusta_.reset(apex, groups, radius);
     slabs_ = slabs;
     frusta_.use_slabs(slabs_);
   }
@@ -68,6 +70,10 @@ class PacketFrusta {
     }
     built_ = built;
   }
+
+  // Whether any plane was built: rays spread too wide (or segments whose
+  // ends lie too near their apex) leave none.
+  bool culls() const { return grid_.on() || frusta_.any_plane(); }
 
   // The groups of `groups` whose frustum may reach the box.
   std::uint64_t box_reached(const Aabb& box, std::uint64_t groups) const {

@@ -199,8 +199,12 @@ TEST(GroupFrusta, EveryHitTriangleIsReachedBySegmentsFromTheApex) {
 // A 32x16-pixel packet from `apex` (offset from the origin by up to
 // `offset`) about a random centre, `pixel` apart: rays, or segments to
 // t = 1 of lengths 1 to 41; with `partial`, random lanes of each group.
+// With a radius, each segment starts at a random point within it of the
+// apex (an area light's sample) and ends where the one from the apex would:
+// q holds the ends relative to the apex, as the packet gives them.
 struct Packet {
   Vec3 apex{0.0f};
+  float radius = 0.0f;
   float pixel = 0.0f;
   float q[64][3][8];
   alignas(32) float reach[64][8];
@@ -208,8 +212,9 @@ struct Packet {
   std::array<Ray, 512> rays;
 };
 
-void make_packet(float offset, bool segments, bool partial, std::mt19937& g, Packet& p) {
+void make_packet(float offset, bool segments, bool partial, std::mt19937& g, Packet& p, float radius = 0.0f) {
   p.apex = offset * random_vec(g) + random_vec(g);
+  p.radius = radius;
   const Vec3 c = glm::normalize(random_vec(g) + Vec3(0.0f, 0.0f, 1e-3f));
   const Vec3 u = glm::normalize(glm::cross(c, std::fabs(c.z) < 0.9f ? Vec3(0, 0, 1) : Vec3(1, 0, 0)));
   const Vec3 v = glm::cross(c, u);
@@ -228,6 +233,14 @@ void make_packet(float offset, bool segments, bool partial, std::mt19937& g, Pac
       Ray& r = p.rays[static_cast<std::size_t>(8 * group + lane)];
       r.origin = p.apex;
       r.direction = d;
+      if (radius > 0.0f) {
+        Vec3 w = random_vec(g);
+        while (glm::dot(w, w) > 1.0f) w = random_vec(g);
+        // Some on the ball's surface, the farthest a sample lies.
+        if (g() % 4 == 0) w = glm::normalize(w);
+        r.origin = p.apex + radius * w;
+        r.direction = (p.apex + d) - r.origin;
+      }
       r.t_min = 0.0f;
       r.t_max = p.reach[group][lane];
     }
@@ -237,7 +250,7 @@ void make_packet(float offset, bool segments, bool partial, std::mt19937& g, Pac
 // The packet's frusta: each group's own (unless `slabs`), then, with
 // `bound`, the packet's bound and the groups' slabs in its basis.
 void build_frusta(const Packet& p, bool segments, bool slabs, bool bound, rt::GroupFrusta<64>& frusta) {
-  frusta.reset(p.apex, 64);
+  frusta.reset(p.apex, 64, p.radius);
   frusta.use_slabs(slabs);
   const auto directions = [&](int group) -> const float (&)[3][8] { return p.q[group]; };
   const auto lanes_of = [&](int group) { return p.lanes[group]; };
@@ -329,6 +342,105 @@ TEST(GroupFrusta, ThePacketFrustumNeverCullsATriangleALaneHits) {
   }
 }
 
+// Segments from anywhere within a radius of the apex (an area light's
+// samples) to ends a packet's frusta are built around: the tilted sides
+// (tilt_side) never cull a triangle or a box a segment meets, with the
+// groups' own frusta, with their slabs and with the packet's bound, near
+// the origin and far from it; and they still cull most triangles beside
+// the packet's shaft.
+TEST(GroupFrusta, SegmentsFromWithinARadiusOfTheApexAreNeverCulled) {
+  for (const bool slabs : {false, true}) {
+    SCOPED_TRACE(slabs ? "slabs" : "own frusta");
+    std::mt19937 g(29);
+    int tried = 0, hit = 0, culled = 0, boxes_entered = 0, missed_from_apex = 0;
+    for (const float offset : {0.0f, 60.0f, 4000.0f}) {
+      for (int packet = 0; packet < 20; ++packet) {
+        Packet pk;
+        const float radius = 0.02f + 0.3f * unit(g);  // the ends lie 1 to 41 away
+        make_packet(offset, true, packet % 4 == 0, g, pk, radius);
+        rt::GroupFrusta<64> frusta, from_apex;
+        build_frusta(pk, true, slabs, true, frusta);
+        // The same ends as rays from the apex itself, for the test's teeth.
+        Packet apex_only = pk;
+        apex_only.radius = 0.0f;
+        build_frusta(apex_only, true, slabs, true, from_apex);
+        for (int trial = 0; trial < 300; ++trial) {
+          const auto [p0, p1, p2] = triangle_near(pk, true, g);
+          const std::uint64_t reached = frusta.reached(p0, p1, p2, ~std::uint64_t{0});
+          const Aabb box{glm::min(p0, glm::min(p1, p2)), glm::max(p0, glm::max(p1, p2))};
+          const std::uint64_t box_groups = frusta.box_reached(box, ~std::uint64_t{0});
+          ++tried;
+          if (reached == 0) ++culled;
+          for (int lane = 0; lane < 512; ++lane) {
+            if (!(pk.lanes[lane / 8] >> (lane % 8) & 1u)) continue;
+            const Ray& ray = pk.rays[static_cast<std::size_t>(lane)];
+            if (enters(ray, box)) {
+              ++boxes_entered;
+              ASSERT_NE(box_groups >> (lane / 8) & 1u, 0u) << "lane " << lane << " enters a culled box; packet "
+                                                            << packet << " trial " << trial << " offset " << offset;
+            }
+            if (!hits(ray, p0, p1, p2)) continue;
+            ++hit;
+            ASSERT_NE(reached >> (lane / 8) & 1u, 0u) << "lane " << lane << " hits a culled triangle; packet "
+                                                       << packet << " trial " << trial << " offset " << offset;
+            if ((from_apex.reached(p0, p1, p2, ~std::uint64_t{0}) >> (lane / 8) & 1u) == 0) ++missed_from_apex;
+          }
+        }
+      }
+    }
+    EXPECT_GT(hit, tried / 10);
+    EXPECT_GT(boxes_entered, tried / 10);
+    EXPECT_GT(culled, tried / 10) << culled << " of " << tried;
+    // Untilted frusta would cull triangles these segments hit.
+    EXPECT_GT(missed_from_apex, hit / 50) << missed_from_apex << " of " << hit;
+  }
+}
+
+// A radius needs the segments' ends: rays without a far plane, or ends
+// within twice the radius of the apex, get no frustum and reach everything.
+TEST(GroupFrusta, ARadiusWithoutFarEndsBuildsNoFrustum) {
+  const Vec3 light(0.5f, 1.0f, -2.0f);
+  float q[3][8] = {};
+  alignas(32) float reach[8];
+  for (int lane = 0; lane < 8; ++lane) {
+    q[0][lane] = 0.01f * static_cast<float>(lane % 4);
+    q[1][lane] = 0.01f * static_cast<float>(lane / 4);
+    q[2][lane] = 1.0f;
+    reach[lane] = 10.0f;
+  }
+  const Vec3 p0 = light + Vec3(3, 3, 5), p1 = light + Vec3(4, 3, 5), p2 = light + Vec3(3, 4, 5);
+  rt::GroupFrusta<8> rays, near, segments;
+  rays.reset(light, 1, 0.5f);
+  rays.set_group(0, q, 0xFFu);
+  EXPECT_FALSE(rays.any_plane());
+  EXPECT_EQ(rays.reached(p0, p1, p2, 1u), 1u);
+  near.reset(light, 1, 6.0f);
+  near.set_group(0, q, 0xFFu, reach);
+  EXPECT_FALSE(near.any_plane());
+  EXPECT_EQ(near.reached(p0, p1, p2, 1u), 1u);
+  // Ends well beyond it: a frustum, and the triangle off to the side is culled.
+  segments.reset(light, 1, 0.5f);
+  segments.set_group(0, q, 0xFFu, reach);
+  EXPECT_TRUE(segments.any_plane());
+  EXPECT_EQ(segments.reached(p0, p1, p2, 1u), 0u);
+  // Near the light, one that the segment from light + (0.45, 0, 0.1) to
+  // its end crosses (at z = 0.5, about (0.43, 0)) is reached, though rays
+  // from the apex itself pass far from it.
+  const Vec3 c0 = light + Vec3(0.38f, -0.02f, 0.5f), c1 = light + Vec3(0.47f, -0.02f, 0.5f),
+             c2 = light + Vec3(0.38f, 0.07f, 0.5f);
+  Ray crossing;
+  crossing.origin = light + Vec3(0.45f, 0.0f, 0.1f);
+  crossing.direction = light + Vec3(0.0f, 0.0f, 10.0f) - crossing.origin;
+  crossing.t_min = 0.0f;
+  crossing.t_max = 1.0f;
+  ASSERT_TRUE(hits(crossing, c0, c1, c2));
+  EXPECT_EQ(segments.reached(c0, c1, c2, 1u), 1u);
+  rt::GroupFrusta<8> from_apex;
+  from_apex.reset(light, 1);
+  from_apex.set_group(0, q, 0xFFu, reach);
+  EXPECT_EQ(from_apex.reached(c0, c1, c2, 1u), 0u);
+}
+
 // reached8 (a leaf's triangles eight at a time, traverse/large_packet.cpp)
 // decides each triangle and group as reached() does with the groups' own
 // frusta alone (the packet's bound is not its to test), and as reached()
@@ -342,7 +454,8 @@ TEST(GroupFrusta, ReachedEightAtATimeDecidesAsOneAtATime) {
       for (const float offset : {0.0f, 60.0f, 4000.0f}) {
         for (int packet = 0; packet < 8; ++packet) {
           Packet pk;
-          make_packet(offset, segments, packet % 4 == 0, g, pk);
+          // Some segment packets start within a radius of the apex (tilted sides).
+          make_packet(offset, segments, packet % 4 == 0, g, pk, segments && packet % 2 == 1 ? 0.2f : 0.0f);
           rt::GroupFrusta<64> frusta, own;
           build_frusta(pk, segments, slabs, true, frusta);
           build_frusta(pk, segments, slabs, false, own);

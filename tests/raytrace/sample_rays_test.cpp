@@ -39,6 +39,12 @@ std::vector<RayKind> ray_kinds() {
   sphere.position = Vec3(1.5f, 3.0f, 2.0f);
   sphere.radius = 0.6f;
   kinds.push_back({"sphere", sphere});
+  // A small one: its samples start close together beside their lengths,
+  // so packets cull them with frusta from the light (traverse/large_packet.cpp,
+  // find_segment_apex).
+  rt::Light small = sphere;
+  small.radius = 0.08f;
+  kinds.push_back({"small sphere", small});
   rt::Light rect;
   rect.kind = rt::Light::Kind::kRect;
   rect.position = Vec3(-1.0f, 2.5f, 1.5f);
