@@ -105,7 +105,8 @@ struct TileScratch {
   // Shadow run r: rays [shadow_region_begin[r], shadow_region_begin[r + 1])
   // come from one region's pixels, those on characters or those on static
   // meshes (runs without a ray have no entry), split finer where the plan
-  // says so (TracePlan::split_fine_shadows, split_static_shadows).
+  // says so (TracePlan::split_fine_shadows, split_static_shadows); segment
+  // rays' runs are one sample class's instead (compact_shadow_rays).
   std::vector<std::uint32_t> shadow_region_begin;
   // How this frame traces (render/trace_plan.h); set by prepare.
   TracePlan plan;

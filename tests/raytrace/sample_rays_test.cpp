@@ -244,7 +244,6 @@ TEST(SamplePattern, EachPixelsSamplesFillEveryStratumOnceAndSpreadOverTheOtherAx
 }
 
 TEST(SamplePattern, ShiftsDependOnSeedStreamAndPixelOnly) {
-  std::set<std::pair<float, float>> seen;
   for (int y = 0; y < 16; ++y) {
     for (int x = 0; x < 16; ++x) {
       const rt::PixelShift a = rt::pixel_shift(9u, 1u, x, y);
@@ -253,13 +252,45 @@ TEST(SamplePattern, ShiftsDependOnSeedStreamAndPixelOnly) {
       ASSERT_EQ(a.eta, b.eta);
       ASSERT_NEAR(a.cos_eta, std::cos(2.0f * 3.14159265f * a.eta), 1e-5f);
       ASSERT_NEAR(a.sin_eta, std::sin(2.0f * 3.14159265f * a.eta), 1e-5f);
-      seen.insert({a.xi, a.eta});
       EXPECT_NE(rt::pixel_shift(10u, 1u, x, y).xi, a.xi);
       EXPECT_NE(rt::pixel_shift(9u, 2u, x, y).xi, a.xi);
     }
   }
-  // Neighbouring pixels are decorrelated: (nearly) all 256 shifts differ.
-  EXPECT_GE(seen.size(), 250u);
+}
+
+// The interleaving: every 2x2 block holds the four classes, their shifts
+// one per quadrant of (xi, eta); the block repeats, so pixels two apart
+// share their shift (and take the same sample each round); and no two
+// neighbours share a class.
+TEST(SamplePattern, EveryTwoByTwoBlockHoldsFourStratifiedShifts) {
+  for (const std::uint32_t stream : {0u, 3u, rt::kAmbientOcclusionStream}) {
+    for (int by = 0; by < 12; by += 2) {
+      for (int bx = 0; bx < 12; bx += 2) {
+        std::set<int> classes, xi_quarters;
+        std::set<float> etas;
+        for (int y = by; y < by + 2; ++y) {
+          for (int x = bx; x < bx + 2; ++x) {
+            const rt::PixelShift a = rt::pixel_shift(7u, stream, x, y);
+            classes.insert(rt::sample_class(x, y));
+            xi_quarters.insert(static_cast<int>(a.xi * 4.0f));
+            etas.insert(a.eta);
+            const rt::PixelShift repeat = rt::pixel_shift(7u, stream, x + 2, y + 6);
+            ASSERT_EQ(repeat.xi, a.xi);
+            ASSERT_EQ(repeat.eta, a.eta);
+            ASSERT_NE(rt::sample_class(x + 1, y), rt::sample_class(x, y));
+            ASSERT_NE(rt::sample_class(x, y + 1), rt::sample_class(x, y));
+            ASSERT_NE(rt::sample_class(x + 1, y + 1), rt::sample_class(x, y));
+          }
+        }
+        EXPECT_EQ(classes.size(), 4u);
+        EXPECT_EQ(xi_quarters.size(), 4u);
+        // One eta per quarter turn: the four are a quarter apart.
+        ASSERT_EQ(etas.size(), 4u);
+        std::vector<float> sorted(etas.begin(), etas.end());
+        for (std::size_t i = 1; i < sorted.size(); ++i) EXPECT_NEAR(sorted[i] - sorted[i - 1], 0.25f, 1e-6f);
+      }
+    }
+  }
 }
 
 }  // namespace

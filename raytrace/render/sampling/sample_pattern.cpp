@@ -7,8 +7,8 @@ namespace sinew::rt {
 namespace {
 
 // An integer mix with full avalanche (two multiply-xorshift rounds): every
-// input bit flips each output bit about half the time, so neighbouring
-// pixels get unrelated shifts.
+// input bit flips each output bit about half the time, so seeds and
+// streams get unrelated offsets.
 std::uint32_t mix(std::uint32_t h) {
   h ^= h >> 16;
   h *= 0x7feb352du;
@@ -43,12 +43,26 @@ float fraction(std::uint32_t bits, int count) {
 
 }  // namespace
 
+int sample_class(int x, int y) {
+  // A 2x2 ordered-dither (Bayer) matrix: classes 0 and 1 on one diagonal,
+  // 2 and 3 on the other.
+  static constexpr int kBayer[kInterleave][kInterleave] = {{0, 2}, {3, 1}};
+  return kBayer[y & (kInterleave - 1)][x & (kInterleave - 1)];
+}
+
 PixelShift pixel_shift(std::uint32_t seed, std::uint32_t stream, int x, int y) {
-  const std::uint32_t h = mix(mix(mix(mix(static_cast<std::uint32_t>(y)) ^ static_cast<std::uint32_t>(x)) ^ stream) ^ seed);
-  const std::uint32_t step = mix(h) >> (32 - 10);  // kAngleSteps = 2^10
-  static_assert(kAngleSteps == 1 << 10);
+  static_assert(kAngleSteps == 1 << 10 && kSampleClasses == 4);
+  const std::uint32_t h = mix(mix(stream) ^ seed);
+  const int k = sample_class(x, y);
+  // The classes' shifts are the four-point Hammersley set of the unit
+  // square, (k / 4, k's two bits reversed / 4), one point per quadrant,
+  // moved as a whole by one hashed offset.
+  static constexpr std::uint32_t kReversed[kSampleClasses] = {0u, 2u, 1u, 3u};
+  const std::uint32_t step =
+      ((mix(h) >> (32 - 10)) + (kAngleSteps / kSampleClasses) * kReversed[k]) & (kAngleSteps - 1u);
   PixelShift shift;
-  shift.xi = fraction(h, 24);
+  // 20 bits: k + the fraction stays below kSampleClasses in a float, so xi below 1.
+  shift.xi = (static_cast<float>(k) + fraction(h, 20)) / static_cast<float>(kSampleClasses);
   shift.eta = static_cast<float>(step) / kAngleSteps;
   shift.cos_eta = angles().cos_of[step];
   shift.sin_eta = angles().sin_of[step];

@@ -8,7 +8,9 @@
 #include <limits>
 #include <vector>
 
+#include "raytrace/render/sampling/sample_pattern.h"
 #include "raytrace/render/stages/stage_support.h"
+#include "raytrace/traverse/large_packet.h"
 #include "raytrace/traverse/traversal_shared.h"
 
 namespace sinew::rt {
@@ -191,12 +193,62 @@ void place_shadow_rays(const Light& light, int l, TileScratch& s) {
   }
 }
 
+namespace {
+
+// Segment rays (an area light's samples, ambient occlusion rays) in runs of
+// one sample class each (render/sampling/sample_pattern.h), those from
+// characters apart from those from static meshes, at most one packet long:
+// a class's hits took the same sample this round, so their rays leave
+// nearly one point of a light (the packet culls them with frusta from it,
+// traverse/large_packet.cpp) or, for ambient occlusion and the sun, run
+// nearly parallel where the surface is flat. Within a class the rays keep
+// the tile's block order.
+void compact_by_class(TileScratch& s) {
+  constexpr std::size_t kRunRays = static_cast<std::size_t>(kMaxPacketGroups) * kBlockLanes;
+  thread_local std::array<std::vector<std::uint32_t>, 2 * kSampleClasses> classes;
+  for (auto& lanes : classes) lanes.clear();
+  for (std::size_t b = 0; b < s.blocks(); ++b) {
+    for (std::uint32_t m = s.shadow_lanes[b]; m != 0; m &= m - 1) {
+      const int lane = std::countr_zero(m);
+      const std::size_t k = b * kBlockLanes + static_cast<std::size_t>(lane);
+      const std::size_t from_static = (s.block_on_character[b] >> lane & 1u) != 0 ? 0 : 1;
+      classes[2 * static_cast<std::size_t>(sample_class(s.pixel_x(k), s.pixel_y(k))) + from_static].push_back(
+          static_cast<std::uint32_t>(k));
+    }
+  }
+  s.shadow_count = 0;
+  s.shadow_region_begin.assign(1, 0u);
+  for (const std::vector<std::uint32_t>& lanes : classes) {
+    for (std::size_t r0 = 0; r0 < lanes.size(); r0 += kRunRays) {
+      const std::size_t r1 = std::min(lanes.size(), r0 + kRunRays);
+      for (std::size_t r = r0; r < r1; ++r) {
+        const std::size_t k = lanes[r], i = s.shadow_count++;
+        s.so_x[i] = s.shadow_from_x[k];
+        s.so_y[i] = s.shadow_from_y[k];
+        s.so_z[i] = s.shadow_from_z[k];
+        s.sd_x[i] = s.shadow_lane_x[k];
+        s.sd_y[i] = s.shadow_lane_y[k];
+        s.sd_z[i] = s.shadow_lane_z[k];
+        s.s_tmax[i] = s.shadow_tmax;
+        s.shadow_pixel[i] = static_cast<std::uint32_t>(k);
+      }
+      s.shadow_region_begin.push_back(static_cast<std::uint32_t>(s.shadow_count));
+    }
+  }
+  if (s.shadow_count == 0) s.shadow_region_begin.clear();
+}
+
+}  // namespace
+
 void compact_shadow_rays(TileScratch& s) {
   if (s.shadows_compacted) return;
   s.shadows_compacted = true;
+  if (s.shadows_per_lane) {
+    compact_by_class(s);
+    return;
+  }
   const bool point = s.shadows_from_point;
-  const bool per_lane = s.shadows_per_lane;
-  const float tmax = per_lane ? s.shadow_tmax : point ? 1.0f : kInf;
+  const float tmax = point ? 1.0f : kInf;
   const Vec3x8 light_at{Float8(s.shadow_origin.x), Float8(s.shadow_origin.y), Float8(s.shadow_origin.z)};
   const Vec3x8 light_dir{Float8(s.shadow_direction.x), Float8(s.shadow_direction.y), Float8(s.shadow_direction.z)};
   s.shadow_count = 0;
@@ -206,10 +258,8 @@ void compact_shadow_rays(TileScratch& s) {
   const auto add_block = [&](std::size_t b, std::uint32_t lanes) {
     const std::size_t k0 = b * kBlockLanes;
     const Vec3x8 placed = load3(s.shadow_lane_x, s.shadow_lane_y, s.shadow_lane_z, k0);
-    const Vec3x8 origin = per_lane ? load3(s.shadow_from_x, s.shadow_from_y, s.shadow_from_z, k0)
-                          : point  ? light_at
-                                   : placed;
-    const Vec3x8 direction = point || per_lane ? placed : light_dir;
+    const Vec3x8 origin = point ? light_at : placed;
+    const Vec3x8 direction = point ? placed : light_dir;
     const std::size_t i = s.shadow_count;
     compress_store(&s.so_x[i], origin.x, lanes);
     compress_store(&s.so_y[i], origin.y, lanes);
