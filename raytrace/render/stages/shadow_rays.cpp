@@ -205,34 +205,47 @@ namespace {
 // the tile's block order.
 void compact_by_class(TileScratch& s) {
   constexpr std::size_t kRunRays = static_cast<std::size_t>(kMaxPacketGroups) * kBlockLanes;
-  thread_local std::array<std::vector<std::uint32_t>, 2 * kSampleClasses> classes;
-  for (auto& lanes : classes) lanes.clear();
+  // Per block, the lanes of each class.
+  thread_local std::vector<std::array<std::uint8_t, kSampleClasses>> class_lanes;
+  class_lanes.assign(s.blocks(), {});
   for (std::size_t b = 0; b < s.blocks(); ++b) {
-    for (std::uint32_t m = s.shadow_lanes[b]; m != 0; m &= m - 1) {
-      const int lane = std::countr_zero(m);
+    if (s.shadow_lanes[b] == 0) continue;
+    for (int lane = 0; lane < kBlockLanes; ++lane) {
       const std::size_t k = b * kBlockLanes + static_cast<std::size_t>(lane);
-      const std::size_t from_static = (s.block_on_character[b] >> lane & 1u) != 0 ? 0 : 1;
-      classes[2 * static_cast<std::size_t>(sample_class(s.pixel_x(k), s.pixel_y(k))) + from_static].push_back(
-          static_cast<std::uint32_t>(k));
+      class_lanes[b][static_cast<std::size_t>(sample_class(s.pixel_x(k), s.pixel_y(k)))] |=
+          static_cast<std::uint8_t>(1u << lane);
     }
   }
   s.shadow_count = 0;
   s.shadow_region_begin.assign(1, 0u);
-  for (const std::vector<std::uint32_t>& lanes : classes) {
-    for (std::size_t r0 = 0; r0 < lanes.size(); r0 += kRunRays) {
-      const std::size_t r1 = std::min(lanes.size(), r0 + kRunRays);
-      for (std::size_t r = r0; r < r1; ++r) {
-        const std::size_t k = lanes[r], i = s.shadow_count++;
-        s.so_x[i] = s.shadow_from_x[k];
-        s.so_y[i] = s.shadow_from_y[k];
-        s.so_z[i] = s.shadow_from_z[k];
-        s.sd_x[i] = s.shadow_lane_x[k];
-        s.sd_y[i] = s.shadow_lane_y[k];
-        s.sd_z[i] = s.shadow_lane_z[k];
-        s.s_tmax[i] = s.shadow_tmax;
-        s.shadow_pixel[i] = static_cast<std::uint32_t>(k);
+  for (int c = 0; c < kSampleClasses; ++c) {
+    for (const bool from_characters : {true, false}) {
+      std::size_t run = 0;
+      for (std::size_t b = 0; b < s.blocks(); ++b) {
+        const std::uint32_t on_character = s.block_on_character[b];
+        const std::uint32_t lanes = s.shadow_lanes[b] & class_lanes[b][static_cast<std::size_t>(c)] &
+                                    (from_characters ? on_character : ~on_character);
+        if (lanes == 0) continue;
+        const std::size_t count = static_cast<std::size_t>(std::popcount(lanes));
+        if (run + count > kRunRays) {
+          s.shadow_region_begin.push_back(static_cast<std::uint32_t>(s.shadow_count));
+          run = 0;
+        }
+        const std::size_t k0 = b * kBlockLanes, i = s.shadow_count;
+        compress_store(&s.so_x[i], Float8::load(&s.shadow_from_x[k0]), lanes);
+        compress_store(&s.so_y[i], Float8::load(&s.shadow_from_y[k0]), lanes);
+        compress_store(&s.so_z[i], Float8::load(&s.shadow_from_z[k0]), lanes);
+        compress_store(&s.sd_x[i], Float8::load(&s.shadow_lane_x[k0]), lanes);
+        compress_store(&s.sd_y[i], Float8::load(&s.shadow_lane_y[k0]), lanes);
+        compress_store(&s.sd_z[i], Float8::load(&s.shadow_lane_z[k0]), lanes);
+        Float8(s.shadow_tmax).store(&s.s_tmax[i]);
+        compress_store_lane_indices(&s.shadow_pixel[i], static_cast<std::uint32_t>(k0), lanes);
+        s.shadow_count += count;
+        run += count;
       }
-      s.shadow_region_begin.push_back(static_cast<std::uint32_t>(s.shadow_count));
+      if (s.shadow_region_begin.back() != s.shadow_count) {
+        s.shadow_region_begin.push_back(static_cast<std::uint32_t>(s.shadow_count));
+      }
     }
   }
   if (s.shadow_count == 0) s.shadow_region_begin.clear();
