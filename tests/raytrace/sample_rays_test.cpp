@@ -102,6 +102,17 @@ TEST(SampleRays, EveryAreaLightAndAmbientOcclusionRayAnswersAsBruteForce) {
               // A tile whose rays reach no object traces none; its rays,
               // compacted here, must all be open.
               rt::compact_shadow_rays(s);
+              // Each run (a packet) holds one sample class: its rays took
+              // the same sample.
+              for (std::size_t r = 0; r + 1 < s.shadow_region_begin.size(); ++r) {
+                const std::size_t i0 = s.shadow_region_begin[r], i1 = s.shadow_region_begin[r + 1];
+                ASSERT_LT(i0, i1);
+                const std::size_t k0 = s.shadow_pixel[i0];
+                for (std::size_t i = i0; i < i1; ++i) {
+                  const std::size_t k = s.shadow_pixel[i];
+                  ASSERT_EQ(rt::sample_class(s.pixel_x(k), s.pixel_y(k)), rt::sample_class(s.pixel_x(k0), s.pixel_y(k0)));
+                }
+              }
               std::vector<bool> has_ray(s.lanes, false);
               for (std::size_t i = 0; i < s.shadow_count; ++i) {
                 const std::size_t k = s.shadow_pixel[i];

@@ -205,15 +205,23 @@ namespace {
 // the tile's block order.
 void compact_by_class(TileScratch& s) {
   constexpr std::size_t kRunRays = static_cast<std::size_t>(kMaxPacketGroups) * kBlockLanes;
-  // Per block, the lanes of each class.
+  // Per block, the lanes of each class: the block holds whole interleaving
+  // blocks, so its first one's pixels give every lane's class.
+  constexpr int kBlockRows = kBlockLanes / kBlockWidth;
+  static_assert(kBlockWidth % kInterleave == 0 && kBlockRows % kInterleave == 0);
   thread_local std::vector<std::array<std::uint8_t, kSampleClasses>> class_lanes;
   class_lanes.assign(s.blocks(), {});
   for (std::size_t b = 0; b < s.blocks(); ++b) {
     if (s.shadow_lanes[b] == 0) continue;
-    for (int lane = 0; lane < kBlockLanes; ++lane) {
-      const std::size_t k = b * kBlockLanes + static_cast<std::size_t>(lane);
-      class_lanes[b][static_cast<std::size_t>(sample_class(s.pixel_x(k), s.pixel_y(k)))] |=
-          static_cast<std::uint8_t>(1u << lane);
+    for (int y = 0; y < kInterleave; ++y) {
+      for (int x = 0; x < kInterleave; ++x) {
+        std::uint32_t repeats = 0;
+        for (int ry = y; ry < kBlockRows; ry += kInterleave) {
+          for (int rx = x; rx < kBlockWidth; rx += kInterleave) repeats |= 1u << (ry * kBlockWidth + rx);
+        }
+        class_lanes[b][static_cast<std::size_t>(sample_class(s.block_x0(b) + x, s.block_y0(b) + y))] |=
+            static_cast<std::uint8_t>(repeats);
+      }
     }
   }
   s.shadow_count = 0;
