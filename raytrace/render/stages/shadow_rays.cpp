@@ -205,34 +205,33 @@ namespace {
 // the tile's block order.
 void compact_by_class(TileScratch& s) {
   constexpr std::size_t kRunRays = static_cast<std::size_t>(kMaxPacketGroups) * kBlockLanes;
-  // Per block, the lanes of each class: the block holds whole interleaving
-  // blocks, so its first one's pixels give every lane's class.
+  // Every block starts a whole number of interleaving blocks from the
+  // tile's corner, so the tile's first pixels give each class's lanes of
+  // every block.
   constexpr int kBlockRows = kBlockLanes / kBlockWidth;
   static_assert(kBlockWidth % kInterleave == 0 && kBlockRows % kInterleave == 0);
-  thread_local std::vector<std::array<std::uint8_t, kSampleClasses>> class_lanes;
-  class_lanes.assign(s.blocks(), {});
-  for (std::size_t b = 0; b < s.blocks(); ++b) {
-    if (s.shadow_lanes[b] == 0) continue;
-    for (int y = 0; y < kInterleave; ++y) {
-      for (int x = 0; x < kInterleave; ++x) {
-        std::uint32_t repeats = 0;
-        for (int ry = y; ry < kBlockRows; ry += kInterleave) {
-          for (int rx = x; rx < kBlockWidth; rx += kInterleave) repeats |= 1u << (ry * kBlockWidth + rx);
-        }
-        class_lanes[b][static_cast<std::size_t>(sample_class(s.block_x0(b) + x, s.block_y0(b) + y))] |=
-            static_cast<std::uint8_t>(repeats);
+  std::array<std::uint32_t, kSampleClasses> class_lanes{};
+  for (int y = 0; y < kInterleave; ++y) {
+    for (int x = 0; x < kInterleave; ++x) {
+      std::uint32_t repeats = 0;
+      for (int ry = y; ry < kBlockRows; ry += kInterleave) {
+        for (int rx = x; rx < kBlockWidth; rx += kInterleave) repeats |= 1u << (ry * kBlockWidth + rx);
       }
+      class_lanes[static_cast<std::size_t>(sample_class(s.tile.x0 + x, s.tile.y0 + y))] |= repeats;
     }
   }
+  // Runs class by class, those from characters first; within a run the
+  // tile's block order. Written run after run, in address order: a
+  // compress_store writes a whole group past its lanes.
+  const Float8 t_max(s.shadow_tmax);
   s.shadow_count = 0;
   s.shadow_region_begin.assign(1, 0u);
-  for (int c = 0; c < kSampleClasses; ++c) {
+  for (const std::uint32_t of_class : class_lanes) {
     for (const bool from_characters : {true, false}) {
       std::size_t run = 0;
       for (std::size_t b = 0; b < s.blocks(); ++b) {
         const std::uint32_t on_character = s.block_on_character[b];
-        const std::uint32_t lanes = s.shadow_lanes[b] & class_lanes[b][static_cast<std::size_t>(c)] &
-                                    (from_characters ? on_character : ~on_character);
+        const std::uint32_t lanes = s.shadow_lanes[b] & of_class & (from_characters ? on_character : ~on_character);
         if (lanes == 0) continue;
         const std::size_t count = static_cast<std::size_t>(std::popcount(lanes));
         if (run + count > kRunRays) {
@@ -246,7 +245,7 @@ void compact_by_class(TileScratch& s) {
         compress_store(&s.sd_x[i], Float8::load(&s.shadow_lane_x[k0]), lanes);
         compress_store(&s.sd_y[i], Float8::load(&s.shadow_lane_y[k0]), lanes);
         compress_store(&s.sd_z[i], Float8::load(&s.shadow_lane_z[k0]), lanes);
-        Float8(s.shadow_tmax).store(&s.s_tmax[i]);
+        t_max.store(&s.s_tmax[i]);
         compress_store_lane_indices(&s.shadow_pixel[i], static_cast<std::uint32_t>(k0), lanes);
         s.shadow_count += count;
         run += count;
