@@ -4,7 +4,8 @@
 // are culled by an interval bound over the rays, carried into each bone's
 // frame and grown by a bound on the single ray's slack, so a lane reaches
 // every cell its single ray reaches; rays from one apex (a camera, a point
-// light) also cull leaf triangles by group frusta. The triangle tests are the
+// light), and segments that start close together (an area light's
+// samples), also cull leaf triangles by group frusta. The triangle tests are the
 // single ray's, so each lane's nearest hit has its t, u and v; the triangle
 // can differ only at an exact tie in t. docs/RAYTRACE.md, "Packets: the one
 // core".
