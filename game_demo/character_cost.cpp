@@ -11,7 +11,7 @@ namespace {
 // the world's step and the scene's per-frame preparation.
 constexpr std::array<std::string_view, 5> kUpdatePhases = {"animation", "skinning", "boxes", "fallback",
                                                            "top level"};
-constexpr std::array<std::string_view, 2> kTracePhases = {"trace primary", "trace shadow"};
+constexpr std::array<std::string_view, 3> kTracePhases = {"trace primary", "trace shadow", "trace ao"};
 
 template <std::size_t N>
 bool listed(const std::array<std::string_view, N>& names, std::string_view name) {

@@ -14,10 +14,10 @@ namespace {
 TEST(CharacterCost, SplitsUpdateAndTracePhasesPerCharacter) {
   const std::vector<std::pair<std::string, double>> phases = {
       {"animation", 1.0}, {"skinning", 2.0},     {"boxes", 0.5},        {"fallback", 0.25}, {"top level", 0.25},
-      {"trace primary", 6.0}, {"trace shadow", 2.0}, {"shade", 100.0}, {"display", 100.0}};
+      {"trace primary", 6.0}, {"trace shadow", 2.0}, {"trace ao", 4.0}, {"shade", 100.0}, {"display", 100.0}};
   const CharacterCost cost = per_character_cost(phases, 4);
   EXPECT_DOUBLE_EQ(cost.update_ms, 4.0 / 4);  // animation + skinning + boxes + fallback + top level
-  EXPECT_DOUBLE_EQ(cost.trace_ms, 8.0 / 4);   // primary + shadow; shading and display count in neither
+  EXPECT_DOUBLE_EQ(cost.trace_ms, 12.0 / 4);  // primary + shadow + ambient occlusion; shading and display count in neither
 }
 
 TEST(CharacterCost, MissingPhasesCountZero) {
