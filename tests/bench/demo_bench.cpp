@@ -30,6 +30,7 @@ struct DemoBenchOptions {
   int frames = 30;
   int warmup = 5;
   bool shadows = true;
+  bool soft = false;  // sinew-demo --soft: its preset of soft shadows and ambient occlusion
   std::string textures = "on";  // on, off, or both (alternating frames)
   std::string model_path;  // empty: the mannequin
   std::string json_path;
@@ -46,6 +47,7 @@ std::vector<BenchFlag> demo_flags() {
       frames_flag("measured frames per count (default 30), after"),
       {"--warmup", "N", "unmeasured frames (default 5)"},
       {"--shadows", "on|off", "shadow rays (default on)"},
+      {"--soft", "", "soft shadows and ambient occlusion: sinew-demo --soft's preset (default off)"},
       {"--textures", "on|off|both", "textured materials (default on); both: alternate frames off and on"},
       {"--model", "PATH", "glTF or Cal3D character (default the procedural mannequin)"},
       json_flag(),
@@ -65,6 +67,7 @@ Status read_options(const BenchArgs& parsed, DemoBenchOptions& o) {
   SINEW_RETURN_IF_ERROR(parsed.read("--frames", 1, 100000, o.frames));
   SINEW_RETURN_IF_ERROR(parsed.read("--warmup", 0, 100000, o.warmup));
   SINEW_RETURN_IF_ERROR(parsed.read("--shadows", o.shadows));
+  o.soft = parsed.has("--soft");
   SINEW_RETURN_IF_ERROR(parsed.read("--textures", o.textures));
   if (o.textures != "on" && o.textures != "off" && o.textures != "both") {
     return invalid_argument("--textures", o.textures, "expected on, off or both");
@@ -101,6 +104,7 @@ Expected<CountResult> measure(const DemoBenchOptions& o, int characters, JobSyst
   so.width = o.width;
   so.height = o.height;
   so.shadows = o.shadows;
+  if (o.soft) so.soft = demo::soft_preset();
   // The demo loads packs; the bench also takes a source model, imported here.
   std::unique_ptr<demo::DemoSession> session;
   if (o.model_path.empty() || character::is_pack_path(o.model_path)) {
@@ -125,7 +129,7 @@ Expected<CountResult> measure(const DemoBenchOptions& o, int characters, JobSyst
     SINEW_ASSIGN_OR_RETURN(const demo::FrameReport report, session->frame(1.0f / 30.0f, input, camera, jobs));
     if (f >= o.warmup) {
       shade[session->render_settings().textures ? 1 : 0].push_back(report.render.shade_ms);
-      rays += report.render.primary_rays + report.render.shadow_rays;
+      rays += report.render.primary_rays + report.render.shadow_rays + report.render.ao_rays;
       r.escaped_triangles += report.scene.escaped_triangles;
       r.primary += report.render.primary;
       r.shadow += report.render.shadow;
@@ -179,7 +183,8 @@ void print_table(const DemoBenchOptions& o, const std::vector<CountResult>& resu
   }
   std::printf("\nPhase columns are per-frame medians in ms over %d frames after %d warm-up frames; fps = 1000 /"
               " their sum. Per character: the update phases (animation, skinning, boxes, fallback, top level) and the"
-              " trace phases (primary, shadow) over the character count. M rays/s counts primary and shadow rays over"
+              " trace phases (primary, shadow, ambient occlusion) over the character count. M rays/s counts primary,"
+              " shadow and ambient occlusion rays over"
               " the whole frame time. The second table is the"
               " tracers' work per ray (render/renderer.h TraversalCounters) over the same frames.\n",
               o.frames, o.warmup);
@@ -194,11 +199,12 @@ int run_demo_bench(const std::vector<std::string>& args, const std::string& comm
   const DemoBenchOptions& o = *parsed;
   JobSystem jobs(o.threads);
   BenchRecord record("demo", command_line, jobs.thread_count());
-  std::printf("  %dx%d, shadows %s, pace spread %.2f\n", o.width, o.height, o.shadows ? "on" : "off",
-              static_cast<double>(o.pace_spread));
+  std::printf("  %dx%d, shadows %s, soft lighting %s, pace spread %.2f\n", o.width, o.height,
+              o.shadows ? "on" : "off", o.soft ? "on" : "off", static_cast<double>(o.pace_spread));
   Json& doc = record.doc();
   doc["size"] = {o.width, o.height};
   doc["shadows"] = o.shadows;
+  doc["soft"] = o.soft;
   doc["textures"] = o.textures;
   doc["pace_spread"] = o.pace_spread;
   doc["counts"] = Json::array();
