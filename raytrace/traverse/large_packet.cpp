@@ -5,6 +5,7 @@
 #include <bit>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <vector>
 
 #include "raytrace/cull/grid_frusta.h"
@@ -19,6 +20,7 @@
 #include "raytrace/traverse/packet_lanes.h"
 #include "raytrace/traverse/packet_rays.h"
 #include "raytrace/traverse/ray_frames.h"
+#include "raytrace/traverse/segment_apex.h"
 #include "raytrace/traverse/traversal_shared.h"
 #include "runtime/math/float8.h"
 
@@ -30,15 +32,12 @@ using packet_lanes::clip_lanes;
 using packet_lanes::for_each_bit;
 using packet_lanes::Group;
 using packet_lanes::PacketRays;
+using packet_lanes::SegmentApex;
 using packet_lanes::thread_query;
 using packet_lanes::kInf;
 using packet_lanes::kLanes;
 using packet_lanes::VisitGroup;
 using packet_lanes::world_eps;
-
-// find_segment_apex: segments whose origins spread over more than
-// 1/kSegmentSpread of their nearest end's distance go without frusta.
-constexpr float kSegmentSpread = 16.0f;
 
 template <TriangleTest kTest, bool kAnyHit>
 class LargeQuery : public PacketRays<kTest, kAnyHit> {
@@ -64,7 +63,7 @@ class LargeQuery : public PacketRays<kTest, kAnyHit> {
     grid_ = {rays.grid_columns, rays.grid_forward, rays.grid_right, rays.grid_up};
     group_frusta_ = rays.group_frusta;
     clip_leaf_lanes_ = rays.clip_leaf_lanes;
-    segment_apex_ = false;
+    segment_apex_found_ = false;
     frusta_.off();
   }
 
@@ -112,13 +111,13 @@ class LargeQuery : public PacketRays<kTest, kAnyHit> {
       if (e != kInf) add({e != e ? -kInf : e, object});
     }
     Candidate* const begin = heap_candidates.empty() ? stack_candidates.data() : heap_candidates.data();
-    segment_apex_ = find_segment_apex();
+    segment_apex_found_ = find_segment_apex();
     // Closest hit: front to back, so an object entered after every lane's
     // best hit is skipped. Any hit from one origin or from near one (shadow
     // rays from a point light, an area light's samples): from the light, so
     // a lane blocked on the way retires before it walks the tree it ends
     // in, which costs most.
-    if (!kAnyHit || common_origin_ || segment_apex_) {
+    if (!kAnyHit || common_origin_ || segment_apex_found_) {
       std::sort(begin, begin + count, [](const Candidate& a, const Candidate& b) {
         return a.entry < b.entry || (a.entry == b.entry && a.object < b.object);
       });
@@ -166,53 +165,14 @@ class LargeQuery : public PacketRays<kTest, kAnyHit> {
     return forward;
   }
 
-  // Any-hit segments from points close together beside the segments'
-  // lengths (an area light's samples, from the light to the hits): the
-  // centre of their origins' box becomes an apex, the farthest origin's
-  // distance from it (grown for rounding) its radius, and each lane's far
-  // end, relative to the apex, its frustum direction (segment_ends_), so
-  // the packet culls with frusta as rays from one point do
-  // (GroupFrusta::reset, tilt_side). False for rays from one origin (their
-  // apex is exact), rays without finite ends, and origins spread over more
-  // than 1/kSegmentSpread of the nearest end's distance: the tilted sides
-  // widen each group's frustum by about the radius near the apex, and past
-  // that the lanes' own clips to cells cull more (docs/RAYTRACE.md, "Soft
-  // shadows and ambient occlusion").
+  // Any-hit segments from points close together (an area light's
+  // samples): their apex, radius and ends (traverse/segment_apex.h). Not
+  // for rays from one origin, whose apex is exact.
   bool find_segment_apex() {
-    if (!kAnyHit || common_origin_ || alive_groups_ == 0 || !forward()) return false;
-    const Float8 inf(kInf);
-    Vec3x8 lo{inf, inf, inf}, hi{-inf, -inf, -inf};
-    bool finite = true;
-    for_each_bit(alive_groups_, [&](int g) {
-      const Group& gr = group_[g];
-      const Mask8 use = Mask8::from_bits(live_[g]);
-      const Vec3x8 o = gr.origin();
-      lo = {min(lo.x, select(use, o.x, inf)), min(lo.y, select(use, o.y, inf)), min(lo.z, select(use, o.z, inf))};
-      hi = {max(hi.x, select(use, o.x, -inf)), max(hi.y, select(use, o.y, -inf)), max(hi.z, select(use, o.z, -inf))};
-      finite = finite && (is_finite(Float8::load(gr.t_limit)) | !use).bits() == 0xFFu;
-    });
-    if (!finite) return false;
-    const Vec3 centre(0.5f * (reduce_min(lo.x) + reduce_max(hi.x)), 0.5f * (reduce_min(lo.y) + reduce_max(hi.y)),
-                      0.5f * (reduce_min(lo.z) + reduce_max(hi.z)));
-    const Vec3x8 at{Float8(centre.x), Float8(centre.y), Float8(centre.z)};
-    Float8 spread(0.0f), nearest(kInf);
-    for_each_bit(alive_groups_, [&](int g) {
-      const Group& gr = group_[g];
-      const Mask8 use = Mask8::from_bits(live_[g]);
-      const Vec3x8 w = gr.origin() - at;
-      const Vec3x8 end = (gr.origin() + Float8::load(gr.t_limit) * gr.direction()) - at;
-      end.x.store(segment_ends_[g].q[0]);
-      end.y.store(segment_ends_[g].q[1]);
-      end.z.store(segment_ends_[g].q[2]);
-      spread = max(spread, select(use, dot(w, w), Float8(0.0f)));
-      nearest = min(nearest, select(use, dot(end, end), inf));
-    });
-    const float radius = far_offset(std::sqrt(reduce_max(spread)));
-    if (!(kSegmentSpread * kSegmentSpread * radius * radius <= reduce_min(nearest)) || !std::isfinite(radius)) {
-      return false;
-    }
-    segment_apex_at_ = centre;
-    segment_apex_radius_ = radius;
+    if (!kAnyHit || common_origin_ || !forward()) return false;
+    const std::optional<SegmentApex> apex = packet_lanes::find_segment_apex(group_, live_, alive_groups_, segment_ends_);
+    if (!apex) return false;
+    segment_apex_ = *apex;
     return true;
   }
 
@@ -222,7 +182,7 @@ class LargeQuery : public PacketRays<kTest, kAnyHit> {
   // other packets go without (frusta_ stays off).
   void prepare_frusta() {
     frusta_.off();
-    if (!common_origin_ && !segment_apex_) return;
+    if (!common_origin_ && !segment_apex_found_) return;
     if (!forward()) return;
     // Shadow packets: the groups' slabs in the packet's basis, cheaper per
     // triangle than their own frusta and built with the packet's bound
@@ -233,7 +193,7 @@ class LargeQuery : public PacketRays<kTest, kAnyHit> {
       frusta_.start(common_origin_at_, 0.0f, groups_, grid_, slabs, directions(), lanes());
       return;
     }
-    frusta_.start(segment_apex_at_, segment_apex_radius_, groups_, grid_, slabs, directions(), lanes());
+    frusta_.start(segment_apex_.at, segment_apex_.radius, groups_, grid_, slabs, directions(), lanes());
     // Segments too near their apex build no plane: their packet walks as
     // one without frusta, clipping lanes to cells.
     ensure_frusta(alive_groups_);
@@ -244,7 +204,7 @@ class LargeQuery : public PacketRays<kTest, kAnyHit> {
   // lanes, as the frusta read them.
   auto directions() const {
     return [this](int g) -> const float (&)[3][kLanes] {
-      return segment_apex_ ? segment_ends_[g].q : group_[g].d;
+      return segment_apex_found_ ? segment_ends_[static_cast<std::size_t>(g)].q : group_[g].d;
     };
   }
   auto lanes() const {
@@ -262,7 +222,7 @@ class LargeQuery : public PacketRays<kTest, kAnyHit> {
       // A lane's points end at t_max (an infinite one: no far plane);
       // segments' directions are their ends.
       const auto reach = [&](int g, float* out) {
-        if (segment_apex_) {
+        if (segment_apex_found_) {
           std::fill_n(out, kLanes, 1.0f);
         } else {
           std::copy_n(group_[g].t_limit, kLanes, out);
@@ -675,14 +635,10 @@ class LargeQuery : public PacketRays<kTest, kAnyHit> {
   PacketFrusta<kMaxPacketGroups>::Grid grid_;  // LargePacketRays' pixel grid
   float visit_slack_ = 0.0f;       // run(): a bound on every lane's slack in an object's box clip
   // find_segment_apex: whether the packet's segments start near one apex,
-  // the apex, its radius and each group's far ends relative to it.
-  bool segment_apex_ = false;
-  Vec3 segment_apex_at_{0.0f};
-  float segment_apex_radius_ = 0.0f;
-  struct SegmentEnds {
-    alignas(32) float q[3][kLanes];
-  };
-  std::array<SegmentEnds, kMaxPacketGroups> segment_ends_;
+  // the apex and its radius, and each group's far ends relative to it.
+  bool segment_apex_found_ = false;
+  SegmentApex segment_apex_;
+  std::array<packet_lanes::SegmentEnds, kMaxPacketGroups> segment_ends_;
   bool group_frusta_ = false;      // LargePacketRays::group_frusta
   bool clip_leaf_lanes_ = false;   // LargePacketRays::clip_leaf_lanes
 };

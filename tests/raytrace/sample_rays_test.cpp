@@ -40,7 +40,7 @@ std::vector<RayKind> ray_kinds() {
   sphere.radius = 0.6f;
   kinds.push_back({"sphere", sphere});
   // A small one: its samples start close together beside their lengths,
-  // so packets cull them with frusta from the light (traverse/large_packet.cpp,
+  // so packets cull them with frusta from the light (traverse/segment_apex.h,
   // find_segment_apex).
   rt::Light small = sphere;
   small.radius = 0.08f;
