@@ -3,6 +3,7 @@
 #include <array>
 #include <cmath>
 #include <random>
+#include <utility>
 
 namespace sinew::demo {
 namespace {
@@ -56,9 +57,9 @@ Arena Arena::generate(std::uint32_t seed, int obstacle_count) {
   return arena;
 }
 
-rt::StaticMeshDesc Arena::static_mesh(float tile) const {
-  rt::StaticMeshDesc mesh;
-  mesh.material_colors = {Vec3(0.62f, 0.62f, 0.60f), Vec3(0.46f, 0.47f, 0.45f)};
+std::vector<rt::StaticMeshDesc> Arena::static_meshes(float tile) const {
+  rt::StaticMeshDesc ground;
+  ground.material_colors = {Vec3(0.62f, 0.62f, 0.60f), Vec3(0.46f, 0.47f, 0.45f)};
   const int tiles = std::max(1, static_cast<int>(std::ceil(2.0f * ground_half_size / tile)));
   const float step = 2.0f * ground_half_size / static_cast<float>(tiles);
   for (int j = 0; j < tiles; ++j) {
@@ -67,15 +68,19 @@ rt::StaticMeshDesc Arena::static_mesh(float tile) const {
       const float z0 = -ground_half_size + step * static_cast<float>(j);
       const float x1 = x0 + step, z1 = z0 + step;
       // Counter-clockwise seen from above (+Y normal).
-      add_quad(mesh, {Vec3(x0, 0.0f, z0), Vec3(x0, 0.0f, z1), Vec3(x1, 0.0f, z1), Vec3(x1, 0.0f, z0)},
+      add_quad(ground, {Vec3(x0, 0.0f, z0), Vec3(x0, 0.0f, z1), Vec3(x1, 0.0f, z1), Vec3(x1, 0.0f, z0)},
                static_cast<std::uint32_t>((i + j) % 2));
     }
   }
+  std::vector<rt::StaticMeshDesc> meshes{std::move(ground)};
+  if (obstacles.empty()) return meshes;
+  rt::StaticMeshDesc boxes;
   for (std::size_t b = 0; b < obstacles.size(); ++b) {
-    mesh.material_colors.push_back(obstacle_colors[b]);
-    add_box(mesh, obstacles[b], static_cast<std::uint32_t>(2 + b));
+    boxes.material_colors.push_back(obstacle_colors[b]);
+    add_box(boxes, obstacles[b], static_cast<std::uint32_t>(b));
   }
-  return mesh;
+  meshes.push_back(std::move(boxes));
+  return meshes;
 }
 
 }  // namespace sinew::demo

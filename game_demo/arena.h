@@ -1,6 +1,6 @@
 // The demo arena: a checkered ground (y = 0, Y up, metres), box obstacles
-// and one point light. The ground and the boxes become one static mesh
-// whose kd-tree the ray tracer builds once; characters walk between the
+// and one point light. The ground and the boxes become two static meshes
+// whose kd-trees the ray tracer builds once; characters walk between the
 // boxes and shadow the ground, the boxes and each other.
 #pragma once
 
@@ -24,9 +24,13 @@ struct Arena {
   // characters start.
   static Arena generate(std::uint32_t seed, int obstacle_count);
 
-  // The floor as checker tiles of `tile` metres (two materials) plus the
-  // boxes (12 triangles each, one material per box).
-  rt::StaticMeshDesc static_mesh(float tile = 2.0f) const;
+  // The floor as checker tiles of `tile` metres (two materials), and the
+  // boxes (10 triangles each, no bottom face, one material per box) when
+  // there are any. The floor is a mesh of its own because its box is its
+  // plane: rays that leave it upwards (area light samples, ambient
+  // occlusion) never enter it, while with the boxes in one mesh they would
+  // walk its tree (render/stages/stage_support.h slack_clearance).
+  std::vector<rt::StaticMeshDesc> static_meshes(float tile = 2.0f) const;
 };
 
 }  // namespace sinew::demo

@@ -121,8 +121,11 @@ Expected<std::unique_ptr<DemoSession>> DemoSession::create(const SessionOptions&
   s.bake_info_.fuzzy_area_ratio = stats.rest_area > 0.0 ? stats.fuzzy_area / stats.rest_area : 0.0;
 
   SINEW_ASSIGN_OR_RETURN(const std::uint32_t character, s.scene_.add_character(s.model_.mesh, fuzzy));
-  SINEW_ASSIGN_OR_RETURN(const std::uint32_t arena_mesh, s.scene_.add_static_mesh(s.arena_.static_mesh()));
-  (void)arena_mesh;  // hits report it as an instance id; nothing to keep
+  for (const rt::StaticMeshDesc& mesh : s.arena_.static_meshes()) {
+    // Hits report each as an instance id; nothing to keep.
+    SINEW_ASSIGN_OR_RETURN(const std::uint32_t id, s.scene_.add_static_mesh(mesh));
+    (void)id;
+  }
   for (int i = 0; i < s.world_.character_count(); ++i) {
     SINEW_ASSIGN_OR_RETURN(const std::uint32_t instance, s.scene_.add_instance(character));
     s.instances_.push_back(instance);

@@ -50,9 +50,13 @@ struct AxisRanges {
   Float4 r_lo{0.0f}, r_hi{0.0f};
   Mask4 positive{}, negative{};       // every direction >= kTinyDirection (<= -kTinyDirection)
   Mask4 not_rising{}, not_falling{};  // no direction > 0 (< 0)
+  Float4 d_lo{0.0f}, d_hi{0.0f};      // the directions (the swept box of passage)
+  // A box holding every point of every ray over its parameter range, where
+  // the set knows one (RayRanges::p_lo, p_hi); +-inf elsewhere.
+  Float4 p_lo{-std::numeric_limits<float>::infinity()}, p_hi{std::numeric_limits<float>::infinity()};
 
   static AxisRanges from(const float (&o_lo)[3], const float (&o_hi)[3], const float (&d_lo)[3],
-                         const float (&d_hi)[3]) {
+                         const float (&d_hi)[3], const float (&p_lo)[3], const float (&p_hi)[3]) {
     const float ones = std::bit_cast<float>(0xFFFFFFFFu);
     float olo[4], ohi[4], rlo[4], rhi[4], pos[4], neg[4], nr[4], nf[4];
     for (int a = 0; a < 4; ++a) {
@@ -70,8 +74,12 @@ struct AxisRanges {
       rlo[a] = lo - std::fabs(lo) * kBoundRelativeMargin;
       rhi[a] = hi + std::fabs(hi) * kBoundRelativeMargin;
     }
+    constexpr float kInf = std::numeric_limits<float>::infinity();
+    const float dlo[4] = {d_lo[0], d_lo[1], d_lo[2], 0.0f}, dhi[4] = {d_hi[0], d_hi[1], d_hi[2], 0.0f};
+    const float plo[4] = {p_lo[0], p_lo[1], p_lo[2], -kInf}, phi[4] = {p_hi[0], p_hi[1], p_hi[2], kInf};
     return {Float4::load(olo), Float4::load(ohi), Float4::load(rlo), Float4::load(rhi),
-            Mask4::load(pos),  Mask4::load(neg),  Mask4::load(nr),   Mask4::load(nf)};
+            Mask4::load(pos),  Mask4::load(neg),  Mask4::load(nr),   Mask4::load(nf),
+            Float4::load(dlo), Float4::load(dhi), Float4::load(plo), Float4::load(phi)};
   }
 
   // The set's passage through the box [lo, hi] (grown by the caller) within
@@ -80,6 +88,25 @@ struct AxisRanges {
     constexpr float kInf = std::numeric_limits<float>::infinity();
     // Every origin on one side of a slab, no direction turning towards it.
     if (((o_hi < lo) & not_rising).any() || ((o_lo > hi) & not_falling).any()) return {kInf, -kInf};
+    // Over a bounded parameter range, the box the rays sweep: on every axis
+    // o + t d lies between o_lo and o_hi moved by the extremes of t d (the
+    // corners of [t_lo, t_hi] x [d_lo, d_hi]), and within the set's own
+    // box of points where it has one (the segments' starts and ends, which
+    // keeps what the ranges of o and d lose: segments from an area light
+    // that all end above a floor), widened by the rounding of o + t d. It
+    // bounds the axes the slabs below cannot (directions of both signs): a
+    // segment set (ambient occlusion, an area light's samples) reaches
+    // only boxes near it.
+    if (t_hi < kInf && t_lo > -kInf) {
+      const Float4 tl(t_lo), th(t_hi);
+      const Float4 reach_lo = min(min(tl * d_lo, th * d_lo), min(tl * d_hi, th * d_hi));
+      const Float4 reach_hi = max(max(tl * d_lo, th * d_lo), max(tl * d_hi, th * d_hi));
+      const Float4 slop =
+          Float4(kBoundRelativeMargin) * (max(abs(o_lo), abs(o_hi)) + max(abs(reach_lo), abs(reach_hi)));
+      const Float4 swept_lo = max(o_lo + reach_lo, p_lo) - slop;
+      const Float4 swept_hi = min(o_hi + reach_hi, p_hi) + slop;
+      if (((swept_hi < lo) | (swept_lo > hi)).any()) return {kInf, -kInf};
+    }
     // Rising rays enter through the lower plane and leave through the
     // upper, falling ones the other way; other axes bound nothing. Each
     // plane's bound is an extreme of the four products of its offset range
@@ -103,6 +130,13 @@ struct RayRanges {
   float o_lo[3] = {0, 0, 0}, o_hi[3] = {0, 0, 0};
   float d_lo[3] = {0, 0, 0}, d_hi[3] = {0, 0, 0};
   float t_lo = 0.0f, t_hi = 0.0f;
+  // A box holding every point o + t d of every ray over its own [t_min,
+  // t_max], where the set keeps one (cull/ray_bound.h RayBound); +-inf:
+  // none.
+  float p_lo[3] = {-std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity(),
+                   -std::numeric_limits<float>::infinity()};
+  float p_hi[3] = {std::numeric_limits<float>::infinity(), std::numeric_limits<float>::infinity(),
+                   std::numeric_limits<float>::infinity()};
   bool finite = true;
 
   // The largest |origin| coordinate.
@@ -172,7 +206,8 @@ class RangeAccumulator {
 class IntervalBound {
  public:
   IntervalBound() = default;
-  explicit IntervalBound(const RayRanges& r) : ranges_(AxisRanges::from(r.o_lo, r.o_hi, r.d_lo, r.d_hi)) {
+  explicit IntervalBound(const RayRanges& r)
+      : ranges_(AxisRanges::from(r.o_lo, r.o_hi, r.d_lo, r.d_hi, r.p_lo, r.p_hi)) {
     unbounded_ = !r.finite;
     // A set holding a non-finite ray spans every parameter.
     t_lo_ = unbounded_ ? -std::numeric_limits<float>::infinity() : r.t_lo;

@@ -36,6 +36,17 @@ void fold_in(bool empty, float* lo, float* hi, Float8 x) {
 
 }  // namespace
 
+void RayBound::fold_points(int a, Float8 lo, Float8 hi) {
+  // Folded before the directions, which clear empty_.
+  if (empty_) {
+    lo.store(lanes_.p_min[a]);
+    hi.store(lanes_.p_max[a]);
+  } else {
+    min(Float8::load(lanes_.p_min[a]), lo).store(lanes_.p_min[a]);
+    max(Float8::load(lanes_.p_max[a]), hi).store(lanes_.p_max[a]);
+  }
+}
+
 bool RayBound::add_directions(const float* const d[3], std::uint32_t lanes) {
   const Mask8 use = Mask8::from_bits(lanes);
   const int first = std::countr_zero(lanes);
@@ -58,10 +69,14 @@ void RayBound::add_lanes(const float* const o[3], const float* const d[3], const
   const int first = std::countr_zero(lanes);
   const Float8 t0p = pick(t_min, use, first), t1p = pick(t_max, use, first);
   Mask8 finite = is_finite(t0p) & (t0p < t1p);
+  // A ray's points lie between its two ends (an infinite one bounds none).
+  const Mask8 bounded = is_finite(t1p);
   for (int a = 0; a < 3; ++a) {
-    const Float8 oa = pick(o[a], use, first);
+    const Float8 oa = pick(o[a], use, first), da = pick(d[a], use, first);
     finite = finite & is_finite(oa);
     fold_in(lane_origins_empty_, lanes_.o_min[a], lanes_.o_max[a], oa);
+    const Float8 start = oa + t0p * da, end = oa + t1p * da;
+    fold_points(a, select(bounded, min(start, end), Float8(-kInf)), select(bounded, max(start, end), Float8(kInf)));
   }
   if (lane_origins_empty_) {
     t0p.store(lanes_.t_min);
@@ -94,6 +109,9 @@ void RayBound::add_shared_groups(const Vec3& origin, const float* const d[3], fl
   // which no fold picks.
   const Float8 plus(kInf), minus(-kInf);
   Float8 lo[3] = {plus, plus, plus}, hi[3] = {minus, minus, minus};
+  // The rays' points (with an infinite t_max: none bounded) over [t_min, t_max].
+  const bool bounded = std::isfinite(t_max);
+  Float8 p_lo[3] = {plus, plus, plus}, p_hi[3] = {minus, minus, minus};
   Mask8 finite = Mask8::from_bits(0xFFu);
   std::uint32_t any = 0;
   for (std::size_t k = 0; k < groups; ++k) {
@@ -106,10 +124,16 @@ void RayBound::add_shared_groups(const Vec3& origin, const float* const d[3], fl
       finite = finite & (is_finite(x) | !use);
       lo[a] = min(lo[a], select(use, x, plus));
       hi[a] = max(hi[a], select(use, x, minus));
+      if (bounded) {
+        const Float8 start = Float8(origin[a]) + Float8(t_min) * x, end = Float8(origin[a]) + Float8(t_max) * x;
+        p_lo[a] = min(p_lo[a], select(use, min(start, end), plus));
+        p_hi[a] = max(p_hi[a], select(use, max(start, end), minus));
+      }
     }
   }
   if (any == 0) return;
   for (int a = 0; a < 3; ++a) {
+    fold_points(a, bounded ? p_lo[a] : minus, bounded ? p_hi[a] : plus);
     if (empty_) {
       lo[a].store(lanes_.d_min[a]);
       hi[a].store(lanes_.d_max[a]);
@@ -151,6 +175,8 @@ void RayBound::fold() const {
       o_lo_[a] = std::min(o_lo_[a], reduce_min(Float8::load(lanes_.o_min[a])));
       o_hi_[a] = std::max(o_hi_[a], reduce_max(Float8::load(lanes_.o_max[a])));
     }
+    p_lo_[a] = reduce_min(Float8::load(lanes_.p_min[a]));
+    p_hi_[a] = reduce_max(Float8::load(lanes_.p_max[a]));
     d_lo_[a] = reduce_min(Float8::load(lanes_.d_min[a]));
     d_hi_[a] = reduce_max(Float8::load(lanes_.d_max[a]));
     o_mag_ = std::max({o_mag_, std::fabs(o_lo_[a]), std::fabs(o_hi_[a])});
@@ -181,6 +207,10 @@ IntervalBound RayBound::test() const {
   }
   r.t_lo = t_lo_;
   r.t_hi = t_hi_;
+  for (int a = 0; a < 3; ++a) {
+    r.p_lo[a] = p_lo_[a];
+    r.p_hi[a] = p_hi_[a];
+  }
   r.finite = !unbounded_;
   return IntervalBound(r);
 }

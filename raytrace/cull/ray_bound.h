@@ -16,6 +16,7 @@
 #include "raytrace/cull/interval_bound.h"
 #include "raytrace/scene/scene.h"
 #include "runtime/math/aabb.h"
+#include "runtime/math/float8.h"
 #include "runtime/math/types.h"
 
 namespace sinew::rt {
@@ -74,12 +75,17 @@ class RayBound {
   void add_shared_groups(const Vec3& origin, const float* const d[3], float t_min, float t_max, std::size_t groups,
                          LanesOf&& lanes_of);
   void fold() const;
+  // Folds lanes' lowest and highest points on axis a into p_min, p_max.
+  void fold_points(int a, Float8 lo, Float8 hi);
 
   // Per lane, the running minimum and maximum of each quantity: the
   // directions of every ray added, the origins and parameters of the rays
   // added with their own (lane_origins_empty_ says whether any were).
+  // p_min, p_max: the points o + t d at t_min and t_max of every ray
+  // (RayRanges::p_lo, p_hi; +-inf for an infinite t).
   struct Lanes {
     float o_min[3][8], o_max[3][8], d_min[3][8], d_max[3][8];
+    float p_min[3][8], p_max[3][8];
     float t_min[8], t_max[8];
   };
   Lanes lanes_{};
@@ -95,6 +101,7 @@ class RayBound {
   mutable float o_lo_[3] = {0, 0, 0}, o_hi_[3] = {0, 0, 0};
   mutable float d_lo_[3] = {0, 0, 0}, d_hi_[3] = {0, 0, 0};
   mutable float t_lo_ = 0.0f, t_hi_ = 0.0f;
+  mutable float p_lo_[3] = {0, 0, 0}, p_hi_[3] = {0, 0, 0};
   mutable float o_mag_ = 0.0f, d_mag_ = 0.0f;
 };
 

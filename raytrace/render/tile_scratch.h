@@ -50,6 +50,11 @@ struct TileScratch {
   std::vector<float> nx, ny, nz;     // unit shading normal facing the camera
   std::vector<float> ar, ag, ab;     // albedo
   std::vector<float> error;          // rounding bound of the position, every axis
+  // The largest |coordinate| of the scene's top level this frame, 0 when it
+  // is empty (reconstruct_surfaces; a host's surfaces): segment rays leave
+  // their surfaces clear of the traversal's slack by it (render/stages/stage_support.h
+  // slack_clearance).
+  float scene_magnitude = 0.0f;
   // The hit's texture coordinates and material, when an output asks for
   // them (SurfaceSettings::hit_attributes): 0 without uvs, kInvalidId
   // without a material.

@@ -163,12 +163,14 @@ Expected<RenderStats> Renderer::render_visibility(const Scene& scene, const Host
   const int tiles_x = (surfaces.width + tile - 1) / tile;
   const int tiles_y = (surfaces.height + tile - 1) / tile;
   std::vector<TileWork> work(static_cast<std::size_t>(tiles_x) * static_cast<std::size_t>(tiles_y));
+  const float scene_magnitude = top_level_magnitude(scene);
   const auto start = std::chrono::steady_clock::now();
   jobs.parallel_for_tiles(surfaces.width, surfaces.height, tile, [&](const Tile& t) {
     TileWork& record = work[static_cast<std::size_t>(t.index)];
     TileScratch& s = tile_scratch();
     s.prepare(t, plan);
     fill_surfaces(in, s);
+    s.scene_magnitude = scene_magnitude;
     for (std::size_t b = 0; b < s.blocks(); ++b) {
       record.surfaces += static_cast<std::uint64_t>(std::popcount(static_cast<unsigned>(s.block_hits[b])));
     }

@@ -2,8 +2,9 @@
 // boxes: it never culls a box some ray of the set enters (against a
 // double-precision slab test), culls a wide flat box by its height and not
 // its width, culls nothing for non-finite rays, bounds groups with one
-// shared origin as their lanes, and through cull_objects keeps every object
-// a ray enters in scenes of few and many objects.
+// shared origin as their lanes, culls what lies beyond short segments of
+// mixed directions, and through cull_objects keeps every object a ray
+// enters in scenes of few and many objects.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -150,6 +151,69 @@ TEST(RayBound, WideFlatBoxesAreCulledByTheirHeightNotTheirWidth) {
   // the scene's reach in the slack of rays that end at t = 1, fewer.
   EXPECT_GT(pushed_sets, 1000u);
   EXPECT_GE(pushed_culled * 100, pushed_sets * 95) << pushed_culled << " of " << pushed_sets;
+}
+
+// Segments whose directions take both signs on every axis (ambient
+// occlusion rays about a normal, an area light's samples): the slabs bound
+// no axis, the box the segments sweep does. Short rays cull the boxes
+// beyond their length; samples from a light that all end just above a
+// floor cull the floor, though their ranges of origin and direction reach
+// it; and a box they pass through is kept.
+TEST(RayBound, SegmentsOfMixedDirectionsCullWhatLiesBeyondThem) {
+  std::mt19937 g(11);
+  alignas(32) float o[3][8], d[3][8], t0[8], t1[8];
+  const float* const op[3] = {o[0], o[1], o[2]};
+  const float* const dp[3] = {d[0], d[1], d[2]};
+  // Ambient occlusion: from near the origin, 0.5 long, every direction.
+  rt::RayBound ao;
+  for (int group = 0; group < 4; ++group) {
+    for (int lane = 0; lane < 8; ++lane) {
+      for (int a = 0; a < 3; ++a) {
+        o[a][lane] = 0.2f * (unit(g) - 0.5f);
+        d[a][lane] = unit(g) - 0.5f;
+      }
+      t0[lane] = 0.0f;
+      t1[lane] = 1.0f;
+    }
+    ao.add_lanes(op, dp, t0, t1, 0xFFu);
+  }
+  const rt::IntervalBound near = ao.test();
+  for (int a = 0; a < 3; ++a) {
+    for (const float side : {-1.0f, 1.0f}) {
+      Vec3 c(0.0f);
+      c[a] = side * 1.0f;
+      EXPECT_FALSE(near.may_enter({c - Vec3(0.2f), c + Vec3(0.2f)}, 1e-6f)) << "axis " << a << " side " << side;
+    }
+  }
+  EXPECT_TRUE(near.may_enter({Vec3(0.3f, -0.05f, -0.05f), Vec3(0.4f, 0.05f, 0.05f)}, 1e-6f));
+  // Samples from a sphere light around (0, 3, 0) to points 1e-3 above a
+  // floor at y = 0.
+  rt::RayBound light;
+  for (int group = 0; group < 4; ++group) {
+    for (int lane = 0; lane < 8; ++lane) {
+      const Vec3 from(0.5f * (unit(g) - 0.5f), 3.0f + 0.5f * (unit(g) - 0.5f), 0.5f * (unit(g) - 0.5f));
+      const Vec3 end(4.0f * (unit(g) - 0.5f), 1e-3f, 4.0f * (unit(g) - 0.5f));
+      for (int a = 0; a < 3; ++a) {
+        o[a][lane] = from[a];
+        d[a][lane] = end[a] - from[a];
+      }
+    }
+    light.add_lanes(op, dp, t0, t1, 0xFFu);
+  }
+  const rt::IntervalBound samples = light.test();
+  EXPECT_FALSE(samples.may_enter({Vec3(-100.0f, 0.0f, -100.0f), Vec3(100.0f, 0.0f, 100.0f)}, 1e-5f));
+  EXPECT_TRUE(samples.may_enter({Vec3(-100.0f, 0.0f, -100.0f), Vec3(100.0f, 2e-3f, 100.0f)}, 1e-5f));
+  // Without the ends' box (the ranges of o and d alone), the floor is reached.
+  rt::RayRanges ranges;
+  for (int a = 0; a < 3; ++a) {
+    ranges.o_lo[a] = a == 1 ? 2.75f : -0.25f;
+    ranges.o_hi[a] = a == 1 ? 3.25f : 0.25f;
+    ranges.d_lo[a] = a == 1 ? -3.25f : -2.25f;
+    ranges.d_hi[a] = a == 1 ? -2.75f : 2.25f;
+  }
+  ranges.t_lo = 0.0f;
+  ranges.t_hi = 1.0f;
+  EXPECT_TRUE(rt::IntervalBound(ranges).may_enter({Vec3(-100.0f, 0.0f, -100.0f), Vec3(100.0f, 0.0f, 100.0f)}, 1e-5f));
 }
 
 TEST(RayBound, NonFiniteRaysCullNothing) {

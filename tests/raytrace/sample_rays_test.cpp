@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <memory>
 #include <set>
 #include <vector>
 
@@ -20,6 +21,7 @@
 #include "raytrace/scene/scene.h"
 #include "tests/raytrace/render_test_support.h"
 #include "tests/support/brute_force.h"
+#include "runtime/jobs/job_system.h"
 
 namespace sinew {
 namespace {
@@ -216,6 +218,97 @@ TEST(SampleRays, RaysRunBetweenTheHitAndThePointsTheShapeAllows) {
       }
     }
     EXPECT_GT(checked, 500u);
+  }
+}
+
+// A floor of 32x32 quads (a kd-tree of its own, y = 0) reaching far beyond
+// the lights, as a game's does, and a box mesh far off, so that the top
+// level holds two objects.
+std::unique_ptr<rt::Scene> tiled_floor_scene() {
+  auto sc = std::make_unique<rt::Scene>();
+  rt::StaticMeshDesc floor;
+  constexpr int kQuads = 32;
+  for (int j = 0; j <= kQuads; ++j) {
+    for (int i = 0; i <= kQuads; ++i) {
+      floor.positions.emplace_back(-40.0f + 2.5f * static_cast<float>(i), 0.0f, -40.0f + 2.5f * static_cast<float>(j));
+    }
+  }
+  for (std::uint32_t j = 0; j < kQuads; ++j) {
+    for (std::uint32_t i = 0; i < kQuads; ++i) {
+      const std::uint32_t a = j * (kQuads + 1) + i, b = a + 1, c = a + kQuads + 1, d = c + 1;
+      floor.triangles.push_back({a, c, b});
+      floor.triangles.push_back({b, c, d});
+    }
+  }
+  EXPECT_TRUE(sc->add_static_mesh(floor).ok());
+  rt::StaticMeshDesc box;
+  box.positions = {{6, 0, 6}, {7, 0, 6}, {6, 0, 7}, {7, 0, 7}, {6, 1, 6}, {7, 1, 6}, {6, 1, 7}, {7, 1, 7}};
+  box.triangles = {{4, 6, 5}, {5, 6, 7}, {0, 4, 1}, {1, 4, 5}, {0, 2, 4}, {2, 6, 4},
+                   {1, 5, 3}, {3, 5, 7}, {2, 3, 6}, {3, 7, 6}};
+  EXPECT_TRUE(sc->add_static_mesh(box).ok());
+  JobSystem jobs(1);
+  EXPECT_TRUE(sc->prepare_frame(rt::FrameOptions{}, jobs).ok());
+  return sc;
+}
+
+// Segment rays leave their surface clear of the traversal's slack
+// (render/stages/stage_support.h slack_clearance): those from a flat floor,
+// in the open, enter no object, not even the floor's, and all answer open
+// as brute force does. The same rays without the clearance enter the floor.
+TEST(SampleRays, RaysLeavingAFlatFloorEnterNoObject) {
+  const std::unique_ptr<rt::Scene> sc = tiled_floor_scene();
+  const std::vector<testing_support::SoupTriangle> soup = testing_support::world_triangles(*sc);
+  const auto camera =
+      rt::PinholeCamera::create({Vec3(0.0f, 3.0f, 2.0f), Vec3(0.0f, 0.0f, 0.0f), Vec3(0, 1, 0), 50.0f}, 32, 32)
+          .value();
+  std::vector<RayKind> kinds = ray_kinds();
+  // The lights above the floor's middle, away from the box.
+  for (RayKind& kind : kinds) kind.light.position = Vec3(0.5f, 3.0f, -0.5f);
+  for (const RayKind& kind : kinds) {
+    for (const TriangleTest test : testing_support::kTests) {
+      for (const bool clear : {true, false}) {
+        SCOPED_TRACE(std::string(kind.name) + (clear ? "" : " without the clearance") + " test " +
+                     std::to_string(static_cast<int>(test)));
+        rt::TileScratch s;
+        rt::TracePlan plan;
+        plan.packet_rays = 256;
+        plan.region_blocks_x = 4;
+        plan.region_blocks_y = 8;
+        s.prepare(Tile{0, 0, 32, 32, 0}, plan);
+        rt::generate_camera_rays(camera, s);
+        rt::TraversalCounters counters;
+        rt::trace_primary(*sc, camera, test, s, counters);
+        rt::reconstruct_surfaces(*sc, {Vec3(0.7f), camera.pixel_spread()}, s);
+        ASSERT_EQ(s.scene_magnitude, 40.0f);
+        if (!clear) s.scene_magnitude = 0.0f;
+        rt::shift_pixels(5u, kind.ambient_occlusion ? rt::kAmbientOcclusionStream : 0u, s);
+        rt::TraversalCounters work;
+        std::size_t rays = 0;
+        for (int j = 0; j < 2; ++j) {
+          rt::set_lit_bit(0, s);
+          if (kind.ambient_occlusion) {
+            rt::place_ao_rays(0.5f, 0, j, 2, s);
+          } else {
+            rt::place_light_samples(kind.light, 0, j, 2, s);
+          }
+          rt::trace_shadow_rays(*sc, test, 0, s, work);
+          rt::compact_shadow_rays(s);
+          for (std::size_t i = 0; i < s.shadow_count; ++i) {
+            const std::size_t k = s.shadow_pixel[i];
+            ASSERT_FALSE(testing_support::any_hit(soup, s.shadow_ray(i), test));
+            ASSERT_NE(s.lit[k] & 1u, 0u) << "pixel " << s.pixel_x(k) << "," << s.pixel_y(k);
+            ++rays;
+          }
+        }
+        EXPECT_GT(rays, 1500u);
+        if (clear) {
+          EXPECT_EQ(work.object_visits, 0u);
+          EXPECT_EQ(work.triangle_tests, 0u);
+        } else {
+          EXPECT_GT(work.object_visits, 0u);
+        }
+      }
+    }
   }
 }
 

@@ -352,7 +352,7 @@ TEST(Soak, LongRandomRunKeepsMemoryFlatPoseSpaceInsideAndAovsClean) {
   rt::Scene scene;
   auto character = scene.add_character(model.mesh, bake->fuzzy.view());
   ASSERT_TRUE(character.ok()) << character.status().message();
-  ASSERT_TRUE(scene.add_static_mesh(arena.static_mesh()).ok());
+  for (const rt::StaticMeshDesc& mesh : arena.static_meshes()) ASSERT_TRUE(scene.add_static_mesh(mesh).ok());
   std::vector<std::uint32_t> world_instances;
   std::vector<Puppet> puppets;  // [0] the switcher, then the probes
   for (int i = 0; i < kWorldCharacters + 1 + kProbes; ++i) {

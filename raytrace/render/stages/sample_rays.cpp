@@ -76,25 +76,30 @@ void place_block(TileScratch& s, std::size_t b, std::uint32_t hits, std::uint32_
 }
 
 // A ray from a point on the light to block k0's hits: its far end is the
-// hit pushed off as a point light's ray pushes it, one float further.
+// hit pushed off as a point light's ray pushes it and clear of the
+// traversal's slack (slack_clearance: the light's share of that slack is
+// within the point light's push already), one float further.
 void place_from_points(TileScratch& s, std::size_t b, std::uint32_t hits, int l, const Vec3x8& from) {
   const std::size_t k0 = b * kBlockLanes;
   const Vec3x8 position = load3(s.px, s.py, s.pz, k0);
   const std::uint32_t facing =
       (dot(load3(s.gx, s.gy, s.gz, k0), from - position) > Float8(0.0f)).bits() & hits;
   const Float8 magnitude = max(max(abs(from.x), abs(from.y)), abs(from.z));
-  const Vec3x8 push = surface_push_from(s, k0, from, magnitude);
+  const Vec3x8 push = surface_push_from(s, k0, from, magnitude, slack_clearance(s, Float8(0.0f)));
   const Vec3x8 moved = position + push;
   const Vec3x8 end{step_away(moved.x, push.x), step_away(moved.y, push.y), step_away(moved.z, push.z)};
   place_block(s, b, hits, facing, l, from, end - from);
 }
 
 // A ray from block k0's hits, pushed off as a directional light's ray
-// starts, along `direction`; those leaving below the surface are dropped.
-void place_from_hits(TileScratch& s, std::size_t b, std::uint32_t hits, int l, const Vec3x8& direction) {
+// starts and clear of the traversal's slack for rays reaching `reach`
+// (slack_clearance), along `direction`; those leaving below the surface
+// are dropped.
+void place_from_hits(TileScratch& s, std::size_t b, std::uint32_t hits, int l, const Vec3x8& direction,
+                     Float8 reach) {
   const std::size_t k0 = b * kBlockLanes;
   const std::uint32_t facing = (dot(load3(s.gx, s.gy, s.gz, k0), direction) > Float8(0.0f)).bits() & hits;
-  const Vec3x8 push = surface_push(s, k0);
+  const Vec3x8 push = surface_push(s, k0, Float8::load(&s.error[k0]) + slack_clearance(s, reach));
   const Vec3x8 moved = load3(s.px, s.py, s.pz, k0) + push;
   const Vec3x8 origin{step_away(moved.x, push.x), step_away(moved.y, push.y), step_away(moved.z, push.z)};
   place_block(s, b, hits, facing, l, origin, direction);
@@ -154,7 +159,7 @@ void place_light_samples(const Light& light, int l, int j, int n, TileScratch& s
       }
       case Light::Kind::kDirectional: {
         const Vec3x8 direction = splat(sun_axis) + (sun_spread * sample.dx) * sun_t1 + (sun_spread * sample.dy) * sun_t2;
-        place_from_hits(s, b, hits, l, direction);
+        place_from_hits(s, b, hits, l, direction, Float8(s.scene_magnitude));
         break;
       }
     }
@@ -177,7 +182,7 @@ void place_ao_rays(float radius, int l, int j, int n, TileScratch& s) {
     complete_basis(g, t1, t2);
     const Float8 lift = sqrt(max(Float8(1.0f) - sample.dx * sample.dx - sample.dy * sample.dy, Float8(0.0f)));
     const Vec3x8 direction = sample.dx * t1 + sample.dy * t2 + lift * g;
-    place_from_hits(s, b, hits, l, length * direction);
+    place_from_hits(s, b, hits, l, length * direction, length);
   }
 }
 

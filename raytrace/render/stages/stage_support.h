@@ -45,10 +45,27 @@ inline Vec3x8 surface_push(const TileScratch& s, std::size_t k0) {
 // The same for rays that run from a point `from` (a light's, of largest
 // |coordinate| `magnitude`) to the hits: shadow_ray_from_light's wider
 // bound, which also covers the rounding of from - hit.
-inline Vec3x8 surface_push_from(const TileScratch& s, std::size_t k0, const Vec3x8& from, Float8 magnitude) {
+// `further`: a distance added to the bound (slack_clearance below).
+inline Vec3x8 surface_push_from(const TileScratch& s, std::size_t k0, const Vec3x8& from, Float8 magnitude,
+                                Float8 further = Float8(0.0f)) {
   const Vec3x8 to = from - load3(s.px, s.py, s.pz, k0);
   const Float8 reach = magnitude + Float8(2.0f) * max(max(abs(to.x), abs(to.y)), abs(to.z));
-  return surface_push(s, k0, Float8::load(&s.error[k0]) + Float8(gamma(32)) * reach);
+  return surface_push(s, k0, Float8::load(&s.error[k0]) + Float8(gamma(32)) * reach + further);
+}
+
+// A further push for segment rays (an area light's samples, ambient
+// occlusion) that clears the traversal's slack around world boxes: over
+// any of them it is at most 2^-21 (|o| + t |d| + |box|), grown by 1%
+// (traverse/ray_frames.h world_slack, cull/ray_bound.h
+// traversal_slack_bound), and here |o|, |box| <= s.scene_magnitude and
+// t |d| <= `reach` (the segment's length from the hit; the scene's
+// magnitude for unbounded rays). Twice that, added to the rounding bound,
+// puts a segment that leaves a flat box (a ground, a wall: its box is its
+// plane) on the box's outer side by more than any slack grows it, so
+// neither the tile's bound nor a packet enters the box, while a hit on it
+// is as impossible as before.
+inline Float8 slack_clearance(const TileScratch& s, Float8 reach) {
+  return Float8(0x1.0p-20f) * (Float8(2.0f * s.scene_magnitude) + reach);
 }
 
 // Bit i: bit l of lit[i], for eight bytes (each lane's bit gathered into

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "raytrace/render/stages/stage_support.h"
+#include "raytrace/traverse/traversal_shared.h"
 #include "runtime/image/texture_sample.h"
 
 namespace sinew::rt {
@@ -232,7 +233,13 @@ SurfaceSettings surface_settings(const RenderSettings& settings, const PinholeCa
   return {settings.default_albedo, camera.pixel_spread(), settings.textures, out.want_hit_attributes()};
 }
 
+float top_level_magnitude(const Scene& scene) {
+  const float magnitude = detail::max_abs(scene.top_level().bounds());
+  return std::isfinite(magnitude) ? magnitude : 0.0f;
+}
+
 void reconstruct_surfaces(const Scene& scene, const SurfaceSettings& settings, TileScratch& s) {
+  s.scene_magnitude = top_level_magnitude(scene);
   const Vec3& default_albedo = settings.default_albedo;
   const std::size_t blocks = s.lanes / kBlockLanes;
   // Each lane's corners, corner normals and albedo (lanes without a hit

@@ -73,6 +73,11 @@ SurfaceSettings surface_settings(const RenderSettings& settings, const PinholeCa
 // pixel's footprint asks for (docs/RAYTRACE.md, "Textures").
 void reconstruct_surfaces(const Scene& scene, const SurfaceSettings& settings, TileScratch& s);
 
+// The largest |coordinate| of the scene's top level this frame, 0 for an
+// empty one: TileScratch::scene_magnitude, which reconstruct_surfaces sets
+// and a host's surfaces set with this.
+float top_level_magnitude(const Scene& scene);
+
 // Light `l`'s shadow rays for the hits whose surface faces it, placed lane
 // by lane (s.shadow_lanes, s.shadow_lane_*); hits facing away lose bit l of
 // s.lit here. A point light's rays are shadow_ray_from_light's (from the
