@@ -5,6 +5,7 @@
 #include <bit>
 #include <cmath>
 
+#include "raytrace/render/sampling/sample_pattern.h"
 #include "raytrace/render/stages/stage_support.h"
 #include "raytrace/render/stages/tile_stages.h"
 #include "raytrace/traverse/traversal_shared.h"
@@ -108,17 +109,29 @@ void place_from_hits(TileScratch& s, std::size_t b, std::uint32_t hits, int l, c
 }  // namespace
 
 void shift_pixels(std::uint32_t seed, std::uint32_t stream, TileScratch& s) {
+  // A pixel's shift depends on its sample class alone, and every block
+  // starts a whole number of interleaving blocks from the tile's corner
+  // (compact_by_class relies on the same), so the first block's eight
+  // shifts are every block's.
+  static_assert(kBlockWidth % kInterleave == 0 && (kBlockLanes / kBlockWidth) % kInterleave == 0);
+  alignas(32) float xi[kBlockLanes], eta[kBlockLanes], cos_eta[kBlockLanes], sin_eta[kBlockLanes];
+  for (int lane = 0; lane < kBlockLanes; ++lane) {
+    const std::size_t k = static_cast<std::size_t>(lane);
+    const PixelShift shift = pixel_shift(seed, stream, s.pixel_x(k), s.pixel_y(k));
+    xi[lane] = shift.xi;
+    eta[lane] = shift.eta;
+    cos_eta[lane] = shift.cos_eta;
+    sin_eta[lane] = shift.sin_eta;
+  }
+  const Float8 block_xi = Float8::load(xi), block_eta = Float8::load(eta);
+  const Float8 block_cos = Float8::load(cos_eta), block_sin = Float8::load(sin_eta);
   for (std::size_t b = 0; b < s.blocks(); ++b) {
     if (s.block_hits[b] == 0) continue;
     const std::size_t k0 = b * kBlockLanes;
-    for (int lane = 0; lane < kBlockLanes; ++lane) {
-      const std::size_t k = k0 + static_cast<std::size_t>(lane);
-      const PixelShift shift = pixel_shift(seed, stream, s.pixel_x(k), s.pixel_y(k));
-      s.shift_xi[k] = shift.xi;
-      s.shift_eta[k] = shift.eta;
-      s.shift_cos[k] = shift.cos_eta;
-      s.shift_sin[k] = shift.sin_eta;
-    }
+    block_xi.store(&s.shift_xi[k0]);
+    block_eta.store(&s.shift_eta[k0]);
+    block_cos.store(&s.shift_cos[k0]);
+    block_sin.store(&s.shift_sin[k0]);
   }
 }
 
