@@ -37,6 +37,7 @@ void TileScratch::prepare(const Tile& area, const TracePlan& frame_plan) {
     block_hits.resize(blocks);
     block_on_character.resize(blocks);
     shadow_lanes.resize(blocks);
+    segments_pending.resize(blocks);
     block_dx.resize(blocks);
     block_dy.resize(blocks);
   }

@@ -98,6 +98,11 @@ struct TileScratch {
   // [0, shadow_tmax): an area light's samples and ambient occlusion rays
   // (render/stages/tile_stages.h place_light_samples, place_ao_rays).
   bool shadows_per_lane = false;
+  // Whether those segments start at points of a light, few of them shared
+  // by many rays (an area light's samples: render/stages/sample_rays.cpp),
+  // so that compaction splits runs by origin.
+  bool segments_share_origins = false;
+  std::vector<std::uint8_t> segments_pending;  // per block, compaction's lanes not yet in a run
   float shadow_tmax = 1.0f;
   std::vector<float> shadow_from_x, shadow_from_y, shadow_from_z;
   // Each pixel's shift of one stream's sample pattern (shift_pixels).

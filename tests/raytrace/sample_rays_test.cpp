@@ -78,7 +78,7 @@ TEST(SampleRays, EveryAreaLightAndAmbientOcclusionRayAnswersAsBruteForce) {
       for (const int packet_rays : {1, 8, 256}) {
         SCOPED_TRACE(std::string(kind.name) + " packet " + std::to_string(packet_rays) + " test " +
                      std::to_string(static_cast<int>(test)));
-        std::size_t rays = 0, blocked = 0, facing_away = 0;
+        std::size_t rays = 0, blocked = 0, facing_away = 0, runs = 0, mixed_runs = 0;
         for (int ty = 0; ty < 48; ty += 16) {
           for (int tx = 0; tx < 48; tx += 16) {
             rt::TileScratch s;
@@ -105,15 +105,19 @@ TEST(SampleRays, EveryAreaLightAndAmbientOcclusionRayAnswersAsBruteForce) {
               // compacted here, must all be open.
               rt::compact_shadow_rays(s);
               // Each run (a packet) holds one sample class: its rays took
-              // the same sample.
+              // the same sample; an area light's run, one point of it.
               for (std::size_t r = 0; r + 1 < s.shadow_region_begin.size(); ++r) {
                 const std::size_t i0 = s.shadow_region_begin[r], i1 = s.shadow_region_begin[r + 1];
                 ASSERT_LT(i0, i1);
                 const std::size_t k0 = s.shadow_pixel[i0];
+                bool one_origin = true;
                 for (std::size_t i = i0; i < i1; ++i) {
                   const std::size_t k = s.shadow_pixel[i];
                   ASSERT_EQ(rt::sample_class(s.pixel_x(k), s.pixel_y(k)), rt::sample_class(s.pixel_x(k0), s.pixel_y(k0)));
+                  one_origin = one_origin && s.so_x[i] == s.so_x[i0] && s.so_y[i] == s.so_y[i0] && s.so_z[i] == s.so_z[i0];
                 }
+                ++runs;
+                mixed_runs += one_origin ? 0 : 1;
               }
               std::vector<bool> has_ray(s.lanes, false);
               for (std::size_t i = 0; i < s.shadow_count; ++i) {
@@ -142,6 +146,17 @@ TEST(SampleRays, EveryAreaLightAndAmbientOcclusionRayAnswersAsBruteForce) {
         EXPECT_LT(blocked, rays);
         if (kind.ambient_occlusion) {
           EXPECT_EQ(facing_away, 0u);
+        }
+        if (packet_rays > 1 && kind.light.kind == rt::Light::Kind::kRect) {
+          EXPECT_EQ(mixed_runs, 0u) << "a class's samples of a rectangle leave one point";
+        }
+        if (packet_rays > 1 && kind.light.kind == rt::Light::Kind::kPoint && !kind.ambient_occlusion) {
+          // Most runs leave one point of the sphere (the hits of one cell
+          // of the snapped axes share a disk); this light is close enough
+          // that some tiles' hits turn it more ways than a class makes runs
+          // for, so both kinds of packet are traced here.
+          EXPECT_LT(mixed_runs * 10, runs);
+          EXPECT_GT(mixed_runs, 0u);
         }
       }
     }
@@ -206,8 +221,11 @@ TEST(SampleRays, RaysRunBetweenTheHitAndThePointsTheShapeAllows) {
         const Vec3 from = ray.origin - light.position;
         if (light.kind == rt::Light::Kind::kPoint) {
           ASSERT_LE(glm::length(from), light.radius * (1.0f + 1e-5f));
+          // On a disk through the centre whose axis is the direction to
+          // the hit snapped to the octahedral grid: within 7.6 degrees.
           const Vec3 axis = glm::normalize(light.position - hit);
-          ASSERT_LT(std::fabs(glm::dot(from, axis)), 1e-5f) << "on the disk facing the hit";
+          ASSERT_LE(std::fabs(glm::dot(from, axis)), glm::length(from) * std::sin(7.6f * 3.14159265f / 180.0f) + 1e-5f)
+              << "on a disk nearly facing the hit";
         } else {
           const float a = glm::dot(from, light.edge_u) / glm::dot(light.edge_u, light.edge_u);
           const float b = glm::dot(from, light.edge_v) / glm::dot(light.edge_v, light.edge_v);

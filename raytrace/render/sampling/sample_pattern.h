@@ -16,8 +16,10 @@
 // offset hashed from (seed, stream). So a block's 4 n samples cover the
 // square evenly and the residual noise is a fine, even dither; and the
 // pixels of one class take the same sample in a round, which the tracer
-// uses: their rays to a light leave nearly one point, so a packet of one
-// class culls with frusta (render/stages/shadow_rays.cpp, the compaction).
+// uses: their rays to a light leave one point of it (a sphere light's for
+// the hits that share its snapped disk, render/stages/sample_rays.cpp), so
+// a packet of one class culls with frusta (render/stages/shadow_rays.cpp,
+// the compaction).
 // Two by two, not wider: a packet's group of eight then spans a strip of
 // 16 pixels; wider interleaving spreads each group further and its frusta
 // reach more triangles than the common point saves.

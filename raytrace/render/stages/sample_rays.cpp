@@ -28,6 +28,40 @@ void complete_basis(const Vec3x8& n, Vec3x8& t1, Vec3x8& t2) {
   t2 = {b, sign + n.y * n.y * a, -n.y};
 }
 
+// A sphere light's disk turns towards each hit in steps: its axis is the
+// direction from the hit, snapped to a grid of kAxisGrid points per unit on
+// the octahedron (|x| + |y| + |z| = 1, the lower half folded over), so that
+// the hits of one grid cell share one disk and, in a round, a sample class
+// takes one point of the light (see snapped_axis).
+constexpr float kAxisGrid = 16.0f;
+static_assert(kAxisGrid == 16.0f, "a power of two: 1 / kAxisGrid is exact");
+
+// x rounded to the nearest integer (|x| < 2^22): the sum with 1.5 * 2^23
+// has no fraction bits left.
+Float8 round_to_integer(Float8 x) {
+  const Float8 magic(12582912.0f);
+  return (x + magic) - magic;
+}
+Float8 sign_of(Float8 x) { return select(x >= Float8(0.0f), Float8(1.0f), Float8(-1.0f)); }
+
+// The unit vector of the octahedral grid point nearest non-zero `w`.
+Vec3x8 snapped_axis(const Vec3x8& w) {
+  const Float8 one(1.0f), grid(kAxisGrid);
+  const Float8 to_octahedron = one / (abs(w.x) + abs(w.y) + abs(w.z));
+  Float8 px = w.x * to_octahedron, py = w.y * to_octahedron;
+  const Mask8 lower = w.z < Float8(0.0f);
+  const Float8 fx = (one - abs(py)) * sign_of(px), fy = (one - abs(px)) * sign_of(py);
+  // Exact: the grid is a power of two.
+  px = round_to_integer(select(lower, fx, px) * grid) * Float8(1.0f / kAxisGrid);
+  py = round_to_integer(select(lower, fy, py) * grid) * Float8(1.0f / kAxisGrid);
+  const Float8 z = one - abs(px) - abs(py);
+  const Mask8 below = z < Float8(0.0f);
+  const Float8 x = select(below, (one - abs(py)) * sign_of(px), px);
+  const Float8 y = select(below, (one - abs(px)) * sign_of(py), py);
+  const Float8 inverse = one / sqrt(x * x + y * y + z * z);
+  return {x * inverse, y * inverse, z * inverse};
+}
+
 // Sample j of n of every lane (render/sampling/sample_pattern.h), on the
 // unit square and on the unit disk.
 struct LaneSamples {
@@ -55,6 +89,7 @@ void start_segments(float t_max, TileScratch& s) {
   s.shadow_region_begin.clear();
   s.shadows_from_point = false;
   s.shadows_per_lane = true;
+  s.segments_share_origins = false;
   s.shadows_aimed_only = false;
   s.shadow_ends = Aabb::empty();
   s.shadow_tmax = t_max;
@@ -138,6 +173,7 @@ void shift_pixels(std::uint32_t seed, std::uint32_t stream, TileScratch& s) {
 void place_light_samples(const Light& light, int l, int j, int n, TileScratch& s) {
   const bool sun = light.kind == Light::Kind::kDirectional;
   start_segments(sun ? kInf : 1.0f, s);
+  s.segments_share_origins = !sun;
   const LatticeSample base = lattice_sample(j);
   const Vec3x8 centre = splat(light.position);
   // The sun: directions through a disk of radius tan(angular radius) one
@@ -153,12 +189,13 @@ void place_light_samples(const Light& light, int l, int j, int n, TileScratch& s
     const LaneSamples sample = lane_samples(s, k0, base, j, n);
     switch (light.kind) {
       case Light::Kind::kPoint: {
-        // A sphere light: points uniform on its disk facing the hit.
+        // A sphere light: points uniform on its disk facing the hit, the
+        // disk's axis snapped (snapped_axis).
         const Vec3x8 w = centre - load3(s.px, s.py, s.pz, k0);
-        const Float8 length = sqrt(dot(w, w));
-        const Mask8 apart = length > Float8(0.0f);
-        const Float8 inverse = select(apart, Float8(1.0f) / length, Float8(0.0f));
-        const Vec3x8 axis{inverse * w.x, inverse * w.y, select(apart, inverse * w.z, Float8(1.0f))};
+        const Mask8 apart = (abs(w.x) + abs(w.y) + abs(w.z)) > Float8(0.0f);
+        const Vec3x8 snapped = snapped_axis(w);
+        const Vec3x8 axis{select(apart, snapped.x, Float8(0.0f)), select(apart, snapped.y, Float8(0.0f)),
+                          select(apart, snapped.z, Float8(1.0f))};
         Vec3x8 t1, t2;
         complete_basis(axis, t1, t2);
         const Float8 rx = Float8(light.radius) * sample.dx, ry = Float8(light.radius) * sample.dy;

@@ -195,14 +195,19 @@ void place_shadow_rays(const Light& light, int l, TileScratch& s) {
 
 namespace {
 
+// The most runs of one origin per sample class and tile (compact_by_class);
+// a tile whose hits turn a sphere light's disk more ways than that (a light
+// among them) puts the rest of a class's rays in one run.
+constexpr int kOriginRuns = 8;
+
 // Segment rays (an area light's samples, ambient occlusion rays) in runs of
 // one sample class each (render/sampling/sample_pattern.h), those from
 // characters apart from those from static meshes, at most one packet long:
-// a class's hits took the same sample this round, so their rays leave
-// nearly one point of a light (the packet culls them with frusta from it,
-// traverse/large_packet.cpp) or, for ambient occlusion and the sun, run
-// nearly parallel where the surface is flat. Within a class the rays keep
-// the tile's block order.
+// a class's hits took the same sample this round, so their rays leave one
+// point of a light where they share its disk (runs split by origin: the
+// packet culls them with frusta from it, traverse/large_packet.cpp) or, for
+// ambient occlusion and the sun, run nearly parallel where the surface is
+// flat. Within a run the rays keep the tile's block order.
 void compact_by_class(TileScratch& s) {
   constexpr std::size_t kRunRays = static_cast<std::size_t>(kMaxPacketGroups) * kBlockLanes;
   // Every block starts a whole number of interleaving blocks from the
@@ -226,33 +231,59 @@ void compact_by_class(TileScratch& s) {
   const Float8 t_max(s.shadow_tmax);
   s.shadow_count = 0;
   s.shadow_region_begin.assign(1, 0u);
+  std::vector<std::uint8_t>& pending = s.segments_pending;
   for (const std::uint32_t of_class : class_lanes) {
-    for (const bool from_characters : {true, false}) {
-      std::size_t run = 0;
-      for (std::size_t b = 0; b < s.blocks(); ++b) {
-        const std::uint32_t on_character = s.block_on_character[b];
-        const std::uint32_t lanes = s.shadow_lanes[b] & of_class & (from_characters ? on_character : ~on_character);
-        if (lanes == 0) continue;
-        const std::size_t count = static_cast<std::size_t>(std::popcount(lanes));
-        if (run + count > kRunRays) {
-          s.shadow_region_begin.push_back(static_cast<std::uint32_t>(s.shadow_count));
-          run = 0;
+    std::size_t first = s.blocks();
+    for (std::size_t b = 0; b < s.blocks(); ++b) {
+      pending[b] = static_cast<std::uint8_t>(s.shadow_lanes[b] & of_class);
+      if (pending[b] != 0 && first == s.blocks()) first = b;
+    }
+    // Segments from a light's points: a run per origin (the class's first
+    // pending ray's, then the next one's), so that each packet starts at
+    // one point and takes the common-origin path; past kOriginRuns
+    // origins the rest share a run. Other segments: one run per class.
+    for (int origin_run = 0; first < s.blocks(); ++origin_run) {
+      const bool by_origin = s.segments_share_origins && origin_run < kOriginRuns;
+      const std::size_t k = first * kBlockLanes + static_cast<std::size_t>(std::countr_zero(pending[first]));
+      const Vec3x8 origin{Float8(s.shadow_from_x[k]), Float8(s.shadow_from_y[k]), Float8(s.shadow_from_z[k])};
+      const auto at_origin = [&](std::size_t b) -> std::uint32_t {
+        if (!by_origin) return 0xFFu;
+        const std::size_t k0 = b * kBlockLanes;
+        return ((Float8::load(&s.shadow_from_x[k0]) == origin.x) & (Float8::load(&s.shadow_from_y[k0]) == origin.y) &
+                (Float8::load(&s.shadow_from_z[k0]) == origin.z))
+            .bits();
+      };
+      for (const bool from_characters : {true, false}) {
+        std::size_t run = 0;
+        for (std::size_t b = first; b < s.blocks(); ++b) {
+          if (pending[b] == 0) continue;
+          const std::uint32_t on_character = s.block_on_character[b];
+          const std::uint32_t lanes =
+              pending[b] & at_origin(b) & (from_characters ? on_character : ~on_character);
+          if (lanes == 0) continue;
+          pending[b] = static_cast<std::uint8_t>(pending[b] & ~lanes);
+          const std::size_t count = static_cast<std::size_t>(std::popcount(lanes));
+          if (run + count > kRunRays) {
+            s.shadow_region_begin.push_back(static_cast<std::uint32_t>(s.shadow_count));
+            run = 0;
+          }
+          const std::size_t k0 = b * kBlockLanes, i = s.shadow_count;
+          compress_store(&s.so_x[i], Float8::load(&s.shadow_from_x[k0]), lanes);
+          compress_store(&s.so_y[i], Float8::load(&s.shadow_from_y[k0]), lanes);
+          compress_store(&s.so_z[i], Float8::load(&s.shadow_from_z[k0]), lanes);
+          compress_store(&s.sd_x[i], Float8::load(&s.shadow_lane_x[k0]), lanes);
+          compress_store(&s.sd_y[i], Float8::load(&s.shadow_lane_y[k0]), lanes);
+          compress_store(&s.sd_z[i], Float8::load(&s.shadow_lane_z[k0]), lanes);
+          t_max.store(&s.s_tmax[i]);
+          compress_store_lane_indices(&s.shadow_pixel[i], static_cast<std::uint32_t>(k0), lanes);
+          s.shadow_count += count;
+          run += count;
         }
-        const std::size_t k0 = b * kBlockLanes, i = s.shadow_count;
-        compress_store(&s.so_x[i], Float8::load(&s.shadow_from_x[k0]), lanes);
-        compress_store(&s.so_y[i], Float8::load(&s.shadow_from_y[k0]), lanes);
-        compress_store(&s.so_z[i], Float8::load(&s.shadow_from_z[k0]), lanes);
-        compress_store(&s.sd_x[i], Float8::load(&s.shadow_lane_x[k0]), lanes);
-        compress_store(&s.sd_y[i], Float8::load(&s.shadow_lane_y[k0]), lanes);
-        compress_store(&s.sd_z[i], Float8::load(&s.shadow_lane_z[k0]), lanes);
-        t_max.store(&s.s_tmax[i]);
-        compress_store_lane_indices(&s.shadow_pixel[i], static_cast<std::uint32_t>(k0), lanes);
-        s.shadow_count += count;
-        run += count;
+        if (s.shadow_region_begin.back() != s.shadow_count) {
+          s.shadow_region_begin.push_back(static_cast<std::uint32_t>(s.shadow_count));
+        }
       }
-      if (s.shadow_region_begin.back() != s.shadow_count) {
-        s.shadow_region_begin.push_back(static_cast<std::uint32_t>(s.shadow_count));
-      }
+      while (first < s.blocks() && pending[first] == 0) ++first;
     }
   }
   if (s.shadow_count == 0) s.shadow_region_begin.clear();
