@@ -232,6 +232,15 @@ void compact_by_class(TileScratch& s) {
   s.shadow_count = 0;
   s.shadow_region_begin.assign(1, 0u);
   std::vector<std::uint8_t>& pending = s.segments_pending;
+  // Raw pointers: a store through a float* may alias a vector's own, which
+  // would reload every array's address after each store.
+  const float* const from[3] = {s.shadow_from_x.data(), s.shadow_from_y.data(), s.shadow_from_z.data()};
+  const float* const along[3] = {s.shadow_lane_x.data(), s.shadow_lane_y.data(), s.shadow_lane_z.data()};
+  float* const origins[3] = {s.so_x.data(), s.so_y.data(), s.so_z.data()};
+  float* const directions[3] = {s.sd_x.data(), s.sd_y.data(), s.sd_z.data()};
+  float* const ends = s.s_tmax.data();
+  std::uint32_t* const pixels = s.shadow_pixel.data();
+  const std::uint8_t* const on_characters = s.block_on_character.data();
   for (const std::uint32_t of_class : class_lanes) {
     std::size_t first = s.blocks();
     for (std::size_t b = 0; b < s.blocks(); ++b) {
@@ -245,19 +254,19 @@ void compact_by_class(TileScratch& s) {
     for (int origin_run = 0; first < s.blocks(); ++origin_run) {
       const bool by_origin = s.segments_share_origins && origin_run < kOriginRuns;
       const std::size_t k = first * kBlockLanes + static_cast<std::size_t>(std::countr_zero(pending[first]));
-      const Vec3x8 origin{Float8(s.shadow_from_x[k]), Float8(s.shadow_from_y[k]), Float8(s.shadow_from_z[k])};
+      const Vec3x8 origin{Float8(from[0][k]), Float8(from[1][k]), Float8(from[2][k])};
       const auto at_origin = [&](std::size_t b) -> std::uint32_t {
         if (!by_origin) return 0xFFu;
         const std::size_t k0 = b * kBlockLanes;
-        return ((Float8::load(&s.shadow_from_x[k0]) == origin.x) & (Float8::load(&s.shadow_from_y[k0]) == origin.y) &
-                (Float8::load(&s.shadow_from_z[k0]) == origin.z))
+        return ((Float8::load(from[0] + k0) == origin.x) & (Float8::load(from[1] + k0) == origin.y) &
+                (Float8::load(from[2] + k0) == origin.z))
             .bits();
       };
       for (const bool from_characters : {true, false}) {
         std::size_t run = 0;
         for (std::size_t b = first; b < s.blocks(); ++b) {
           if (pending[b] == 0) continue;
-          const std::uint32_t on_character = s.block_on_character[b];
+          const std::uint32_t on_character = on_characters[b];
           const std::uint32_t lanes =
               pending[b] & at_origin(b) & (from_characters ? on_character : ~on_character);
           if (lanes == 0) continue;
@@ -268,14 +277,12 @@ void compact_by_class(TileScratch& s) {
             run = 0;
           }
           const std::size_t k0 = b * kBlockLanes, i = s.shadow_count;
-          compress_store(&s.so_x[i], Float8::load(&s.shadow_from_x[k0]), lanes);
-          compress_store(&s.so_y[i], Float8::load(&s.shadow_from_y[k0]), lanes);
-          compress_store(&s.so_z[i], Float8::load(&s.shadow_from_z[k0]), lanes);
-          compress_store(&s.sd_x[i], Float8::load(&s.shadow_lane_x[k0]), lanes);
-          compress_store(&s.sd_y[i], Float8::load(&s.shadow_lane_y[k0]), lanes);
-          compress_store(&s.sd_z[i], Float8::load(&s.shadow_lane_z[k0]), lanes);
-          t_max.store(&s.s_tmax[i]);
-          compress_store_lane_indices(&s.shadow_pixel[i], static_cast<std::uint32_t>(k0), lanes);
+          for (int a = 0; a < 3; ++a) {
+            compress_store(origins[a] + i, Float8::load(from[a] + k0), lanes);
+            compress_store(directions[a] + i, Float8::load(along[a] + k0), lanes);
+          }
+          t_max.store(ends + i);
+          compress_store_lane_indices(pixels + i, static_cast<std::uint32_t>(k0), lanes);
           s.shadow_count += count;
           run += count;
         }
