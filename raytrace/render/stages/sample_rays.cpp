@@ -29,12 +29,14 @@ void complete_basis(const Vec3x8& n, Vec3x8& t1, Vec3x8& t2) {
 }
 
 // A sphere light's disk turns towards each hit in steps: its axis is the
-// direction from the hit, snapped to a grid of kAxisGrid points per unit on
+// direction from the hit, snapped to a grid of kAxisSteps points per unit on
 // the octahedron (|x| + |y| + |z| = 1, the lower half folded over), so that
 // the hits of one grid cell share one disk and, in a round, a sample class
 // takes one point of the light (see snapped_axis).
-constexpr float kAxisGrid = 16.0f;
-static_assert(kAxisGrid == 16.0f, "a power of two: 1 / kAxisGrid is exact");
+// 16: at most 7.6 degrees off facing (docs/RAYTRACE.md, "The rays"); a
+// power of two, so that dividing by it is exact.
+constexpr unsigned kAxisSteps = 16;
+static_assert(std::has_single_bit(kAxisSteps));
 
 // x rounded to the nearest integer (|x| < 2^22): the sum with 1.5 * 2^23
 // has no fraction bits left.
@@ -46,14 +48,14 @@ Float8 sign_of(Float8 x) { return select(x >= Float8(0.0f), Float8(1.0f), Float8
 
 // The unit vector of the octahedral grid point nearest non-zero `w`.
 Vec3x8 snapped_axis(const Vec3x8& w) {
-  const Float8 one(1.0f), grid(kAxisGrid);
+  const Float8 one(1.0f), grid(static_cast<float>(kAxisSteps)), cell(1.0f / static_cast<float>(kAxisSteps));
   const Float8 to_octahedron = one / (abs(w.x) + abs(w.y) + abs(w.z));
   Float8 px = w.x * to_octahedron, py = w.y * to_octahedron;
   const Mask8 lower = w.z < Float8(0.0f);
   const Float8 fx = (one - abs(py)) * sign_of(px), fy = (one - abs(px)) * sign_of(py);
   // Exact: the grid is a power of two.
-  px = round_to_integer(select(lower, fx, px) * grid) * Float8(1.0f / kAxisGrid);
-  py = round_to_integer(select(lower, fy, py) * grid) * Float8(1.0f / kAxisGrid);
+  px = round_to_integer(select(lower, fx, px) * grid) * cell;
+  py = round_to_integer(select(lower, fy, py) * grid) * cell;
   const Float8 z = one - abs(px) - abs(py);
   const Mask8 below = z < Float8(0.0f);
   const Float8 x = select(below, (one - abs(py)) * sign_of(px), px);
