@@ -20,6 +20,12 @@ Status check_sampling(const RenderSettings& settings, std::span<const Light> lig
     return invalid_argument("settings.ao_rays", std::to_string(settings.ao_rays),
                             "must be 0 to " + std::to_string(kMaxSamples));
   }
+  const int steps = settings.sphere_disk_steps;
+  if (steps != 0 && (steps < kMinSphereDiskSteps || steps > kMaxSphereDiskSteps || (steps & (steps - 1)) != 0)) {
+    return invalid_argument("settings.sphere_disk_steps", std::to_string(steps),
+                            "must be 0 or a power of two from " + std::to_string(kMinSphereDiskSteps) + " to " +
+                                std::to_string(kMaxSphereDiskSteps));
+  }
   if (settings.ao_rays > 0 && !(std::isfinite(settings.ao_radius) && settings.ao_radius > 0.0f)) {
     return invalid_argument("settings.ao_radius", std::to_string(settings.ao_radius), "must be finite and above 0");
   }

@@ -42,6 +42,12 @@ struct Light {
 // Lights one render shades with, each with its own shadow ray.
 inline constexpr std::size_t kMaxLights = 8;
 
+// The coarsest and finest grids RenderSettings::sphere_disk_steps takes
+// (at 4 a disk may turn 29 degrees off facing its hit, at 2 it would turn
+// 55).
+inline constexpr int kMinSphereDiskSteps = 4;
+inline constexpr int kMaxSphereDiskSteps = 1 << 20;
+
 struct RenderSettings {
   TriangleTest triangle_test = TriangleTest::kFast;
   bool shadows = true;
@@ -56,6 +62,15 @@ struct RenderSettings {
   // The stochastic rays' pattern (render/sampling/sample_pattern.h): a
   // function of this seed, the pixel and the sample.
   std::uint32_t sample_seed = 0;
+  // A sphere light's samples lie on its disk facing the hit, turned in
+  // steps: the disk's axis is the hit's direction snapped to a grid of this
+  // many points per unit on the octahedron (docs/RAYTRACE.md, "The rays"),
+  // so that neighbouring hits share sample points and trace as packets from
+  // one point. The disk is at most about 122 / steps degrees off facing
+  // the hit: 7.6 at 16; each doubling halves that and splits packets finer.
+  // 0: every hit's own facing disk. 0 or a power of two from
+  // kMinSphereDiskSteps to kMaxSphereDiskSteps.
+  int sphere_disk_steps = 16;
   // Textured materials sample their texture (docs/RAYTRACE.md, "Textures");
   // off, every material shows its colour alone.
   bool textures = true;

@@ -33,6 +33,7 @@ struct RayKind {
   const char* name;
   rt::Light light;  // unused for ambient occlusion
   bool ambient_occlusion = false;
+  int disk_steps = rt::RenderSettings{}.sphere_disk_steps;  // a sphere light's (RenderSettings::sphere_disk_steps)
 };
 
 std::vector<RayKind> ray_kinds() {
@@ -41,6 +42,10 @@ std::vector<RayKind> ray_kinds() {
   sphere.position = Vec3(1.5f, 3.0f, 2.0f);
   sphere.radius = 0.6f;
   kinds.push_back({"sphere", sphere});
+  // Each hit's own facing disk (RenderSettings::sphere_disk_steps 0): the
+  // samples of a class leave many points near one another, and packets
+  // cull them from an apex with a radius or clip lanes.
+  kinds.push_back({"sphere facing each hit", sphere, false, 0});
   // A small one: its samples start close together beside their lengths,
   // so packets cull them with frusta from the light (traverse/segment_apex.h,
   // find_segment_apex).
@@ -98,7 +103,7 @@ TEST(SampleRays, EveryAreaLightAndAmbientOcclusionRayAnswersAsBruteForce) {
               if (kind.ambient_occlusion) {
                 rt::place_ao_rays(kAoRadius, 0, j, kSamples, s);
               } else {
-                rt::place_light_samples(kind.light, 0, j, kSamples, s);
+                rt::place_light_samples(kind.light, kind.disk_steps, 0, j, kSamples, s);
               }
               rt::trace_shadow_rays(sc, test, 0, s, counters);
               // A tile whose rays reach no object traces none; its rays,
@@ -150,7 +155,8 @@ TEST(SampleRays, EveryAreaLightAndAmbientOcclusionRayAnswersAsBruteForce) {
         if (packet_rays > 1 && kind.light.kind == rt::Light::Kind::kRect) {
           EXPECT_EQ(mixed_runs, 0u) << "a class's samples of a rectangle leave one point";
         }
-        if (packet_rays > 1 && kind.light.kind == rt::Light::Kind::kPoint && !kind.ambient_occlusion) {
+        if (packet_rays > 1 && kind.light.kind == rt::Light::Kind::kPoint && !kind.ambient_occlusion &&
+            kind.disk_steps > 0) {
           // Most runs leave one point of the sphere (the hits of one cell
           // of the snapped axes share a disk); this light is close enough
           // that some tiles' hits turn it more ways than a class makes runs
@@ -172,9 +178,16 @@ TEST(SampleRays, RaysRunBetweenTheHitAndThePointsTheShapeAllows) {
   const auto camera =
       rt::PinholeCamera::create({Vec3(0.6f, 1.3f, 2.6f), Vec3(0.0f, 0.8f, 0.0f), Vec3(0, 1, 0), 50.0f}, 32, 32)
           .value();
-  const std::vector<RayKind> kinds = ray_kinds();
+  std::vector<RayKind> kinds = ray_kinds();
+  // A sphere light's disk at the extremes of its steps: each hit's own
+  // facing disk (0), the coarsest and the finest grids.
+  for (const int steps : {0, rt::kMinSphereDiskSteps, rt::kMaxSphereDiskSteps}) {
+    RayKind sphere = kinds.front();
+    sphere.disk_steps = steps;
+    kinds.push_back(sphere);
+  }
   for (const RayKind& kind : kinds) {
-    SCOPED_TRACE(kind.name);
+    SCOPED_TRACE(std::string(kind.name) + " steps " + std::to_string(kind.disk_steps));
     rt::TileScratch s;
     s.prepare(Tile{0, 0, 32, 32, 0}, rt::TracePlan{});
     rt::generate_camera_rays(camera, s);
@@ -189,7 +202,7 @@ TEST(SampleRays, RaysRunBetweenTheHitAndThePointsTheShapeAllows) {
       if (kind.ambient_occlusion) {
         rt::place_ao_rays(0.5f, 0, j, 4, s);
       } else {
-        rt::place_light_samples(light, 0, j, 4, s);
+        rt::place_light_samples(light, kind.disk_steps, 0, j, 4, s);
       }
       rt::compact_shadow_rays(s);
       for (std::size_t i = 0; i < s.shadow_count; ++i) {
@@ -222,9 +235,11 @@ TEST(SampleRays, RaysRunBetweenTheHitAndThePointsTheShapeAllows) {
         if (light.kind == rt::Light::Kind::kPoint) {
           ASSERT_LE(glm::length(from), light.radius * (1.0f + 1e-5f));
           // On a disk through the centre whose axis is the direction to
-          // the hit snapped to the octahedral grid: within 7.6 degrees.
+          // the hit snapped to the octahedral grid: within 122 / steps
+          // degrees (29.3 at 4, 7.6 at 16); without steps, facing it.
           const Vec3 axis = glm::normalize(light.position - hit);
-          ASSERT_LE(std::fabs(glm::dot(from, axis)), glm::length(from) * std::sin(7.6f * 3.14159265f / 180.0f) + 1e-5f)
+          const float tilt = kind.disk_steps == 0 ? 0.0f : 122.0f / static_cast<float>(kind.disk_steps);
+          ASSERT_LE(std::fabs(glm::dot(from, axis)), glm::length(from) * std::sin(tilt * 3.14159265f / 180.0f) + 1e-5f)
               << "on a disk nearly facing the hit";
         } else {
           const float a = glm::dot(from, light.edge_u) / glm::dot(light.edge_u, light.edge_u);
@@ -307,7 +322,7 @@ TEST(SampleRays, RaysLeavingAFlatFloorEnterNoObject) {
           if (kind.ambient_occlusion) {
             rt::place_ao_rays(0.5f, 0, j, 2, s);
           } else {
-            rt::place_light_samples(kind.light, 0, j, 2, s);
+            rt::place_light_samples(kind.light, kind.disk_steps, 0, j, 2, s);
           }
           rt::trace_shadow_rays(*sc, test, 0, s, work);
           rt::compact_shadow_rays(s);

@@ -184,6 +184,11 @@ TEST(SoftShadows, BadSamplingSettingsAreRefusedByName) {
   s.shadow_samples = rt::kMaxSamples + 1;
   refused(s, "shadow_samples");
   s = {};
+  for (const int steps : {-1, 1, 2, 3, 24, rt::kMaxSphereDiskSteps * 2}) {
+    s.sphere_disk_steps = steps;
+    refused(s, "sphere_disk_steps");
+  }
+  s = {};
   s.ao_rays = -1;
   refused(s, "ao_rays");
   s.ao_rays = 4;

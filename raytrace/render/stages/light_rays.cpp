@@ -71,7 +71,7 @@ void trace_light_rays(const RenderSettings& settings, std::span<const Light> lig
       const int n = settings.shadow_samples;
       work.shadowed += trace_rounds(trace, settings, n, static_cast<std::uint32_t>(l), bit,
                                     &s.light_fraction[l * s.lanes], s, work.shadow,
-                                    [&](int j) { place_light_samples(light, bit, j, n, s); });
+                                    [&](int j) { place_light_samples(light, settings.sphere_disk_steps, bit, j, n, s); });
       continue;
     }
     aim_shadow_rays(light, bit, s);

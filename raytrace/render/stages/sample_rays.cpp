@@ -28,16 +28,6 @@ void complete_basis(const Vec3x8& n, Vec3x8& t1, Vec3x8& t2) {
   t2 = {b, sign + n.y * n.y * a, -n.y};
 }
 
-// A sphere light's disk turns towards each hit in steps: its axis is the
-// direction from the hit, snapped to a grid of kAxisSteps points per unit on
-// the octahedron (|x| + |y| + |z| = 1, the lower half folded over), so that
-// the hits of one grid cell share one disk and, in a round, a sample class
-// takes one point of the light (see snapped_axis).
-// 16: at most 7.6 degrees off facing (docs/RAYTRACE.md, "The rays"); a
-// power of two, so that dividing by it is exact.
-constexpr unsigned kAxisSteps = 16;
-static_assert(std::has_single_bit(kAxisSteps));
-
 // x rounded to the nearest integer (|x| < 2^22): the sum with 1.5 * 2^23
 // has no fraction bits left.
 Float8 round_to_integer(Float8 x) {
@@ -46,9 +36,15 @@ Float8 round_to_integer(Float8 x) {
 }
 Float8 sign_of(Float8 x) { return select(x >= Float8(0.0f), Float8(1.0f), Float8(-1.0f)); }
 
-// The unit vector of the octahedral grid point nearest non-zero `w`.
-Vec3x8 snapped_axis(const Vec3x8& w) {
-  const Float8 one(1.0f), grid(static_cast<float>(kAxisSteps)), cell(1.0f / static_cast<float>(kAxisSteps));
+// A sphere light's disk turns towards each hit in steps: its axis is the
+// direction from the hit snapped to a grid of `steps` points per unit on the
+// octahedron (|x| + |y| + |z| = 1, the lower half folded over), so that the
+// hits of one grid cell share one disk and, in a round, a sample class
+// takes one point of the light. `steps` is a power of two
+// (RenderSettings::sphere_disk_steps), so dividing by it is exact. Returns
+// the unit vector of the grid point nearest non-zero `w`.
+Vec3x8 snapped_axis(const Vec3x8& w, int steps) {
+  const Float8 one(1.0f), grid(static_cast<float>(steps)), cell(1.0f / static_cast<float>(steps));
   const Float8 to_octahedron = one / (abs(w.x) + abs(w.y) + abs(w.z));
   Float8 px = w.x * to_octahedron, py = w.y * to_octahedron;
   const Mask8 lower = w.z < Float8(0.0f);
@@ -172,7 +168,7 @@ void shift_pixels(std::uint32_t seed, std::uint32_t stream, TileScratch& s) {
   }
 }
 
-void place_light_samples(const Light& light, int l, int j, int n, TileScratch& s) {
+void place_light_samples(const Light& light, int disk_steps, int l, int j, int n, TileScratch& s) {
   const bool sun = light.kind == Light::Kind::kDirectional;
   start_segments(sun ? kInf : 1.0f, s);
   s.segments_share_origins = !sun;
@@ -192,12 +188,14 @@ void place_light_samples(const Light& light, int l, int j, int n, TileScratch& s
     switch (light.kind) {
       case Light::Kind::kPoint: {
         // A sphere light: points uniform on its disk facing the hit, the
-        // disk's axis snapped (snapped_axis).
+        // disk's axis snapped (snapped_axis) or, with no steps, the hit's own.
         const Vec3x8 w = centre - load3(s.px, s.py, s.pz, k0);
-        const Mask8 apart = (abs(w.x) + abs(w.y) + abs(w.z)) > Float8(0.0f);
-        const Vec3x8 snapped = snapped_axis(w);
-        const Vec3x8 axis{select(apart, snapped.x, Float8(0.0f)), select(apart, snapped.y, Float8(0.0f)),
-                          select(apart, snapped.z, Float8(1.0f))};
+        const Float8 length = sqrt(dot(w, w));
+        const Mask8 apart = length > Float8(0.0f);
+        const Float8 inverse = select(apart, Float8(1.0f) / length, Float8(0.0f));
+        const Vec3x8 facing = disk_steps > 0 ? snapped_axis(w, disk_steps) : Vec3x8{inverse * w.x, inverse * w.y, inverse * w.z};
+        const Vec3x8 axis{select(apart, facing.x, Float8(0.0f)), select(apart, facing.y, Float8(0.0f)),
+                          select(apart, facing.z, Float8(1.0f))};
         Vec3x8 t1, t2;
         complete_basis(axis, t1, t2);
         const Float8 rx = Float8(light.radius) * sample.dx, ry = Float8(light.radius) * sample.dy;

@@ -135,7 +135,8 @@ void shift_pixels(std::uint32_t seed, std::uint32_t stream, TileScratch& s);
 // off as a point light's rays end (t in [0, 1)); or, for the sun, from the
 // hit pushed off along a direction within its angular radius (t unbounded).
 // Hits whose surface faces away from their sample lose bit l of s.lit.
-void place_light_samples(const Light& light, int l, int j, int n, TileScratch& s);
+// A sphere's disk turns in steps of `disk_steps` (RenderSettings::sphere_disk_steps).
+void place_light_samples(const Light& light, int disk_steps, int l, int j, int n, TileScratch& s);
 // Ambient occlusion ray j of n per hit: cosine distributed about the
 // camera-facing geometric normal, `radius` long (t in [0, 1) along radius
 // times the unit direction), from the hit pushed off.
