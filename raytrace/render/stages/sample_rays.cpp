@@ -193,7 +193,8 @@ void place_light_samples(const Light& light, int disk_steps, int l, int j, int n
         const Float8 length = sqrt(dot(w, w));
         const Mask8 apart = length > Float8(0.0f);
         const Float8 inverse = select(apart, Float8(1.0f) / length, Float8(0.0f));
-        const Vec3x8 facing = disk_steps > 0 ? snapped_axis(w, disk_steps) : Vec3x8{inverse * w.x, inverse * w.y, inverse * w.z};
+        const Vec3x8 facing =
+            disk_steps > 0 ? snapped_axis(w, disk_steps) : Vec3x8{inverse * w.x, inverse * w.y, inverse * w.z};
         const Vec3x8 axis{select(apart, facing.x, Float8(0.0f)), select(apart, facing.y, Float8(0.0f)),
                           select(apart, facing.z, Float8(1.0f))};
         Vec3x8 t1, t2;
