@@ -67,6 +67,16 @@ std::vector<RayKind> ray_kinds() {
   return kinds;
 }
 
+// Round j of n of the kind's rays, placed on bit 0 (ambient occlusion
+// rays `ao_radius` long).
+void place_round(const RayKind& kind, float ao_radius, int j, int n, rt::TileScratch& s) {
+  if (kind.ambient_occlusion) {
+    rt::place_ao_rays(ao_radius, 0, j, n, s);
+  } else {
+    rt::place_light_samples(kind.light, kind.disk_steps, 0, j, n, s);
+  }
+}
+
 // Every tile of a 48x48 image of the test scene: rounds of each ray kind,
 // traced by the renderer's stage, each ray's answer checked against
 // brute force.
@@ -100,11 +110,7 @@ TEST(SampleRays, EveryAreaLightAndAmbientOcclusionRayAnswersAsBruteForce) {
             for (int j = 0; j < kSamples; ++j) {
               std::fill(s.lit.begin(), s.lit.end(), std::uint8_t{0});
               rt::set_lit_bit(0, s);
-              if (kind.ambient_occlusion) {
-                rt::place_ao_rays(kAoRadius, 0, j, kSamples, s);
-              } else {
-                rt::place_light_samples(kind.light, kind.disk_steps, 0, j, kSamples, s);
-              }
+              place_round(kind, kAoRadius, j, kSamples, s);
               rt::trace_shadow_rays(sc, test, 0, s, counters);
               // A tile whose rays reach no object traces none; its rays,
               // compacted here, must all be open.
@@ -199,11 +205,7 @@ TEST(SampleRays, RaysRunBetweenTheHitAndThePointsTheShapeAllows) {
     std::size_t checked = 0;
     for (int j = 0; j < 4; ++j) {
       rt::set_lit_bit(0, s);
-      if (kind.ambient_occlusion) {
-        rt::place_ao_rays(0.5f, 0, j, 4, s);
-      } else {
-        rt::place_light_samples(light, kind.disk_steps, 0, j, 4, s);
-      }
+      place_round(kind, 0.5f, j, 4, s);
       rt::compact_shadow_rays(s);
       for (std::size_t i = 0; i < s.shadow_count; ++i) {
         const std::size_t k = s.shadow_pixel[i];
@@ -319,11 +321,7 @@ TEST(SampleRays, RaysLeavingAFlatFloorEnterNoObject) {
         std::size_t rays = 0;
         for (int j = 0; j < 2; ++j) {
           rt::set_lit_bit(0, s);
-          if (kind.ambient_occlusion) {
-            rt::place_ao_rays(0.5f, 0, j, 2, s);
-          } else {
-            rt::place_light_samples(kind.light, kind.disk_steps, 0, j, 2, s);
-          }
+          place_round(kind, 0.5f, j, 2, s);
           rt::trace_shadow_rays(*sc, test, 0, s, work);
           rt::compact_shadow_rays(s);
           for (std::size_t i = 0; i < s.shadow_count; ++i) {

@@ -36,6 +36,15 @@ Float8 round_to_integer(Float8 x) {
 }
 Float8 sign_of(Float8 x) { return select(x >= Float8(0.0f), Float8(1.0f), Float8(-1.0f)); }
 
+// The octahedron's fold between its upper and lower halves (its own
+// inverse): (x, y) -> ((1 - |y|) sign x, (1 - |x|) sign y), where `fold`.
+void fold_octahedron(Mask8 fold, Float8& x, Float8& y) {
+  const Float8 one(1.0f);
+  const Float8 fx = (one - abs(y)) * sign_of(x), fy = (one - abs(x)) * sign_of(y);
+  x = select(fold, fx, x);
+  y = select(fold, fy, y);
+}
+
 // A sphere light's disk turns towards each hit in steps: its axis is the
 // direction from the hit snapped to a grid of `steps` points per unit on the
 // octahedron (|x| + |y| + |z| = 1, the lower half folded over), so that the
@@ -46,16 +55,13 @@ Float8 sign_of(Float8 x) { return select(x >= Float8(0.0f), Float8(1.0f), Float8
 Vec3x8 snapped_axis(const Vec3x8& w, int steps) {
   const Float8 one(1.0f), grid(static_cast<float>(steps)), cell(1.0f / static_cast<float>(steps));
   const Float8 to_octahedron = one / (abs(w.x) + abs(w.y) + abs(w.z));
-  Float8 px = w.x * to_octahedron, py = w.y * to_octahedron;
-  const Mask8 lower = w.z < Float8(0.0f);
-  const Float8 fx = (one - abs(py)) * sign_of(px), fy = (one - abs(px)) * sign_of(py);
+  Float8 x = w.x * to_octahedron, y = w.y * to_octahedron;
+  fold_octahedron(w.z < Float8(0.0f), x, y);
   // Exact: the grid is a power of two.
-  px = round_to_integer(select(lower, fx, px) * grid) * cell;
-  py = round_to_integer(select(lower, fy, py) * grid) * cell;
-  const Float8 z = one - abs(px) - abs(py);
-  const Mask8 below = z < Float8(0.0f);
-  const Float8 x = select(below, (one - abs(py)) * sign_of(px), px);
-  const Float8 y = select(below, (one - abs(px)) * sign_of(py), py);
+  x = round_to_integer(x * grid) * cell;
+  y = round_to_integer(y * grid) * cell;
+  const Float8 z = one - abs(x) - abs(y);
+  fold_octahedron(z < Float8(0.0f), x, y);
   const Float8 inverse = one / sqrt(x * x + y * y + z * z);
   return {x * inverse, y * inverse, z * inverse};
 }
@@ -190,11 +196,17 @@ void place_light_samples(const Light& light, int disk_steps, int l, int j, int n
         // A sphere light: points uniform on its disk facing the hit, the
         // disk's axis snapped (snapped_axis) or, with no steps, the hit's own.
         const Vec3x8 w = centre - load3(s.px, s.py, s.pz, k0);
-        const Float8 length = sqrt(dot(w, w));
-        const Mask8 apart = length > Float8(0.0f);
-        const Float8 inverse = select(apart, Float8(1.0f) / length, Float8(0.0f));
-        const Vec3x8 facing =
-            disk_steps > 0 ? snapped_axis(w, disk_steps) : Vec3x8{inverse * w.x, inverse * w.y, inverse * w.z};
+        Vec3x8 facing;
+        Mask8 apart;
+        if (disk_steps > 0) {
+          apart = (abs(w.x) + abs(w.y) + abs(w.z)) > Float8(0.0f);
+          facing = snapped_axis(w, disk_steps);
+        } else {
+          const Float8 length = sqrt(dot(w, w));
+          apart = length > Float8(0.0f);
+          const Float8 inverse = Float8(1.0f) / length;
+          facing = {inverse * w.x, inverse * w.y, inverse * w.z};
+        }
         const Vec3x8 axis{select(apart, facing.x, Float8(0.0f)), select(apart, facing.y, Float8(0.0f)),
                           select(apart, facing.z, Float8(1.0f))};
         Vec3x8 t1, t2;
